@@ -1,0 +1,136 @@
+"""Instrument adapters: one module per vendor format, a plain-dict registry, one ``read``.
+
+>>> import labbrdf
+>>> m = labbrdf.read("w2_10102006.dat")           # doctest: +SKIP
+>>> labbrdf.adapters.formats()                    # doctest: +SKIP
+
+Dispatch (:func:`read`): an explicit ``format`` wins; else the file's extension, when it
+belongs to one format only; else header sniffing among the formats of that extension (or
+all formats), when exactly one claims the file. Otherwise :class:`AdapterError` names the
+candidates. Readers never try each other under ``except``: a parse error is reported as is.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+from collections.abc import Iterable
+from pathlib import Path
+
+from ..dataset import Measurement, concat
+from ._base import AdapterError, Format
+
+__all__ = ["AdapterError", "Format", "READERS", "formats", "read", "read_many", "sniff"]
+
+# One module per vendor; each defines FORMATS: tuple[Format, ...].
+_MODULES = (
+    "woollam",
+    "accurion",
+    "filmsense",
+    "sentech",
+    "jasco",
+    "perkinelmer",
+    "cary",
+    "jcamp",
+    "spc",
+    "labbrdf_csv",
+    "native",
+)
+
+#: name -> Format
+READERS: dict[str, Format] = {}
+for _mod in _MODULES:
+    try:
+        _m = importlib.import_module(f"{__name__}.{_mod}")
+    except ModuleNotFoundError as _exc:  # TODO(integration): drop once every module exists
+        if _exc.name != f"{__name__}.{_mod}":
+            raise
+        continue
+    for _f in _m.FORMATS:
+        if _f.name in READERS:
+            raise RuntimeError(f"duplicate adapter name {_f.name!r}")
+        READERS[_f.name] = _f
+
+_SNIFF_BYTES = 8192
+
+
+def formats() -> list[dict[str, object]]:
+    """The supported formats: name, description, extensions, quantities."""
+    return [
+        {
+            "name": f.name,
+            "description": f.description,
+            "extensions": list(f.extensions),
+            "quantities": list(f.quantities),
+        }
+        for f in READERS.values()
+    ]
+
+
+def _by_extension(path: Path) -> list[str]:
+    name = path.name.lower()
+    return [n for n, f in READERS.items() if any(name.endswith(e) for e in f.extensions)]
+
+
+def sniff(path: str | os.PathLike[str]) -> list[str]:
+    """Names of the formats whose sniffer claims the file."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(_SNIFF_BYTES)
+    except OSError as exc:
+        raise AdapterError(path, f"cannot be read ({exc.strerror or exc})") from None
+    return [n for n, f in READERS.items() if f.sniff(head)]
+
+
+def _read_with(name: str, path: Path) -> Measurement:
+    m = READERS[name].read(path)
+    if not isinstance(m, Measurement):  # a reader bug, not a user error
+        raise TypeError(f"adapter {name!r} returned {type(m).__name__}, not a Measurement")
+    m.meta.setdefault("format", name)
+    return m
+
+
+def read(path: str | os.PathLike[str], format: str | None = None) -> Measurement:
+    """Read one instrument export into a validated :class:`~labbrdf.dataset.Measurement`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The export file.
+    format : str, optional
+        A registry name (see :func:`formats`); by default chosen from the extension and
+        the header.
+
+    Raises
+    ------
+    AdapterError
+        The file cannot be read, or the format is ambiguous or unknown.
+    """
+    p = Path(path)
+    if format is not None:
+        if format not in READERS:
+            raise AdapterError(
+                path, f"unknown format {format!r}; supported formats are {sorted(READERS)}"
+            )
+        return _read_with(format, p)
+    if not p.is_file():
+        raise AdapterError(path, "no such file" if not p.exists() else "not a regular file")
+    by_ext = _by_extension(p)
+    if len(by_ext) == 1:
+        return _read_with(by_ext[0], p)
+    claimed = sniff(p)
+    pool = [n for n in claimed if n in by_ext] if by_ext else claimed
+    if len(pool) == 1:
+        return _read_with(pool[0], p)
+    if not pool:
+        hint = f" (extension matches {by_ext})" if by_ext else ""
+        raise AdapterError(
+            path,
+            f"no adapter recognises this file{hint}; pass format= one of {sorted(READERS)}",
+        )
+    raise AdapterError(path, f"several adapters claim this file: {pool}; pass format=")
+
+
+def read_many(paths: Iterable[str | os.PathLike[str]], format: str | None = None) -> Measurement:
+    """Read several files and concatenate them (each row keeps its ``source``)."""
+    return concat(read(p, format) for p in paths)

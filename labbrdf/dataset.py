@@ -1,0 +1,477 @@
+"""The common dataset: one tidy table for every instrument.
+
+A :class:`Measurement` is a long ("tidy") :class:`pandas.DataFrame`, one measured value per
+row, plus a JSON-safe ``meta`` dict. Every adapter returns one; every workflow (fit, report)
+reads one. The schema is that of DESIGN.md, "The common dataset":
+
+==================  ========  ===============================================================
+column              dtype     meaning
+==================  ========  ===============================================================
+``sample``          str       sample name (file header, else file stem)
+``instrument``      str       instrument / software, e.g. ``woollam-wvase``
+``source``          str       file name the row came from
+``quantity``        category  one of :data:`QUANTITIES`
+``value``           float     the value in canonical units (finite)
+``sigma``           float     1-sigma uncertainty, NaN where the file has none
+``unit``            str       ``deg``, ``1`` (fraction) or ``sr-1``
+``wavelength_nm``   float     vacuum wavelength [nm]
+``theta_i_deg``     float     angle of incidence [deg], NaN for normal-incidence/sphere data
+``theta_r_deg``     float     detector polar angle [deg], NaN where not applicable
+``phi_r_deg``       float     detector azimuth of the outward direction [deg], source at 0,
+                              specular half-plane at 180; NaN where not applicable
+==================  ========  ===============================================================
+
+Optional columns (:data:`OPTIONAL_COLUMNS`) carry what some instruments add: ``time_s``
+(time stamp of a kinetic series [s]), ``channel`` (polarisation or generalized-ellipsometry
+channel: ``p``, ``s``, ``pp``, ``ps``, ``sp``), ``x_mm``/``y_mm`` (stage position of the
+spot [mm]). Canonical units: angles in degrees, Delta in [0, 360) (Nebraska convention),
+reflectance, transmittance and depolarization as fractions.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "COLUMNS",
+    "OPTIONAL_COLUMNS",
+    "QUANTITIES",
+    "DatasetError",
+    "Measurement",
+    "atomic_output",
+    "concat",
+    "empty_frame",
+    "make_frame",
+    "read",
+    "read_csv",
+    "read_parquet",
+    "validate",
+    "write",
+    "write_csv",
+    "write_parquet",
+]
+
+#: The required columns, in canonical order, with their dtypes.
+COLUMNS: dict[str, str] = {
+    "sample": "object",
+    "instrument": "object",
+    "source": "object",
+    "quantity": "category",
+    "value": "float64",
+    "sigma": "float64",
+    "unit": "object",
+    "wavelength_nm": "float64",
+    "theta_i_deg": "float64",
+    "theta_r_deg": "float64",
+    "phi_r_deg": "float64",
+}
+
+#: Optional columns a reader may add, with their dtypes.
+OPTIONAL_COLUMNS: dict[str, str] = {
+    "time_s": "float64",
+    "channel": "object",
+    "x_mm": "float64",
+    "y_mm": "float64",
+}
+
+_MUELLER = tuple(f"mueller_{i}{j}" for i in range(1, 5) for j in range(1, 5))
+
+#: Allowed quantities and the unit each must carry.
+QUANTITIES: dict[str, tuple[str, ...]] = {
+    "psi": ("deg",),
+    "delta": ("deg",),
+    "reflectance": ("1",),
+    "specular_intensity": ("1", "sr-1"),
+    "hemispherical_reflectance": ("1",),
+    "transmittance": ("1",),
+    "absorbance": ("1",),
+    "brdf": ("sr-1",),
+    "depolarization": ("1",),
+    **{m: ("1",) for m in _MUELLER},
+}
+
+_META_KEY = b"labbrdf.meta"
+_CSV_META_PREFIX = "# labbrdf-meta: "
+
+
+class DatasetError(ValueError):
+    """A table does not follow the labbrdf schema; the message names column and rows."""
+
+
+def _rows(mask: np.ndarray, limit: int = 8) -> str:
+    idx = np.flatnonzero(mask)
+    shown = ", ".join(str(i) for i in idx[:limit])
+    more = f" and {idx.size - limit} more" if idx.size > limit else ""
+    return f"rows {shown}{more}"
+
+
+def validate(df: pd.DataFrame) -> pd.DataFrame:
+    """Check a table against the schema and return it with canonical dtypes and order.
+
+    Parameters
+    ----------
+    df : pandas.DataFrame
+        The table to check.
+
+    Returns
+    -------
+    pandas.DataFrame
+        A copy with the canonical column order and dtypes and a fresh RangeIndex.
+
+    Raises
+    ------
+    DatasetError
+        Naming the column and the offending rows (positions in ``df``).
+    """
+    if not isinstance(df, pd.DataFrame):
+        raise DatasetError(f"expected a pandas DataFrame, got {type(df).__name__}")
+    missing = [c for c in COLUMNS if c not in df.columns]
+    if missing:
+        raise DatasetError(f"missing column(s) {missing}; required are {list(COLUMNS)}")
+    extra = [c for c in df.columns if c not in COLUMNS and c not in OPTIONAL_COLUMNS]
+    if extra:
+        raise DatasetError(
+            f"unknown column(s) {extra}; optional columns are {list(OPTIONAL_COLUMNS)}"
+        )
+    if len(df) == 0:
+        raise DatasetError("the table has no rows")
+    out = df.reset_index(drop=True)
+    cols = list(COLUMNS) + [c for c in OPTIONAL_COLUMNS if c in out.columns]
+    out = out[cols].copy()
+
+    for name in ("sample", "instrument", "source", "unit"):
+        col = out[name]
+        bad = ~col.map(lambda v: isinstance(v, str) and v != "").to_numpy(bool)
+        if bad.any():
+            raise DatasetError(f"column {name!r}: expected a non-empty string in {_rows(bad)}")
+        out[name] = col.astype(object)
+    if "channel" in out.columns:
+        col = out["channel"]
+        bad = ~col.map(lambda v: isinstance(v, str)).to_numpy(bool)
+        if bad.any():
+            raise DatasetError(f"column 'channel': expected a string in {_rows(bad)}")
+        out["channel"] = col.astype(object)
+
+    floats = [c for c, t in {**COLUMNS, **OPTIONAL_COLUMNS}.items() if t == "float64"]
+    for name in floats:
+        if name not in out.columns:
+            continue
+        try:
+            out[name] = pd.to_numeric(out[name], errors="raise").astype("float64")
+        except (TypeError, ValueError) as exc:
+            raise DatasetError(f"column {name!r}: expected numbers ({exc})") from None
+
+    q = out["quantity"].astype(str).to_numpy()
+    bad = ~np.isin(q, list(QUANTITIES))
+    if bad.any():
+        raise DatasetError(
+            f"column 'quantity': unknown quantity {sorted(set(q[bad]))} in {_rows(bad)}; "
+            f"allowed are {list(QUANTITIES)}"
+        )
+    unit = out["unit"].to_numpy(dtype=object)
+    bad = np.array([u not in QUANTITIES[qq] for qq, u in zip(q, unit, strict=True)])
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise DatasetError(
+            f"column 'unit': {unit[i]!r} does not fit quantity {q[i]!r} "
+            f"(expected {QUANTITIES[q[i]]}) in {_rows(bad)}"
+        )
+
+    value = out["value"].to_numpy()
+    bad = ~np.isfinite(value)
+    if bad.any():
+        raise DatasetError(f"column 'value': expected finite numbers, NaN/inf in {_rows(bad)}")
+    sigma = out["sigma"].to_numpy()
+    bad = np.isinf(sigma) | (sigma < 0)
+    if bad.any():
+        raise DatasetError(f"column 'sigma': expected >= 0 or NaN in {_rows(bad)}")
+    wl = out["wavelength_nm"].to_numpy()
+    bad = ~(np.isfinite(wl) & (wl > 0))
+    if bad.any():
+        raise DatasetError(f"column 'wavelength_nm': expected finite > 0 in {_rows(bad)}")
+    for name in ("theta_i_deg", "theta_r_deg"):
+        a = out[name].to_numpy()
+        bad = np.isinf(a) | (a < 0) | (a > 90)
+        if bad.any():
+            raise DatasetError(f"column {name!r}: expected [0, 90] deg or NaN in {_rows(bad)}")
+    a = out["phi_r_deg"].to_numpy()
+    bad = np.isinf(a) | (a < 0) | (a >= 360)
+    if bad.any():
+        raise DatasetError(f"column 'phi_r_deg': expected [0, 360) deg or NaN in {_rows(bad)}")
+    psi = q == "psi"
+    bad = psi & ((value < 0) | (value > 90))
+    if bad.any():
+        raise DatasetError(f"column 'value': psi outside [0, 90] deg in {_rows(bad)}")
+    bad = (q == "delta") & ((value < 0) | (value >= 360))
+    if bad.any():
+        raise DatasetError(
+            f"column 'value': delta outside [0, 360) deg (Nebraska convention) in {_rows(bad)}"
+        )
+    out["quantity"] = pd.Categorical(q, categories=list(QUANTITIES))
+    return out
+
+
+def _check_meta(meta: Mapping[str, Any]) -> dict[str, Any]:
+    if not isinstance(meta, Mapping):
+        raise DatasetError(f"meta must be a mapping, got {type(meta).__name__}")
+    try:
+        return json.loads(json.dumps(dict(meta), allow_nan=False))
+    except (TypeError, ValueError) as exc:
+        raise DatasetError(f"meta is not JSON-safe: {exc}") from None
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """A validated table plus JSON-safe metadata.
+
+    Parameters
+    ----------
+    data : pandas.DataFrame
+        Rows in the labbrdf schema; validated on construction.
+    meta : dict
+        JSON-safe metadata (instrument settings, header lines, conventions). For a
+        concatenation of several files it holds ``{"parts": [{"source": ..., "meta": ...}]}``.
+    """
+
+    data: pd.DataFrame
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "data", validate(self.data))
+        object.__setattr__(self, "meta", _check_meta(self.meta))
+
+    def __len__(self) -> int:
+        return len(self.data)
+
+    @property
+    def quantities(self) -> list[str]:
+        """Quantities present, in schema order."""
+        present = set(self.data["quantity"].astype(str))
+        return [q for q in QUANTITIES if q in present]
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-safe one-line description: sample, rows, quantities, ranges."""
+        d = self.data
+        wl = d["wavelength_nm"]
+        th = d["theta_i_deg"].dropna().round(3).unique()
+        return {
+            "sample": sorted(set(d["sample"])),
+            "rows": int(len(d)),
+            "quantities": self.quantities,
+            "wavelength_nm": [float(wl.min()), float(wl.max())],
+            "theta_i_deg": sorted(float(t) for t in th),
+        }
+
+
+def make_frame(
+    *,
+    sample: str,
+    instrument: str,
+    source: str,
+    quantity: str | Iterable[str],
+    value: Any,
+    unit: str | Iterable[str],
+    wavelength_nm: Any,
+    sigma: Any = np.nan,
+    theta_i_deg: Any = np.nan,
+    theta_r_deg: Any = np.nan,
+    phi_r_deg: Any = np.nan,
+    **optional: Any,
+) -> pd.DataFrame:
+    """Build a schema table from arrays and scalars (broadcast to one length).
+
+    Optional columns (``time_s``, ``channel``, ``x_mm``, ``y_mm``) go in ``optional``.
+    The result is not validated; wrap it in :class:`Measurement` to do so.
+    """
+    unknown = set(optional) - set(OPTIONAL_COLUMNS)
+    if unknown:
+        raise DatasetError(f"unknown optional column(s) {sorted(unknown)}")
+    value = np.atleast_1d(np.asarray(value, dtype=float))
+    n = value.shape[0]
+    cols: dict[str, Any] = {
+        "sample": sample,
+        "instrument": instrument,
+        "source": source,
+        "quantity": quantity,
+        "value": value,
+        "sigma": sigma,
+        "unit": unit,
+        "wavelength_nm": wavelength_nm,
+        "theta_i_deg": theta_i_deg,
+        "theta_r_deg": theta_r_deg,
+        "phi_r_deg": phi_r_deg,
+        **optional,
+    }
+    out = {}
+    for k, v in cols.items():
+        if isinstance(v, str) or np.ndim(v) == 0:
+            out[k] = [v] * n
+        else:
+            arr = list(v) if not isinstance(v, np.ndarray) else v
+            if len(arr) != n:
+                raise DatasetError(f"column {k!r} has {len(arr)} values, expected {n}")
+            out[k] = arr
+    return pd.DataFrame(out)
+
+
+def empty_frame() -> pd.DataFrame:
+    """An empty table with the schema's columns (for building up, never for returning)."""
+    return pd.DataFrame({c: pd.Series(dtype=t) for c, t in COLUMNS.items()})
+
+
+def concat(measurements: Iterable[Measurement]) -> Measurement:
+    """Concatenate several measurements; each part's meta is kept under ``parts``.
+
+    A measurement that is itself a concatenation contributes its parts, so nesting is flat.
+    """
+    ms = list(measurements)
+    if not ms:
+        raise DatasetError("nothing to concatenate: no measurements given")
+    parts: list[dict[str, Any]] = []
+    for m in ms:
+        if not isinstance(m, Measurement):
+            raise DatasetError(f"expected Measurement, got {type(m).__name__}")
+        if "parts" in m.meta and set(m.meta) == {"parts"}:
+            parts.extend(m.meta["parts"])
+        else:
+            sources = sorted(set(m.data["source"]))
+            parts.append({"source": sources[0] if len(sources) == 1 else sources, "meta": m.meta})
+    frames = [m.data for m in ms]
+    data = pd.concat(
+        [f.assign(quantity=f["quantity"].astype(str)) for f in frames], ignore_index=True
+    )
+    return Measurement(data, {"parts": parts})
+
+
+# --------------------------------------------------------------------------- I/O
+
+
+@contextmanager
+def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
+    """Yield a temporary file name beside ``path``; rename it onto ``path`` on success.
+
+    On any exception the temporary file is removed and ``path`` is left as it was, so a
+    failed write never leaves a half-written or clobbered file.
+    """
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    os.close(fd)
+    try:
+        yield tmp
+        os.replace(tmp, target)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def write_parquet(m: Measurement, path: str | os.PathLike[str]) -> Path:
+    """Write a measurement to Parquet (meta in the file's key-value metadata), atomically."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pandas(m.data, preserve_index=False)
+    md = dict(table.schema.metadata or {})
+    md[_META_KEY] = json.dumps(m.meta, allow_nan=False).encode()
+    with atomic_output(path) as tmp:
+        pq.write_table(table.replace_schema_metadata(md), tmp)
+    return Path(path)
+
+
+def read_parquet(path: str | os.PathLike[str]) -> Measurement:
+    """Read a Parquet file written by :func:`write_parquet`."""
+    import pyarrow.parquet as pq
+
+    try:
+        table = pq.read_table(path)
+    except Exception as exc:  # pyarrow raises several types for a bad file
+        raise DatasetError(f"{path}: not a readable Parquet file ({exc})") from None
+    md = table.schema.metadata or {}
+    meta = json.loads(md[_META_KEY]) if _META_KEY in md else {}
+    df = table.to_pandas()
+    try:
+        return Measurement(df, meta)
+    except DatasetError as exc:
+        raise DatasetError(f"{path}: {exc}") from None
+
+
+def write_csv(m: Measurement, path: str | os.PathLike[str]) -> Path:
+    """Write a measurement to CSV, atomically.
+
+    The first line is ``# labbrdf-meta: <json>``; the rest is the table with floats written
+    in their shortest round-tripping form, so :func:`read_csv` gives back the same numbers.
+    """
+    with atomic_output(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
+        fh.write(_CSV_META_PREFIX + json.dumps(m.meta, allow_nan=False) + "\n")
+        m.data.to_csv(fh, index=False, lineterminator="\n")
+    return Path(path)
+
+
+def read_csv(path: str | os.PathLike[str]) -> Measurement:
+    """Read a CSV file written by :func:`write_csv` (a plain schema CSV works too)."""
+    path = Path(path)
+    with open(path, encoding="utf-8", newline="") as fh:
+        first = fh.readline()
+        meta: dict[str, Any] = {}
+        if first.startswith(_CSV_META_PREFIX):
+            try:
+                meta = json.loads(first[len(_CSV_META_PREFIX) :])
+            except json.JSONDecodeError as exc:
+                raise DatasetError(f"{path}, line 1: bad labbrdf-meta JSON ({exc})") from None
+        else:
+            fh.seek(0)
+        dtypes = {c: str for c in ("sample", "instrument", "source", "unit", "channel")}
+        try:
+            df = pd.read_csv(fh, dtype=dtypes, keep_default_na=False, na_values=[""])
+        except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
+            raise DatasetError(f"{path}: not a labbrdf CSV table ({exc})") from None
+    try:
+        return Measurement(df, meta)
+    except DatasetError as exc:
+        raise DatasetError(f"{path}: {exc}") from None
+
+
+def write(m: Measurement, path: str | os.PathLike[str]) -> Path:
+    """Write by extension: ``.parquet`` or ``.csv``."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".parquet":
+        return write_parquet(m, path)
+    if suffix == ".csv":
+        return write_csv(m, path)
+    raise DatasetError(f"{path}: cannot write {suffix!r}; use .parquet or .csv")
+
+
+def read(path: str | os.PathLike[str]) -> Measurement:
+    """Read a labbrdf dataset file by extension: ``.parquet`` or ``.csv``."""
+    suffix = Path(path).suffix.lower()
+    if suffix == ".parquet":
+        return read_parquet(path)
+    if suffix == ".csv":
+        return read_csv(path)
+    raise DatasetError(f"{path}: not a labbrdf dataset file (.parquet or .csv)")
+
+
+def wrap_delta(delta_deg: Any) -> np.ndarray:
+    """Wrap Delta [deg] into [0, 360) (Nebraska convention range)."""
+    d = np.mod(np.asarray(delta_deg, dtype=float), 360.0)
+    # np.mod can return 360.0 for tiny negative inputs
+    return np.where(d >= 360.0, d - 360.0, d)
+
+
+def is_finite_number(x: Any) -> bool:
+    """True for a finite real number."""
+    try:
+        return math.isfinite(float(x))
+    except (TypeError, ValueError):
+        return False

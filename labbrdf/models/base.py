@@ -1,0 +1,237 @@
+"""Parameters and the model base class shared by every reflectance/BRDF model.
+
+Physics layer: numpy only (no pandas I/O, matplotlib or nlopt).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = ["Model", "ModelError", "Parameter", "Parameters"]
+
+
+class ModelError(ValueError):
+    """Unknown model, option or parameter name, or an invalid parameter value."""
+
+
+@dataclass
+class Parameter:
+    """One named model parameter (lmfit-like).
+
+    Attributes
+    ----------
+    name : str
+    value : float
+        Current (initial, or fitted) value.
+    min, max : float
+        Bounds; global optimisers need both finite.
+    vary : bool
+        False keeps the parameter fixed at ``value`` during a fit.
+    units : str
+        Units in the labbrdf spelling: ``"1"``, ``"rad"``, ``"sr-1"``, ``"nm"``.
+    log : bool
+        Search on a log scale (needs ``min > 0``).
+    description : str
+    stderr : float or None
+        1-sigma standard error, filled by a fit.
+    ci95 : tuple of float or None
+        95% interval, filled by a fit.
+    correl : dict or None
+        Correlation coefficients with the other varying parameters, filled by a fit.
+    """
+
+    name: str
+    value: float
+    min: float = -math.inf
+    max: float = math.inf
+    vary: bool = True
+    units: str = "1"
+    log: bool = False
+    description: str = ""
+    stderr: float | None = None
+    ci95: tuple[float, float] | None = None
+    correl: dict[str, float] | None = None
+
+    def __post_init__(self) -> None:
+        self.value = float(self.value)
+        self.min = float(self.min)
+        self.max = float(self.max)
+        if self.min > self.max:
+            raise ModelError(f"parameter {self.name!r}: min {self.min} > max {self.max}")
+        if self.log and not self.min > 0:
+            raise ModelError(f"parameter {self.name!r}: log scale needs min > 0")
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-safe dict."""
+        return {
+            "name": self.name,
+            "value": self.value,
+            "min": self.min,
+            "max": self.max,
+            "vary": self.vary,
+            "units": self.units,
+            "stderr": self.stderr,
+            "ci95": list(self.ci95) if self.ci95 is not None else None,
+        }
+
+
+class Parameters(Mapping[str, Parameter]):
+    """Ordered mapping name -> :class:`Parameter` with ``add``."""
+
+    def __init__(self, params: Mapping[str, Parameter] | None = None) -> None:
+        self._p: dict[str, Parameter] = dict(params or {})
+
+    def add(
+        self,
+        name: str,
+        value: float,
+        min: float = -math.inf,
+        max: float = math.inf,
+        vary: bool = True,
+        units: str = "1",
+        **kw: Any,
+    ) -> Parameter:
+        p = Parameter(name, value, min, max, vary, units, **kw)
+        self._p[name] = p
+        return p
+
+    def __getitem__(self, key: str) -> Parameter:
+        try:
+            return self._p[key]
+        except KeyError:
+            raise ModelError(
+                f"unknown parameter {key!r}; parameters are {list(self._p)}"
+            ) from None
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._p)
+
+    def __len__(self) -> int:
+        return len(self._p)
+
+    def __repr__(self) -> str:
+        inner = ", ".join(f"{k}={p.value:.6g}" for k, p in self._p.items())
+        return f"Parameters({inner})"
+
+    def copy(self) -> Parameters:
+        return Parameters(copy.deepcopy(self._p))
+
+    def values(self) -> dict[str, float]:  # type: ignore[override]
+        """name -> value (plain floats)."""
+        return {k: p.value for k, p in self._p.items()}
+
+    def varying(self) -> list[str]:
+        return [k for k, p in self._p.items() if p.vary]
+
+
+class Model(ABC):
+    """A reflectance/BRDF model: named parameters, a vectorised ``evaluate``, metadata.
+
+    Subclasses set the class attributes and implement :meth:`_evaluate` (and
+    :meth:`linear_components` when every term is linear in some parameters).
+
+    Angles are in radians here, as in the papers; ``phi_r`` is the outward azimuth of the
+    detector with the source at 0, so ``phi_r = pi`` is the specular half-plane.
+    """
+
+    #: registry name
+    name: str = ""
+    #: citation and DOI of the formula
+    reference: str = ""
+    doi: str = ""
+    #: names of parameters that enter linearly (may be profiled out by least squares)
+    linear: tuple[str, ...] = ()
+
+    def __init__(self, **options: Any) -> None:
+        self.options: dict[str, Any] = dict(options)
+        self.params: Parameters = self.default_params()
+
+    # ---------------------------------------------------------------- to implement
+    @abstractmethod
+    def default_params(self) -> Parameters:
+        """Fresh Parameters with default values and the recommended bounds."""
+
+    @abstractmethod
+    def _evaluate(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> NDArray:
+        """The BRDF [sr^-1] for parameter values ``p`` (broadcast arrays, radians)."""
+
+    def linear_components(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> dict[str, NDArray] | None:
+        """Basis functions b_j with f = sum_j p[j] * b_j over :attr:`linear`, or None."""
+        return None
+
+    def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:
+        """Whether f(i, r) == f(r, i) for these parameter values."""
+        return False
+
+    # ---------------------------------------------------------------- public
+    def values(self, params: Mapping[str, float] | Parameters | None = None) -> dict[str, float]:
+        """Current values, updated from ``params`` (a mapping name -> value or Parameters)."""
+        vals = self.params.values()
+        if params is not None:
+            for k, v in params.items():
+                if k not in vals:
+                    raise ModelError(
+                        f"model {self.name!r} has no parameter {k!r}; parameters are {list(vals)}"
+                    )
+                vals[k] = float(v.value if isinstance(v, Parameter) else v)
+        return vals
+
+    def evaluate(
+        self,
+        theta_i: ArrayLike,
+        theta_r: ArrayLike,
+        phi_r: ArrayLike = np.pi,
+        wavelength: ArrayLike | None = None,
+        params: Mapping[str, float] | Parameters | None = None,
+    ) -> NDArray[np.float64]:
+        """The BRDF [sr^-1] at incidence ``theta_i`` and detector (``theta_r``, ``phi_r``) [rad].
+
+        Inputs broadcast against each other; ``params`` overrides current values.
+        """
+        p = self.values(params)
+        ti, tr, pr = np.broadcast_arrays(
+            np.asarray(theta_i, float), np.asarray(theta_r, float), np.asarray(phi_r, float)
+        )
+        wl = None if wavelength is None else np.asarray(wavelength, float)
+        return np.asarray(self._evaluate(p, ti, tr, pr, wl), dtype=float)
+
+    __call__ = evaluate
+
+    def describe(self) -> dict[str, Any]:
+        """JSON-safe description: name, options, reference, DOI, parameters."""
+        return {
+            "model": self.name,
+            "options": {
+                k: (v if isinstance(v, str | int | float | bool | type(None)) else repr(v))
+                for k, v in self.options.items()
+            },
+            "reference": self.reference,
+            "doi": self.doi,
+            "params": [self.params[k].as_dict() for k in self.params],
+        }
+
+    def __repr__(self) -> str:
+        opts = ", ".join(f"{k}={v!r}" for k, v in self.options.items())
+        return f"{type(self).__name__}({opts})"

@@ -1,0 +1,48 @@
+"""Shared test fixtures and tolerances.
+
+Tests that need ../shared (real instrument exports, oracles) use the ``shared_dir``,
+``real_exports`` or ``oracles`` fixtures, which skip cleanly where the folder is absent
+(a user's clone has no ../shared).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+FIXTURES = ROOT / "fixtures"
+SHARED = Path(os.environ.get("LABBRDF_SHARED", ROOT.parent / "shared"))
+
+#: relative tolerance against double-precision oracles (issue 2: 1e-10)
+RTOL_ORACLE = 1e-10
+
+
+@pytest.fixture(scope="session")
+def fixtures_dir() -> Path:
+    return FIXTURES
+
+
+@pytest.fixture(scope="session")
+def shared_dir() -> Path:
+    if not SHARED.is_dir():
+        pytest.skip(f"{SHARED} absent (real exports and oracles live outside the project)")
+    return SHARED
+
+
+@pytest.fixture(scope="session")
+def real_exports(shared_dir: Path) -> Path:
+    d = shared_dir / "real-exports"
+    if not d.is_dir():
+        pytest.skip(f"{d} absent")
+    return d
+
+
+@pytest.fixture(scope="session")
+def oracles(shared_dir: Path) -> Path:
+    d = shared_dir / "oracles"
+    if not d.is_dir():
+        pytest.skip(f"{d} absent")
+    return d
