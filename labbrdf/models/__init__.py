@@ -36,3 +36,7 @@ MODELS["smooth3"] = Smooth3
 from .five_param import FiveParam  # noqa: E402
 
 MODELS["five_param"] = FiveParam
+
+from .microfacet import Microfacet  # noqa: E402
+
+MODELS["microfacet"] = Microfacet

@@ -114,6 +114,9 @@ class Parameters(Mapping[str, Parameter]):
     def __iter__(self) -> Iterator[str]:
         return iter(self._p)
 
+    def __contains__(self, key: object) -> bool:
+        return key in self._p
+
     def __len__(self) -> int:
         return len(self._p)
 

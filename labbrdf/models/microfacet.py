@@ -1,0 +1,358 @@
+"""GGX microfacet BRDF with separable Smith shadowing and the exact complex Fresnel factor.
+
+Physics layer: numpy only (the Fresnel amplitudes and the ellipsometric inversion come from
+:mod:`labbrdf.optics`).
+
+``f = scale * F(theta_d) D(h) G1(w_i) G1(w_o) / (4 cos theta_i cos theta_r)`` [sr^-1], where
+h is the half vector, theta_d the local incidence angle on the facet (cos = w_i.h), D the
+GGX (Trowbridge-Reitz) distribution and G1 the Smith masking function of GGX. This is the
+single-scattering model of Mitsuba's ``roughconductor`` (distribution ``ggx``) and of
+NIST SCATMECH's ``Shadowed_Facet_BRDF_Model`` with the ellipsoid (GGX) slope distribution
+(oracles README section 4).
+
+References
+----------
+.. [1] Walter B., Marschner S. R., Li H., Torrance K. E., "Microfacet models for refraction
+   through rough surfaces", Proc. EGSR 2007, eqs. (20), (33), (34).
+   doi:10.2312/EGWR/EGSR07/195-206
+.. [2] Trowbridge T. S., Reitz K. P., "Average irregularity representation of a rough surface
+   for ray reflection", J. Opt. Soc. Am. 65(5), 531-536 (1975). doi:10.1364/JOSA.65.000531
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..optics import fresnel_cos, nk_from_psi_delta
+from .base import Model, ModelError, Parameters
+
+__all__ = ["Microfacet", "ggx_distribution", "smith_g1_ggx", "stokes_from_jones"]
+
+_SHADOWING = ("smith", "none")
+
+# coherency vector (Es Es*, Es Ep*, Ep Es*, Ep Ep*) -> Stokes (S0, S1, S2, S3), LB convention
+_A = np.array([[1, 0, 0, 1], [1, 0, 0, -1], [0, 1, 1, 0], [0, 1j, -1j, 0]], dtype=complex)
+_A_INV = np.linalg.inv(_A)
+
+
+def ggx_distribution(cos_m: ArrayLike, alpha: float) -> NDArray[np.float64]:
+    """GGX / Trowbridge-Reitz normal distribution D(m) [sr^-1], eq. (33) of [1]_.
+
+    ``D = alpha^2 / (pi cos^4 theta_m (alpha^2 + tan^2 theta_m)^2)
+    = alpha^2 / (pi (1 + (alpha^2 - 1) cos^2 theta_m)^2)``, normalised so that
+    ``int D cos theta_m d omega_m = 1``.
+
+    Parameters
+    ----------
+    cos_m : array_like
+        Cosine of the facet-normal polar angle [1], in (0, 1].
+    alpha : float
+        GGX roughness [1] (not an RMS slope), > 0.
+
+    Returns
+    -------
+    ndarray
+        D [sr^-1]; 0 where ``cos_m <= 0``.
+
+    Notes
+    -----
+    The 2022 paper's eq. (14) misses alpha^2 in the numerator (DESIGN.md errata).
+    """
+    c2 = np.asarray(cos_m, dtype=float) ** 2
+    d = alpha**2 / (math.pi * (1.0 + (alpha**2 - 1.0) * c2) ** 2)
+    return np.where(np.asarray(cos_m) > 0, d, 0.0)
+
+
+def smith_g1_ggx(cos_v: ArrayLike, alpha: float) -> NDArray[np.float64]:
+    """Smith masking function of GGX, ``G1 = 2 / (1 + sqrt(1 + alpha^2 tan^2 theta_v))``.
+
+    Eq. (34) of [1]_.
+
+    Parameters
+    ----------
+    cos_v : array_like
+        Cosine of the direction's polar angle [1].
+    alpha : float
+        GGX roughness [1].
+
+    Returns
+    -------
+    ndarray
+        G1 [1] in [0, 1]; 0 where ``cos_v <= 0``.
+    """
+    c = np.asarray(cos_v, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tan2 = np.where(c > 0, (1.0 - c * c) / (c * c), np.inf)
+        return np.where(c > 0, 2.0 / (1.0 + np.sqrt(1.0 + alpha**2 * tan2)), 0.0)
+
+
+def stokes_from_jones(jones: NDArray) -> NDArray[np.float64]:
+    """Mueller matrix (..., 4, 4) of Jones matrices (..., 2, 2) in the LB Stokes convention.
+
+    S0 = |Es|^2 + |Ep|^2, S1 = |Es|^2 - |Ep|^2, S2 = 2 Re(Es Ep*), S3 = 2 Im(Es* Ep)
+    (oracles README section 2: S3 = +1 when E turns from s towards p, time factor exp(-iwt)).
+
+    Parameters
+    ----------
+    jones : ndarray
+        Complex Jones matrices acting on (Es, Ep).
+
+    Returns
+    -------
+    ndarray
+        Real Mueller matrices (..., 4, 4).
+    """
+    j = np.asarray(jones, dtype=complex)
+    kron = (j[..., :, None, :, None] * np.conj(j)[..., None, :, None, :]).reshape(
+        *j.shape[:-2], 4, 4
+    )
+    return np.real(_A @ kron @ _A_INV)
+
+
+class Microfacet(Model):
+    """GGX microfacet BRDF with Smith G1 G1 and the exact Fresnel factor of a substrate.
+
+    Options (exactly one of the first three)
+    ----------------------------------------
+    n, k : float
+        Complex index N = n + ik of the substrate (k >= 0), ambient index 1.
+    psi_delta : tuple of float
+        ``(psi_deg, delta_deg, theta_deg)`` measured by an ellipsometer on the same sample;
+        N comes from the two-phase inversion :func:`labbrdf.optics.nk_from_psi_delta`.
+    ideal_mirror : bool
+        F = 1 (rs = -1, rp = +1, the limit N -> i infinity).
+    shadowing : {"smith", "none"}, default "smith"
+        Separable Smith ``G1(w_i) G1(w_o)`` or G = 1.
+
+    Parameters: ``alpha`` [1] in [1e-3, 1.5] (log), ``scale`` [1] in [0, 10], fixed at 1
+    (free it for relative data; it enters linearly).
+
+    Notes
+    -----
+    Reciprocal for every parameter value (D, G and F(w_i.h) are symmetric). Energy is
+    conserved with Smith shadowing (single scattering loses energy, up to 21 % for
+    alpha = 0.4); with G = 1 the albedo exceeds 1 at grazing incidence.
+    The index is taken wavelength-independent: fit one model per wavelength.
+    """
+
+    name = "microfacet"
+    reference = (
+        "Walter B. et al., Microfacet models for refraction through rough surfaces, "
+        "EGSR 2007 (GGX D, Smith G1); Fresnel amplitudes of the substrate"
+    )
+    doi = "10.2312/EGWR/EGSR07/195-206"
+    linear = ("scale",)
+
+    def __init__(
+        self,
+        n: float | None = None,
+        k: float | None = None,
+        psi_delta: tuple[float, float, float] | None = None,
+        ideal_mirror: bool = False,
+        shadowing: str = "smith",
+        **options: Any,
+    ) -> None:
+        if options:
+            raise ModelError(
+                f"model 'microfacet' got unknown options {sorted(options)}; "
+                "options are ['n', 'k', 'psi_delta', 'ideal_mirror', 'shadowing']"
+            )
+        if shadowing not in _SHADOWING:
+            raise ModelError(
+                f"microfacet option 'shadowing' must be one of "
+                f"{list(_SHADOWING)}; got {shadowing!r}"
+            )
+        given = [n is not None, psi_delta is not None, bool(ideal_mirror)]
+        if sum(given) != 1:
+            raise ModelError(
+                "microfacet needs exactly one of n=(and k=), "
+                "psi_delta=(psi_deg, delta_deg, theta_deg) or ideal_mirror=True"
+            )
+        if k is not None and n is None:
+            raise ModelError("microfacet option 'k' needs 'n' as well")
+        opts: dict[str, Any] = {"shadowing": shadowing}
+        self.N: complex | None
+        if n is not None:
+            kk = 0.0 if k is None else k
+            if not (
+                np.isfinite(n) and np.isfinite(kk) and n >= 0 and kk >= 0 and (n > 0 or kk > 0)
+            ):
+                raise ModelError(
+                    f"microfacet options n, k must be finite, >= 0 and not both "
+                    f"0 (N = n + ik); got n={n!r}, k={kk!r}"
+                )
+            self.N = complex(n, kk)
+            opts.update(n=float(n), k=float(kk))
+        elif psi_delta is not None:
+            try:
+                psi, delta, theta = (float(x) for x in psi_delta)
+            except (TypeError, ValueError):
+                raise ModelError(
+                    "microfacet option 'psi_delta' must be three numbers "
+                    f"(psi_deg, delta_deg, theta_deg); got {psi_delta!r}"
+                ) from None
+            big_n = complex(nk_from_psi_delta(psi, delta, theta))
+            self.N = big_n
+            opts.update(psi_delta=(psi, delta, theta), n=big_n.real, k=big_n.imag)
+        else:
+            self.N = None
+            opts.update(ideal_mirror=True)
+        self._shadowing = shadowing
+        super().__init__(**opts)
+
+    def default_params(self) -> Parameters:
+        """alpha 0.2 in [1e-3, 1.5] (log); scale 1, fixed."""
+        p = Parameters()
+        p.add("alpha", 0.2, 1e-3, 1.5, units="1", log=True, description="GGX roughness")
+        p.add(
+            "scale",
+            1.0,
+            0.0,
+            10.0,
+            vary=False,
+            units="1",
+            description="overall factor (relative data)",
+        )
+        return p
+
+    def lobe_width(self, p: Mapping[str, float]) -> float:
+        """Angular scale of the lobe in theta_r [rad] (a quadrature hint): ``2 alpha``."""
+        return 2.0 * float(p["alpha"])
+
+    def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:
+        """Always True."""
+        return True
+
+    # ------------------------------------------------------------------ internals
+    def _amplitudes(self, cos_d: NDArray) -> tuple[NDArray, NDArray]:
+        if self.N is None:
+            return -np.ones_like(cos_d, dtype=complex), np.ones_like(cos_d, dtype=complex)
+        rs, rp = fresnel_cos(1.0, self.N, cos_d)[:2]
+        return np.asarray(rs, dtype=complex), np.asarray(rp, dtype=complex)
+
+    def _geometry(
+        self, ti: NDArray, tr: NDArray, pr: NDArray
+    ) -> tuple[NDArray, NDArray, NDArray, NDArray, NDArray]:
+        wi = np.stack(np.broadcast_arrays(np.sin(ti), 0.0 * ti, np.cos(ti)), axis=-1)
+        wo = np.stack([np.sin(tr) * np.cos(pr), np.sin(tr) * np.sin(pr), np.cos(tr)], axis=-1)
+        hv = wi + wo
+        norm = np.linalg.norm(hv, axis=-1, keepdims=True)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            h = np.where(norm > 0, hv / norm, np.array([0.0, 0.0, 1.0]))
+        cos_d = np.clip(np.sum(wi * h, axis=-1), 0.0, 1.0)
+        return wi, wo, h, cos_d, h[..., 2]
+
+    def _scalar_factor(
+        self, p: Mapping[str, float], ti: NDArray, tr: NDArray, cos_h: NDArray
+    ) -> NDArray:
+        alpha = p["alpha"]
+        if not alpha > 0:
+            raise ModelError(f"microfacet parameter 'alpha' must be > 0; got {alpha!r}")
+        ci, co = np.cos(ti), np.cos(tr)
+        up = (ci > 0) & (co > 0)
+        d = ggx_distribution(cos_h, alpha)
+        g = (
+            smith_g1_ggx(ci, alpha) * smith_g1_ggx(co, alpha)
+            if self._shadowing == "smith"
+            else np.ones_like(d)
+        )
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(up, p["scale"] * d * g / (4.0 * ci * co), 0.0)
+
+    def _evaluate(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> NDArray:
+        _, _, _, cos_d, cos_h = self._geometry(theta_i, theta_r, phi_r)
+        rs, rp = self._amplitudes(cos_d)
+        fres = 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
+        return self._scalar_factor(p, theta_i, theta_r, cos_h) * fres
+
+    def linear_components(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> dict[str, NDArray] | None:
+        """``{"scale": f / scale}``."""
+        q = dict(p, scale=1.0)
+        return {"scale": self._evaluate(q, theta_i, theta_r, phi_r, wavelength)}
+
+    # ------------------------------------------------------------------ polarization
+    def mueller(
+        self,
+        theta_i: ArrayLike,
+        theta_r: ArrayLike,
+        phi_r: ArrayLike = np.pi,
+        params: Mapping[str, float] | Parameters | None = None,
+    ) -> NDArray[np.float64]:
+        """Mueller BRDF (..., 4, 4) [sr^-1] in the LB convention of oracles README section 2.
+
+        Frames: for each ray ``s = phi_hat(phi) = (-sin phi, cos phi, 0)`` with phi the ray's
+        azimuth (0 for the incident ray, ``phi_r`` for the exit ray, also at theta = 0) and
+        ``p = k x s``. The facet's Jones matrix ``diag(rs, rp)`` acts in the facet frame
+        ``s_f = k_in x h / |k_in x h|``, ``p = k x s_f``, and is carried into the ray frames
+        by the projections of the basis vectors; the Mueller matrix follows from the Jones
+        matrix (:func:`stokes_from_jones`). Element [0, 0] equals :meth:`evaluate`.
+
+        Parameters
+        ----------
+        theta_i, theta_r, phi_r : array_like
+            Incidence, detector polar angle and detector outward azimuth [rad].
+        params : mapping or Parameters or None
+            Parameter overrides.
+
+        Returns
+        -------
+        ndarray
+            f_M [sr^-1], shape ``broadcast(theta_i, theta_r, phi_r) + (4, 4)``.
+        """
+        p = self.values(params)
+        ti, tr, pr = np.broadcast_arrays(
+            np.asarray(theta_i, float), np.asarray(theta_r, float), np.asarray(phi_r, float)
+        )
+        wi, wo, h, cos_d, cos_h = self._geometry(ti, tr, pr)
+        k_in, k_out = -wi, wo
+        zero = np.zeros_like(pr)
+        s_in = np.broadcast_to(np.array([0.0, 1.0, 0.0]), wi.shape)
+        s_out = np.stack([-np.sin(pr), np.cos(pr), zero], axis=-1)
+        p_in, p_out = np.cross(k_in, s_in), np.cross(k_out, s_out)
+        sf = np.cross(k_in, h)
+        nf = np.linalg.norm(sf, axis=-1, keepdims=True)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            sf = np.where(nf > 1e-12, sf / nf, s_in)  # normal facet incidence: any s works
+        pf_in, pf_out = np.cross(k_in, sf), np.cross(k_out, sf)
+
+        def dot(a: NDArray, b: NDArray) -> NDArray:
+            return np.sum(a * b, axis=-1)
+
+        b_in = np.stack(
+            [
+                np.stack([dot(sf, s_in), dot(sf, p_in)], -1),
+                np.stack([dot(pf_in, s_in), dot(pf_in, p_in)], -1),
+            ],
+            -2,
+        )
+        b_out = np.stack(
+            [
+                np.stack([dot(s_out, sf), dot(s_out, pf_out)], -1),
+                np.stack([dot(p_out, sf), dot(p_out, pf_out)], -1),
+            ],
+            -2,
+        )
+        rs, rp = self._amplitudes(cos_d)
+        jf = np.zeros((*rs.shape, 2, 2), dtype=complex)
+        jf[..., 0, 0], jf[..., 1, 1] = rs, rp
+        m = stokes_from_jones(b_out @ jf @ b_in)
+        return self._scalar_factor(p, ti, tr, cos_h)[..., None, None] * m

@@ -1,0 +1,141 @@
+"""Three-parameter smooth-sample reflectance model of Zou, Bai and Wu (2013).
+
+Physics layer: numpy only.
+
+References
+----------
+.. [1] Zou X., Bai L., Wu Z., "Mirror reflectance spectrum modeling of smooth samples",
+   Acta Optica Sinica 33(6), 0612008 (2013). doi:10.3788/AOS201333.0612008
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .base import Model, ModelError, Parameters
+
+__all__ = ["Smooth3", "smooth3_brdf"]
+
+
+def smooth3_brdf(
+    theta_i: NDArray, theta_r: NDArray, k1: float, k2: float, k3: float
+) -> NDArray[np.float64]:
+    """Zou-Bai-Wu 3-parameter reflectance, eq. (7) of [1]_.
+
+    ``R = k1 / (8 cos(theta_i) cos(theta_r)) * exp(-(theta_i - theta_r - k2)**2 / k3**2)``
+
+    Parameters
+    ----------
+    theta_i, theta_r : array_like
+        Incidence and detector polar angles from the mean normal [rad]; ``theta_r`` on the
+        specular side (the specular direction is ``theta_r = theta_i``).
+    k1 : float
+        Amplitude [1].
+    k2 : float
+        Lobe shift: the peak sits at ``theta_r = theta_i - k2`` [rad].
+    k3 : float
+        1/e half-width of the lobe in ``theta_r`` [rad], > 0.
+
+    Returns
+    -------
+    ndarray
+        Reflectance per steradian [sr^-1]; ``inf`` at ``theta = pi/2`` where the cosine vanishes.
+    """
+    ti = np.asarray(theta_i, dtype=float)
+    tr = np.asarray(theta_r, dtype=float)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        return k1 / (8.0 * np.cos(ti) * np.cos(tr)) * np.exp(-(((ti - tr - k2) / k3) ** 2))
+
+
+class Smooth3(Model):
+    """3-parameter smooth-sample model, eq. (7) of Zou, Bai, Wu 2013.
+
+    ``R = k1 / (8 cos theta_i cos theta_r) exp(-(theta_i - theta_r - k2)^2 / k3^2)`` [sr^-1],
+    with one parameter triple per wavelength.
+
+    Parameters (notes/models.md 1.5): ``k1`` [1] in [0, 5] (linear, may be profiled out),
+    ``k2`` [rad] in [-0.5, 0.5], ``k3`` [rad] in [1e-3, pi/2] searched on a log scale.
+
+    Notes
+    -----
+    The paper's model is in-plane; here it is used as a BRDF without azimuth dependence
+    (``phi_r`` is ignored), which is how its hemispherical integral (paper Table 3) was made.
+    The model is reciprocal iff ``k2 == 0`` (notes/models.md 1.3), contrary to the paper's
+    claim. Energy is conserved only over a finite incidence range, not for ``k1 <= 4/pi`` as
+    the paper's eq. (8) states (notes/models.md 1.4; see :mod:`labbrdf.integrate`).
+    On the specular line only ``k1 exp(-k2^2/k3^2)`` is identifiable.
+    """
+
+    name = "smooth3"
+    reference = (
+        "Zou X., Bai L., Wu Z., Mirror reflectance spectrum modeling of smooth "
+        "samples, Acta Optica Sinica 33(6) 0612008 (2013), eq. (7)"
+    )
+    doi = "10.3788/AOS201333.0612008"
+    linear = ("k1",)
+
+    def __init__(self, **options: Any) -> None:
+        if options:
+            raise ModelError(f"model 'smooth3' takes no options; got {sorted(options)}")
+        super().__init__()
+
+    def default_params(self) -> Parameters:
+        """Defaults near the paper's OSR 550 nm fit; bounds of notes/models.md 1.5."""
+        p = Parameters()
+        p.add("k1", 1.0, 0.0, 5.0, units="1", description="amplitude")
+        p.add("k2", 0.0, -0.5, 0.5, units="rad", description="lobe shift (peak at ti - k2)")
+        p.add(
+            "k3",
+            0.4,
+            1e-3,
+            math.pi / 2,
+            units="rad",
+            log=True,
+            description="1/e half-width of the lobe",
+        )
+        return p
+
+    def _evaluate(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> NDArray:
+        _check_k3(p["k3"])
+        return smooth3_brdf(theta_i, theta_r, p["k1"], p["k2"], p["k3"])
+
+    def linear_components(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> dict[str, NDArray] | None:
+        """``{"k1": R / k1}``: the model is exactly linear in k1."""
+        _check_k3(p["k3"])
+        return {"k1": smooth3_brdf(theta_i, theta_r, 1.0, p["k2"], p["k3"])}
+
+    def lobe_width(self, p: Mapping[str, float]) -> float:
+        """Angular scale of the lobe in theta_r [rad] (a quadrature hint): ``k3``."""
+        return float(p["k3"])
+
+    def lobe_centre(self, p: Mapping[str, float], theta_i: float) -> float:
+        """Polar angle of the lobe peak [rad] (a quadrature hint): ``theta_i - k2``."""
+        return float(theta_i - p["k2"])
+
+    def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:
+        """True iff ``k2 == 0`` (notes/models.md 1.3)."""
+        return self.values(params)["k2"] == 0.0
+
+
+def _check_k3(k3: float) -> None:
+    if not k3 > 0:
+        raise ModelError(f"smooth3 parameter 'k3' must be > 0 [rad]; got {k3!r}")
