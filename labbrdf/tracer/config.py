@@ -1,0 +1,267 @@
+"""Configuration of a tracer run: a frozen, JSON-able dataclass."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, field, replace
+from typing import Any
+
+__all__ = ["Coating", "Substrate", "TraceConfig"]
+
+SCATTERING = ("single", "multiple")
+TERMINATION = ("threshold", "roulette")
+
+
+def _check(cond: bool, name: str, expected: str, value: Any) -> None:
+    if not cond:
+        raise ValueError(f"{name} must be {expected}, got {value!r}")
+
+
+def _finite(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+@dataclass(frozen=True)
+class Substrate:
+    """Opaque substrate: complex index N = n + ik and GGX roughness.
+
+    Parameters
+    ----------
+    n, k : float
+        Real and imaginary parts of the index [1], k >= 0.
+    alpha : float
+        GGX roughness [1] (0 = smooth).
+    mirror : bool
+        Ideal mirror (|r_s| = |r_p| = 1, the perfect-conductor limit r_s = -1, r_p = +1);
+        n and k are then ignored. For the white-furnace test.
+    """
+
+    n: float = 1.55
+    k: float = 7.71
+    alpha: float = 0.2
+    mirror: bool = False
+
+    def __post_init__(self) -> None:
+        _check(_finite(self.n) and self.n >= 0, "substrate.n", "a finite number >= 0", self.n)
+        _check(_finite(self.k) and self.k >= 0, "substrate.k", "a finite number >= 0", self.k)
+        _check(
+            _finite(self.alpha) and 0 <= self.alpha <= 10,
+            "substrate.alpha",
+            "in [0, 10]",
+            self.alpha,
+        )
+        _check(
+            self.mirror or complex(self.n, self.k) != 0,
+            "substrate n + ik",
+            "non-zero (or mirror=True)",
+            (self.n, self.k),
+        )
+
+
+@dataclass(frozen=True)
+class Coating:
+    """A dielectric coating (varnish) over the substrate.
+
+    Parameters
+    ----------
+    n : float
+        Real index of the coating [1], > 0.
+    k : float
+        Extinction coefficient [1] >= 0; enters only through Beer-Lambert absorption,
+        attenuation coefficient 4 pi k / lambda per unit path length.
+    thickness_nm : float
+        Physical thickness [nm] >= 0.
+    alpha : float
+        GGX roughness of the top (air/coating) interface [1].
+    """
+
+    n: float = 1.5
+    k: float = 0.0
+    thickness_nm: float = 162.5
+    alpha: float = 0.2
+
+    def __post_init__(self) -> None:
+        _check(_finite(self.n) and self.n > 0, "coating.n", "a finite number > 0", self.n)
+        _check(_finite(self.k) and self.k >= 0, "coating.k", "a finite number >= 0", self.k)
+        _check(
+            _finite(self.thickness_nm) and self.thickness_nm >= 0,
+            "coating.thickness_nm",
+            "a finite number >= 0",
+            self.thickness_nm,
+        )
+        _check(
+            _finite(self.alpha) and 0 <= self.alpha <= 10,
+            "coating.alpha",
+            "in [0, 10]",
+            self.alpha,
+        )
+
+
+@dataclass(frozen=True)
+class TraceConfig:
+    """Everything that defines a tracer run (and hence its result, bit for bit).
+
+    Parameters
+    ----------
+    wavelength_nm : float
+        Vacuum wavelength [nm].
+    theta_i_deg : float
+        Polar angle of the source direction [deg], in [0, 90); the source azimuth is 0.
+    substrate : Substrate
+        The opaque substrate.
+    coating : Coating or None
+        Optional dielectric coating on top of the substrate.
+    rays : int
+        Number of rays.
+    seed : int
+        Seed; block b uses ``numpy.random.SeedSequence([seed, b])``.
+    scattering : {"multiple", "single"}
+        ``"multiple"``: random walk on each microsurface (Heitz et al. 2016), energy
+        conserving. ``"single"``: one facet event per interface with separable Smith masking
+        G1(w_i) G1(w_o) (the oracles' model); masked weight is terminated.
+    termination : {"threshold", "roulette"}
+        Rays whose intensity (unpolarized input) falls below ``tau`` are dropped
+        (the paper's threshold) or play Russian roulette (unbiased).
+    tau : float
+        Weight threshold [1].
+    max_bounces : int
+        Maximum number of facet events per ray; the rest is terminated.
+    theta_step_deg, phi_step_deg : float
+        Grid steps [deg]; must divide 90 and 360. The default 1-degree grid has the paper's
+        91 x 360 bins.
+    coherent : bool
+        Replace coating + substrate by one rough interface whose facets reflect with the
+        coherent thin-film (Airy) amplitudes of a conformal film (needs a coating, and
+        not an ideal mirror); the facets use the coating's alpha.
+    block_rays : int
+        Rays per random-number block (part of the definition of the random streams).
+    """
+
+    wavelength_nm: float = 650.0
+    theta_i_deg: float = 45.0
+    substrate: Substrate = field(default_factory=Substrate)
+    coating: Coating | None = None
+    rays: int = 200_000
+    seed: int = 0
+    scattering: str = "multiple"
+    termination: str = "threshold"
+    tau: float = 1e-4
+    max_bounces: int = 100
+    theta_step_deg: float = 1.0
+    phi_step_deg: float = 1.0
+    coherent: bool = False
+    block_rays: int = 32768
+
+    def __post_init__(self) -> None:
+        if isinstance(self.substrate, dict):
+            object.__setattr__(self, "substrate", Substrate(**self.substrate))
+        if isinstance(self.coating, dict):
+            object.__setattr__(self, "coating", Coating(**self.coating))
+        _check(isinstance(self.substrate, Substrate), "substrate", "a Substrate", self.substrate)
+        _check(
+            self.coating is None or isinstance(self.coating, Coating),
+            "coating",
+            "a Coating or None",
+            self.coating,
+        )
+        _check(
+            _finite(self.wavelength_nm) and self.wavelength_nm > 0,
+            "wavelength_nm",
+            "a finite number > 0",
+            self.wavelength_nm,
+        )
+        _check(
+            _finite(self.theta_i_deg) and 0 <= self.theta_i_deg < 90,
+            "theta_i_deg",
+            "in [0, 90)",
+            self.theta_i_deg,
+        )
+        _check(
+            isinstance(self.rays, int) and not isinstance(self.rays, bool) and self.rays > 0,
+            "rays",
+            "a positive integer",
+            self.rays,
+        )
+        _check(
+            isinstance(self.seed, int) and not isinstance(self.seed, bool) and self.seed >= 0,
+            "seed",
+            "a non-negative integer",
+            self.seed,
+        )
+        _check(
+            self.scattering in SCATTERING, "scattering", f"one of {SCATTERING}", self.scattering
+        )
+        _check(
+            self.termination in TERMINATION,
+            "termination",
+            f"one of {TERMINATION}",
+            self.termination,
+        )
+        _check(_finite(self.tau) and 0 <= self.tau < 1, "tau", "in [0, 1)", self.tau)
+        _check(
+            isinstance(self.max_bounces, int) and self.max_bounces >= 1,
+            "max_bounces",
+            "an integer >= 1",
+            self.max_bounces,
+        )
+        for name, full in (("theta_step_deg", 90.0), ("phi_step_deg", 360.0)):
+            step = getattr(self, name)
+            ok = _finite(step) and step > 0 and abs(full / step - round(full / step)) < 1e-9
+            _check(ok, name, f"a positive divisor of {full:g}", step)
+        _check(
+            isinstance(self.block_rays, int) and self.block_rays >= 1,
+            "block_rays",
+            "an integer >= 1",
+            self.block_rays,
+        )
+        _check(
+            not self.coherent or self.coating is not None,
+            "coherent",
+            "False when there is no coating",
+            self.coherent,
+        )
+
+        _check(
+            not (self.coherent and self.substrate.mirror),
+            "coherent",
+            "False with an ideal-mirror substrate (the film needs n + ik)",
+            self.coherent,
+        )
+
+    @property
+    def n_blocks(self) -> int:
+        """Number of random-number blocks."""
+        return -(-self.rays // self.block_rays)
+
+    def block_size(self, block: int) -> int:
+        """Rays in block ``block`` (the last one may be short)."""
+        return min(self.block_rays, self.rays - block * self.block_rays)
+
+    def replace(self, **changes: Any) -> TraceConfig:
+        """A copy with some fields changed."""
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON-safe dict."""
+        return asdict(self)
+
+    def to_json(self) -> str:
+        """JSON text (sorted keys)."""
+        return json.dumps(self.to_dict(), sort_keys=True)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> TraceConfig:
+        """Inverse of :meth:`to_dict`; unknown keys raise ``ValueError``."""
+        known = set(cls.__dataclass_fields__)
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(
+                f"unknown TraceConfig keys {unknown}; expected some of {sorted(known)}"
+            )
+        return cls(**data)
+
+    @classmethod
+    def from_json(cls, text: str) -> TraceConfig:
+        """Inverse of :meth:`to_json`."""
+        return cls.from_dict(json.loads(text))

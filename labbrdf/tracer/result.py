@@ -1,0 +1,230 @@
+"""The pBRDF of a tracer run: Mueller matrix per bin, maps, albedo, energy ledger, .npz I/O."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from labbrdf.tracer.binning import Grid
+from labbrdf.tracer.config import TraceConfig
+
+__all__ = ["TraceResult", "trace_summary"]
+
+UNPOLARIZED = (1.0, 0.0, 0.0, 0.0)
+
+
+def _stokes(stokes_in: ArrayLike) -> NDArray[np.float64]:
+    s = np.asarray(stokes_in, dtype=float)
+    if s.shape != (4,) or not np.all(np.isfinite(s)):
+        raise ValueError(f"stokes_in must be 4 finite numbers [S0, S1, S2, S3], got {stokes_in!r}")
+    if s[0] <= 0 or np.sqrt((s[1:] ** 2).sum()) > s[0] * (1 + 1e-12):
+        raise ValueError(f"stokes_in must have S0 > 0 and DOP <= 1, got {stokes_in!r}")
+    return s
+
+
+@dataclass
+class TraceResult:
+    """Result of :func:`labbrdf.tracer.trace`.
+
+    Attributes
+    ----------
+    config : TraceConfig
+    sums, sumsq : ndarray, shape (n_theta, n_phi, 4, 4)
+        Summed exit Mueller weights per bin and their squares (per-ray spread).
+    counts : ndarray of int, shape (n_theta, n_phi)
+        Exiting rays per bin.
+    hemi : ndarray, shape (4, 4)
+        Exit Mueller weights summed over the hemisphere, per incident ray.
+    ledger : dict
+        ``exited``, ``absorbed``, ``terminated`` (fractions of the incident power,
+        unpolarized input) and ``incident`` (rays).
+    block_hemi : ndarray, shape (n_blocks, 4, 4)
+        ``hemi`` of each block, per ray of that block (block-spread error estimates).
+    block_rays : ndarray of int, shape (n_blocks,)
+    seconds : float
+        Wall time of the run [s].
+    events : int
+        Facet events traced.
+    """
+
+    config: TraceConfig
+    sums: NDArray[np.float64]
+    sumsq: NDArray[np.float64]
+    counts: NDArray[np.int64]
+    hemi: NDArray[np.float64]
+    ledger: dict[str, float]
+    block_hemi: NDArray[np.float64]
+    block_rays: NDArray[np.int64]
+    seconds: float = 0.0
+    events: int = 0
+    _grid: Grid = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self._grid = Grid(self.config.theta_step_deg, self.config.phi_step_deg)
+
+    # -- grid ----------------------------------------------------------------------
+    @property
+    def grid(self) -> Grid:
+        """The binning grid."""
+        return self._grid
+
+    @property
+    def rays(self) -> int:
+        """Number of traced rays."""
+        return self.config.rays
+
+    @property
+    def theta_r_deg(self) -> NDArray[np.float64]:
+        """Polar bin centres [deg]."""
+        return self._grid.theta_centres_deg
+
+    @property
+    def phi_r_deg(self) -> NDArray[np.float64]:
+        """Azimuth bin centres [deg] (source at 0, specular half-plane at 180)."""
+        return self._grid.phi_centres_deg
+
+    @property
+    def theta_r_edges_deg(self) -> NDArray[np.float64]:
+        """Polar bin edges [deg]."""
+        return self._grid.theta_edges_deg
+
+    @property
+    def phi_r_edges_deg(self) -> NDArray[np.float64]:
+        """Azimuth bin edges [deg] (the first bin wraps around 0)."""
+        return self._grid.phi_edges_deg
+
+    # -- pBRDF -----------------------------------------------------------------------
+    @property
+    def mueller(self) -> NDArray[np.float64]:
+        """Bin-averaged Mueller BRDF, shape (n_theta, n_phi, 4, 4) [sr^-1].
+
+        ``f = W / (N Omega_cos)``: summed weights over rays times cos-weighted solid angle
+        (derivation in :mod:`labbrdf.tracer.binning`).
+        """
+        w = self._grid.cos_solid_angle_sr[:, :, None, None]
+        return self.sums / (self.rays * w)
+
+    @property
+    def mueller_stderr(self) -> NDArray[np.float64]:
+        """Monte Carlo standard error of :attr:`mueller` from the per-ray spread [sr^-1]."""
+        n = self.rays
+        mean = self.sums / n
+        var = np.maximum(self.sumsq / n - mean * mean, 0.0) / n
+        return np.sqrt(var) / self._grid.cos_solid_angle_sr[:, :, None, None]
+
+    def stokes(self, stokes_in: ArrayLike = UNPOLARIZED) -> NDArray[np.float64]:
+        """Exit Stokes BRDF ``f @ S_in`` per bin, shape (n_theta, n_phi, 4) [sr^-1]."""
+        return self.mueller @ _stokes(stokes_in)
+
+    def s0(self, stokes_in: ArrayLike = UNPOLARIZED) -> NDArray[np.float64]:
+        """S0 map [sr^-1] for the input Stokes vector (default unpolarized)."""
+        return self.stokes(stokes_in)[..., 0]
+
+    def dop(self, stokes_in: ArrayLike = UNPOLARIZED) -> NDArray[np.float64]:
+        """Degree of polarization map (Dong 2022 eq. (13)); NaN where no ray exited [1]."""
+        st = self.stokes(stokes_in)
+        pol = np.sqrt((st[..., 1:] ** 2).sum(axis=-1))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(st[..., 0] > 0, pol / st[..., 0], np.nan)
+
+    def albedo(self, stokes_in: ArrayLike = UNPOLARIZED) -> float:
+        """Directional-hemispherical reflectance: exited S0 / incident S0 [1]."""
+        s = _stokes(stokes_in)
+        return float((self.hemi @ s)[0] / s[0])
+
+    def hemi_stderr(self) -> NDArray[np.float64]:
+        """Standard error of :attr:`hemi` from the spread of the blocks, shape (4, 4).
+
+        NaN with fewer than 2 blocks. Blocks of unequal size are weighted by their rays.
+        """
+        a = self.block_hemi
+        w = self.block_rays.astype(float)[:, None, None]
+        nb = a.shape[0]
+        if nb < 2:
+            return np.full((4, 4), np.nan)
+        mean = (a * w).sum(axis=0) / w.sum()
+        var = ((w * (a - mean) ** 2).sum(axis=0) / w.sum()) * nb / (nb - 1)
+        return np.sqrt(var / nb)
+
+    def albedo_stderr(self, stokes_in: ArrayLike = UNPOLARIZED) -> float:
+        """Standard error of :meth:`albedo` from the spread of the blocks [1]."""
+        s = _stokes(stokes_in)
+        a = self.block_hemi @ s
+        w = self.block_rays.astype(float)
+        nb = a.shape[0]
+        if nb < 2:
+            return float("nan")
+        a0 = a[:, 0] / s[0]
+        mean = np.sum(a0 * w) / w.sum()
+        var = np.sum(w * (a0 - mean) ** 2) / w.sum() * nb / (nb - 1)
+        return float(np.sqrt(var / nb))
+
+    # -- I/O -------------------------------------------------------------------------
+    def save(self, path: str | Path) -> Path:
+        """Write an .npz with ``mueller``, bin centres/edges, config JSON and ledger."""
+        path = Path(path)
+        np.savez_compressed(
+            path,
+            mueller=self.mueller,
+            mueller_stderr=self.mueller_stderr,
+            theta_r_deg=self.theta_r_deg,
+            phi_r_deg=self.phi_r_deg,
+            theta_r_edges_deg=self.theta_r_edges_deg,
+            phi_r_edges_deg=self.phi_r_edges_deg,
+            sums=self.sums,
+            sumsq=self.sumsq,
+            counts=self.counts,
+            hemi=self.hemi,
+            block_hemi=self.block_hemi,
+            block_rays=self.block_rays,
+            config=np.array(self.config.to_json()),
+            ledger=np.array(json.dumps(self.ledger, sort_keys=True)),
+            seconds=np.array(self.seconds),
+            events=np.array(self.events),
+        )
+        return path if path.suffix == ".npz" else path.with_name(path.name + ".npz")
+
+    @classmethod
+    def load(cls, path: str | Path) -> TraceResult:
+        """Read a file written by :meth:`save`."""
+        path = Path(path)
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                cfg = TraceConfig.from_json(str(z["config"]))
+                return cls(
+                    config=cfg,
+                    sums=z["sums"],
+                    sumsq=z["sumsq"],
+                    counts=z["counts"],
+                    hemi=z["hemi"],
+                    ledger=json.loads(str(z["ledger"])),
+                    block_hemi=z["block_hemi"],
+                    block_rays=z["block_rays"],
+                    seconds=float(z["seconds"]),
+                    events=int(z["events"]),
+                )
+        except (KeyError, ValueError, OSError) as exc:
+            raise ValueError(f"{path}: not a labbrdf TraceResult .npz ({exc})") from exc
+
+
+def trace_summary(result: TraceResult) -> dict[str, Any]:
+    """JSON-safe summary for the CLI: albedo, energy fractions, rays, seconds."""
+    led = result.ledger
+    return {
+        "albedo": result.albedo(),
+        "albedo_stderr": result.albedo_stderr(),
+        "energy": {
+            "exited": led["exited"],
+            "absorbed": led["absorbed"],
+            "terminated": led["terminated"],
+        },
+        "rays": result.rays,
+        "seconds": result.seconds,
+        "events": result.events,
+        "config": result.config.to_dict(),
+    }

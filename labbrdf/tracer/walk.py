@@ -1,0 +1,376 @@
+"""The per-block random walk: all rays of a block advance together, one event per step.
+
+State of a ray: direction ``k`` (3,), Stokes frame x axis ``s`` (3,), Mueller matrix
+``M`` (4, 4), the interface it is on (``TOP`` = air/coating, ``SUB`` = substrate), the side
+of that interface (``below``: inside the coating, under the top interface), its height on
+the microsurface ``h`` (multiple scattering; +inf when it arrives from the bulk) and the
+number of facet events.
+
+One step, for every live ray:
+
+1. *Leave or hit.* ``scattering="multiple"``: the next intersection height on the
+   microsurface (Heitz et al. 2016, uniform height distribution, uncorrelated Smith
+   masking); the ray leaves with probability ``C1(h)^Lambda``. ``scattering="single"``:
+   a ray leaves right after its single facet event, weighted by ``G1(w_o)``; a ray whose
+   outgoing direction points back into the surface is terminated.
+2. *Route* a leaving ray: up out of the top interface (or out of a bare substrate) ->
+   exit and binning; down out of the top interface -> across the coating to the substrate;
+   up out of the substrate under a coating -> across the coating to the top interface from
+   below. Crossing the coating multiplies M by the Beer-Lambert factor
+   ``exp(-4 pi k_c d / (lambda |cos theta|))``.
+3. *Scatter* a hitting ray: a visible GGX normal (Heitz 2018 / Dupuy & Benyoub 2023), the
+   frame rotated to the facet's s axis, Fresnel reflection (conductor; ideal mirror; or
+   coherent film) or, at the dielectric top interface, reflection or refraction chosen with
+   the probability equal to the reflected fraction of the ray's current Stokes vector for
+   unpolarized input (the paper's step 3 uses ``(Rs + Rp)/2``, which is the same for an
+   unpolarized ray), the Mueller weight divided by that probability. A refracted ray
+   changes side and its height changes sign (Heitz 2016, dielectric walk).
+4. *Terminate*: after ``max_bounces`` events, or below the weight threshold ``tau``
+   (``termination="threshold"``, Dong 2022 sec. 2.3) or by Russian roulette.
+
+Energy ledger (unpolarized input, per ray exact): every change of ``M00`` is booked:
+exit -> exited; Fresnel loss at the substrate and Beer-Lambert loss -> absorbed (the
+dielectric interface conserves M00 to round-off by the choice of probability, and its
+round-off is booked as absorbed too); masking in single mode, max_bounces, threshold and
+roulette kills -> terminated; a roulette survivor's boost is booked as negative terminated.
+So exited + absorbed + terminated = rays to round-off.
+
+Notes
+-----
+Geometric model of the coating (position-free, Guo et al. 2018 style): the layers are
+laterally infinite and the interfaces statistically independent; only directions matter.
+A ray crossing the coating travels ``d / |cos theta|`` with ``theta`` the angle of its
+direction to the macroscopic normal (the mean planes are parallel, a distance d apart).
+Fresnel coefficients at the coating interfaces use the real part of the coating index;
+its ``k`` only enters the Beer-Lambert factor. The paper's threshold tau is applied to the
+intensity of the unpolarized-input Stokes vector (M00).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from labbrdf.tracer.binning import Grid, bin_exits
+from labbrdf.tracer.config import TraceConfig
+from labbrdf.tracer.interfaces import apply_fresnel, fresnel_abcs, rotate_frame, s_axis
+from labbrdf.tracer.sampling import sample_height, sample_vndf, smith_g1, smith_lambda
+
+__all__ = ["BlockTally", "run_unit", "trace_block"]
+
+TOP, SUB = 0, 1
+
+
+@dataclass
+class BlockTally:
+    """What one block contributes (folded by the driver in block order)."""
+
+    block: int
+    rays: int
+    sums: NDArray[np.float64]  # (n_bins, 16) summed exit Mueller elements
+    sumsq: NDArray[np.float64]  # (n_bins, 16) summed squares (per-ray variance)
+    counts: NDArray[np.int64]  # (n_bins,) exiting rays
+    exited: float
+    absorbed: float
+    terminated: float
+    hemi: NDArray[np.float64]  # (16,) summed exit Mueller over the hemisphere
+    events: int
+
+
+def _grid(cfg: TraceConfig) -> Grid:
+    return Grid(cfg.theta_step_deg, cfg.phi_step_deg)
+
+
+class _Setup:
+    """Per-run constants derived from the config."""
+
+    def __init__(self, cfg: TraceConfig) -> None:
+        sub, coat = cfg.substrate, cfg.coating
+        self.single = cfg.scattering == "single"
+        self.layered = coat is not None and not cfg.coherent
+        self.coherent = bool(cfg.coherent)
+        self.mirror = sub.mirror
+        self.n_sub = complex(sub.n, sub.k)
+        self.alpha_sub = coat.alpha if (coat is not None and cfg.coherent) else sub.alpha
+        self.alpha_top = coat.alpha if coat is not None else 0.0
+        self.n_coat = coat.n if coat is not None else 1.0
+        self.k_coat = coat.k if coat is not None else 0.0
+        self.d = coat.thickness_nm if coat is not None else 0.0
+        self.lam = cfg.wavelength_nm
+        self.coat = coat
+        self.n_above_sub = self.n_coat if self.layered else 1.0
+
+    def beer_lambert(self, kz: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        if self.k_coat == 0 or self.d == 0:
+            return None
+        return np.exp(-4 * np.pi * self.k_coat * self.d / (self.lam * np.abs(kz)))
+
+    def substrate_abcs(
+        self, cos_i: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray]:
+        if self.coherent:
+            from labbrdf.optics import film_amplitudes
+
+            theta = np.degrees(np.arccos(np.clip(cos_i, 0.0, 1.0)))
+            coat = self.coat
+            rs, rp = film_amplitudes(
+                1.0, complex(coat.n, coat.k), self.n_sub, coat.thickness_nm, self.lam, theta
+            )
+            rs2 = np.abs(rs) ** 2
+            rp2 = np.abs(rp) ** 2
+            x = rs * np.conj(rp)
+            return 0.5 * (rs2 + rp2), 0.5 * (rs2 - rp2), x.real, x.imag
+        refl, _, _ = fresnel_abcs(self.n_above_sub, self.n_sub, cos_i, mirror=self.mirror)
+        return refl
+
+    def layered_abcs(
+        self, cos_i: NDArray[np.float64], on_top: NDArray[np.bool_], below: NDArray[np.bool_]
+    ) -> tuple[tuple, tuple, NDArray[np.float64], NDArray[np.float64]]:
+        """Reflection/transmission numbers for a mix of top-interface and substrate rays."""
+        nc = self.n_coat
+        n1 = np.where(on_top & below, nc, np.where(on_top, 1.0, nc)).astype(np.complex128)
+        n2 = np.where(on_top, np.where(below, 1.0, nc), 0.0).astype(np.complex128)
+        if not self.mirror:
+            n2 = np.where(on_top, n2, self.n_sub)
+        else:
+            n2 = np.where(on_top, n2, 1.0 + 0.0j)  # placeholder, overridden below
+        refl, tr, cos_t = fresnel_abcs(n1, n2, cos_i, opaque=~on_top)
+        if self.mirror:
+            sub = ~on_top
+            refl = (
+                np.where(sub, 1.0, refl[0]),
+                np.where(sub, 0.0, refl[1]),
+                np.where(sub, -1.0, refl[2]),
+                np.where(sub, 0.0, refl[3]),
+            )
+        eta = np.where(on_top, n1.real / np.where(on_top, n2.real, 1.0), 1.0)
+        return refl, tr, cos_t, eta
+
+
+def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
+    """Trace the rays of block ``block`` with generator ``SeedSequence([seed, block])``.
+
+    Parameters
+    ----------
+    cfg : TraceConfig
+    block : int
+        Block index in ``range(cfg.n_blocks)``.
+
+    Returns
+    -------
+    BlockTally
+    """
+    if not 0 <= block < cfg.n_blocks:
+        raise ValueError(f"block must be in [0, {cfg.n_blocks}), got {block!r}")
+    su = _Setup(cfg)
+    grid = _grid(cfg)
+    n = cfg.block_size(block)
+    rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, block]))
+    th = np.radians(cfg.theta_i_deg)
+    k = np.zeros((3, n))
+    k[0] = -np.sin(th)
+    k[2] = -np.cos(th)
+    s = np.zeros((3, n))
+    s[1] = 1.0  # phi_hat(phi_i = 0)
+    M = np.zeros((4, 4, n))
+    for i in range(4):
+        M[i, i] = 1.0
+    iface = np.full(n, TOP if su.layered else SUB, dtype=np.int8)
+    below = np.zeros(n, dtype=bool)
+    h = np.full(n, np.inf)
+    fresh = np.ones(n, dtype=bool)
+    bounces = np.zeros(n, dtype=np.int32)
+    absorbed = 0.0
+    terminated = 0.0
+    events = 0
+    ex_k: list[NDArray] = []
+    ex_s: list[NDArray] = []
+    ex_M: list[NDArray] = []
+
+    while k.shape[1]:
+        m_ = k.shape[1]
+        alive = np.ones(m_, dtype=bool)
+        kz_loc = np.where(below, -k[2], k[2])
+        alpha = np.where(iface == TOP, su.alpha_top, su.alpha_sub)
+
+        # 1. leave or hit
+        if su.single:
+            leave = ~fresh
+            if leave.any():
+                back = leave & (kz_loc <= 0)
+                terminated += float(M[0, 0, back].sum())
+                alive &= ~back
+                go = leave & ~back
+                g = np.where(go, smith_g1(kz_loc, alpha), 1.0)
+                terminated += float((M[0, 0] * (1.0 - g))[go].sum())
+                M *= g
+                leave = go
+        else:
+            lam = smith_lambda(kz_loc, alpha)
+            leave, h_new = sample_height(kz_loc, lam, h, rng.random(m_))
+            h = np.where(leave, h, h_new)
+
+        # 2. route leaving rays: exit, or cross the coating to the other interface
+        if leave.any():
+            out = leave & (((iface == TOP) & ~below) | ((iface == SUB) & (not su.layered)))
+            if out.any():
+                ex_k.append(k[:, out])
+                ex_s.append(s[:, out])
+                ex_M.append(M[:, :, out])
+                alive &= ~out
+            if su.layered:
+                cross_ = leave & ~out
+                if cross_.any():
+                    ci = np.nonzero(cross_)[0]
+                    att = su.beer_lambert(k[2, ci])
+                    if att is not None:
+                        absorbed += float((M[0, 0, ci] * (1.0 - att)).sum())
+                        M[:, :, ci] *= att
+                    up = iface[ci] == SUB
+                    iface[ci] = np.where(up, TOP, SUB)
+                    below[ci] = up
+                    fresh[ci] = True
+                    if not su.single:
+                        # arrival height on the next microsurface (always a hit: the ray
+                        # travels towards it)
+                        kz_new = np.where(up, -k[2, ci], k[2, ci])
+                        a_new = np.where(up, su.alpha_top, su.alpha_sub)
+                        lam_new = smith_lambda(kz_new, a_new)
+                        _, h[ci] = sample_height(
+                            kz_new, lam_new, np.full(ci.size, np.inf), rng.random(ci.size)
+                        )
+
+        # max bounces: a ray that would need one more event is terminated
+        over = alive & (bounces >= cfg.max_bounces)
+        if over.any():
+            terminated += float(M[0, 0, over].sum())
+            alive &= ~over
+
+        if not alive.all():
+            k, s, M = k[:, alive], s[:, alive], M[:, :, alive]
+            iface, below, h = iface[alive], below[alive], h[alive]
+            fresh, bounces = fresh[alive], bounces[alive]
+        m_ = k.shape[1]
+        if m_ == 0:
+            break
+
+        # 3. scatter every remaining ray (all are on a microsurface and hit a facet)
+        u = rng.random((3, m_))
+        events += m_
+        on_top = iface == TOP
+        a = np.where(on_top, su.alpha_top, su.alpha_sub)
+        wi = -k
+        wi[2] = np.where(below, k[2], wi[2])
+        m = sample_vndf(wi, a, u[0], u[1])
+        m[2] = np.where(below, -m[2], m[2])
+        cos_i = np.clip(-(k[0] * m[0] + k[1] * m[1] + k[2] * m[2]), 0.0, 1.0)
+        s_loc = s_axis(k, m, s)
+        rotate_frame(M, k, s, s_loc)
+        m00 = M[0, 0].copy()
+        kr = k + 2.0 * cos_i * m
+        trans = None
+        if not su.layered:
+            A, B, C, S = su.substrate_abcs(cos_i)
+            apply_fresnel(M, A, B, C, S)
+            knew = kr
+        else:
+            refl, tr, cos_t, eta = su.layered_abcs(cos_i, on_top, below)
+            s0 = M[0, 0]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                pr = np.where(s0 > 0, (refl[0] * s0 + refl[1] * M[1, 0]) / s0, refl[0])
+                pr = np.where(on_top, np.clip(pr, 0.0, 1.0), 1.0)  # opaque substrate
+                trans = u[2] >= pr
+                wr = np.where(trans, 0.0, 1.0 / np.where(trans, 1.0, pr))
+                wt = np.where(trans, 1.0 / np.where(trans, 1.0 - pr, 1.0), 0.0)
+            apply_fresnel(
+                M,
+                refl[0] * wr + tr[0] * wt,
+                refl[1] * wr + tr[1] * wt,
+                refl[2] * wr + tr[2] * wt,
+                refl[3] * wr + tr[3] * wt,
+            )
+            if trans.any():
+                kt = eta * k + (eta * cos_i - cos_t) * m
+                knew = np.where(trans, kt, kr)
+            else:
+                knew = kr
+        k = knew / np.sqrt(knew[0] * knew[0] + knew[1] * knew[1] + knew[2] * knew[2])
+        s = s_loc
+        absorbed += float((m00 - M[0, 0]).sum())
+        bounces += 1
+        fresh[:] = False
+        if trans is not None and trans.any():
+            below = below ^ trans
+            h = np.where(trans, -h, h)
+
+        # 4. weight threshold / roulette
+        alive = np.ones(m_, dtype=bool)
+        if cfg.tau > 0:
+            low = M[0, 0] < cfg.tau
+            if low.any():
+                if cfg.termination == "threshold":
+                    terminated += float(M[0, 0, low].sum())
+                    alive &= ~low
+                else:
+                    idx = np.nonzero(low)[0]
+                    p = M[0, 0, idx] / cfg.tau
+                    survive = rng.random(idx.size) < p
+                    dead = idx[~survive]
+                    live = idx[survive]
+                    terminated += float(M[0, 0, dead].sum())
+                    before = M[0, 0, live].copy()
+                    M[:, :, live] /= p[survive]
+                    terminated += float((before - M[0, 0, live]).sum())
+                    alive[dead] = False
+        else:
+            dead = ~(M[0, 0] > 0)
+            if dead.any():
+                terminated += float(M[0, 0, dead].sum())
+                alive &= ~dead
+
+        if not alive.all():
+            k, s, M = k[:, alive], s[:, alive], M[:, :, alive]
+            iface, below, h = iface[alive], below[alive], h[alive]
+            fresh, bounces = fresh[alive], bounces[alive]
+
+    # binning of the exits, in the LB exit frames phi_hat(phi)
+    if ex_k:
+        ke = np.concatenate(ex_k, axis=1)
+        se = np.concatenate(ex_s, axis=1)
+        Me = np.concatenate(ex_M, axis=2)
+        idx, phi = grid.index(ke)
+        s_det = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+        rotate_frame(Me, ke, se, s_det)
+        rows = Me.reshape(16, -1)
+        sums, sumsq, counts = bin_exits(grid, idx, rows)
+        hemi = rows.sum(axis=1)
+    else:
+        nb = grid.n_bins
+        sums, sumsq = np.zeros((nb, 16)), np.zeros((nb, 16))
+        counts = np.zeros(nb, dtype=np.int64)
+        hemi = np.zeros(16)
+    return BlockTally(
+        block=block,
+        rays=n,
+        sums=sums,
+        sumsq=sumsq,
+        counts=counts,
+        exited=float(hemi[0]),
+        absorbed=absorbed,
+        terminated=terminated,
+        hemi=hemi,
+        events=events,
+    )
+
+
+def run_unit(cfg: TraceConfig, blocks: list[int] | tuple[int, ...]) -> list[BlockTally]:
+    """Work unit: trace the listed blocks (picklable, for ``map``)."""
+    return [trace_block(cfg, b) for b in blocks]
+
+
+def _unit(args: tuple[TraceConfig, tuple[int, ...]]) -> list[BlockTally]:
+    """Single-argument form of :func:`run_unit` for ``map(func, items)``."""
+    cfg, blocks = args
+    return run_unit(cfg, blocks)
