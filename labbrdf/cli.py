@@ -246,33 +246,46 @@ def _complex(text: str, what: str) -> complex:
 
 
 def cmd_trace(args: argparse.Namespace) -> int:
+    import functools
+
     from . import tracer
-    from .parallel import check_scheduler
+    from .parallel import check_scheduler, imap
 
     check_scheduler(args.scheduler)
     sub = _complex(args.substrate, "--substrate")
     kw: dict[str, Any] = {
         "wavelength_nm": args.wavelength,
         "theta_i_deg": args.theta_i,
-        "substrate": tracer.Layer(n=sub.real, k=sub.imag, alpha=args.alpha),
+        "substrate": tracer.Substrate(n=sub.real, k=sub.imag, alpha=args.alpha),
         "rays": args.rays,
         "seed": args.seed,
-        "single_scattering": args.single_scattering,
+        "scattering": "single" if args.single_scattering else "multiple",
         "coherent": args.coherent,
     }
     if args.coating is not None:
         coat = _complex(args.coating, "--coating")
         if args.thickness is None:
             raise UsageError("--coating needs --thickness (nm)")
-        kw["coating"] = tracer.Layer(
+        kw["coating"] = tracer.Coating(
             n=coat.real,
             k=coat.imag,
-            alpha=args.coating_alpha if args.coating_alpha is not None else args.alpha,
             thickness_nm=args.thickness,
+            alpha=args.coating_alpha if args.coating_alpha is not None else args.alpha,
         )
+    elif args.thickness is not None or args.coating_alpha is not None:
+        raise UsageError("--thickness and --coating-alpha need --coating")
     config = tracer.TraceConfig(**kw)
+    mapper: Any = map
+    if args.scheduler != "serial":
+        mapper = functools.partial(
+            imap,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            progress=not args.json,
+            desc="trace",
+        )
     t0 = time.perf_counter()
-    result = tracer.trace(config, scheduler=args.scheduler, workers=args.workers)
+    result = tracer.trace(config, map=mapper)
     seconds = time.perf_counter() - t0
     if args.output:
         result.save(args.output)

@@ -1,0 +1,213 @@
+"""Speed and quality of labbrdf.fit: time per fit and chi-square reached.
+
+Run: ``python benchmarks/bench_fit.py [--repeat N] [--skip-batch] [--workers 2]``
+
+Prints, per model, the median over the fixture groups (OSR and mirror x 360/500/550/860 nm,
+synthetic with the fixtures' noise, ``fixtures/specular/*.csv``) of the wall time per fit
+and the chi-square reached by
+
+* ``default``: ``labbrdf.fit(model, data)`` (GN_CRS2_LM+LN_BOBYQA, profiled amplitudes,
+  data-driven start, default budgets);
+* ``crs3000``: nlopt GN_CRS2_LM with 3000 evaluations, then LN_BOBYQA, every parameter
+  searched (no profiling, no guess);
+* ``de``: ``scipy.optimize.differential_evolution`` (polish on, seed 0) on the same
+  chi-square and bounds;
+
+and the worst ratio chi2(default) / chi2(de) (aim: <= 1, never worse). Then it times
+``fit_many`` on one synthetic sample with 761 wavelengths (240-1000 nm) on a process pool.
+
+Aims (issue 4): <= 10 ms per smooth3 fit, <= 100 ms per five_param fit, 761 wavelengths
+in < 5 s on 2 cores. Not a timed test: numbers depend on the machine and its load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy import optimize
+
+from labbrdf.fit import FitData, Objective, fit, fit_many
+from labbrdf.models import MODELS, get
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Zou 2013 Tables 1-2 (k1, k2 [rad], k3 [rad]); used when the fixture files are absent
+ZOU2013 = {
+    "OSR": {
+        360: (0.7443, -0.01156, 0.4161),
+        500: (0.9740, -0.01506, 0.4177),
+        550: (1.0150, -0.01660, 0.4176),
+        860: (1.0310, -0.01968, 0.4155),
+    },
+    "mirror": {
+        360: (0.4972, 0.1379, 0.3704),
+        500: (0.5580, 0.1659, 0.3693),
+        550: (0.5494, 0.1682, 0.3693),
+        860: (0.3909, 0.1594, 0.3710),
+    },
+}
+
+
+def synthetic(k: tuple[float, float, float], rng: np.random.Generator) -> FitData:
+    """Fixture geometry and noise model (fixtures/README.md) from smooth3 parameters."""
+    ti = np.repeat([30.0, 45.0, 60.0], 21)
+    tr = ti + np.tile(np.round(np.arange(-2.0, 2.0001, 0.2), 10), 3)
+    y = get("smooth3").evaluate(
+        np.radians(ti), np.radians(tr), params=dict(zip(("k1", "k2", "k3"), k, strict=True))
+    )
+    sigma = np.hypot(0.005 * y, 1e-4)
+    return FitData(ti, tr, y + sigma * rng.standard_normal(y.size), sigma)
+
+
+def fixture_groups() -> list[tuple[str, FitData]]:
+    groups = []
+    files = [ROOT / "fixtures" / "specular" / f"{s}_specular.csv" for s in ("osr", "mirror")]
+    if all(f.is_file() for f in files):
+        for f in files:
+            df = pd.read_csv(f, comment="#")
+            for wl, g in df.groupby("wavelength_nm"):
+                groups.append(
+                    (
+                        f"{f.stem.split('_')[0]} {wl:g} nm",
+                        FitData(
+                            g["theta_i_deg"],
+                            g["theta_r_deg"],
+                            g["value"],
+                            g["sigma"],
+                            g["phi_r_deg"],
+                        ),
+                    )
+                )
+        return groups
+    rng = np.random.default_rng(20130612)
+    for s, tab in ZOU2013.items():
+        for wl, k in tab.items():
+            groups.append((f"{s} {wl} nm (generated)", synthetic(k, rng)))
+    return groups
+
+
+def de_fit(model_name: str, fd: FitData) -> tuple[float, float]:
+    """differential_evolution (polish on) on the weighted chi-square; (chi2, seconds).
+
+    Every varying parameter is searched (no profiling), on the same [0, 1] box as nlopt
+    (log scale for ``log`` parameters such as k3 and kb), so the comparison is of the
+    optimisers, not of the parametrisations.
+    """
+    model = get(model_name)
+    obj = Objective(model, fd, model.params, 1.0 / np.asarray(fd.sigma) ** 2)
+    lo, hi = obj.bounds()
+    t0 = time.perf_counter()
+    with np.errstate(all="ignore"):
+        res = optimize.differential_evolution(
+            lambda x: obj(x), list(zip(lo, hi, strict=True)), seed=0, polish=True
+        )
+        _, chi2 = obj.solve(obj.from_vector(res.x))
+    return float(chi2), time.perf_counter() - t0
+
+
+def timed(f, repeat: int) -> tuple[object, float]:
+    best = math.inf
+    out = None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = f()
+        best = min(best, time.perf_counter() - t0)
+    return out, best
+
+
+def bench_model(model_name: str, groups: list[tuple[str, FitData]], repeat: int) -> None:
+    print(f"\n== {model_name}: {len(groups)} fixture groups, best of {repeat} per fit ==")
+    print(
+        f"{'group':<22}{'default ms':>11}{'chi2':>12}{'crs3000 ms':>12}{'chi2':>12}"
+        f"{'DE ms':>10}{'chi2':>12}"
+    )
+    rows = []
+    for label, fd in groups:
+        r0, t0 = timed(lambda fd=fd: fit(model_name, fd), repeat)
+        r1, t1 = timed(
+            lambda fd=fd: fit(model_name, fd, maxeval=(3000, None), profile=False, guess=False), 1
+        )
+        c2, t2 = de_fit(model_name, fd)
+        rows.append((t0, r0.chisqr, t1, r1.chisqr, t2, c2, r0.success))
+        print(
+            f"{label:<22}{t0 * 1e3:11.2f}{r0.chisqr:12.6g}{t1 * 1e3:12.1f}{r1.chisqr:12.6g}"
+            f"{t2 * 1e3:10.0f}{c2:12.6g}"
+        )
+    a = np.array([r[:6] for r in rows], float)
+    med = np.median(a, axis=0)
+    print(
+        f"{'median':<22}{med[0] * 1e3:11.2f}{med[1]:12.6g}{med[2] * 1e3:12.1f}"
+        f"{med[3]:12.6g}{med[4] * 1e3:10.0f}{med[5]:12.6g}"
+    )
+    print(
+        "worst chi2(default)/chi2(DE) - 1 = "
+        f"{np.max(a[:, 1] / a[:, 5]) - 1:+.1e}; worst chi2(default)/chi2(crs3000) - 1 = "
+        f"{np.max(a[:, 1] / a[:, 3]) - 1:+.1e} (|x| < 1e-8: same optimum to the local "
+        f"tolerances); all successful: {all(r[6] for r in rows)}"
+    )
+
+
+def bench_batch(workers: int) -> None:
+    """fit_many over 761 wavelengths of one sample (parameters drift with wavelength)."""
+    rng = np.random.default_rng(1)
+    wls = np.arange(240.0, 1001.0)
+    frames = []
+    for wl in wls:
+        s = (wl - 240.0) / 760.0
+        k = (0.7 + 0.3 * s, -0.01 - 0.01 * s, 0.415 + 0.002 * s)
+        fd = synthetic(k, rng)
+        frames.append(
+            pd.DataFrame(
+                {
+                    "sample": "OSR",
+                    "instrument": "synthetic",
+                    "source": "bench",
+                    "quantity": "brdf",
+                    "value": fd.value,
+                    "sigma": fd.sigma,
+                    "unit": "sr-1",
+                    "wavelength_nm": wl,
+                    "theta_i_deg": fd.theta_i_deg,
+                    "theta_r_deg": fd.theta_r_deg,
+                    "phi_r_deg": 180.0,
+                }
+            )
+        )
+    df = pd.concat(frames, ignore_index=True)
+    print(
+        f"\n== fit_many: smooth3, {wls.size} wavelengths, {len(df)} rows, processes x {workers} =="
+    )
+    t0 = time.perf_counter()
+    table = fit_many(df, "smooth3", scheduler="processes", workers=workers, progress=False)
+    dt = time.perf_counter() - t0
+    print(
+        f"wall {dt:.2f} s (aim < 5 s on 2 cores), {1e3 * dt / wls.size:.2f} ms per "
+        f"wavelength, success {int(table['success'].sum())}/{len(table)}, median fit "
+        f"{1e3 * table['elapsed_s'].median():.2f} ms"
+    )
+    t0 = time.perf_counter()
+    fit_many(df, "smooth3", scheduler="serial", progress=False)
+    print(f"serial: {time.perf_counter() - t0:.2f} s")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=5, help="timing repeats per fit (best of)")
+    ap.add_argument("--workers", type=int, default=2, help="process-pool workers for fit_many")
+    ap.add_argument("--skip-batch", action="store_true", help="skip the 761-wavelength batch")
+    args = ap.parse_args()
+    groups = fixture_groups()
+    bench_model("smooth3", groups, args.repeat)
+    if "five_param" in MODELS:
+        bench_model("five_param", groups, max(1, args.repeat // 2))
+    if not args.skip_batch:
+        bench_batch(args.workers)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,697 @@
+"""The fitter: nlopt stages (global then local) over an Objective, then uncertainties."""
+
+from __future__ import annotations
+
+import copy
+import math
+import time
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import nlopt
+import numpy as np
+import pandas as pd
+from numpy.typing import ArrayLike, NDArray
+from scipy import optimize, special
+
+from ..dataset import Measurement
+from ..models import Model, Parameters
+from ..models import get as get_model
+from .data import FitData, FitError, _as_fit_data, _clean
+from .objective import GUESSES, Objective
+from .result import FitResult
+from .uncertainty import AT_BOUND_FRAC, _jacobian, _uncertainties
+
+__all__ = ["ALGORITHMS", "CONSTRAINED", "SPECULAR_LINE_SHAPE", "fit", "parse_method"]
+
+#: every nlopt algorithm, by name (``GN_CRS2_LM`` ...), read from the nlopt module itself
+ALGORITHMS: dict[str, int] = {
+    name: getattr(nlopt, name)
+    for name in dir(nlopt)
+    if name.startswith(("GN_", "GD_", "LN_", "LD_", "AUGLAG", "G_MLSL"))
+    and isinstance(getattr(nlopt, name), int)
+}
+
+#: algorithms that accept nonlinear inequality constraints (nlopt docs, "Algorithms")
+CONSTRAINED = frozenset(
+    {
+        "GN_ORIG_DIRECT",
+        "GN_ORIG_DIRECT_L",
+        "GN_ISRES",
+        "GN_AGS",
+        "LN_COBYLA",
+        "LD_MMA",
+        "LD_CCSAQ",
+        "LD_SLSQP",
+        "AUGLAG",
+        "AUGLAG_EQ",
+        "LN_AUGLAG",
+        "LN_AUGLAG_EQ",
+        "LD_AUGLAG",
+        "LD_AUGLAG_EQ",
+    }
+)
+
+
+#: models whose shape parameters cannot be identified from specular-line data alone
+#: (notes/models.md 1.1: on theta_r == theta_i smooth3 gives only k1 exp(-k2^2/k3^2))
+SPECULAR_LINE_SHAPE = {"smooth3": ("k2", "k3")}
+
+
+# default stage settings (tuned with benchmarks/bench_fit.py)
+_GLOBAL_MAXEVAL_GUESSED = 30  # x (n + 1) when a data-driven starting point exists
+_GLOBAL_MAXEVAL_BLIND = 100  # x (n + 1) otherwise
+_LOCAL_MAXEVAL_PER_DIM = 400
+_LOCAL_XTOL_REL = 1e-10
+_LOCAL_FTOL_REL = 1e-13
+_OK_CODES = (nlopt.SUCCESS, nlopt.STOPVAL_REACHED, nlopt.FTOL_REACHED, nlopt.XTOL_REACHED)
+
+
+def parse_method(method: str) -> list[str]:
+    """Split ``"GLOBAL+LOCAL"`` into checked nlopt algorithm names (one name = one stage).
+
+    Names are case-insensitive and may carry nlopt's ``NLOPT_`` prefix.
+
+    Raises
+    ------
+    FitError
+        For an unknown name, listing the valid ones.
+    """
+    if not isinstance(method, str) or not method.strip():
+        raise FitError(f"method must be a string such as 'GN_CRS2_LM+LN_BOBYQA', got {method!r}")
+    stages = []
+    for raw in method.split("+"):
+        name = raw.strip().upper().removeprefix("NLOPT_")
+        if name not in ALGORITHMS:
+            raise FitError(
+                f"unknown nlopt algorithm {raw.strip()!r} in method {method!r}; valid names "
+                f"are {sorted(ALGORITHMS)}"
+            )
+        stages.append(name)
+    return stages
+
+
+def _is_global(name: str) -> bool:
+    return name.startswith(("GN_", "GD_", "G_MLSL"))
+
+
+def _needs_grad(name: str) -> bool:
+    return name.startswith(("GD_", "LD_"))
+
+
+def _energy_rho(
+    model: Model, energy: bool | Callable[..., ArrayLike]
+) -> Callable[[dict[str, float], NDArray], NDArray]:
+    if callable(energy):
+        return lambda vals, th: np.asarray(energy(vals, th), float)
+    try:
+        from ..integrate import hemispherical_reflectance
+    except ImportError as exc:  # pragma: no cover - integrate ships with labbrdf
+        raise FitError("energy_constraint=True needs labbrdf.integrate") from exc
+    return lambda vals, th: np.asarray(hemispherical_reflectance(model, vals, th), float)
+
+
+def _copy_params(p: Parameters) -> Parameters:
+    """A copy whose Parameter objects are new (fields are immutable or replaced, not mutated)."""
+    return Parameters({k: copy.copy(q) for k, q in p.items()})
+
+
+def _setup_params(
+    model: Model, params: Parameters | Mapping[str, float] | None, fix: Mapping[str, float] | None
+) -> Parameters:
+    p = _copy_params(model.params)
+    if params is not None:
+        for k, v in params.items():
+            if k not in p:
+                raise FitError(
+                    f"params: model {model.name!r} has no parameter {k!r}; "
+                    f"parameters are {list(p)}"
+                )
+            if isinstance(v, Mapping) or hasattr(v, "vary"):
+                src = v if isinstance(v, Mapping) else v.__dict__
+                for a in ("value", "min", "max", "vary", "log"):
+                    if a in src:
+                        setattr(p[k], a, src[a])
+            else:
+                p[k].value = float(v)
+    for k, v in (fix or {}).items():
+        if k not in p:
+            raise FitError(
+                f"fix: model {model.name!r} has no parameter {k!r}; parameters are {list(p)}"
+            )
+        if not math.isfinite(float(v)):
+            raise FitError(f"fix: {k}={v!r} must be a finite number")
+        p[k].value = float(v)
+        p[k].vary = False
+    for k, q in p.items():
+        if not math.isfinite(q.value):
+            raise FitError(f"parameter {k!r}: initial value {q.value!r} is not finite")
+        if q.vary:
+            if q.min >= q.max:
+                raise FitError(f"parameter {k!r}: min {q.min} must be < max {q.max} to vary")
+            if q.log and not q.min > 0:
+                raise FitError(f"parameter {k!r}: a log-scale search needs min > 0, got {q.min}")
+            q.value = min(max(q.value, q.min), q.max)
+    return p
+
+
+def _run_stage(
+    obj: Objective,
+    name: str,
+    budget: int,
+    x: NDArray,
+    seed: int,
+    cons: Callable[[NDArray], float] | None,
+) -> tuple[NDArray, dict[str, Any]]:
+    """One nlopt stage from ``x``; returns the best point and a stage record."""
+    n = obj.n
+    opt = nlopt.opt(ALGORITHMS[name], n)
+    lo, hi = obj.bounds()
+    opt.set_lower_bounds(lo)
+    opt.set_upper_bounds(hi)
+    opt.set_min_objective(obj)
+    opt.set_maxeval(budget)
+    if not _is_global(name):
+        opt.set_xtol_rel(_LOCAL_XTOL_REL)
+        opt.set_ftol_rel(_LOCAL_FTOL_REL)
+    if "MLSL" in name or "AUGLAG" in name:
+        sub = nlopt.opt(nlopt.LD_LBFGS if _needs_grad(name) else nlopt.LN_BOBYQA, n)
+        sub.set_xtol_rel(1e-8)
+        sub.set_maxeval(_LOCAL_MAXEVAL_PER_DIM * n)
+        opt.set_local_optimizer(sub)
+    if cons is not None:
+
+        def constraint(xx: NDArray, grad: NDArray) -> float:
+            c = cons(xx)
+            for j in range(grad.size):  # forward differences on the unit-box scale
+                x2 = np.array(xx, float)
+                x2[j] += 1e-7
+                grad[j] = (cons(x2) - c) / 1e-7
+            return c
+
+        opt.add_inequality_constraint(constraint, 1e-10)
+    nlopt.srand(seed)
+    nfev0 = obj.nfev
+    x0 = np.clip(x, lo, hi)
+    try:
+        x = opt.optimize(x0)
+        code = opt.last_optimize_result()
+        message = _code_message(code)
+    except nlopt.RoundoffLimited:
+        code, message = nlopt.ROUNDOFF_LIMITED, "roundoff limited (best point kept)"
+        x = obj.best_x if obj.best_x is not None else x0
+    except (nlopt.runtime_error, RuntimeError) as exc:  # NLOPT_FAILURE: keep the best point
+        code, message = nlopt.FAILURE, f"nlopt failure ({name}): {exc or 'generic'}"
+        x = obj.best_x if obj.best_x is not None else x0
+    nfev = obj.nfev - nfev0
+    _, f = obj.solve(obj.from_vector(x))
+    if cons is None and obj.best_x is not None and obj.best_f < f:
+        x, f = obj.best_x, obj.best_f  # a stage may end on a worse point than it has seen
+    info = {
+        "algorithm": name,
+        "nfev": nfev,
+        "chisqr": float(f),
+        "code": int(code),
+        "message": message,
+    }
+    return np.asarray(x, float), info
+
+
+def fit(
+    model: Model | str,
+    data: Measurement | pd.DataFrame | FitData,
+    *,
+    method: str = "GN_CRS2_LM+LN_BOBYQA",
+    seed: int = 0,
+    params: Parameters | Mapping[str, Any] | None = None,
+    fix: Mapping[str, float] | None = None,
+    profile: bool | None = None,
+    energy_constraint: bool | Callable[..., ArrayLike] = False,
+    maxeval: int | Sequence[int | None] | None = None,
+    quantity: str | None = None,
+    unit: str | None = None,
+    use_sigma: bool | None = None,
+    nan_policy: str = "raise",
+    guess: bool = True,
+    ci: str = "wald",
+) -> FitResult:
+    """Fit a reflectance/BRDF model: an nlopt global stage inside the bounds, then a local one.
+
+    Parameters
+    ----------
+    model : Model or str
+        A model instance or a registry name (``"smooth3"``).
+    data : Measurement, DataFrame or FitData
+        Rows with quantity ``brdf`` or ``specular_intensity`` (angles [deg]); one sample and
+        one wavelength (see :func:`fit_many` for batches).
+    method : str
+        nlopt algorithm names joined by ``+``, run in turn, each from the best point of the
+        previous one. Global stages need finite bounds on every varying parameter.
+    seed : int
+        Passed to ``nlopt.srand`` before every stage: the fit is reproducible.
+    params : Parameters or mapping, optional
+        Initial values (name -> value) or per-parameter settings
+        (name -> {"value", "min", "max", "vary", "log"}) overriding the model's defaults.
+    fix : mapping, optional
+        name -> value to hold fixed (the CLI's ``--fix NAME=VALUE``).
+    profile : bool, optional
+        Solve the model's linear amplitudes (``Model.linear``) by bounded linear least
+        squares at every step. None (default): whenever the model provides linear components
+        and one of them varies.
+    energy_constraint : bool or callable
+        Keep the directional-hemispherical reflectance rho(theta_i) <= 1 over the measured
+        incidence range (notes/models.md 1.4). True uses
+        :func:`labbrdf.integrate.hemispherical_reflectance`; a callable
+        ``rho(values, theta_i_deg) -> array`` replaces it. rho is checked on the measured
+        incidence angles plus 7 equally spaced ones from the smallest to the largest. With
+        one profiled amplitude (smooth3's k1) rho is linear in it and the constraint is an
+        upper bound on it, exact and usable with any algorithm; otherwise every stage must
+        take constraints (:data:`CONSTRAINED`, e.g. ``"GN_ISRES+LN_COBYLA"``).
+    maxeval : int or sequence, optional
+        Evaluation budget per stage (one number for all stages, or one per stage).
+        Default: ``30 (n + 1)`` for a global stage that starts from a :data:`GUESSES` point,
+        ``100 (n + 1)`` without one, and ``400 n`` for a local stage, where ``n`` is the
+        number of searched (non-profiled) parameters (tuned with benchmarks/bench_fit.py).
+    quantity, unit : str, optional
+        Which rows to fit when the data mix quantities or units.
+    use_sigma : bool, optional
+        Weight by ``1/sigma^2``. None: when every point has a finite sigma > 0; a table with
+        sigma on some rows only is refused.
+    nan_policy : {"raise", "omit"}
+        Points with NaN/inf values or angles raise, or are dropped and counted in
+        ``FitResult.ndropped``.
+    guess : bool
+        Start from the data-driven guess of :data:`GUESSES` (smooth3: a parabola through
+        log R) for the varying parameters not given in ``params``; the global stage keeps
+        that point in its population, so it can only improve on it.
+    ci : {"wald", "profile"}
+        95% intervals from the covariance (``wald``: value +- t stderr, fast) or from the
+        profile of chi-square (``profile``: where the minimum of chi-square over the other
+        parameters rises by ``t^2`` (times ``redchi`` without sigma); about 20 local fits
+        per parameter, better coverage when parameters are strongly correlated). Not
+        combined with ``energy_constraint``.
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    FitError
+        Unknown method or parameter name, too few points, all points on the specular line
+        for smooth3's shape parameters, NaN/inf data, mixed quantities, bad sigma.
+    labbrdf.models.ModelError
+        Unknown model name.
+
+    Notes
+    -----
+    Uncertainties come from the Jacobian of the weighted residuals at the optimum (central
+    differences in the parameters' natural scale): ``covar = inv(J^T W J)``, multiplied by
+    ``redchi`` when the data have no sigma (the scatter of the residuals then estimates the
+    noise, as lmfit's ``scale_covar``); not multiplied when sigma is given, so an honest
+    sigma gives honest intervals. 95% intervals use Student's t with ``nfree`` degrees of
+    freedom and are clipped to the bounds. Profiling the linear amplitudes makes smooth3 a
+    2-D search (k2, k3) with k1 exact.
+
+    When every point of a smooth3 fit lies on the specular line (theta_r == theta_i) the fit
+    is refused unless k2 and k3 are fixed: there only k1 exp(-k2^2/k3^2) is identifiable
+    (notes/models.md 1.1), and fixing k2 = 0 alone would leave k3 without any effect.
+    """
+    t0 = time.perf_counter()
+    if isinstance(model, str):
+        model = get_model(model)
+    if not isinstance(model, Model):
+        raise FitError(f"model: expected a Model or a model name, got {type(model).__name__}")
+    stages = parse_method(method)
+    if ci not in ("wald", "profile"):
+        raise FitError(f"ci must be 'wald' or 'profile', got {ci!r}")
+    if ci == "profile" and energy_constraint not in (False, None):
+        raise FitError("ci='profile' is not combined with energy_constraint; use ci='wald'")
+    fd, ndropped = _clean(_as_fit_data(data, quantity, unit), nan_policy)
+    p = _setup_params(model, params, fix)
+    guessed = guess and _apply_guess(model, fd, p, set(params or ()))
+    weights, use_sigma = _weights(fd, use_sigma)
+    varying = p.varying()
+    _check_design(model, fd, varying)
+    n_pts, nvarys = len(fd), len(varying)
+
+    # ---- profiling and the energy constraint
+    lin = [k for k in model.linear if k in varying]
+    if profile and not lin:
+        raise FitError(
+            f"profile=True but model {model.name!r} has no varying linear "
+            f"parameters (linear: {list(model.linear)})"
+        )
+    profile = bool(lin) if profile is None else profile
+    rho_fn, th_grid = None, None
+    if energy_constraint is not False and energy_constraint is not None:
+        ti = np.asarray(fd.theta_i_deg, float)
+        th_grid = np.unique(np.concatenate([np.linspace(ti.min(), ti.max(), 7), ti]))
+        rho_fn = _energy_rho(model, energy_constraint)
+        profile = profile and len(lin) == 1  # rho <= 1 is a box only for one amplitude
+    prof = lin if profile else []
+    linear_upper = _energy_bound(rho_fn, prof[0], th_grid) if rho_fn and prof else None
+    obj = Objective(model, fd, p, weights, prof, linear_upper)
+    if prof and obj.linear_basis_missing():
+        raise FitError(
+            f"model {model.name!r} declares linear parameters but gives no "
+            "linear components; pass profile=False"
+        )
+    cons = None
+    if rho_fn is not None and not prof:
+
+        def cons(xx: NDArray) -> float:
+            return float(np.max(rho_fn(obj.from_vector(xx), th_grid)) - 1.0)
+
+    budgets = _budgets(obj, stages, maxeval, cons is not None, lin, guessed)
+
+    # ---- stages
+    x = obj.to_vector(p.values())
+    stage_info: list[dict[str, Any]] = []
+    last_code, message = nlopt.SUCCESS, "no search needed: only profiled parameters vary"
+    with np.errstate(all="ignore"):
+        for name, budget in zip(stages, budgets, strict=True):
+            if obj.n == 0:
+                break
+            x, info = _run_stage(obj, name, budget, x, int(seed), cons)
+            stage_info.append(info)
+            last_code, message = info["code"], info["message"]
+
+    # ---- final values and statistics
+    with np.errstate(all="ignore"):
+        vals, chisqr = obj.solve(obj.from_vector(x) if obj.n else dict(obj.base))
+        best = obj.model_values(vals)
+        finite = all(math.isfinite(v) for v in vals.values()) and math.isfinite(chisqr)
+        J = _jacobian(obj, vals, varying) if finite else np.full((n_pts, nvarys), np.nan)
+    resid = obj.y - best
+    nfree = n_pts - nvarys
+    redchi = chisqr / nfree
+    covar, stderr, correl, reasons, cond = _uncertainties(
+        J, varying, vals, 1.0 if use_sigma else redchi, nfree
+    )
+    out, flags = _fitted_params(p, vals, stderr, correl, reasons, nfree)
+    warn = [f"{ndropped} point(s) with NaN/inf values dropped (nan_policy='omit')"] * (
+        ndropped > 0
+    )
+    if ci == "profile" and finite:
+        delta = float(special.stdtrit(nfree, 0.975)) ** 2 * (1.0 if use_sigma else redchi)
+        with np.errstate(all="ignore"):
+            for k in varying:
+                try:
+                    out[k].ci95 = _profile_interval(
+                        model, fd, out, weights, prof, k, chisqr, delta, int(seed)
+                    )
+                except (ValueError, RuntimeError) as exc:  # keep the Wald interval
+                    warn.append(f"{k}: profile interval not found ({exc}); Wald interval kept")
+    if finite:
+        ok = last_code in _OK_CODES or (
+            bool(stages) and _is_global(stages[-1]) and last_code == nlopt.MAXEVAL_REACHED
+        )
+        success = ok or obj.n == 0
+    else:
+        success = False
+        message = "non-finite parameters or chi-square: " + message
+    energy_info = None
+    if rho_fn is not None:
+        rho_max = float(np.max(rho_fn(vals, th_grid)))
+        energy_info = {
+            "theta_i_deg": th_grid.tolist(),
+            "max_rho": rho_max,
+            "active": rho_max > 1 - 1e-6,
+        }
+        if rho_max > 1 + 1e-6:
+            success = False
+            message = f"energy constraint violated (max rho {rho_max:.6g}); " + message
+    y = obj.y
+    rmse_pct = float(100 * np.sqrt(np.mean((resid / y) ** 2))) if np.all(y != 0) else None
+    log_l = n_pts * math.log(max(chisqr, 1e-300) / n_pts)
+    return FitResult(
+        model=model.name,
+        options=dict(model.describe()["options"]),
+        method="+".join(stages),
+        seed=int(seed),
+        params=out,
+        init_values=p.values(),
+        var_names=varying,
+        covar=covar,
+        flags=flags,
+        flag_reasons={k: r for k, r in reasons.items() if r},
+        profiled=list(prof),
+        nfev=sum(s["nfev"] for s in stage_info),
+        ndata=n_pts,
+        nvarys=nvarys,
+        nfree=nfree,
+        chisqr=float(chisqr),
+        redchi=float(redchi),
+        aic=float(log_l + 2 * nvarys),
+        bic=float(log_l + math.log(n_pts) * nvarys),
+        rmse=float(np.sqrt(np.mean(resid**2))),
+        rmse_pct=rmse_pct,
+        weighted=bool(use_sigma),
+        success=bool(success),
+        message=message,
+        elapsed_s=time.perf_counter() - t0,
+        quantity=fd.quantity,
+        unit=fd.unit,
+        ndropped=ndropped,
+        stages=stage_info,
+        energy=energy_info,
+        warnings=warn,
+        ci_method=ci,
+        cond=cond,
+        residual=resid,
+        best_fit=best,
+    )
+
+
+def _profile_chi2(
+    model: Model,
+    fd: FitData,
+    best: Parameters,
+    weights: NDArray,
+    prof: list[str],
+    name: str,
+    value: float,
+    seed: int,
+) -> float:
+    """Minimum chi-square over the other parameters with ``name`` held at ``value``."""
+    pf = _copy_params(best)
+    pf[name].value, pf[name].vary = float(value), False
+    obj = Objective(model, fd, pf, weights, [k for k in prof if k != name])
+    if obj.n == 0:
+        return obj.solve(dict(obj.base))[1]
+    n = obj.n
+    _, info = _run_stage(
+        obj, "LN_BOBYQA", _LOCAL_MAXEVAL_PER_DIM * n, obj.to_vector(obj.base), seed, None
+    )
+    return min(info["chisqr"], obj.best_f)
+
+
+def _profile_interval(
+    model: Model,
+    fd: FitData,
+    best: Parameters,
+    weights: NDArray,
+    prof: list[str],
+    name: str,
+    chi2_min: float,
+    delta: float,
+    seed: int,
+) -> tuple[float, float]:
+    """Where the profiled chi-square crosses ``chi2_min + delta`` on each side (or a bound).
+
+    Steps outward from the optimum (first step t x stderr, then doubling) until the profile
+    exceeds the level, then solves for the crossing with Brent's method to 1e-3 stderr.
+    """
+    q = best[name]
+    v0 = q.value
+    se = q.stderr if q.stderr is not None and q.stderr > 0 else 1e-3 * max(abs(v0), 1e-3)
+
+    def g(v: float) -> float:
+        return _profile_chi2(model, fd, best, weights, prof, name, v, seed) - chi2_min - delta
+
+    ends = []
+    for sign, bound in ((-1.0, q.min), (1.0, q.max)):
+        a, step = v0, math.sqrt(delta) * se if delta > 0 else se
+        for _ in range(60):
+            b = v0 + sign * step
+            if (b - bound) * sign >= 0:
+                b = bound
+            gb = g(b)
+            if gb > 0:
+                ends.append(optimize.brentq(g, a, b, xtol=1e-3 * se) if a != b else b)
+                break
+            if b == bound:
+                ends.append(bound)
+                break
+            a, step = b, 2 * step
+        else:
+            raise RuntimeError(f"no crossing within {step:.3g} of the optimum")
+    return ends[0], ends[1]
+
+
+def _apply_guess(model: Model, fd: FitData, p: Parameters, given: set[str]) -> bool:
+    """Start varying parameters not set by the caller at the :data:`GUESSES` point."""
+    if model.name not in GUESSES:
+        return False
+    with np.errstate(all="ignore"):
+        g = GUESSES[model.name](
+            np.radians(np.asarray(fd.theta_i_deg)),
+            np.radians(np.asarray(fd.theta_r_deg)),
+            np.asarray(fd.value),
+        )
+    used = False
+    for k, v in g.items():
+        q = p[k]
+        if q.vary and k not in given and math.isfinite(v) and q.min < v < q.max:
+            q.value = float(v)
+            used = True
+    return used
+
+
+def _weights(fd: FitData, use_sigma: bool | None) -> tuple[NDArray, bool]:
+    """Weights 1/sigma^2 (or ones) and whether sigma is used."""
+    sig = np.asarray(fd.sigma, float)
+    has = np.isfinite(sig)
+    if use_sigma is None:
+        if has.any() and not has.all():
+            raise FitError(
+                f"data: sigma is given for {int(has.sum())} of {sig.size} points; "
+                "give it for all or pass use_sigma=False to ignore it"
+            )
+        use_sigma = bool(has.all())
+    if not use_sigma:
+        return np.ones_like(sig), False
+    if not has.all() or np.any(sig <= 0):
+        raise FitError("data: use_sigma needs a finite sigma > 0 on every point")
+    return 1.0 / sig**2, True
+
+
+def _check_design(model: Model, fd: FitData, varying: list[str]) -> None:
+    """Refuse designs that cannot identify the free parameters."""
+    if not varying:
+        raise FitError("nothing to fit: every parameter is fixed")
+    n_pts, nvarys = len(fd), len(varying)
+    if n_pts <= nvarys:
+        raise FitError(
+            f"data: {n_pts} point(s) for {nvarys} free parameter(s) {varying}; "
+            f"need at least {nvarys + 1} to fit and estimate uncertainties"
+        )
+    shape = [k for k in SPECULAR_LINE_SHAPE.get(model.name, ()) if k in varying]
+    on_line = np.abs(np.asarray(fd.theta_r_deg) - np.asarray(fd.theta_i_deg)) < 1e-9
+    if shape and on_line.all():
+        raise FitError(
+            f"data: all {n_pts} points lie on the specular line theta_r == theta_i, where "
+            f"{model.name} identifies only k1 exp(-k2^2/k3^2) (notes/models.md 1.1); "
+            f"add off-specular points or fix {list(SPECULAR_LINE_SHAPE[model.name])}, "
+            "e.g. fix={'k2': 0.0, 'k3': 0.4}"
+        )
+
+
+def _energy_bound(
+    rho_fn: Callable[[dict[str, float], NDArray], NDArray], k_lin: str, th_grid: NDArray
+) -> Callable[[dict[str, float]], float]:
+    """Upper bound on the one profiled amplitude from rho(theta) <= 1 (rho is linear in it)."""
+
+    def upper(vals: dict[str, float]) -> float:
+        r1 = rho_fn({**vals, k_lin: 1.0}, th_grid)
+        r0 = rho_fn({**vals, k_lin: 0.0}, th_grid)
+        if not (np.all(np.isfinite(r1)) and np.all(np.isfinite(r0))):
+            return 0.0
+        slope = r1 - r0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ub = np.where(slope > 0, (1.0 - r0) / slope, np.inf)
+        return float(np.min(ub))
+
+    return upper
+
+
+def _budgets(
+    obj: Objective,
+    stages: list[str],
+    maxeval: int | Sequence[int | None] | None,
+    constrained: bool,
+    lin: list[str],
+    guessed: bool,
+) -> list[int]:
+    """Check the stages against the search (bounds, constraints); evaluation budgets."""
+    n = obj.n
+    lo, hi = obj.bounds()
+    for name in stages:
+        if n and _is_global(name) and not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+            bad = [
+                k
+                for k, a, b in zip(obj.names, lo, hi, strict=True)
+                if not (math.isfinite(a) and math.isfinite(b))
+            ]
+            raise FitError(
+                f"global algorithm {name} needs finite bounds; set min and max of {bad}"
+            )
+        if n and constrained and name not in CONSTRAINED:
+            raise FitError(
+                f"energy_constraint with {name}: this algorithm takes no constraints and "
+                f"the amplitudes {lin} cannot carry it as a bound; use one of "
+                f"{sorted(CONSTRAINED)}"
+            )
+    if maxeval is None or isinstance(maxeval, int):
+        given: list[int | None] = [maxeval] * len(stages)
+    else:
+        given = list(maxeval)
+        if len(given) != len(stages):
+            raise FitError(f"maxeval: {len(given)} budgets for {len(stages)} stage(s)")
+    per = _GLOBAL_MAXEVAL_GUESSED if guessed else _GLOBAL_MAXEVAL_BLIND
+    return [
+        int(b)
+        if b is not None
+        else (per * (n + 1) if _is_global(s) else _LOCAL_MAXEVAL_PER_DIM * n)
+        for s, b in zip(stages, given, strict=True)
+    ]
+
+
+def _fitted_params(
+    p: Parameters,
+    vals: dict[str, float],
+    stderr: dict[str, float | None],
+    correl: dict[str, dict[str, float]],
+    reasons: dict[str, list[str]],
+    nfree: int,
+) -> tuple[Parameters, dict[str, list[str]]]:
+    """Parameters with fitted values, stderr, 95% intervals, correlations; the flags."""
+    tq = float(special.stdtrit(nfree, 0.975))  # Student t 97.5 % quantile
+    out = _copy_params(p)
+    flags: dict[str, list[str]] = {}
+    for k, q in out.items():
+        q.value = vals[k]
+        if not q.vary:
+            continue
+        fl = []
+        tol = AT_BOUND_FRAC * (q.max - q.min)
+        for side in ("min", "max"):
+            if math.isfinite(tol) and abs(q.value - getattr(q, side)) <= tol:
+                fl.append("at_bound")
+                reasons[k].insert(
+                    0, f"at bound: {q.value:.6g} at its {side} {getattr(q, side):.6g}"
+                )
+        if any(r.startswith("not identifiable") for r in reasons[k]):
+            fl.append("not_identifiable")
+        elif any(r.startswith("poorly determined") for r in reasons[k]):
+            fl.append("poorly_determined")
+        if fl:
+            flags[k] = fl
+        se = stderr[k]
+        q.stderr = se
+        if se is not None:
+            q.ci95 = (max(q.value - tq * se, q.min), min(q.value + tq * se, q.max))
+        q.correl = correl[k] or None
+    return out, flags
+
+
+def _code_message(code: int) -> str:
+    return {
+        nlopt.SUCCESS: "success",
+        nlopt.STOPVAL_REACHED: "stopval reached",
+        nlopt.FTOL_REACHED: "ftol_rel reached",
+        nlopt.XTOL_REACHED: "xtol_rel reached",
+        nlopt.MAXEVAL_REACHED: "maxeval reached",
+        nlopt.MAXTIME_REACHED: "maxtime reached",
+    }.get(code, f"nlopt code {code}")

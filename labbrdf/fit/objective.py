@@ -1,0 +1,278 @@
+"""Weighted least squares as a function of a flat, bounded search vector.
+
+Linear amplitudes are profiled out by exact bounded linear least squares; smooth3 gets a
+data-driven starting point (:data:`GUESSES`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..models import Model, Parameters
+from .data import FitData, FitError
+
+__all__ = ["GUESSES", "Objective"]
+
+_PENALTY = 1e100  # objective value for non-finite model output (inf breaks local methods)
+
+
+def _guess_smooth3(ti: NDArray, tr: NDArray, y: NDArray) -> dict[str, float]:
+    """Starting values for smooth3 from a quadratic fit of log(8 y cos ti cos tr) in ti - tr.
+
+    Eq. (7) of Zou et al. (2013) is log-quadratic in d = ti - tr [rad]:
+    ``log(8 R cos ti cos tr) = (log k1 - k2^2/k3^2) + (2 k2/k3^2) d - d^2/k3^2``, so an
+    ordinary least-squares parabola gives (k1, k2, k3) when its curvature is negative.
+    Returns {} when it is not (noise-dominated scans).
+    """
+    ok = y > 0
+    if ok.sum() < 4:
+        return {}
+    d = (ti - tr)[ok]
+    if np.ptp(d) == 0:
+        return {}
+    z = np.log(8 * y[ok] * np.cos(ti[ok]) * np.cos(tr[ok]))
+    a2, a1, a0 = np.polyfit(d, z, 2)
+    if not a2 < 0:
+        return {}
+    k3 = 1.0 / math.sqrt(-a2)
+    k2 = a1 * k3**2 / 2
+    k1 = math.exp(a0 + (k2 / k3) ** 2)
+    return {"k1": k1, "k2": k2, "k3": k3} if math.isfinite(k1) else {}
+
+
+#: starting-value heuristics by model name, ``guess(theta_i, theta_r, value) -> dict``
+#: (radians); the global stage starts its population from this point
+GUESSES: dict[str, Callable[[NDArray, NDArray, NDArray], dict[str, float]]] = {
+    "smooth3": _guess_smooth3,
+}
+
+
+def _bounded_lsq(G: NDArray, g: NDArray, lo: NDArray, hi: NDArray) -> NDArray:
+    """Minimise ``p^T G p - 2 g^T p`` subject to ``lo <= p <= hi`` (exact, small k).
+
+    For positive definite G the minimiser is the unconstrained one when that is feasible;
+    otherwise some coefficient sits at one of its bounds, and the rest solve the same
+    problem one size smaller (recursion over 2k bound choices; k is 1 or 2 in our models).
+    A singular G (a basis function that vanishes) falls back to the bounds enumeration.
+    """
+    k = g.size
+    if k == 1:
+        p = g[0] / G[0, 0] if G[0, 0] > 0 else 0.0
+        return np.array([min(max(p, lo[0]), hi[0])])
+    if k == 2:
+        det = G[0, 0] * G[1, 1] - G[0, 1] * G[1, 0]
+        if det > 0:
+            p = np.array(
+                [(g[0] * G[1, 1] - g[1] * G[0, 1]) / det, (g[1] * G[0, 0] - g[0] * G[1, 0]) / det]
+            )
+            if lo[0] <= p[0] <= hi[0] and lo[1] <= p[1] <= hi[1]:
+                return p
+        best2, best_val2 = (min(max(0.0, lo[0]), hi[0]), min(max(0.0, lo[1]), hi[1])), math.inf
+        for j, o in ((0, 1), (1, 0)):
+            for bound in (lo[j], hi[j]):
+                if not math.isfinite(bound):
+                    continue
+                po = (g[o] - G[o, j] * bound) / G[o, o] if G[o, o] > 0 else 0.0
+                po = min(max(po, lo[o]), hi[o])
+                q = (bound, po) if j == 0 else (po, bound)
+                val = (
+                    G[0, 0] * q[0] * q[0]
+                    + 2 * G[0, 1] * q[0] * q[1]
+                    + G[1, 1] * q[1] * q[1]
+                    - 2 * (g[0] * q[0] + g[1] * q[1])
+                )
+                if val < best_val2:
+                    best2, best_val2 = q, val
+        return np.array(best2, float)
+    else:
+        try:
+            p = np.linalg.solve(G, g)
+            if np.all(p >= lo) and np.all(p <= hi):
+                return p
+        except np.linalg.LinAlgError:
+            pass
+    best, best_val = np.clip(np.zeros(k), lo, hi), math.inf
+    for j in range(k):
+        rest = [i for i in range(k) if i != j]
+        for bound in (lo[j], hi[j]):
+            if not math.isfinite(bound):
+                continue
+            sub = _bounded_lsq(
+                G[np.ix_(rest, rest)], g[rest] - G[rest, j] * bound, lo[rest], hi[rest]
+            )
+            p = np.empty(k)
+            p[j] = bound
+            p[rest] = sub
+            val = p @ G @ p - 2.0 * g @ p
+            if val < best_val:
+                best, best_val = p, val
+    return best
+
+
+class Objective:
+    """Weighted least squares of a model against data, as a function of a flat vector.
+
+    The search vector holds the varying, non-profiled parameters, each mapped to [0, 1]
+    across its bounds (on a log scale for ``log`` parameters; unmapped where a bound is
+    infinite). Linear amplitudes listed in ``profile`` are solved for at every call by
+    bounded linear least squares (exact, so their bounds hold).
+
+    Parameters
+    ----------
+    model : Model
+        The forward model.
+    data : FitData
+        Clean data (finite values).
+    params : Parameters
+        Initial values, bounds and ``vary`` flags.
+    weights : ndarray
+        Per-point weights ``1/sigma^2`` (ones when the data have no sigma).
+    profile : sequence of str
+        Linear parameters to profile out.
+    linear_upper : callable, optional
+        ``linear_upper(values) -> float``: an extra upper bound on the single profiled
+        parameter (the energy constraint).
+    """
+
+    def __init__(
+        self,
+        model: Model,
+        data: FitData,
+        params: Parameters,
+        weights: NDArray,
+        profile: Sequence[str] = (),
+        linear_upper: Callable[[dict[str, float]], float] | None = None,
+    ) -> None:
+        self.model = model
+        self.data = data
+        self.params = params
+        self.profile = tuple(profile)
+        self.linear_upper = linear_upper
+        self.names = [k for k in params.varying() if k not in self.profile]
+        self.ti = np.radians(np.asarray(data.theta_i_deg, float))
+        self.tr = np.radians(np.asarray(data.theta_r_deg, float))
+        self.pr = np.radians(np.asarray(data.phi_r_deg, float))
+        self.wl = None if data.wavelength_nm is None else np.asarray(data.wavelength_nm, float)
+        self.y = np.asarray(data.value, float)
+        self.w = np.asarray(weights, float)
+        self.sw = np.sqrt(self.w)
+        self.base = {k: p.value for k, p in params.items()}
+        ps = [params[k] for k in self.names]
+        self._log = np.array([p.log for p in ps], bool)
+        lo = np.array([p.min for p in ps])
+        hi = np.array([p.max for p in ps])
+        self._tlo = np.where(self._log, np.log(np.where(self._log, lo, 1.0)), lo)
+        self._thi = np.where(self._log, np.log(np.where(self._log, hi, 1.0)), hi)
+        self._scaled = np.isfinite(self._tlo) & np.isfinite(self._thi) & (self._thi > self._tlo)
+        self._spec = [
+            (k, bool(sc), float(a), float(b - a) if sc else 1.0, bool(lg))
+            for k, sc, a, b, lg in zip(
+                self.names, self._scaled, self._tlo, self._thi, self._log, strict=True
+            )
+        ]
+        self._lin_lo = np.array([params[k].min for k in self.profile])
+        self._lin_hi = np.array([params[k].max for k in self.profile])
+        self.nfev = 0
+        self.best_f = math.inf
+        self.best_x: NDArray | None = None
+
+    # ---- vector <-> values
+    @property
+    def n(self) -> int:
+        """Length of the search vector (varying, non-profiled parameters)."""
+        return len(self.names)
+
+    def to_vector(self, values: Mapping[str, float]) -> NDArray[np.float64]:
+        """Search vector of the parameter values ``values`` (name -> natural value)."""
+        v = np.array([values[k] for k in self.names], float)
+        t = np.where(self._log, np.log(np.where(self._log, v, 1.0)), v)
+        span = np.where(self._scaled, self._thi - self._tlo, 1.0)
+        return np.where(self._scaled, (t - self._tlo) / span, t)
+
+    def from_vector(self, x: ArrayLike) -> dict[str, float]:
+        """Every parameter's natural value at search vector ``x`` (profiled ones unsolved)."""
+        vals = dict(self.base)
+        for (k, scaled, lo, span, log), xi in zip(self._spec, x, strict=True):
+            t = lo + float(xi) * span if scaled else float(xi)
+            vals[k] = math.exp(t) if log else t
+        return vals
+
+    def bounds(self) -> tuple[NDArray, NDArray]:
+        """Lower and upper bounds of the search vector (0 and 1 where mapped)."""
+        lo = np.where(self._scaled, 0.0, self._tlo)
+        hi = np.where(self._scaled, 1.0, self._thi)
+        return lo, hi
+
+    def linear_basis_missing(self) -> bool:
+        """True when the model gives no linear components (cannot profile)."""
+        one = slice(0, 1)
+        wl = None if self.wl is None else self.wl[one]
+        comps = self.model.linear_components(
+            self.base, self.ti[one], self.tr[one], self.pr[one], wl
+        )
+        return comps is None
+
+    # ---- model
+    def model_values(self, vals: Mapping[str, float]) -> NDArray[np.float64]:
+        """The model at every data point for full parameter values ``vals``.
+
+        Callers wrap the search in ``np.errstate`` (grazing angles may overflow).
+        """
+        return np.asarray(self.model._evaluate(vals, self.ti, self.tr, self.pr, self.wl), float)
+
+    def solve(self, vals: dict[str, float]) -> tuple[dict[str, float], float]:
+        """Fill in the profiled parameters; return the values and chi-square."""
+        if not self.profile:
+            r = self.sw * (self.y - self.model_values(vals))
+            return vals, float(r @ r)
+        comps = self.model.linear_components(vals, self.ti, self.tr, self.pr, self.wl)
+        if comps is None:
+            raise FitError(f"model {self.model.name!r} gave no linear components to profile")
+        resid = self.y
+        for k, b in comps.items():
+            if k not in self.profile:
+                resid = resid - vals[k] * b
+        c = self.sw * resid
+        hi = self._lin_hi
+        if self.linear_upper is not None:
+            hi = np.minimum(hi, self.linear_upper(vals))
+        hi = np.maximum(hi, self._lin_lo)
+        if len(self.profile) == 1:  # the common case, kept free of small-array overhead
+            a = self.sw * comps[self.profile[0]]
+            G, g = float(a @ a), float(a @ c)
+            p0 = g / G if G > 0 else 0.0
+            p0 = min(max(p0, float(self._lin_lo[0])), float(hi[0]))
+            vals[self.profile[0]] = p0
+            r = c - p0 * a
+            return vals, float(r @ r)
+        A = np.stack([comps[k] for k in self.profile], axis=1) * self.sw[:, None]
+        p = _bounded_lsq(A.T @ A, A.T @ c, self._lin_lo, hi)
+        for k, v in zip(self.profile, p, strict=True):
+            vals[k] = float(v)
+        r = c - A @ p
+        return vals, float(r @ r)
+
+    def __call__(self, x: NDArray, grad: NDArray | None = None) -> float:
+        """chi-square at search vector ``x`` (nlopt signature; finite-difference gradient)."""
+        f = self._f(x)
+        if grad is not None and grad.size > 0:
+            h = 1e-6  # central differences on the unit-box scale
+            for j in range(x.size):
+                xp, xm = np.array(x, float), np.array(x, float)
+                xp[j] += h
+                xm[j] -= h
+                grad[j] = (self._f(xp) - self._f(xm)) / (2 * h)
+        return f
+
+    def _f(self, x: NDArray) -> float:
+        self.nfev += 1
+        _, chi2 = self.solve(self.from_vector(x))
+        if not math.isfinite(chi2):
+            return _PENALTY
+        if chi2 < self.best_f:
+            self.best_f, self.best_x = chi2, np.array(x, float)
+        return chi2

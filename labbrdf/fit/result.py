@@ -1,0 +1,329 @@
+"""FitResult: lmfit's attribute names, a JSON-safe summary, a text report and an HTML view."""
+
+from __future__ import annotations
+
+import html
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..models import Parameters
+
+__all__ = ["FitResult"]
+
+
+def _jsonable(v: Any) -> Any:
+    if isinstance(v, dict):
+        return {str(k): _jsonable(x) for k, x in v.items()}
+    if isinstance(v, list | tuple):
+        return [_jsonable(x) for x in v]
+    if isinstance(v, np.ndarray):
+        return [_jsonable(x) for x in v.tolist()]
+    if isinstance(v, bool | np.bool_):
+        return bool(v)
+    if isinstance(v, int | np.integer):
+        return int(v)
+    if isinstance(v, float | np.floating):
+        return float(v) if math.isfinite(v) else None
+    return v
+
+
+def _decimals(stderr: float) -> int:
+    """Decimals that keep two significant digits of ``stderr``."""
+    return max(0, 1 - math.floor(math.log10(stderr)))
+
+
+def _fmt_unc(value: float, stderr: float | None) -> str:
+    """``value +/- stderr`` with as many digits as the uncertainty supports (2 significant)."""
+    if stderr is None or not math.isfinite(stderr) or stderr <= 0:
+        return f"{value:.7g} +/- (not estimated)"
+    dec = _decimals(stderr)
+    if dec > 12:
+        return f"{value:.10g} +/- {stderr:.2g}"
+    return f"{value:.{dec}f} +/- {stderr:.{dec}f}"
+
+
+def _fmt_ci(ci: tuple[float, float] | None, stderr: float | None) -> str:
+    """``[lo, hi]`` to the decimals of :func:`_fmt_unc`."""
+    if ci is None or stderr is None or not (math.isfinite(stderr) and stderr > 0):
+        return ""
+    dec = min(_decimals(stderr), 12)
+    return f"[{ci[0]:.{dec}f}, {ci[1]:.{dec}f}]"
+
+
+@dataclass
+class FitResult:
+    """Outcome of :func:`fit`, with lmfit's attribute names.
+
+    Attributes
+    ----------
+    model : str
+        Registry name of the model.
+    options : dict
+        The model options (``G``, the five-parameter shadowing choice, lives here).
+    method : str
+        The algorithm stages joined by ``+``.
+    seed : int
+        Seed given to ``nlopt.srand`` before each stage.
+    params : Parameters
+        Fitted values with ``stderr``, ``ci95`` (95% interval, see ``ci_method``, clipped
+        to the bounds) and ``correl``.
+    init_values : dict
+        Starting values.
+    var_names : list of str
+        The varying parameters (profiled ones included), the order of ``covar``.
+    covar : ndarray or None
+        Covariance of the varying parameters.
+    flags : dict
+        name -> list of ``"at_bound"``, ``"not_identifiable"`` (relative stderr above
+        :data:`REL_STDERR_MAX`, |correlation| above :data:`CORREL_MAX`, singular or
+        ill-conditioned J^T W J, or no effect on the data) or ``"poorly_determined"``
+        (relative stderr above :data:`REL_STDERR_POOR`).
+    flag_reasons : dict
+        name -> list of human-readable reasons for the flags.
+    profiled : list of str
+        Linear parameters solved by bounded linear least squares.
+    nfev, ndata, nvarys, nfree : int
+        Objective evaluations, points, varying parameters, ``ndata - nvarys``.
+    chisqr, redchi, aic, bic : float
+        chi-square (weighted by 1/sigma^2 when the data have sigma), ``chisqr/nfree``,
+        Akaike and Bayesian information criteria (lmfit's definitions).
+    rmse : float
+        Root-mean-square residual ``sqrt(mean((y - f)^2))`` [data units].
+    rmse_pct : float or None
+        The paper's "RMSE / %" (Tables 1-2): ``100 sqrt(mean(((y - f) / y)^2))`` [%]; None
+        when a measured value is 0.
+    weighted : bool
+        Whether the data carried sigma (weights 1/sigma^2, covariance not rescaled).
+    success : bool
+        The last stage converged and every parameter and chisqr is finite.
+    message : str
+    elapsed_s : float
+        Wall time of the fit [s].
+    ndropped : int
+        Points dropped by ``nan_policy='omit'``.
+    stages : list of dict
+        Per stage: algorithm, nfev, chisqr, nlopt return code and message.
+    energy : dict or None
+        The energy constraint: incidence grid [deg] and max rho at the optimum.
+    warnings : list of str
+        Notes on the data or the fit (dropped points, intervals not found).
+    ci_method : str
+        ``wald`` (value +- t stderr, Student t with ``nfree`` degrees of freedom) or
+        ``profile`` (profile of chi-square); see :func:`labbrdf.fit.fit`.
+    residual : ndarray
+        ``y - f`` at the optimum [data units].
+    best_fit : ndarray
+        The model at the data points [data units].
+
+    Notes
+    -----
+    The 2013 paper reports "RMSE / %" without a formula (its fits used a Matlab toolbox,
+    its ref. [22]); we read it as the relative root-mean-square residual in percent, the
+    reading under which its "less than 5 %" engineering criterion makes sense for a
+    relative measurement. ``rmse`` gives the absolute figure in the data's units.
+    """
+
+    model: str
+    options: dict[str, Any]
+    method: str
+    seed: int
+    params: Parameters
+    init_values: dict[str, float]
+    var_names: list[str]
+    covar: NDArray | None
+    flags: dict[str, list[str]]
+    flag_reasons: dict[str, list[str]]
+    profiled: list[str]
+    nfev: int
+    ndata: int
+    nvarys: int
+    nfree: int
+    chisqr: float
+    redchi: float
+    aic: float
+    bic: float
+    rmse: float
+    rmse_pct: float | None
+    weighted: bool
+    success: bool
+    message: str
+    elapsed_s: float
+    quantity: str = "brdf"
+    unit: str = "sr-1"
+    ndropped: int = 0
+    stages: list[dict[str, Any]] = field(default_factory=list)
+    energy: dict[str, Any] | None = None
+    warnings: list[str] = field(default_factory=list)
+    ci_method: str = "wald"
+    cond: float | None = None
+    residual: NDArray | None = field(default=None, repr=False)
+    best_fit: NDArray | None = field(default=None, repr=False)
+
+    @property
+    def G(self) -> Any:
+        """The shadowing-function choice G of the five-parameter model (None otherwise).
+
+        Read from the model option ``shadowing`` (or ``G``).
+        """
+        return self.options.get("shadowing", self.options.get("G"))
+
+    @property
+    def values(self) -> dict[str, float]:
+        """name -> fitted value."""
+        return self.params.values()
+
+    def summary(self) -> dict[str, Any]:
+        """Plain-Python, JSON-safe dict (NaN/inf as None) for reports and the CLI."""
+        params = {}
+        for k, p in self.params.items():
+            params[k] = {
+                "value": p.value,
+                "stderr": p.stderr,
+                "ci95": list(p.ci95) if p.ci95 is not None else None,
+                "min": p.min,
+                "max": p.max,
+                "vary": p.vary,
+                "units": p.units,
+                "init_value": self.init_values.get(k),
+                "profiled": k in self.profiled,
+                "flags": list(self.flags.get(k, [])),
+                "at_bound": "at_bound" in self.flags.get(k, []),
+                "flag_reasons": list(self.flag_reasons.get(k, [])),
+                "correl": dict(p.correl) if p.correl else {},
+            }
+        out = {
+            "model": self.model,
+            "options": self.options,
+            "G": self.G,
+            "method": self.method,
+            "seed": self.seed,
+            "params": params,
+            "var_names": self.var_names,
+            "nfev": self.nfev,
+            "ndata": self.ndata,
+            "nvarys": self.nvarys,
+            "nfree": self.nfree,
+            "chisqr": self.chisqr,
+            "redchi": self.redchi,
+            "aic": self.aic,
+            "bic": self.bic,
+            "rmse": self.rmse,
+            "rmse_pct": self.rmse_pct,
+            "quantity": self.quantity,
+            "unit": self.unit,
+            "weighted": self.weighted,
+            "success": self.success,
+            "message": self.message,
+            "elapsed_s": self.elapsed_s,
+            "ndropped": self.ndropped,
+            "stages": self.stages,
+            "energy": self.energy,
+            "warnings": self.warnings,
+            "cond": self.cond,
+            "ci_method": self.ci_method,
+        }
+        return _jsonable(out)
+
+    def _param_lines(self) -> list[tuple[str, str, str, str]]:
+        rows = []
+        for k, p in self.params.items():
+            if not p.vary:
+                rows.append((k, f"{p.value:.7g} (fixed)", "", ""))
+                continue
+            ci = _fmt_ci(p.ci95, p.stderr)
+            note = ", ".join(self.flags.get(k, []))
+            if k in self.profiled:
+                note = ", ".join(x for x in (note, "profiled") if x)
+            rows.append((k, _fmt_unc(p.value, p.stderr), ci, note))
+        return rows
+
+    def fit_report(self, min_correl: float = 0.1) -> str:
+        """lmfit-like text report: Model, Fit Statistics, Variables, Correlations, Warnings."""
+        unit = self.unit
+        lines = [
+            "[[Model]]",
+            f"    {self.model} {self.options or ''}".rstrip(),
+            "[[Fit Statistics]]",
+            f"    # fitting method   = {self.method} (seed {self.seed})",
+            f"    # function evals   = {self.nfev}",
+            f"    # data points      = {self.ndata}"
+            + (f" ({self.ndropped} dropped: NaN/inf)" if self.ndropped else ""),
+            f"    # variables        = {self.nvarys}",
+            f"    chi-square         = {self.chisqr:.6g}"
+            + ("" if self.weighted else " (unweighted: no sigma in the data)"),
+            f"    reduced chi-square = {self.redchi:.6g}",
+            f"    Akaike info crit   = {self.aic:.6g}",
+            f"    Bayesian info crit = {self.bic:.6g}",
+            f"    RMSE               = {self.rmse:.4g} [{unit}]",
+            "    RMSE (paper, %)    = "
+            + ("n/a" if self.rmse_pct is None else f"{self.rmse_pct:.4g}"),
+            f"    success            = {self.success} ({self.message})",
+            f"    elapsed            = {self.elapsed_s * 1e3:.1f} ms",
+            "[[Variables]]",
+        ]
+        for k, val, ci, note in self._param_lines():
+            s = f"    {k + ':':<6} {val}"
+            if ci:
+                s += f"  95%{' (profile)' if self.ci_method == 'profile' else ''} {ci}"
+            if note:
+                s += f"  ({note})"
+            lines.append(s)
+        pairs = []
+        for k in self.var_names:
+            for j, c in (self.params[k].correl or {}).items():
+                if k < j and abs(c) >= min_correl:
+                    pairs.append((abs(c), f"    C({k}, {j}) = {c:+.4f}"))
+        if pairs:
+            lines.append(f"[[Correlations]] (unreported correlations are < {min_correl:.3f})")
+            lines += [s for _, s in sorted(pairs, reverse=True)]
+        notes = [f"{k}: {r}" for k, rs in self.flag_reasons.items() for r in rs]
+        notes += self.warnings
+        if self.energy:
+            notes.append(
+                f"energy constraint: max rho = {self.energy['max_rho']:.6g} over "
+                f"theta_i {self.energy['theta_i_deg'][0]:.4g}-"
+                f"{self.energy['theta_i_deg'][-1]:.4g} deg"
+            )
+        if notes:
+            lines.append("[[Warnings]]")
+            lines += [f"    {n}" for n in notes]
+        return "\n".join(lines)
+
+    def _repr_html_(self) -> str:
+        e = html.escape
+        stats_rows = [
+            ("method", self.method),
+            ("seed", self.seed),
+            ("nfev", self.nfev),
+            ("data points", self.ndata),
+            ("variables", self.nvarys),
+            ("chi-square", f"{self.chisqr:.6g}"),
+            ("reduced chi-square", f"{self.redchi:.6g}"),
+            ("RMSE", f"{self.rmse:.4g} {self.unit}"),
+            ("RMSE (paper, %)", "n/a" if self.rmse_pct is None else f"{self.rmse_pct:.4g}"),
+            ("success", f"{self.success} ({self.message})"),
+            ("elapsed", f"{self.elapsed_s * 1e3:.1f} ms"),
+        ]
+        h = [f"<h4>Fit of {e(self.model)} {e(str(self.options or ''))}</h4>", "<table><tbody>"]
+        h += [f"<tr><th>{e(str(a))}</th><td>{e(str(b))}</td></tr>" for a, b in stats_rows]
+        h += [
+            "</tbody></table>",
+            "<table><thead><tr><th>name</th><th>value +/- stderr</th>"
+            "<th>95% interval</th><th>flags</th></tr></thead><tbody>",
+        ]
+        for k, val, ci, note in self._param_lines():
+            h.append(
+                f"<tr><td>{e(k)}</td><td>{e(val)}</td><td>{e(ci)}</td><td>{e(note)}</td></tr>"
+            )
+        h.append("</tbody></table>")
+        notes = [f"{k}: {r}" for k, rs in self.flag_reasons.items() for r in rs] + self.warnings
+        if notes:
+            h.append("<ul>" + "".join(f"<li>{e(n)}</li>" for n in notes) + "</ul>")
+        return "\n".join(h)
+
+    def __str__(self) -> str:
+        return self.fit_report()
