@@ -150,15 +150,16 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
     cols = list(COLUMNS) + [c for c in OPTIONAL_COLUMNS if c in out.columns]
     out = out[cols].copy()
 
+    unit_col = out["unit"]  # before the conversion below: factorizes fast if categorical
     for name in ("sample", "instrument", "source", "unit"):
         col = out[name]
-        bad = ~col.map(lambda v: isinstance(v, str) and v != "").to_numpy(bool)
+        bad = _not_str(col, nonempty=True)
         if bad.any():
             raise DatasetError(f"column {name!r}: expected a non-empty string in {_rows(bad)}")
         out[name] = col.astype(object)
     if "channel" in out.columns:
         col = out["channel"]
-        bad = ~col.map(lambda v: isinstance(v, str)).to_numpy(bool)
+        bad = _not_str(col, nonempty=False)
         if bad.any():
             raise DatasetError(f"column 'channel': expected a string in {_rows(bad)}")
         out["channel"] = col.astype(object)
@@ -172,15 +173,24 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
         except (TypeError, ValueError) as exc:
             raise DatasetError(f"column {name!r}: expected numbers ({exc})") from None
 
-    q = out["quantity"].astype(str).to_numpy()
-    bad = ~np.isin(q, list(QUANTITIES))
+    # quantity and unit checks work on the distinct values (factorize), not row by row
+    qcodes, quniq = pd.factorize(out["quantity"], use_na_sentinel=False)
+    quniq = np.array([str(v) for v in quniq], dtype=object)
+    q = quniq[qcodes]
+    bad = ~np.isin(quniq, list(QUANTITIES))[qcodes]
     if bad.any():
         raise DatasetError(
             f"column 'quantity': unknown quantity {sorted(set(q[bad]))} in {_rows(bad)}; "
             f"allowed are {list(QUANTITIES)}"
         )
     unit = out["unit"].to_numpy(dtype=object)
-    bad = np.array([u not in QUANTITIES[qq] for qq, u in zip(q, unit, strict=True)])
+    ucodes, uuniq = pd.factorize(unit_col, use_na_sentinel=False)
+    pair = qcodes.astype(np.int64) * len(uuniq) + ucodes
+    pairs, inverse = np.unique(pair, return_inverse=True)
+    pair_bad = np.array(
+        [uuniq[k % len(uuniq)] not in QUANTITIES[quniq[k // len(uuniq)]] for k in pairs]
+    )
+    bad = pair_bad[inverse.ravel()]
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise DatasetError(
@@ -209,17 +219,42 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
     bad = np.isinf(a) | (a < 0) | (a >= 360)
     if bad.any():
         raise DatasetError(f"column 'phi_r_deg': expected [0, 360) deg or NaN in {_rows(bad)}")
-    psi = q == "psi"
+    psi = (quniq == "psi")[qcodes]
     bad = psi & ((value < 0) | (value > 90))
     if bad.any():
         raise DatasetError(f"column 'value': psi outside [0, 90] deg in {_rows(bad)}")
-    bad = (q == "delta") & ((value < 0) | (value >= 360))
+    bad = (quniq == "delta")[qcodes] & ((value < 0) | (value >= 360))
     if bad.any():
         raise DatasetError(
             f"column 'value': delta outside [0, 360) deg (Nebraska convention) in {_rows(bad)}"
         )
-    out["quantity"] = pd.Categorical(q, categories=list(QUANTITIES))
+    cat_index = np.array([list(QUANTITIES).index(v) for v in quniq], dtype=np.int64)
+    out["quantity"] = pd.Categorical.from_codes(cat_index[qcodes], categories=list(QUANTITIES))
     return out
+
+
+def _not_str(col: pd.Series, *, nonempty: bool) -> np.ndarray:
+    """True where a value is not a string (or is empty, with ``nonempty``); vectorised.
+
+    Categorical and string-typed columns are checked on their distinct values; an object
+    column is checked by pandas' type inference first, and row by row only when it holds
+    something other than strings.
+    """
+    if isinstance(col.dtype, pd.CategoricalDtype):
+        cats = col.cat.categories
+        ok = np.array([isinstance(v, str) and (v != "" or not nonempty) for v in cats], bool)
+        codes = col.cat.codes.to_numpy()
+        if ok.size == 0:
+            return np.ones(len(col), dtype=bool)
+        return np.where(codes < 0, True, ~ok[np.maximum(codes, 0)])
+    if isinstance(col.dtype, pd.StringDtype) or (
+        col.dtype == object and pd.api.types.infer_dtype(col, skipna=False) == "string"
+    ):
+        bad = col.isna().to_numpy(bool)
+        if nonempty:
+            bad = bad | (col == "").fillna(False).to_numpy(bool)
+        return bad
+    return ~col.map(lambda v: isinstance(v, str) and (v != "" or not nonempty)).to_numpy(bool)
 
 
 def _check_meta(meta: Mapping[str, Any]) -> dict[str, Any]:

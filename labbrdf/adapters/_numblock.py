@@ -1,0 +1,460 @@
+"""Numeric blocks of text exports: a vectorised parser with line-numbered errors.
+
+Private helpers shared by the ellipsometer adapters (Woollam, Accurion, Film Sense,
+SENTECH). The block parser reads a block of delimited numbers with
+:func:`pandas.read_csv` (C engine) and falls back to a strict line-by-line parser only when
+the fast path meets something it cannot read; the slow parser is the authority: it either
+returns the same table or raises :class:`AdapterError` naming the file, the line and what
+was expected. A reader therefore never returns a half-read file, and a good file is parsed
+at pandas speed.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+import re
+import warnings
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ..dataset import DatasetError, Measurement
+from ._base import AdapterError
+
+__all__ = [
+    "Block",
+    "NUMBER",
+    "build_frame",
+    "labels",
+    "body_bytes",
+    "group_angles",
+    "head_lines",
+    "measurement",
+    "parse_block",
+    "split_head",
+]
+
+#: What a number may look like in an export: decimal point only, optional exponent,
+#: ``inf``/``Infinity``/``nan`` in any case (CompleteEASE writes ``inf``, Accurion ``NaN``).
+NUMBER = re.compile(
+    r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.IGNORECASE
+)
+_TAG = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+
+
+@dataclass(frozen=True)
+class Block:
+    """A parsed numeric block.
+
+    Attributes
+    ----------
+    values : numpy.ndarray
+        ``(n, ncols)`` float64; empty or missing trailing fields are NaN.
+    lines : numpy.ndarray
+        ``(n,)`` 1-based line number of each row in the file.
+    tags : numpy.ndarray or None
+        ``(n,)`` object array with the alphabetic tag of each row (``""`` for an untagged
+        row), or None when the block was parsed without tags.
+    blank_lines : int
+        Number of empty (or whitespace-only) lines skipped.
+    nfields : numpy.ndarray or None
+        ``(n,)`` number of fields as written (separator count + 1, tag included), for
+        TAB-separated blocks; None for whitespace-separated ones.
+    """
+
+    values: np.ndarray
+    lines: np.ndarray
+    tags: np.ndarray | None
+    blank_lines: int
+    nfields: np.ndarray | None = None
+
+
+_EOL = re.compile(r"\r\n|\n|\r")
+
+
+def head_lines(text: str, n: int) -> tuple[list[str], int]:
+    """The first ``n`` lines of ``text`` (CRLF, LF or CR ends) and the offset after them."""
+    head: list[str] = []
+    pos = 0
+    while len(head) < n and pos < len(text):
+        m = _EOL.search(text, pos)
+        if m is None:
+            head.append(text[pos:])
+            return head, len(text)
+        head.append(text[pos : m.start()])
+        pos = m.end()
+    return head, pos
+
+
+def split_head(text: str, n: int) -> tuple[list[str], str]:
+    """Split off the first ``n`` lines of ``text``; return them and the rest (the body).
+
+    Line ends may be CRLF, LF or CR; a missing final newline is fine.
+    """
+    head, pos = head_lines(text, n)
+    return head, text[pos:]
+
+
+def body_bytes(raw: bytes, text: str, offset: int, encoding: str) -> bytes:
+    """The bytes of ``text[offset:]`` cut from ``raw`` (``text`` decoded from ``raw``)."""
+    bom = 3 if raw.startswith(b"\xef\xbb\xbf") else 0
+    return raw[bom + len(text[:offset].encode(encoding)) :]
+
+
+def _slow(
+    path: str | os.PathLike[str],
+    body: str,
+    first_line: int,
+    ncols: int,
+    sep: str | None,
+    tagged: bool,
+) -> Block:
+    """Strict line-by-line parser; the authority on what a valid block is."""
+    lines = body.splitlines()
+    vals = np.full((len(lines), ncols), np.nan)
+    tags = np.full(len(lines), "", dtype=object)
+    keep = np.ones(len(lines), dtype=bool)
+    nfields = np.zeros(len(lines), dtype=np.int64)
+    for i, line in enumerate(lines):
+        lineno = first_line + i
+        fields = line.split(sep) if sep is not None else line.split()
+        nfields[i] = len(fields)
+        while fields and not fields[-1].strip():
+            fields.pop()
+        if not fields:
+            keep[i] = False
+            continue
+        if tagged:
+            first = fields[0].strip()
+            if first[:1].isalpha():
+                if not _TAG.fullmatch(first):
+                    raise AdapterError(path, f"bad row tag {first!r}", lineno)
+                tags[i] = first
+                fields = fields[1:]
+        if len(fields) > ncols:
+            raise AdapterError(
+                path, f"expected at most {ncols} numeric fields, found {len(fields)}", lineno
+            )
+        for j, f in enumerate(fields):
+            f = f.strip()
+            if not f:
+                continue
+            if not NUMBER.fullmatch(f):
+                shown = f if len(f) <= 40 else f[:37] + "..."
+                raise AdapterError(
+                    path,
+                    f"field {j + 1 + (tags[i] != '')}: expected a number, found {shown!r}",
+                    lineno,
+                )
+            vals[i, j] = float(f)
+    linenos = first_line + np.flatnonzero(keep)
+    return Block(
+        vals[keep],
+        linenos,
+        tags[keep] if tagged else None,
+        int((~keep).sum()),
+        nfields[keep] if sep is not None else None,
+    )
+
+
+_READ_KW: dict[str, Any] = {
+    "header": None,
+    "index_col": False,
+    "keep_default_na": False,
+    "na_values": ["", "NaN", "nan"],
+    "skip_blank_lines": False,
+    "quoting": csv.QUOTE_NONE,
+    "engine": "c",
+}
+
+
+def _line_starts(arr: np.ndarray) -> np.ndarray:
+    starts = np.concatenate(([0], np.flatnonzero(arr == 10) + 1))
+    return starts[starts < arr.size]
+
+
+def _line_starts_alpha(arr: np.ndarray, starts: np.ndarray) -> bool:
+    if arr.size == 0:
+        return False
+    c = arr[starts] | 0x20
+    return bool(((c >= ord("a")) & (c <= ord("z"))).any())
+
+
+def _fields_per_line(arr: np.ndarray, starts: np.ndarray, sep: str) -> np.ndarray:
+    """Separator count + 1 for every line (vectorised)."""
+    seps = np.flatnonzero(arr == ord(sep))
+    ends = np.concatenate((starts[1:], [arr.size]))
+    return np.searchsorted(seps, ends) - np.searchsorted(seps, starts) + 1
+
+
+def _fast(
+    body: str,
+    data: bytes,
+    first_line: int,
+    ncols: int,
+    sep: str | None,
+    tagged: bool,
+    count_fields: bool,
+) -> Block | None:
+    """pandas C-engine parse; None when anything looks off (the caller then goes slow).
+
+    Lone CR line ends, form feeds and the like make pandas and the line count disagree;
+    the row-count cross-check below sends such blocks to the slow parser.
+    """
+    if re.search(rb"\S", data) is None:
+        return Block(np.empty((0, ncols)), np.empty(0, dtype=np.int64), None, 0)
+    arr = np.frombuffer(data, dtype=np.uint8)
+    starts = _line_starts(arr)
+    with_tags = tagged and _line_starts_alpha(arr, starts)
+    width = ncols + 1 if with_tags else ncols
+    kw = dict(_READ_KW)
+    kw["sep"] = sep if sep is not None else r"\s+"
+    if with_tags:
+        kw["dtype"] = {0: object, **{k: np.float64 for k in range(1, width)}}
+    else:
+        kw["dtype"] = np.float64
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            df = pd.read_csv(io.BytesIO(data), names=list(range(width)), **kw)
+    except (ValueError, TypeError, pd.errors.ParserError, pd.errors.ParserWarning):
+        return None
+    if with_tags:
+        col0 = df[0].to_numpy(dtype=object)
+        rest = df.iloc[:, 1:].to_numpy(dtype=np.float64)
+        s0 = pd.Series(col0, dtype=object)
+        present = s0.notna().to_numpy()
+        is_tag = present & s0.str.match(r"[A-Za-z]", na=False).to_numpy(dtype=bool)
+        if is_tag.any() and not s0[is_tag].str.fullmatch(_TAG.pattern).all():
+            return None
+        num0 = pd.to_numeric(s0.where(~is_tag), errors="coerce").to_numpy(dtype=np.float64)
+        bad0 = present & ~is_tag & np.isnan(num0)
+        if bad0.any():  # could be a literal NaN or garbage: let the slow path decide
+            return None
+        vals = np.where(is_tag[:, None], rest, np.column_stack([num0, rest[:, :-1]]))
+        over = ~is_tag & ~np.isnan(rest[:, -1])
+        if over.any():
+            return None
+        tags = np.where(is_tag, col0, "").astype(object)
+    else:
+        vals = df.to_numpy(dtype=np.float64)
+        tags = None
+    blank = np.isnan(vals).all(axis=1)
+    if tags is not None:
+        blank &= tags == ""
+    n = len(vals)
+    # pandas skips a whitespace-separated block's leading-space lines differently; cross-check
+    # the number of rows against the number of lines so that line numbers stay exact.
+    nlines = len(body.splitlines()) if sep is None else starts.size
+    if n != nlines:
+        return None
+    keep = ~blank
+    linenos = first_line + np.flatnonzero(keep)
+    nfields = None
+    if count_fields and sep is not None:
+        nfields = _fields_per_line(arr, starts, sep)[keep]
+    return Block(
+        vals[keep], linenos, None if tags is None else tags[keep], int(blank.sum()), nfields
+    )
+
+
+def parse_block(
+    path: str | os.PathLike[str],
+    body: str,
+    first_line: int,
+    ncols: int,
+    *,
+    sep: str | None = "\t",
+    tagged: bool = False,
+    count_fields: bool = False,
+    data: bytes | None = None,
+) -> Block:
+    """Parse a block of delimited numbers.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (for error messages).
+    body : str
+        The block's text, starting at a line start.
+    first_line : int
+        1-based line number of the block's first line in the file.
+    ncols : int
+        Maximum number of numeric fields per row (after the tag, if any); shorter rows are
+        padded with NaN, trailing empty fields (trailing TABs or spaces) are ignored.
+    sep : str or None
+        Field separator; None splits on runs of whitespace.
+    tagged : bool
+        Whether a row may start with an alphabetic tag (Woollam ``pR``, ``dpolE``, ...).
+    count_fields : bool
+        Fill :attr:`Block.nfields` (TAB-separated blocks only).
+    data : bytes, optional
+        ``body`` encoded in an ASCII-compatible encoding, when the caller has it (saves
+        re-encoding a large block).
+
+    Returns
+    -------
+    Block
+        Values, line numbers and tags; blank lines are skipped and counted.
+
+    Raises
+    ------
+    AdapterError
+        A row with too many fields or a field that is not a number, naming its line.
+    """
+    if data is None:
+        data = body.encode("utf-8")
+    block = _fast(body, data, first_line, ncols, sep, tagged, count_fields)
+    if block is None:
+        block = _slow(path, body, first_line, ncols, sep, tagged)
+    elif tagged and block.tags is None:
+        block = Block(
+            block.values,
+            block.lines,
+            np.full(len(block.lines), "", dtype=object),
+            block.blank_lines,
+            block.nfields,
+        )
+    return block
+
+
+def group_angles(angles: Any, tol: float = 0.05) -> list[dict[str, float | int]]:
+    """Group nearly equal angles for a summary (goniometer readings such as 64.999634).
+
+    Parameters
+    ----------
+    angles : array_like
+        Angles [deg]; NaN ignored.
+    tol : float
+        Largest gap inside one group [deg].
+
+    Returns
+    -------
+    list of dict
+        One ``{"nominal", "min", "max", "rows"}`` per group, ascending; ``nominal`` is the
+        group mean rounded to 3 decimals. The data themselves are never rounded.
+    """
+    a = np.asarray(angles, dtype=float).ravel()
+    a = np.sort(a[np.isfinite(a)])
+    if a.size == 0:
+        return []
+    cuts = np.flatnonzero(np.diff(a) > tol) + 1
+    out = []
+    for g in np.split(a, cuts):
+        out.append(
+            {
+                "nominal": round(float(g.mean()), 3),
+                "min": float(g[0]),
+                "max": float(g[-1]),
+                "rows": int(g.size),
+            }
+        )
+    return out
+
+
+def build_frame(
+    *,
+    sample: str,
+    instrument: str,
+    source: str,
+    quantity: Any,
+    value: Any,
+    unit: Any,
+    wavelength_nm: Any,
+    sigma: Any = np.nan,
+    theta_i_deg: Any = np.nan,
+    theta_r_deg: Any = np.nan,
+    phi_r_deg: Any = np.nan,
+    **optional: Any,
+) -> pd.DataFrame:
+    """Build a schema table from arrays and scalars without per-row Python work.
+
+    Like :func:`labbrdf.dataset.make_frame`, but string columns are built as categoricals
+    (a constant string, an object array, or a :class:`pandas.Categorical` made with
+    :func:`labels`), which keeps files of millions of rows fast; :func:`measurement`
+    validates the result (and :func:`labbrdf.dataset.validate` turns them into plain
+    strings).
+    """
+    value = np.asarray(value, dtype=float).ravel()
+    n = value.size
+
+    def num(v: Any) -> np.ndarray:
+        if np.ndim(v) == 0:
+            return np.full(n, v, dtype=float)
+        arr = np.asarray(v, dtype=float).ravel()
+        if arr.size != n:  # pragma: no cover - programming error
+            raise ValueError(f"column has {arr.size} values, expected {n}")
+        return arr
+
+    def text(v: Any) -> pd.Categorical:
+        if isinstance(v, str):
+            return pd.Categorical.from_codes(np.zeros(n, dtype=np.int8), categories=[v])
+        if isinstance(v, pd.Categorical):
+            out = v
+        else:
+            out = pd.Categorical(np.asarray(v, dtype=object).ravel())
+        if len(out) != n:  # pragma: no cover - programming error
+            raise ValueError(f"column has {len(out)} values, expected {n}")
+        return out
+
+    cols: dict[str, Any] = {
+        "sample": text(sample),
+        "instrument": text(instrument),
+        "source": text(source),
+        "quantity": text(quantity),
+        "value": value,
+        "sigma": num(sigma),
+        "unit": text(unit),
+        "wavelength_nm": num(wavelength_nm),
+        "theta_i_deg": num(theta_i_deg),
+        "theta_r_deg": num(theta_r_deg),
+        "phi_r_deg": num(phi_r_deg),
+    }
+    for k, v in optional.items():
+        cols[k] = text(v) if k == "channel" else num(v)
+    return pd.DataFrame(cols, copy=False)
+
+
+def labels(names: list[str], counts: list[int] | np.ndarray) -> pd.Categorical:
+    """``names[k]`` repeated ``counts[k]`` times, as a categorical (no per-row strings)."""
+    uniq = list(dict.fromkeys(names))
+    codes = np.array([uniq.index(x) for x in names], dtype=np.int16)
+    return pd.Categorical.from_codes(np.repeat(codes, counts), categories=uniq)
+
+
+def measurement(
+    path: str | os.PathLike[str], frame: pd.DataFrame, meta: dict[str, Any]
+) -> Measurement:
+    """Validate into a :class:`Measurement`; a schema problem becomes an :class:`AdapterError`."""
+    if len(frame) == 0:
+        raise AdapterError(path, "no data rows found")
+    try:
+        return Measurement(frame, meta)
+    except DatasetError as exc:
+        raise AdapterError(path, f"data do not fit the labbrdf schema: {exc}") from None
+
+
+def first_bad(mask: np.ndarray) -> int | None:
+    """Index of the first True in ``mask`` or None."""
+    idx = np.flatnonzero(mask)
+    return int(idx[0]) if idx.size else None
+
+
+def check_rows(path: str | os.PathLike[str], block: Block, mask: np.ndarray, message: str) -> None:
+    """Raise ``AdapterError(path, message, line)`` for the first row where ``mask`` is True."""
+    i = first_bad(mask)
+    if i is not None:
+        raise AdapterError(path, message, int(block.lines[i]))
+
+
+def delta_range(delta: np.ndarray) -> list[float] | None:
+    """[min, max] of the Delta values as written in the file (JSON-safe), None if empty."""
+    d = np.asarray(delta, dtype=float)
+    d = d[np.isfinite(d)]
+    if d.size == 0:
+        return None
+    return [float(d.min()), float(d.max())]

@@ -1,0 +1,584 @@
+"""J.A. Woollam ASCII data files: WVASE32 and CompleteEASE exports (``.dat``).
+
+Layout (notes/formats.md sections 1-2, checked on every real file in
+``shared/real-exports/woollam-*``): a header of up to five lines found by content, not by
+position --
+
+1. a free-text title (may be empty: CompleteEASE 3.x),
+2. ``VASEmethod[...]`` (ellipsometry) or ``RTmethod[...]`` (intensity reflectance), a list
+   of ``key=value`` items and bare flags ending with a date,
+3. ``Original[<file name>]`` (WVASE only),
+4. optionally ``Dynamic`` (CompleteEASE 3.x kinetic series),
+5. the spectral unit on its own line: ``nm``, ``eV``, ``Angstroms`` (seen in real files;
+   ``A``, ``um``, ``microns`` and ``cm-1`` are accepted too but were not seen);
+
+then one record per line, TAB separated. An untagged row is ``x AOI Psi Delta sPsi sDelta``
+(CompleteEASE 3.x adds a trailing TAB; the dynamic variant adds an empty column and the time
+in minutes). A tagged row starts with its data type:
+
+==============================  =================================================  ==========
+tag                             fields after the tag                               quantity
+==============================  =================================================  ==========
+``E``                           x AOI Psi Delta sPsi sDelta                         psi, delta
+``AnE`` / ``Aps`` / ``Asp``     x AOI Psi Delta sPsi sDelta (channel pp / ps / sp)  psi, delta
+``dpolE`` / ``dPolE``           x AOI depolarisation[%] sigma[%]                    depolarization
+``uR`` / ``pR`` / ``sR``        x AOI R sigma (channel u / p / s)                   see below
+``mm11`` .. ``mm44``            x AOI M M sM sM (value written twice)               mueller_ij
+==============================  =================================================  ==========
+
+Reflectance: in an ``RTmethod`` file the ``uR``/``pR``/``sR`` rows are calibrated specular
+reflectances (fractions, as in ``ta2o5_02262007_rp.dat``) and become ``reflectance`` with
+theta_r = theta_i, phi_r = 180 deg. In an ellipsometric (``VASEmethod``) file an ``uR`` row
+is the reflected intensity the ellipsometer recorded on the side: CompleteEASE 3.65 writes
+values of 0.65-6.9 with a constant placeholder sigma of 1 that rise and fall with wavelength
+like a lamp spectrum, which is neither a reflectance fraction (> 1) nor a plausible percent
+reflectance of the sample at 70 deg. Those rows are kept as ``specular_intensity`` (unit
+``1``, arbitrary scale), never as reflectance.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from datetime import datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ..dataset import Measurement, wrap_delta
+from ._base import AdapterError, Format, decode, read_bytes
+from ._numblock import (
+    Block,
+    body_bytes,
+    build_frame,
+    check_rows,
+    delta_range,
+    group_angles,
+    head_lines,
+    labels,
+    measurement,
+    parse_block,
+)
+
+__all__ = [
+    "FORMATS",
+    "WVASE_HC_EV_NM",
+    "parse_method",
+    "read_woollam",
+    "sniff_completeease",
+    "sniff_wvase",
+]
+
+_METHOD = re.compile(r"^\s*(VASE|RT)method\[(.*)\]\s*$")
+_ORIGINAL = re.compile(r"^\s*Original\[(.*)\]\s*$")
+
+#: spectral unit line -> (canonical name, conversion to nm)
+_UNITS: dict[str, str] = {
+    "nm": "nm",
+    "ev": "eV",
+    "angstroms": "Angstrom",
+    "angstrom": "Angstrom",
+    "a": "Angstrom",
+    "um": "um",
+    "microns": "um",
+    "micrometers": "um",
+    "cm-1": "cm-1",
+    "1/cm": "cm-1",
+}
+
+#: The h*c [eV nm] WVASE32 uses to write an eV axis: lambda[nm] = 1240 / E[eV]. Inverting
+#: the software's own conversion gives back the monochromator's wavelengths: the eV grid of
+#: ``wafer_2_01242007.dat`` times 1240 reproduces the nm grid of ``w2_10102006.dat`` (same
+#: instrument and spectral grid) to 6e-7 relative, the 7 digits printed; CODATA
+#: hc = 1239.84198 eV nm would be 1.3e-4 (0.2 nm at 1698 nm) off.
+WVASE_HC_EV_NM = 1240.0
+
+_PSI_DELTA = {"": "", "E": "", "AnE": "pp", "Aps": "ps", "Asp": "sp"}
+_DEPOL = {"dpolE", "dPolE"}
+_REFL = {"uR": "u", "pR": "p", "sR": "s"}
+_MM = {f"mm{i}{j}": f"mueller_{i}{j}" for i in range(1, 5) for j in range(1, 5)}
+_NFIELDS = {
+    **{t: 6 for t in _PSI_DELTA},
+    **{t: 4 for t in _DEPOL},
+    **{t: 4 for t in _REFL},
+    **{t: 6 for t in _MM},
+}
+_SUPPORTED = sorted(set(_NFIELDS) - {""})
+_DATE_FORMATS = ("%a %b %d %H:%M:%S %Y",)
+
+
+# ----------------------------------------------------------------------------- sniffing
+
+
+def _method_line(head: bytes) -> str | None:
+    try:
+        text = head.decode("latin-1")
+        for line in text.splitlines()[:4]:
+            if _METHOD.match(line) or line.lstrip().startswith(("VASEmethod[", "RTmethod[")):
+                return line
+    except Exception:  # a sniffer never raises
+        return None
+    return None
+
+
+def sniff_wvase(head: bytes) -> bool:
+    """True for a WVASE32 export: a ``VASEmethod[``/``RTmethod[`` line without CompleteEASE."""
+    line = _method_line(head)
+    return line is not None and "CompleteEASE" not in line
+
+
+def sniff_completeease(head: bytes) -> bool:
+    """True for a CompleteEASE export: the method line names ``CompleteEASE=``."""
+    line = _method_line(head)
+    return line is not None and "CompleteEASE" in line
+
+
+# ----------------------------------------------------------------------------- header
+
+
+def _number_or_text(v: str) -> float | int | str:
+    try:
+        f = float(v)
+    except ValueError:
+        return v
+    if not np.isfinite(f):
+        return v
+    return int(f) if re.fullmatch(r"[+-]?\d+", v) else f
+
+
+def parse_method(line: str) -> dict[str, Any]:
+    """Parse a ``VASEmethod[...]`` / ``RTmethod[...]`` line.
+
+    Parameters
+    ----------
+    line : str
+        The method line.
+
+    Returns
+    -------
+    dict
+        ``method`` (``"VASEmethod"`` or ``"RTmethod"``), ``settings`` (``key=value`` items,
+        numbers as numbers; keys kept verbatim, e.g. ``"Acq. Parameters"``), ``flags`` (bare
+        items such as ``Isotropic``), ``date`` (the date item as written) and ``datetime``
+        (ISO 8601, when the date parses), ``simulated`` (True for WVASE's model-generated
+        ``Simulation for ...`` / ``Normal Fit Generation`` data) and ``software``.
+
+    Raises
+    ------
+    ValueError
+        The line is not a method line.
+    """
+    m = _METHOD.match(line)
+    if m is None:
+        raise ValueError(f"not a VASEmethod[...] / RTmethod[...] line: {line!r}")
+    out: dict[str, Any] = {"method": f"{m.group(1)}method", "settings": {}, "flags": []}
+    simulated = False
+    for item in (s.strip() for s in m.group(2).split(",")):
+        if not item:
+            continue
+        if "=" in item:
+            k, v = (s.strip() for s in item.split("=", 1))
+            out["settings"][k] = _number_or_text(v)
+            continue
+        for fmt in _DATE_FORMATS:
+            try:
+                out["datetime"] = datetime.strptime(item, fmt).isoformat()
+                out["date"] = item
+                break
+            except ValueError:
+                continue
+        else:
+            if item.startswith(("Simulation for", "Normal Fit Generation")):
+                simulated = True
+            out["flags"].append(item)
+    out["simulated"] = simulated
+    st = out["settings"]
+    if "CompleteEASE" in st:
+        out["software"] = f"CompleteEASE {st['CompleteEASE']}"
+    elif "WVASE" in st:
+        out["software"] = f"WVASE32 {st['WVASE']}"
+    return out
+
+
+def _header(path: str | os.PathLike[str], text: str) -> tuple[dict[str, Any], int, int]:
+    """Find the header lines by content; return meta, the body's offset and first line."""
+    lines, _ = head_lines(text, 7)
+    meta: dict[str, Any] = {}
+    i = 0
+    # title: every line before the method line (normally one, may be empty)
+    mi = next((k for k, s in enumerate(lines[:3]) if _METHOD.match(s)), None)
+    if mi is None:
+        raise AdapterError(
+            path,
+            "no VASEmethod[...] or RTmethod[...] line in the first 3 lines: not a Woollam "
+            "WVASE32/CompleteEASE ASCII export",
+            min(len(lines), 2) or 1,
+        )
+    if mi > 2 or (mi == 2 and lines[0].strip()):
+        raise AdapterError(path, "expected at most one title line before the method line", mi)
+    meta["title"] = lines[mi - 1].strip() if mi >= 1 else ""
+    meta.update(parse_method(lines[mi]))
+    i = mi + 1
+    if i < len(lines) and _ORIGINAL.match(lines[i]):
+        meta["original_file"] = _ORIGINAL.match(lines[i]).group(1)  # type: ignore[union-attr]
+        i += 1
+    meta["dynamic"] = False
+    if i < len(lines) and lines[i].strip().lower() == "dynamic":
+        meta["dynamic"] = True
+        i += 1
+    if i >= len(lines):
+        raise AdapterError(path, "file ends before the spectral unit line (nm, eV, Angstroms)")
+    unit = lines[i].strip()
+    if unit.lower() not in _UNITS:
+        raise AdapterError(
+            path,
+            f"expected the spectral unit line (nm, eV or Angstroms), found {unit[:40]!r}",
+            i + 1,
+        )
+    meta["spectral_unit"] = _UNITS[unit.lower()]
+    meta["spectral_unit_as_written"] = unit
+    if meta["spectral_unit"] == "eV":
+        meta["ev_to_nm"] = "lambda[nm] = 1240 / E[eV] (the constant WVASE writes eV with)"
+    _, offset = head_lines(text, i + 1)
+    return meta, offset, i + 2
+
+
+def _to_nm(
+    path: str | os.PathLike[str], x: np.ndarray, unit: str, block: Block, rows: np.ndarray
+) -> np.ndarray:
+    check_rows(
+        path,
+        block,
+        rows & ~(np.isfinite(x) & (x > 0)),
+        f"spectral value must be a finite number > 0 [{unit}]",
+    )
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if unit == "nm":
+            return x
+        if unit == "eV":
+            return WVASE_HC_EV_NM / x
+        if unit == "Angstrom":
+            return x / 10.0
+        if unit == "um":
+            return x * 1000.0
+        if unit == "cm-1":
+            return 1e7 / x
+    raise AssertionError(unit)  # pragma: no cover
+
+
+# ----------------------------------------------------------------------------- reader
+
+
+def read_woollam(path: str | os.PathLike[str]) -> Measurement:
+    """Read a WVASE32 or CompleteEASE ASCII data file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.dat`` export.
+
+    Returns
+    -------
+    Measurement
+        Rows ``psi``/``delta`` [deg] (with ``channel`` ``pp``/``ps``/``sp`` for generalized
+        ellipsometry), ``depolarization`` [fraction], ``reflectance`` [fraction] (RTmethod
+        files, ``channel`` ``u``/``p``/``s``), ``specular_intensity`` (uR inside an
+        ellipsometric file, arbitrary scale) and ``mueller_ij`` (normalised), with the
+        file's sigmas, wavelength in nm, theta_i = the AOI as written (never rounded),
+        theta_r = theta_i and phi_r = 180 deg (specular). Dynamic CompleteEASE data carry
+        ``time_s``. Delta is wrapped into [0, 360).
+
+    Raises
+    ------
+    AdapterError
+        Not a Woollam export, unknown tag or unit, a row with the wrong number of fields
+        or a non-number (with its line), psi or AOI outside [0, 90] deg, no data.
+
+    Notes
+    -----
+    Conventions (checked on the real files, notes/formats.md 1-2):
+
+    * Delta is Woollam's, i.e. the Nebraska convention of DESIGN.md (Delta = 180 deg at
+      normal incidence, 0 < Delta < 180 deg for an absorbing substrate: the Ta metal file
+      ``w2_10102006.dat`` has 68 < Delta < 159 deg). Files write it in 0..360 or -180..180;
+      it is only wrapped, and the range as written is kept in ``meta["delta_range_in_file"]``.
+    * eV is converted by lambda = 1240 eV nm / E (not E * hc, the pyElli 0.23.1 bug), with
+      the 1240 WVASE itself uses (see :data:`WVASE_HC_EV_NM`), giving 245.73-1697.77 nm for
+      ``wafer_2_01242007.dat`` like the nm files of the same instrument; Angstrom by /10.
+    * Depolarisation (``dpolE``) is written in percent and stored as a fraction, sigma too.
+    * CompleteEASE 3.x static files interleave per wavelength a Psi/Delta row, a ``dPolE``
+      row and an ``uR`` row whose AOI field is 0. Such a tagged row with AOI 0 at most two
+      lines after a Psi/Delta row of the same wavelength (its triplet) was measured in the
+      same acquisition, so it gets that row's AOI; ``meta["aoi_reassigned"]`` counts them.
+      A tagged row with AOI 0 anywhere else stays at normal incidence.
+    * Rows whose value is not finite (CompleteEASE 6.x writes a whole ``uR`` block of
+      ``inf``: nothing was measured) are dropped, and each drop is listed in
+      ``meta["dropped_rows"]`` with tag, count and reason; never silently.
+    * Mueller rows (``mm12`` ...) write the value twice and the sigma twice (formats.md 1,
+      not seen in a real file); the first copy of each is used.
+    """
+    raw = read_bytes(path)
+    text, encoding = decode(raw, path)
+    meta, offset, first = _header(path, text)
+    p = Path(path)
+    meta = {"source_file": p.name, "encoding": encoding, **meta}
+    data = body_bytes(raw, text, offset, encoding)
+    block = parse_block(path, text[offset:], first, 8, sep="\t", tagged=True, data=data)
+    if len(block.lines) == 0:
+        raise AdapterError(path, "no data rows after the header")
+    v = block.values
+    assert block.tags is not None
+    # tags as small integer codes: comparisons on 10^6 object strings are slow
+    tcodes, tuniq = pd.factorize(block.tags)
+    utags = [str(t) for t in tuniq]
+    code = {t: k for k, t in enumerate(utags)}
+
+    def is_tag(*names: str) -> np.ndarray:
+        ks = [code[t] for t in names if t in code]
+        return np.isin(tcodes, ks) if ks else np.zeros(len(tcodes), dtype=bool)
+
+    # ---- tags and field counts
+    unknown = [t for t in utags if t not in _NFIELDS]
+    if unknown:
+        check_rows(
+            path,
+            block,
+            is_tag(unknown[0]),
+            f"unsupported data tag {unknown[0]!r}; supported are {_SUPPORTED} "
+            "and untagged Psi/Delta rows",
+        )
+    nf = np.array([_NFIELDS[t] for t in utags], dtype=np.int64)[tcodes]
+    filled = ~np.isnan(v)
+    # required fields: all of the first nf must be present ...
+    idx = np.arange(v.shape[1])
+    need = idx[None, :] < nf[:, None]
+    missing = need & ~filled
+    # an empty field is never a value: a missing number is an error, only a written
+    # inf/NaN counts as "not measured" (dropped and reported below)
+    check_rows(
+        path,
+        block,
+        missing.any(axis=1),
+        "missing field(s): expected x, AOI and the values of this row type "
+        "(6 fields for Psi/Delta, 4 for dpolE/uR/pR/sR)",
+    )
+    dynamic = bool(meta["dynamic"])
+    extra = filled & ~need
+    if dynamic:
+        # untagged dynamic rows: x AOI Psi Delta sPsi sDelta <empty> time_min
+        untagged = is_tag("")
+        check_rows(
+            path,
+            block,
+            untagged & ~filled[:, 7],
+            "dynamic data: expected the time [min] in field 8",
+        )
+        extra[untagged, 7] = False
+    check_rows(
+        path,
+        block,
+        extra.any(axis=1),
+        "too many fields for this row type (6 for Psi/Delta, 4 for dpolE/uR/pR/sR)",
+    )
+
+    x = v[:, 0]
+    unit = meta["spectral_unit"]
+    wl = _to_nm(path, x, unit, block, np.ones(len(x), dtype=bool))
+    aoi = v[:, 1].copy()
+    check_rows(
+        path,
+        block,
+        ~(np.isfinite(aoi) & (aoi >= 0) & (aoi <= 90)),
+        "angle of incidence must be within [0, 90] deg",
+    )
+    time_s = v[:, 7] * 60.0 if dynamic else None
+
+    # ---- CompleteEASE 3.x: tagged rows with AOI 0 after a Psi/Delta row of the same x
+    is_pd = is_tag(*_PSI_DELTA)
+    reassigned = 0
+    zero = ~is_pd & (aoi == 0)
+    if zero.any() and is_pd.any():
+        last_pd = np.where(is_pd, np.arange(len(tcodes)), -1)
+        last_pd = np.maximum.accumulate(last_pd)
+        ok = zero & (last_pd >= 0)
+        j = np.where(ok, last_pd, 0)
+        same = ok & (x[j] == x) & (np.arange(len(tcodes)) - j <= 2)
+        aoi[same] = aoi[j[same]]
+        reassigned = int(same.sum())
+    if reassigned:
+        meta["aoi_reassigned"] = {
+            "rows": reassigned,
+            "reason": "tagged rows written with AOI 0 right after the Psi/Delta row of the "
+            "same wavelength (CompleteEASE 3.x interleaved export) take that row's AOI",
+        }
+
+    parts: list[dict[str, Any]] = []
+    dropped: list[dict[str, Any]] = []
+    rt = meta["method"] == "RTmethod"
+    n = len(tcodes)
+
+    def add(
+        rows: np.ndarray,
+        quantity: str,
+        value: np.ndarray,
+        sigma: np.ndarray,
+        unit_: str,
+        channel: str,
+        tag: str,
+    ) -> None:
+        """Collect one quantity of the rows ``rows`` (full-length mask); drop non-finite."""
+        bad_sigma = np.zeros(n, dtype=bool)
+        bad_sigma[rows] = ~np.isnan(sigma) & ~(np.isfinite(sigma) & (sigma >= 0))
+        check_rows(path, block, bad_sigma, "sigma must be a finite number >= 0")
+        good = np.isfinite(value)
+        nbad = int((~good).sum())
+        if nbad:
+            kind = "inf" if np.isinf(value[~good]).all() else "NaN/inf"
+            dropped.append(
+                {
+                    "tag": tag or "(untagged)",
+                    "quantity": quantity,
+                    "count": nbad,
+                    "reason": f"value is {kind}: not measured",
+                }
+            )
+        parts.append(
+            {
+                "r": np.flatnonzero(rows)[good],
+                "quantity": quantity,
+                "value": value[good],
+                "sigma": sigma[good],
+                "unit": unit_,
+                "channel": channel,
+            }
+        )
+
+    delta_seen: list[np.ndarray] = []
+    for t in sorted(utags):
+        rows = tcodes == code[t]
+        if t in _PSI_DELTA:
+            psi, delta = v[:, 2], v[:, 3]
+            check_rows(
+                path,
+                block,
+                rows & np.isfinite(psi) & ((psi < 0) | (psi > 90)),
+                "psi must be within [0, 90] deg",
+            )
+            psi, delta = psi[rows], delta[rows]
+            delta_seen.append(delta)
+            ch = _PSI_DELTA[t]
+            # psi and delta of one line share its fate: both kept or both dropped
+            both = np.isfinite(psi) & np.isfinite(delta)
+            add(rows, "psi", np.where(both, psi, np.nan), v[rows, 4], "deg", ch, t)
+            add(
+                rows,
+                "delta",
+                np.where(both, wrap_delta(np.where(both, delta, 0.0)), np.nan),
+                v[rows, 5],
+                "deg",
+                ch,
+                t,
+            )
+        elif t in _DEPOL:
+            add(rows, "depolarization", v[rows, 2] / 100.0, v[rows, 3] / 100.0, "1", "", t)
+        elif t in _REFL:
+            q = "reflectance" if rt else "specular_intensity"
+            add(rows, q, v[rows, 2], v[rows, 3], "1", _REFL[t], t)
+        else:  # Mueller
+            add(rows, _MM[t], v[rows, 2], v[rows, 4], "1", "", t)
+
+    if not parts or sum(len(pp["r"]) for pp in parts) == 0:
+        raise AdapterError(
+            path,
+            "no finite data values in the file" + (f" (dropped: {dropped})" if dropped else ""),
+        )
+
+    # rows come grouped by tag and quantity (file order within each group)
+    r = np.concatenate([pp["r"] for pp in parts])
+    counts = [len(pp["r"]) for pp in parts]
+
+    def num(key: str) -> np.ndarray:
+        return np.concatenate([pp[key] for pp in parts])
+
+    def lab(key: str) -> pd.Categorical:
+        return labels([pp[key] for pp in parts], counts)
+
+    optional: dict[str, Any] = {}
+    if any(pp["channel"] and len(pp["r"]) for pp in parts):
+        optional["channel"] = lab("channel")
+    if time_s is not None:
+        optional["time_s"] = time_s[r]
+    sample = meta["title"] or p.stem
+    software = meta.get("software", "")
+    instrument = (
+        "woollam-completeease" if software.startswith("CompleteEASE") else ("woollam-wvase")
+    )
+    frame = build_frame(
+        sample=sample,
+        instrument=instrument,
+        source=p.name,
+        quantity=lab("quantity"),
+        value=num("value"),
+        sigma=num("sigma"),
+        unit=lab("unit"),
+        wavelength_nm=wl[r],
+        theta_i_deg=aoi[r],
+        theta_r_deg=aoi[r],
+        phi_r_deg=180.0,
+        **optional,
+    )
+    if dynamic:
+        meta["time_unit_in_file"] = "min"
+    meta["variant"] = _variant(meta, "" in code)
+    counts_per_tag = np.bincount(tcodes, minlength=len(utags))
+    meta["tags"] = {t or "(untagged)": int(counts_per_tag[code[t]]) for t in sorted(utags)}
+    meta["data_lines"] = int(n)
+    meta["blank_lines_skipped"] = block.blank_lines
+    meta["dropped_rows"] = dropped
+    meta["delta_convention"] = "Nebraska (Woollam): Delta = 180 deg at normal incidence"
+    meta["delta_range_in_file"] = delta_range(np.concatenate(delta_seen)) if delta_seen else None
+    meta["delta_range"] = "[0, 360)"
+    meta["angles_deg"] = group_angles(aoi)
+    meta["wavelength_nm"] = [float(np.min(wl)), float(np.max(wl))]
+    return measurement(path, frame, meta)
+
+
+def _variant(meta: dict[str, Any], untagged_rows: bool) -> str:
+    sw = meta.get("software", "")
+    if sw.startswith("CompleteEASE"):
+        if meta["dynamic"]:
+            return "completeease-dynamic"
+        if untagged_rows:
+            return "completeease-interleaved"
+        return "completeease-tagged"
+    return "wvase-rt" if meta["method"] == "RTmethod" else "wvase"
+
+
+FORMATS: tuple[Format, ...] = (
+    Format(
+        name="woollam-wvase",
+        description="J.A. Woollam WVASE32 ASCII data (VASEmethod/RTmethod), psi/Delta, "
+        "generalized ellipsometry, depolarization, reflectance, Mueller matrix",
+        extensions=(".dat",),
+        sniff=sniff_wvase,
+        read=read_woollam,
+        quantities=(
+            "psi",
+            "delta",
+            "depolarization",
+            "reflectance",
+            "specular_intensity",
+            *_MM.values(),
+        ),
+    ),
+    Format(
+        name="woollam-completeease",
+        description="J.A. Woollam CompleteEASE ASCII export (3.x static/dynamic, 6.x tagged)",
+        extensions=(".dat",),
+        sniff=sniff_completeease,
+        read=read_woollam,
+        quantities=("psi", "delta", "depolarization", "specular_intensity"),
+    ),
+)
