@@ -1,0 +1,422 @@
+"""The report's building blocks: checks, tables, figures, formatting and atomic output.
+
+A report is built into one JSON-safe ``results`` dict (written as ``results.json``) and a
+dict of embedded figures. Every table cell on the page is rendered from ``results`` with
+:func:`fmt` and carries a ``data-key`` (a JSON pointer into ``results.json``) and a
+``data-fmt`` (the format spec), so that every number on the page can be traced back.
+
+Check statuses: ``pass``, ``fail`` and ``skipped``. Only ``fail`` makes the exit code
+non-zero; a section whose inputs or modules are missing renders "not available: <reason>"
+and its checks are ``skipped``, never ``pass``.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime as _dt
+import io
+import json
+import math
+import os
+import shutil
+import sys
+import tempfile
+import time
+import traceback
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "STATUSES",
+    "Builder",
+    "Unavailable",
+    "atomic_dir",
+    "fmt",
+    "jsonable",
+    "resolve",
+]
+
+#: the three check outcomes
+STATUSES = ("pass", "fail", "skipped")
+
+
+class Unavailable(Exception):
+    """A section cannot be computed (a module, a file or an optional input is missing)."""
+
+
+# --------------------------------------------------------------------------- values
+
+
+def jsonable(x: Any) -> Any:
+    """A JSON-safe copy: numpy scalars/arrays to Python, NaN and inf to None, keys to str."""
+    if isinstance(x, Mapping):
+        return {str(k): jsonable(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [jsonable(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return [jsonable(v) for v in x.tolist()]
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, (int, np.integer)):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        v = float(x)
+        return v if math.isfinite(v) else None
+    if x is None or isinstance(x, str):
+        return x
+    if isinstance(x, Path):
+        return str(x)
+    return str(x)
+
+
+def fmt(value: Any, spec: str = "") -> str:
+    """The one formatting function for every value shown on the page.
+
+    Parameters
+    ----------
+    value : Any
+        A number, a string, a bool or None (shown as an em dash).
+    spec : str
+        A Python format spec for numbers (``".4g"``, ``".3f"``); ``"%"`` multiplies a
+        fraction by 100 and shows 2 decimals; empty means ``".6g"`` for floats.
+
+    Returns
+    -------
+    str
+    """
+    if value is None:
+        return "\u2014"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, (int, np.integer)) and not spec:
+        return str(int(value))
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        v = float(value)
+        if not math.isfinite(v):
+            return "\u2014"
+        if spec == "%":
+            return f"{100.0 * v:.2f}"
+        if spec.endswith("d"):
+            return format(int(round(v)), spec) if v == round(v) else format(v, ".6g")
+        return format(v, spec or ".6g")
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(fmt(v, spec) for v in value) + "]"
+    return str(value)
+
+
+def resolve(results: Mapping[str, Any], pointer: str) -> Any:
+    """The value at a JSON pointer (``/tables/fits/rows/0/k1``) in ``results``."""
+    node: Any = results
+    for part in pointer.lstrip("/").split("/"):
+        part = part.replace("~1", "/").replace("~0", "~")
+        node = node[int(part)] if isinstance(node, list) else node[part]
+    return node
+
+
+def _esc_pointer(s: str) -> str:
+    return str(s).replace("~", "~0").replace("/", "~1")
+
+
+# --------------------------------------------------------------------------- builder
+
+
+class Builder:
+    """Collects sections, tables, figures and checks into ``results``.
+
+    Parameters
+    ----------
+    title : str
+        Page title.
+    progress : bool
+        Print one line per step on stderr.
+    """
+
+    def __init__(self, title: str, *, progress: bool = False, meta: Mapping | None = None):
+        self.results: dict[str, Any] = {
+            "title": title,
+            "meta": {
+                "created_utc": _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%dT%H:%M:%SZ"),
+                **dict(meta or {}),
+            },
+            "sections": [],
+            "tables": {},
+            "figures": {},
+            "checks": [],
+            "summary": {},
+        }
+        self.images: dict[str, str] = {}
+        self.swatches: dict[str, str] = {}
+        self.progress = progress
+        self._t0 = time.perf_counter()
+        self._current: dict[str, Any] | None = None
+
+    # ---- progress
+    def log(self, msg: str) -> None:
+        """One progress line on stderr (when enabled)."""
+        if self.progress:
+            dt = time.perf_counter() - self._t0
+            sys.stderr.write(f"[labbrdf report {dt:6.1f} s] {msg}\n")
+            sys.stderr.flush()
+
+    # ---- sections
+    @contextmanager
+    def section(self, sid: str, title: str) -> Iterator[dict[str, Any]]:
+        """Open a section; exceptions inside it are recorded, not raised.
+
+        :class:`Unavailable` (and ImportError of a labbrdf module) mark the section "not
+        available" and its checks skipped; any other exception becomes a failed check
+        naming the error, so that a bug shows on the page and in the exit code.
+        """
+        sec: dict[str, Any] = {
+            "id": sid,
+            "title": title,
+            "status": "ok",
+            "reason": None,
+            "text": [],
+            "items": [],
+        }
+        self.results["sections"].append(sec)
+        self._current = sec
+        self.log(f"section {sid}: {title}")
+        try:
+            yield sec
+        except Unavailable as exc:
+            self._unavailable(sec, str(exc))
+        except ImportError as exc:
+            self._unavailable(sec, f"module missing ({exc})")
+        except Exception as exc:  # noqa: BLE001 - shown on the page, fails the run
+            tb = traceback.format_exception_only(type(exc), exc)[-1].strip()
+            sec["status"] = "error"
+            sec["reason"] = tb
+            self.check(
+                f"{sid}.completed",
+                f"section '{title}' ran to the end",
+                "fail",
+                against="no exception",
+                reason=tb,
+            )
+        finally:
+            self._current = None
+
+    def _unavailable(self, sec: dict[str, Any], reason: str) -> None:
+        sec["status"] = "not available"
+        sec["reason"] = reason
+        self._current = sec
+        self.check(
+            f"{sec['id']}.available",
+            f"section '{sec['title']}' computed",
+            "skipped",
+            against="its inputs and modules",
+            reason=f"not available: {reason}",
+        )
+
+    def _sec(self) -> dict[str, Any]:
+        if self._current is None:
+            raise RuntimeError("no open section")
+        return self._current
+
+    def text(self, paragraph: str) -> None:
+        """A paragraph of plain text (escaped on the page)."""
+        self._sec()["items"].append({"kind": "text", "text": paragraph})
+
+    def note(self, label: str, body: str) -> None:
+        """A labelled line, e.g. a "not available" part inside a section that runs."""
+        self._sec()["items"].append({"kind": "note", "label": label, "text": body})
+
+    def table(
+        self,
+        tid: str,
+        title: str,
+        columns: Sequence[tuple[str, str, str]],
+        rows: Sequence[Mapping[str, Any]],
+        caption: str = "",
+    ) -> None:
+        """Add a table.
+
+        Parameters
+        ----------
+        tid : str
+            Unique id (also the CSV file name, ``tables/<tid>.csv``).
+        columns : sequence of (key, label, fmt)
+            Row key, column header (with units) and the :func:`fmt` spec.
+        rows : sequence of mappings
+        """
+        if tid in self.results["tables"]:
+            raise ValueError(f"duplicate table id {tid!r}")
+        self.results["tables"][tid] = {
+            "title": title,
+            "caption": caption,
+            "columns": [{"key": k, "label": lab, "fmt": f} for k, lab, f in columns],
+            "rows": [jsonable({k: r.get(k) for k, _, _ in columns}) for r in rows],
+        }
+        self._sec()["items"].append({"kind": "table", "id": tid})
+
+    def figure(self, fid: str, title: str, caption: str, uri: str | None) -> None:
+        """Add an embedded figure (``uri`` is a ``data:image/png;base64,`` URI)."""
+        if fid in self.results["figures"]:
+            raise ValueError(f"duplicate figure id {fid!r}")
+        if not uri:
+            raise ValueError(f"figure {fid!r} has no image")
+        self.results["figures"][fid] = {"title": title, "caption": caption}
+        self.images[fid] = uri
+        self._sec()["items"].append({"kind": "figure", "id": fid})
+
+    def swatch(self, sid: str, hex_colour: str) -> None:
+        """A colour swatch (hex ``#rrggbb`` computed by the report, never from a file)."""
+        if not (len(hex_colour) == 7 and hex_colour[0] == "#"):
+            raise ValueError(f"bad colour {hex_colour!r}")
+        int(hex_colour[1:], 16)
+        self.swatches[sid] = hex_colour
+        self._sec()["items"].append({"kind": "swatch", "id": sid, "hex": hex_colour})
+
+    def check(
+        self,
+        cid: str,
+        name: str,
+        status: str | bool,
+        *,
+        against: str = "",
+        value: Any = None,
+        tolerance: Any = None,
+        justification: str = "",
+        reason: str = "",
+    ) -> dict[str, Any]:
+        """Record a check: ``status`` is True/False or one of :data:`STATUSES`."""
+        if isinstance(status, (bool, np.bool_)):
+            status = "pass" if status else "fail"
+        if status not in STATUSES:
+            raise ValueError(f"check status must be one of {STATUSES}, got {status!r}")
+        sec = self._current["id"] if self._current is not None else "extra"
+        c = jsonable(
+            {
+                "id": cid,
+                "section": sec,
+                "name": name,
+                "status": status,
+                "against": against,
+                "value": value,
+                "tolerance": tolerance,
+                "justification": justification,
+                "reason": reason,
+            }
+        )
+        self.results["checks"].append(c)
+        if self._current is not None:
+            self._current["items"].append(
+                {"kind": "check", "index": len(self.results["checks"]) - 1}
+            )
+        self.log(f"  check {cid}: {status.upper()}" + (f" ({reason})" if reason else ""))
+        return c
+
+    def skip(self, cid: str, name: str, reason: str, *, against: str = "") -> None:
+        """A check that could not run."""
+        self.check(cid, name, "skipped", against=against, reason=reason)
+
+    # ---- finish
+    def finish(self) -> int:
+        """Fill the summary; return the exit code (1 if any check failed)."""
+        counts = {s: 0 for s in STATUSES}
+        for c in self.results["checks"]:
+            counts[c["status"]] += 1
+        code = 1 if counts["fail"] else 0
+        self.results["summary"] = {**counts, "total": sum(counts.values()), "exit_code": code}
+        self.results["meta"]["elapsed_s"] = round(time.perf_counter() - self._t0, 3)
+        return code
+
+
+# --------------------------------------------------------------------------- output
+
+
+def _cell(v: Any) -> Any:
+    if v is None:
+        return ""
+    return json.dumps(v) if isinstance(v, (list, dict)) else v
+
+
+def tables_csv(results: Mapping[str, Any]) -> dict[str, str]:
+    """Every table of ``results`` as CSV text (full precision), by table id."""
+    out: dict[str, str] = {}
+    for tid, t in results["tables"].items():
+        buf = io.StringIO()
+        keys = [c["key"] for c in t["columns"]]
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(keys)
+        for r in t["rows"]:
+            w.writerow([_cell(r.get(k)) for k in keys])
+        out[tid] = buf.getvalue()
+    checks = io.StringIO()
+    keys = [
+        "id",
+        "section",
+        "name",
+        "status",
+        "value",
+        "tolerance",
+        "against",
+        "justification",
+        "reason",
+    ]
+    w = csv.writer(checks, lineterminator="\n")
+    w.writerow(keys)
+    for c in results["checks"]:
+        w.writerow([_cell(c.get(k)) for k in keys])
+    out["checks"] = checks.getvalue()
+    return out
+
+
+def atomic_dir(out: str | os.PathLike[str], write: Callable[[Path], None]) -> Path:
+    """Build a folder with ``write(tmp)`` and move it into place at ``out``.
+
+    The folder is built in a temporary sibling of ``out``; then an existing ``out`` is
+    renamed aside, the new folder renamed in, and the old one deleted. If ``write``
+    raises, the temporary folder is removed and an existing ``out`` is left untouched.
+    """
+    out = Path(out).resolve()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.new-", dir=out.parent))
+    mask = os.umask(0)
+    os.umask(mask)
+    os.chmod(tmp, 0o777 & ~mask)  # mkdtemp makes 0700; a report folder is normally shared
+    try:
+        write(tmp)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    old: Path | None = None
+    if out.exists():
+        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
+        old.rmdir()
+        os.replace(out, old)
+    try:
+        os.replace(tmp, out)
+    except BaseException:
+        if old is not None:
+            os.replace(old, out)
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+    return out
+
+
+def write_report(
+    out: str | os.PathLike[str],
+    results: Mapping[str, Any],
+    html_text: str,
+) -> Path:
+    """Write ``index.html``, ``results.json`` and ``tables/*.csv`` atomically into ``out``."""
+    payload = json.dumps(jsonable(results), indent=1, allow_nan=False)
+    csvs = tables_csv(results)
+
+    def _write(d: Path) -> None:
+        (d / "index.html").write_text(html_text, encoding="utf-8")
+        (d / "results.json").write_text(payload, encoding="utf-8")
+        (d / "tables").mkdir()
+        for tid, text in csvs.items():
+            (d / "tables" / f"{tid}.csv").write_text(text, encoding="utf-8")
+
+    return atomic_dir(out, _write)

@@ -1,0 +1,418 @@
+"""Figures of the report: matplotlib (Agg backend), returned as base64 PNG data URIs.
+
+Every function takes plain arrays and labels (never file text into code paths other than
+labels, which matplotlib draws as text), labels its axes with units, and returns a
+``data:image/png;base64,...`` string. Figures are closed after rendering.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+__all__ = [
+    "save_trace_maps_png",
+    "compare_models_figure",
+    "hemispherical_figure",
+    "polar_maps_figure",
+    "scan_figure",
+    "spectra_figure",
+    "spectrum_figure",
+    "to_uri",
+    "xy_figure",
+]
+
+DPI = 80
+_MARKERS = ("s", "^", "v", "o", "D", "P", "X")
+_COLOURS = ("C0", "C1", "C2", "C3", "C4", "C5", "C6")
+
+
+def to_uri(fig: Figure, dpi: int = DPI) -> str:
+    """Render ``fig`` to PNG and return it as a data URI; the figure is closed."""
+    buf = io.BytesIO()
+    try:
+        fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+    finally:
+        plt.close(fig)
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _text(s: Any) -> str:
+    # matplotlib mathtext interprets $...$: show file text literally
+    return str(s).replace("$", r"\$")
+
+
+def scan_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
+    """Measured points and model curves per incidence angle, with residuals (Figs. 2-3 style).
+
+    Parameters
+    ----------
+    panels : sequence of mappings
+        One per wavelength: ``{"label": str, "series": [{"theta_i": float,
+        "theta_r": array [deg], "value": array [sr^-1], "sigma": array or None,
+        "curve_theta_r": array [deg], "curves": {model_name: array [sr^-1]},
+        "residual": {model_name: array [%]}}]}``.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    str
+        PNG data URI.
+    """
+    n = max(1, len(panels))
+    fig, axes = plt.subplots(
+        2, n, figsize=(3.3 * n, 5.4), squeeze=False, gridspec_kw={"height_ratios": [3, 1.4]}
+    )
+    for j, panel in enumerate(panels):
+        ax, axr = axes[0, j], axes[1, j]
+        for k, s in enumerate(panel["series"]):
+            c = _COLOURS[k % len(_COLOURS)]
+            m = _MARKERS[k % len(_MARKERS)]
+            lab = f"{s['theta_i']:g}\u00b0"
+            sig = s.get("sigma")
+            ax.errorbar(
+                s["theta_r"],
+                s["value"],
+                yerr=sig,
+                fmt=m,
+                ms=3.5,
+                color=c,
+                mfc="none",
+                lw=0.8,
+                alpha=0.6,
+                zorder=1,
+                label=f"measured {lab}",
+            )
+            for q, (name, curve) in enumerate(s.get("curves", {}).items()):
+                ax.plot(
+                    s["curve_theta_r"],
+                    curve,
+                    ls=("-", "--", ":")[q % 3],
+                    lw=1.4,
+                    zorder=3,
+                    color="k" if q else c,
+                    label=f"{name} {lab}",
+                )
+            for q, (name, res) in enumerate(s.get("residual", {}).items()):
+                axr.plot(s["theta_r"], res, m, color=c, ms=3, mfc="none" if q else c, label=name)
+        ax.set_title(_text(panel["label"]), fontsize=10)
+        ax.set_xlabel(r"$\theta_r$ [deg]")
+        axr.set_xlabel(r"$\theta_r$ [deg]")
+        axr.axhline(0.0, color="0.4", lw=0.6)
+        if j == 0:
+            ax.set_ylabel(r"BRDF [sr$^{-1}$]")
+            axr.set_ylabel("residual [%]")
+        ax.grid(alpha=0.3)
+        axr.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=6.5, loc="best")
+    if title:
+        fig.suptitle(_text(title), fontsize=11)
+    fig.tight_layout()
+    return to_uri(fig)
+
+
+def spectra_figure(
+    params: Sequence[str],
+    units: Mapping[str, str],
+    series: Sequence[Mapping[str, Any]],
+    title: str = "",
+) -> str:
+    """Fitted parameters against wavelength with 95 % error bars.
+
+    Parameters
+    ----------
+    params : sequence of str
+        Parameter names, one panel each.
+    units : mapping
+        Parameter -> unit label.
+    series : sequence of mappings
+        ``{"label": str, "wavelength": array [nm], "values": {p: array},
+        "lo": {p: array}, "hi": {p: array}, "style": "fit" | "published"}``.
+    """
+    n = max(1, len(params))
+    fig, axes = plt.subplots(1, n, figsize=(3.4 * n, 3.2), squeeze=False)
+    for j, p in enumerate(params):
+        ax = axes[0, j]
+        for k, s in enumerate(series):
+            wl = np.asarray(s["wavelength"], float)
+            v = np.asarray(s["values"][p], float)
+            if s.get("style") == "published":
+                ax.plot(wl, v, "k*", ms=7, label=_text(s["label"]))
+                continue
+            lo = s.get("lo", {}).get(p)
+            hi = s.get("hi", {}).get(p)
+            yerr = None
+            if lo is not None and hi is not None:
+                lo = np.asarray(lo, float)
+                hi = np.asarray(hi, float)
+                ok = np.isfinite(lo) & np.isfinite(hi)
+                yerr = np.where(ok, np.vstack([v - lo, hi - v]), 0.0)
+                yerr = np.clip(yerr, 0.0, None)
+            ax.errorbar(
+                wl,
+                v,
+                yerr=yerr,
+                fmt=_MARKERS[k % 7] + "-",
+                color=_COLOURS[k % 7],
+                ms=4,
+                mfc="none",
+                capsize=2,
+                lw=0.9,
+                label=_text(s["label"]),
+            )
+        ax.set_xlabel("wavelength [nm]")
+        ax.set_ylabel(f"{p} [{units.get(p, '1')}]")
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=7)
+    if title:
+        fig.suptitle(_text(title), fontsize=11)
+    fig.tight_layout()
+    return to_uri(fig)
+
+
+def compare_models_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
+    """Measured BRDF against two fitted models at one incidence angle (Fig. 4 style).
+
+    ``panels``: ``{"label", "theta_r" [deg], "value" [sr^-1], "curve_theta_r" [deg],
+    "curves": {name: array}}``.
+    """
+    n = max(1, len(panels))
+    fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.2), squeeze=False)
+    for j, p in enumerate(panels):
+        ax = axes[0, j]
+        ax.plot(p["theta_r"], p["value"], "*", color="0.15", ms=6, label="measured")
+        for q, (name, curve) in enumerate(p["curves"].items()):
+            ax.plot(
+                p["curve_theta_r"],
+                curve,
+                ("-s", "--v", ":o")[q % 3],
+                ms=3,
+                markevery=10,
+                color=_COLOURS[q + 1],
+                lw=1.2,
+                label=_text(name),
+            )
+        ax.set_title(_text(p["label"]), fontsize=10)
+        ax.set_xlabel(r"$\theta_r$ [deg]")
+        if j == 0:
+            ax.set_ylabel(r"BRDF [sr$^{-1}$]")
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=7)
+    if title:
+        fig.suptitle(_text(title), fontsize=11)
+    fig.tight_layout()
+    return to_uri(fig)
+
+
+def hemispherical_figure(
+    measured: Mapping[str, Any] | None,
+    points: Sequence[Mapping[str, Any]],
+    title: str = "",
+) -> str:
+    """Hemispherical reflectance [%] against wavelength: spectrophotometer and integrals.
+
+    ``measured``: ``{"label", "wavelength" [nm], "value" [fraction]}`` or None;
+    ``points``: ``{"label", "wavelength", "value" [fraction], "marker"}``.
+    """
+    fig, ax = plt.subplots(figsize=(6.2, 3.8))
+    if measured is not None:
+        ax.plot(
+            measured["wavelength"],
+            100 * np.asarray(measured["value"], float),
+            "-",
+            color="0.3",
+            lw=1.2,
+            label=_text(measured["label"]),
+        )
+    for k, p in enumerate(points):
+        ax.plot(
+            p["wavelength"],
+            100 * np.asarray(p["value"], float),
+            p.get("marker", _MARKERS[k % 7]),
+            ms=6,
+            mfc="none",
+            color=p.get("color", _COLOURS[k % 7]),
+            label=_text(p["label"]),
+        )
+    ax.set_xlabel("wavelength [nm]")
+    ax.set_ylabel("hemispherical reflectance [%]")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    if title:
+        ax.set_title(_text(title), fontsize=10)
+    fig.tight_layout()
+    return to_uri(fig)
+
+
+def spectrum_figure(
+    wavelength: Any,
+    value: Any,
+    used_wavelength: Any,
+    used_value: Any,
+    title: str = "",
+    ylabel: str = "reflectance [%]",
+) -> str:
+    """A measured spectrum (points) and the spectrum used after inter/extrapolation (line)."""
+    fig, ax = plt.subplots(figsize=(6.2, 3.4))
+    ax.plot(
+        used_wavelength,
+        100 * np.asarray(used_value, float),
+        "-",
+        color="C0",
+        lw=1.2,
+        label="used (interpolated / extrapolated)",
+    )
+    ax.plot(wavelength, 100 * np.asarray(value, float), "o", color="k", ms=4, label="measured")
+    ax.set_xlabel("wavelength [nm]")
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    if title:
+        ax.set_title(_text(title), fontsize=10)
+    fig.tight_layout()
+    return to_uri(fig)
+
+
+def xy_figure(
+    series: Sequence[Mapping[str, Any]],
+    xlabel: str,
+    ylabel: str,
+    title: str = "",
+    logy: bool = False,
+) -> str:
+    """Generic lines/points: ``{"x", "y", "label", "style"}`` per series."""
+    fig, ax = plt.subplots(figsize=(6.2, 3.6))
+    for k, s in enumerate(series):
+        ax.plot(
+            s["x"],
+            s["y"],
+            s.get("style", "-"),
+            color=s.get("color", _COLOURS[k % 7]),
+            ms=3.5,
+            mfc="none",
+            lw=1.1,
+            label=_text(s["label"]),
+        )
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    if logy:
+        ax.set_yscale("log")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    if title:
+        ax.set_title(_text(title), fontsize=10)
+    fig.tight_layout()
+    return to_uri(fig)
+
+
+def polar_maps_figure(
+    labels: Sequence[str],
+    s0: Sequence[np.ndarray],
+    dop: Sequence[np.ndarray],
+    theta_edges_deg: np.ndarray,
+    phi_edges_deg: np.ndarray,
+    title: str = "",
+    s0_max: Sequence[float | None] | None = None,
+) -> str:
+    """Hemisphere maps of S0 and DOP, one column per case (2022 paper Figs. 7-14 style).
+
+    Polar axes: azimuth = phi_r (outward, source at 0, specular half-plane at 180 deg),
+    radius = theta_r [deg]. S0 is the pBRDF element M00 [sr^-1] for unpolarized input
+    (shared colour scale per row is NOT used: each case gets its own, the paper's way);
+    DOP is dimensionless in [0, 1].
+
+    Parameters
+    ----------
+    labels : sequence of str
+    s0, dop : sequence of (n_theta, n_phi) arrays
+    theta_edges_deg : (n_theta + 1,) array
+    phi_edges_deg : (n_phi + 1,) array
+    title : str
+    s0_max : sequence of float or None, optional
+        Upper end of each S0 colour scale (e.g. ignoring bins with few rays).
+    """
+    n = max(1, len(labels))
+    fig, axes = plt.subplots(
+        2, n, figsize=(3.3 * n, 6.6), subplot_kw={"projection": "polar"}, squeeze=False
+    )
+    ph = np.deg2rad(np.asarray(phi_edges_deg, float))
+    th = np.asarray(theta_edges_deg, float)
+    P, T = np.meshgrid(ph, th)
+    for j in range(len(labels)):
+        for i, (data, name, cmap, lim) in enumerate(
+            (
+                (s0[j], r"$S_0$ [sr$^{-1}$]", "inferno", None),
+                (dop[j], "DOP [1]", "viridis", (0.0, 1.0)),
+            )
+        ):
+            ax = axes[i, j]
+            z = np.ma.masked_invalid(np.asarray(data, float))
+            kw = {} if lim is None else {"vmin": lim[0], "vmax": lim[1]}
+            if i == 0 and s0_max is not None and s0_max[j] is not None:
+                kw = {"vmin": 0.0, "vmax": s0_max[j]}
+            mesh = ax.pcolormesh(P, T, z, cmap=cmap, shading="flat", **kw)
+            ax.set_ylim(0, th[-1])
+            ax.set_yticks([30, 60, 90])
+            ax.set_yticklabels(["30\u00b0", "60\u00b0", "90\u00b0"], fontsize=6, color="w")
+            ax.tick_params(axis="x", labelsize=6)
+            ax.set_title(f"{_text(labels[j])}\n{name}", fontsize=8)
+            cb = fig.colorbar(mesh, ax=ax, shrink=0.7, pad=0.1)
+            cb.ax.tick_params(labelsize=6)
+    fig.text(
+        0.01,
+        0.01,
+        r"angle: $\varphi_r$ [deg] (specular at 180); radius: "
+        r"$\theta_r$ [deg]",
+        fontsize=7,
+    )
+    if title:
+        fig.suptitle(_text(title), fontsize=11)
+    fig.tight_layout()
+    return to_uri(fig)
+
+
+def save_trace_maps_png(result: Any, path: str | Any, stokes_in: Any = (1, 0, 0, 0)) -> Any:
+    """Write the S0 and DOP hemisphere maps of one tracer result to a PNG file.
+
+    Parameters
+    ----------
+    result : labbrdf.tracer.TraceResult
+        Needs ``mueller`` (n_theta, n_phi, 4, 4) [sr^-1] and the bin edges [deg].
+    path : path-like
+        Output ``.png``.
+    stokes_in : sequence of 4 floats
+        Input Stokes vector (default unpolarized).
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from pathlib import Path
+
+    m = np.asarray(result.mueller, float)
+    s = m @ np.asarray(stokes_in, float)
+    s0 = s[..., 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dop = np.where(s0 > 0, np.sqrt(np.sum(s[..., 1:] ** 2, axis=-1)) / s0, np.nan)
+    uri = polar_maps_figure(
+        ["tracer"],
+        [s0],
+        [dop],
+        np.asarray(result.theta_r_edges_deg, float),
+        np.asarray(result.phi_r_edges_deg, float),
+        title=f"input Stokes {list(stokes_in)}",
+    )
+    p = Path(path)
+    p.write_bytes(base64.b64decode(uri.split(",", 1)[1]))
+    return p

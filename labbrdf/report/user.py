@@ -1,0 +1,120 @@
+"""``labbrdf report DATA... --model NAME -o DIR``: the report for a user's own files.
+
+The same kind of page as the validation report: what was ingested, the fits (per sample and
+wavelength, with uncertainties, intervals, flags and RMSE), measured points with the model
+curves and residuals, parameter spectra, energy and reciprocity of every fit, and the sample
+colour when spectrophotometer reflectance is among the files.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from . import figure_sections, html, properties, sections
+from ._common import Builder, write_report
+
+__all__ = ["user_report"]
+
+
+def user_report(
+    paths: Sequence[str | os.PathLike[str]],
+    model: str,
+    out: str | os.PathLike[str],
+    *,
+    options: Mapping[str, Any] | None = None,
+    method: str = sections.METHOD,
+    seed: int = 0,
+    progress: bool = True,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    title: str | None = None,
+    **kw: Any,
+) -> int:
+    """Build a report for the given files and write it (atomically) to ``out``.
+
+    Parameters
+    ----------
+    paths : sequence of path-like
+        Instrument export files (any format :func:`labbrdf.read` knows).
+    model : str
+        Registry name of the model to fit (``smooth3``, ``five_param``, ``microfacet``).
+    out : path-like
+        Output folder (``index.html``, ``results.json``, ``tables/*.csv``).
+    options : mapping, optional
+        Model options, e.g. ``{"shadowing": "mb"}`` for five_param.
+    method, seed :
+        Optimiser (nlopt names joined by ``+``) and seed, as for :func:`labbrdf.fit`.
+    progress : bool
+        Progress lines on stderr.
+    scheduler, workers :
+        Executor for the fits (:mod:`labbrdf.parallel`); None runs in this process.
+    title : str, optional
+        Page title.
+    **kw :
+        ``quick`` is accepted for symmetry with :func:`~labbrdf.report.validate` (no effect).
+
+    Returns
+    -------
+    int
+        0 when every check passed or was skipped, 1 when one failed (e.g. a file that
+        cannot be read).
+
+    Raises
+    ------
+    ValueError
+        No paths, or an unknown model name or option (before anything is written).
+    """
+    from labbrdf import models
+
+    unknown = set(kw) - {"quick"}
+    if unknown:
+        raise TypeError(f"user_report() got unexpected keyword argument(s) {sorted(unknown)}")
+    paths = [Path(p) for p in ([paths] if isinstance(paths, (str, os.PathLike)) else paths)]
+    if not paths:
+        raise ValueError("paths: expected at least one data file")
+    opts = dict(options or {})
+    try:
+        models.get(model, **opts)
+    except Exception as exc:
+        raise ValueError(f"model: {exc}") from None
+    import labbrdf
+
+    b = Builder(
+        title or f"labbrdf report: {model} fits",
+        progress=progress,
+        meta={
+            "labbrdf_version": labbrdf.__version__,
+            "mode": "user",
+            "model": model,
+            "options": opts,
+            "method": method,
+            "seed": seed,
+            "files": [str(p) for p in paths],
+        },
+    )
+    ctx = sections.Context(
+        b, scheduler=scheduler, workers=workers, progress=progress, method=method, seed=seed
+    )
+    with b.section("ingest", "Ingested files"):
+        b.text(
+            f"{len(paths)} file(s) given; each was read with labbrdf.read into the common dataset."
+        )
+        sections.ingest(ctx, paths)
+    with b.section("fits", f"Fitted {model} parameters per sample and wavelength"):
+        sections.fits_section(ctx, [(model, opts)])
+    with b.section("scans", "Measured points and model curves"):
+        figure_sections.scans_section(ctx, [model])
+    with b.section("spectra", "Parameter spectra against wavelength"):
+        figure_sections.spectra_section(ctx, model)
+    with b.section("physics", "Energy conservation and reciprocity of every fit"):
+        properties.physics_section(ctx)
+    with b.section("colour", "Sample colour from spectrophotometer reflectance"):
+        properties.colour_section(ctx)
+    code = b.finish()
+    page = html.render(b.results, b.images, b.swatches)
+    write_report(out, b.results, page)
+    b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
+    return code
