@@ -118,6 +118,20 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     return 2 if failures else 0
 
 
+def _short(text: str, width: int = 36) -> str:
+    return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def _quantities_cell(qs: list[str]) -> str:
+    mm = [q for q in qs if q.startswith("mueller_")]
+    rest = [q for q in qs if not q.startswith("mueller_")]
+    if len(mm) > 2:
+        rest.append(f"mueller({len(mm)})")
+    else:
+        rest.extend(mm)
+    return ",".join(rest)
+
+
 def _print_ingest_table(rows: list[dict[str, Any]]) -> None:
     head = ["file", "format", "sample", "quantities", "wavelength_nm", "theta_i_deg", "rows"]
     table = []
@@ -128,8 +142,12 @@ def _print_ingest_table(rows: list[dict[str, Any]]) -> None:
             [
                 Path(r["file"]).name,
                 str(r["format"]),
-                str(r["sample"]),
-                ",".join(r["quantities"]),
+                _short(
+                    str(r["sample"])
+                    if isinstance(r["sample"], str)
+                    else f"{len(r['sample'])} samples: {r['sample'][0]}, ..."
+                ),
+                _quantities_cell(r["quantities"]),
                 f"{wl[0]:.6g}-{wl[1]:.6g}",
                 ",".join(f"{t:g}" for t in th[:8]) + (",..." if len(th) > 8 else "") or "-",
                 str(r["rows"]),

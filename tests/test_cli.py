@@ -123,3 +123,26 @@ def test_formats_json(capsys):
     assert main(["formats", "--json"]) == 0
     names = [f["name"] for f in json.loads(capsys.readouterr().out)]
     assert "labbrdf-parquet" in names
+
+
+def test_dataset_csv_is_read_without_format(dataset_files, tmp_path, capsys):
+    # .csv is shared by Cary, the labbrdf scan layouts and labbrdf datasets: the sniffer decides
+    out = tmp_path / "all.csv"
+    assert main(["ingest", *map(str, dataset_files), "-o", str(out)]) == 0
+    capsys.readouterr()
+    assert main(["ingest", str(out), "--json"]) == 0
+    (obj,) = json.loads(capsys.readouterr().out)
+    assert obj["format"] == "labbrdf-dataset-csv"
+    assert obj["rows"] == 10
+
+
+def test_every_real_export_reads_through_one_entry_point(real_exports):
+    """Issue 3: all 29 real files read by labbrdf.read without naming the format."""
+    import labbrdf
+
+    files = sorted(p for p in real_exports.rglob("*") if p.is_file() and p.name != "PROVENANCE.md")
+    assert len(files) == 29
+    for p in files:
+        m = labbrdf.read(p)
+        assert len(m) > 0, p
+        assert m.meta["format"] != "labbrdf-dataset-csv", p

@@ -40,12 +40,7 @@ _MODULES = (
 #: name -> Format
 READERS: dict[str, Format] = {}
 for _mod in _MODULES:
-    try:
-        _m = importlib.import_module(f"{__name__}.{_mod}")
-    except ModuleNotFoundError as _exc:  # TODO(integration): drop once every module exists
-        if _exc.name != f"{__name__}.{_mod}":
-            raise
-        continue
+    _m = importlib.import_module(f"{__name__}.{_mod}")
     for _f in _m.FORMATS:
         if _f.name in READERS:
             raise RuntimeError(f"duplicate adapter name {_f.name!r}")

@@ -6,6 +6,7 @@ Adapters import only :mod:`labbrdf.dataset` and this module.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -107,9 +108,9 @@ def decode(
             return raw.decode(enc), enc
         except UnicodeDecodeError:
             continue
-    # report where the first undecodable byte is
+    # report where the last encoding tried (the most permissive) fails
     try:
-        raw.decode(encodings[0])
+        raw.decode(encodings[-1])
     except UnicodeDecodeError as exc:
         line = raw[: exc.start].count(b"\n") + 1
         raise AdapterError(
@@ -118,6 +119,16 @@ def decode(
     raise AdapterError(path, "cannot be decoded")  # pragma: no cover
 
 
+_EOL = re.compile(r"\r\n|\n|\r")
+
+
 def split_lines(text: str) -> list[str]:
-    """Split on CRLF, LF or CR; a missing final newline is fine."""
-    return text.splitlines()
+    """Split on CRLF, LF or CR only; a missing final newline is fine.
+
+    Unlike :meth:`str.splitlines` this does not break at form feeds, vertical tabs or
+    Unicode line separators, which can occur inside a field of a real export.
+    """
+    lines = _EOL.split(text)
+    if lines and lines[-1] == "":
+        lines.pop()
+    return lines

@@ -51,7 +51,7 @@ FORMATS = (
     Format(
         "labbrdf-dataset-csv",
         "labbrdf dataset (CSV with a '# labbrdf-meta:' first line)",
-        (),
+        (".csv",),
         _sniff_csv,
         read_dataset_csv,
     ),

@@ -1,0 +1,234 @@
+"""Mutation fuzzing of every adapter over every real export, and "reading never writes".
+
+For each format in ``labbrdf.adapters.READERS`` with real files in ../shared/real-exports
+(the format of a file is the one ``labbrdf.read`` dispatches it to), Hypothesis mutates the
+file's bytes and reads the result with that format forced. Mutations:
+
+``truncate``  keep the first k bytes, 0 <= k < size;
+``delete``    remove one line (lines split at CR, LF, CRLF, endings kept);
+``duplicate`` repeat one line;
+``flip``      overwrite 1-4 random bytes with random values;
+``insert``    insert a garbage token (``NaN``, ``1e999``, ``,``, TAB, CRLF, NUL, ``##``, ...).
+
+Contract checked on every example (n = rows + ``meta["dropped_points"]``, i.e. the points
+the reader found, kept or dropped as missing; n0 the same for the unmutated file):
+
+1. Nothing but :class:`~labbrdf.adapters.AdapterError` is ever raised (no IndexError,
+   struct.error, UnicodeDecodeError, DatasetError, RuntimeWarning ...).
+2. No wrong row count comes back silently:
+
+   * ``COUNTED`` formats, whose files state their point count (JASCO text and binary,
+     PerkinElmer, JCAMP-DX, SPC) or whose reader checks the wavelength steps against the
+     instrument's data interval (Cary): every mutation either raises or gives n == n0.
+     One documented exception: deleting the first or last data row of a Cary sample leaves
+     a shorter but consistent scan (as real scans stopped early are, ``filters.csv``
+     sample 600LP1), so for Cary ``delete`` the bound is n0 - k <= n <= n0 with k the
+     numbers on the deleted line.
+   * other formats (no declared count): a truncated file never yields more points than
+     the whole file, n <= n0.
+
+Examples are bounded (``EXAMPLES`` per file, derandomized, no example database), so the
+run is reproducible and takes well under a minute.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import shutil
+import tempfile
+from pathlib import Path
+
+import pytest
+
+hypothesis = pytest.importorskip("hypothesis")
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+import labbrdf  # noqa: E402
+from labbrdf.adapters import READERS, AdapterError, sniff  # noqa: E402
+
+COUNTED = {
+    "jasco-spectramanager-text",
+    "jasco-jws",
+    "perkinelmer-uvwinlab-asc",
+    "jcamp-dx",
+    "galactic-spc",
+    "agilent-cary-winuv-csv",
+}
+EXAMPLES = 30
+GARBAGE = [
+    b"NaN", b"nan", b"inf", b"-inf", b"1e999", b"-", b"+", b".", b",", b";", b"\t", b" ",
+    b"\r\n", b"\n", b"\r", b"#", b"##", b"?", b"\x00", b"\xff\xfe", b"\xe9", b"\x85",
+    b"0", b"9999", b"abc", b"##END=", b"#DATA", b"XYDATA", b"\x0c",
+]  # fmt: skip
+_NUMBER = re.compile(rb"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def _real_files(real_exports: Path) -> list[Path]:
+    return sorted(p for p in real_exports.glob("*/*") if p.is_file() and p.suffix != ".md")
+
+
+def _format_of(path: Path) -> str | None:
+    """The format ``labbrdf.read`` dispatches the file to (None when ambiguous or unknown)."""
+    name = path.name.lower()
+    by_ext = [n for n, f in READERS.items() if any(name.endswith(e) for e in f.extensions)]
+    if len(by_ext) == 1:
+        return by_ext[0]
+    claimed = sniff(path)
+    pool = [n for n in claimed if n in by_ext] if by_ext else claimed
+    return pool[0] if len(pool) == 1 else None
+
+
+def _points(m: labbrdf.Measurement) -> int:
+    return len(m) + int(m.meta.get("dropped_points", 0) or 0)
+
+
+def _mutate(raw: bytes, data: st.DataObject) -> tuple[str, bytes, int]:
+    """A mutated copy of ``raw``, the operation, and k (numbers on a deleted line)."""
+    op = data.draw(st.sampled_from(["truncate", "delete", "duplicate", "flip", "insert"]))
+    if op == "truncate":
+        return op, raw[: data.draw(st.integers(0, len(raw) - 1))], 0
+    if op in ("delete", "duplicate"):
+        lines = raw.splitlines(keepends=True)
+        i = data.draw(st.integers(0, len(lines) - 1))
+        k = len(_NUMBER.findall(lines[i]))
+        new = lines[:i] + lines[i + 1 :] if op == "delete" else lines[: i + 1] + lines[i:]
+        return op, b"".join(new), k
+    buf = bytearray(raw)
+    if op == "flip":
+        for _ in range(data.draw(st.integers(1, 4))):
+            buf[data.draw(st.integers(0, len(buf) - 1))] = data.draw(st.integers(0, 255))
+        return op, bytes(buf), 0
+    at = data.draw(st.integers(0, len(buf)))
+    return op, bytes(buf[:at] + data.draw(st.sampled_from(GARBAGE)) + buf[at:]), 0
+
+
+def _check(fmt: str, op: str, k: int, n0: int, m: labbrdf.Measurement) -> None:
+    n = _points(m)
+    if fmt in COUNTED:
+        if fmt == "agilent-cary-winuv-csv" and op == "delete":
+            assert n0 - k <= n <= n0, f"{op}: {n} points, expected {n0 - k}..{n0}"
+        else:
+            assert n == n0, f"{op}: {n} points read silently, the file has {n0}"
+    elif op == "truncate":
+        assert n <= n0, f"truncation gave {n} points, more than the whole file's {n0}"
+
+
+def _fuzz_file(fmt: str, raw: bytes, n0: int, target: Path) -> None:
+    reader = READERS[fmt].read
+
+    @settings(
+        max_examples=EXAMPLES,
+        deadline=None,
+        derandomize=True,
+        database=None,
+        suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+    )
+    @given(data=st.data())
+    def run(data: st.DataObject) -> None:
+        op, mutated, k = _mutate(raw, data)
+        target.write_bytes(mutated)
+        try:
+            m = reader(target)
+        except AdapterError as exc:
+            assert str(target) in str(exc), f"the error does not name the file: {exc}"
+            return
+        assert set(m.data["source"]) == {target.name}
+        _check(fmt, op, k, n0, m)
+
+    run()
+
+
+@pytest.mark.parametrize("fmt", sorted(READERS))
+def test_mutated_real_files_raise_adaptererror_or_keep_their_count(
+    real_exports: Path, fmt: str
+) -> None:
+    files = [p for p in _real_files(real_exports) if _format_of(p) == fmt]
+    if not files:
+        pytest.skip(f"no real export of {fmt}")
+    with tempfile.TemporaryDirectory() as tmp:
+        for path in files:
+            n0 = _points(READERS[fmt].read(path))
+            _fuzz_file(fmt, path.read_bytes(), n0, Path(tmp) / path.name)
+
+
+#: synthetic files of labbrdf's own CSV layouts (no real export exists), one row per line
+_OWN = {
+    "labbrdf-specular-scan": "# labbrdf specular-scan v1\r\n# sample: M1\r\n# quantity: brdf\r\n"
+    "wavelength_nm,theta_i_deg,theta_r_deg,value,sigma\r\n"
+    + "".join(f"632.8,45,{t},{0.5 + t},0.01\r\n" for t in range(-20, 70, 5)),
+    "labbrdf-hemispherical-reflectance": "# labbrdf hemispherical-reflectance v1\n# unit: %\n"
+    "# theta_i_deg: 8\nwavelength_nm,value,sigma\n"
+    + "".join(f"{wl},{wl / 50:.3f},\n" for wl in range(300, 1300, 50)),
+}
+
+
+@pytest.mark.parametrize("fmt", sorted(_OWN))
+def test_mutated_own_csv_files_raise_adaptererror_or_lose_only_the_touched_rows(
+    tmp_path: Path, fmt: str
+) -> None:
+    """One data row per line: a truncated file gives exactly its remaining data lines (the
+    last one possibly cut short but still numeric), a deleted line costs at most one row, a
+    duplicated line adds at most one; ``#`` inserted or flipped in at a line start comments
+    a row out, so a flip or an insertion may lose rows (one per changed byte) but never
+    add one."""
+    raw = _OWN[fmt].encode()
+    src = tmp_path / "orig.csv"
+    src.write_bytes(raw)
+    n0 = _points(READERS[fmt].read(src))
+    assert n0 == 18 if fmt == "labbrdf-specular-scan" else n0 == 20
+    target = tmp_path / "mutated.csv"
+
+    @settings(max_examples=60, deadline=None, derandomize=True, database=None)
+    @given(data=st.data())
+    def run(data: st.DataObject) -> None:
+        op, mutated, _ = _mutate(raw, data)
+        target.write_bytes(mutated)
+        try:
+            m = READERS[fmt].read(target)
+        except AdapterError as exc:
+            assert str(target) in str(exc)
+            return
+        n = _points(m)
+        if op == "truncate":  # exactly the data lines kept, the last one maybe partial
+            lines = mutated.splitlines()
+            head = next(i for i, ln in enumerate(lines) if ln.startswith(b"wavelength_nm"))
+            low = high = sum(1 for ln in lines[head + 1 :] if ln.strip())
+        else:
+            low, high = {"delete": (n0 - 1, n0), "duplicate": (n0, n0 + 1)}.get(op, (n0 - 4, n0))
+        assert low <= n <= high, f"{op}: {n} points from a file of {n0}"
+
+    run()
+
+
+def _snapshot(root: Path) -> dict[str, tuple[int, int, str]]:
+    out = {}
+    for dirpath, dirnames, filenames in os.walk(root):
+        for name in dirnames + filenames:
+            p = Path(dirpath) / name
+            st_ = p.stat()
+            digest = hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else "dir"
+            out[str(p.relative_to(root))] = (st_.st_size, st_.st_mtime_ns, digest)
+    return out
+
+
+def test_reading_never_writes(real_exports: Path, tmp_path: Path, monkeypatch) -> None:
+    """Read every export from a writable copy: no file appears, changes or is touched."""
+    copy = tmp_path / "exports"
+    for p in _real_files(real_exports):
+        (copy / p.parent.name).mkdir(parents=True, exist_ok=True)
+        shutil.copy2(p, copy / p.parent.name / p.name)
+    work = tmp_path / "cwd"
+    work.mkdir()
+    monkeypatch.chdir(work)  # nothing may land in the working directory either
+    before = _snapshot(tmp_path)
+    read = 0
+    for p in _real_files(copy):
+        if _format_of(p) is None:
+            continue
+        labbrdf.read(p)
+        read += 1
+    assert read > 0
+    assert _snapshot(tmp_path) == before
