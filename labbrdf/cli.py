@@ -24,14 +24,21 @@ class UsageError(Exception):
     """A command-line input error: printed, exit code 2."""
 
 
-def _emit_json(obj: Any) -> None:
-    print(json.dumps(obj, indent=2, allow_nan=False))
-
-
-def _finite_or_none(x: Any) -> Any:
+def _json_safe(x: Any) -> Any:
+    """NaN/inf -> None (JSON null), recursively; numpy scalars -> Python numbers."""
+    if isinstance(x, dict):
+        return {k: _json_safe(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_json_safe(v) for v in x]
+    if hasattr(x, "item") and not isinstance(x, str | bytes):
+        x = x.item()
     if isinstance(x, float) and not math.isfinite(x):
         return None
     return x
+
+
+def _emit_json(obj: Any) -> None:
+    print(json.dumps(_json_safe(obj), indent=2, allow_nan=False))
 
 
 def _parse_assignments(items: Sequence[str] | None, what: str) -> dict[str, float]:
@@ -54,6 +61,18 @@ def _add_scheduler(p: argparse.ArgumentParser) -> None:
         help="serial, processes (default), local (dask LocalCluster) or tcp://host:port",
     )
     p.add_argument("--workers", type=int, default=None, help="worker processes (default: cores)")
+
+
+def _check_executor(args: argparse.Namespace) -> None:
+    """Reject a bad ``--scheduler`` / ``--workers`` before any work is done."""
+    from .parallel import check_scheduler
+
+    try:
+        check_scheduler(args.scheduler)
+    except ValueError as exc:
+        raise UsageError(f"--scheduler: {exc}") from None
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers must be >= 1, got {args.workers}")
 
 
 # ------------------------------------------------------------------------------- ingest
@@ -179,9 +198,8 @@ def cmd_formats(args: argparse.Namespace) -> int:
 def cmd_fit(args: argparse.Namespace) -> int:
     from . import adapters
     from .fit import fit_many
-    from .parallel import check_scheduler
 
-    check_scheduler(args.scheduler)
+    _check_executor(args)
     data = adapters.read_many(args.files)
     fix = _parse_assignments(args.fix, "--fix")
     by = [c.strip() for c in args.by.split(",") if c.strip()]
@@ -267,9 +285,9 @@ def cmd_trace(args: argparse.Namespace) -> int:
     import functools
 
     from . import tracer
-    from .parallel import check_scheduler, imap
+    from .parallel import imap
 
-    check_scheduler(args.scheduler)
+    _check_executor(args)
     sub = _complex(args.substrate, "--substrate")
     kw: dict[str, Any] = {
         "wavelength_nm": args.wavelength,
@@ -329,10 +347,9 @@ def cmd_trace(args: argparse.Namespace) -> int:
 
 
 def cmd_validate(args: argparse.Namespace) -> int:
-    from .parallel import check_scheduler
     from .report import validate
 
-    check_scheduler(args.scheduler)
+    _check_executor(args)
     return int(
         validate(
             out=args.out,

@@ -146,3 +146,158 @@ def test_every_real_export_reads_through_one_entry_point(real_exports):
         m = labbrdf.read(p)
         assert len(m) > 0, p
         assert m.meta["format"] != "labbrdf-dataset-csv", p
+
+
+FIXTURES_SCAN = __import__("pathlib").Path(__file__).resolve().parents[1] / "fixtures/specular"
+
+
+def test_fit_json_has_one_object_per_group(capsys, tmp_path):
+    out = tmp_path / "params.csv"
+    code = main(
+        [
+            "fit",
+            str(FIXTURES_SCAN / "osr_specular.csv"),
+            "--model",
+            "smooth3",
+            "--scheduler",
+            "serial",
+            "--json",
+            "-o",
+            str(out),
+        ]
+    )
+    assert code == 0
+    groups = json.loads(capsys.readouterr().out)
+    assert [g["group"]["wavelength_nm"] for g in groups] == [360.0, 500.0, 550.0, 860.0]
+    g = groups[2]
+    assert set(g) >= {"group", "params", "rmse", "nfev", "success"}
+    assert set(g["params"]) == {"k1", "k2", "k3"}
+    k1 = g["params"]["k1"]
+    assert set(k1) == {"value", "stderr", "ci95", "at_bound"}
+    # the fixture was generated from Table 1 (OSR 550 nm: k1 = 1.0150)
+    assert k1["ci95"][0] <= 1.0150 <= k1["ci95"][1]
+    import pandas as pd
+
+    assert len(pd.read_csv(out)) == 4
+
+
+def test_fit_fix_and_bad_names(capsys):
+    scan = str(FIXTURES_SCAN / "osr_specular.csv")
+    assert (
+        main(
+            ["fit", scan, "--model", "smooth3", "--scheduler", "serial", "--fix", "k2=0", "--json"]
+        )
+        == 0
+    )
+    groups = json.loads(capsys.readouterr().out)
+    assert all(g["params"]["k2"]["value"] == 0.0 for g in groups)
+    assert main(["fit", scan, "--model", "nope", "--scheduler", "serial"]) == 2
+    assert "unknown model 'nope'" in capsys.readouterr().err
+    assert main(["fit", scan, "--model", "smooth3", "--method", "GN_NOPE"]) == 2
+    assert "GN_CRS2_LM" in capsys.readouterr().err  # lists the valid names
+    assert main(["fit", scan, "--model", "smooth3", "--fix", "k2"]) == 2
+    assert "expected NAME=VALUE" in capsys.readouterr().err
+    assert main(["fit", scan, "--model", "smooth3", "--scheduler", "gpu"]) == 2
+    assert "unknown scheduler" in capsys.readouterr().err
+
+
+def test_hemispherical_json_matches_notes_table(capsys):
+    # notes/models.md 1.2: OSR 550 nm published fit, rho = 57.0607 % at 45 deg, 58.9843 % at 46
+    code = main(
+        [
+            "hemispherical",
+            "--model",
+            "smooth3",
+            "--param",
+            "k1=1.0150",
+            "--param",
+            "k2=-0.01660",
+            "--param",
+            "k3=0.4176",
+            "--theta-i",
+            "45",
+            "46",
+            "--json",
+        ]
+    )
+    assert code == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["theta_i_deg"] for r in rows] == [45.0, 46.0]
+    assert abs(rows[0]["rho"] - 0.570607) < 5e-7
+    assert abs(rows[1]["rho"] - 0.589843) < 5e-7
+
+
+def test_hemispherical_unknown_parameter(capsys):
+    assert main(["hemispherical", "--model", "smooth3", "--param", "k9=1", "--theta-i", "45"]) == 2
+    assert "k9" in capsys.readouterr().err
+
+
+def test_trace_json_and_npz(tmp_path, capsys):
+    out = tmp_path / "al.npz"
+    code = main(
+        [
+            "trace",
+            "--substrate",
+            "1.55+7.71j",
+            "--alpha",
+            "0.2",
+            "--theta-i",
+            "45",
+            "--wavelength",
+            "650",
+            "--rays",
+            "20000",
+            "--seed",
+            "1",
+            "--scheduler",
+            "serial",
+            "--single-scattering",
+            "-o",
+            str(out),
+            "--json",
+        ]
+    )
+    assert code == 0
+    s = json.loads(capsys.readouterr().out)
+    assert {"albedo", "energy", "rays", "seconds"} <= set(s)
+    e = s["energy"]
+    assert abs(e["exited"] + e["absorbed"] + e["terminated"] - 1.0) < 1e-12
+    assert s["rays"] == 20000
+    # single-scattering Al albedo at 45 deg, alpha 0.2 (oracles: ~0.85); loose physical bound
+    assert 0.7 < s["albedo"] < 0.95
+    import numpy as np
+
+    d = np.load(out)
+    assert d["mueller"].shape == (91, 360, 4, 4)
+    assert d["theta_r_edges_deg"].shape == (92,) and d["phi_r_edges_deg"].shape == (361,)
+
+
+def test_trace_bad_index_and_missing_thickness(capsys):
+    base = ["trace", "--alpha", "0.2", "--theta-i", "45", "--wavelength", "650", "--rays", "10"]
+    assert main([*base, "--substrate", "abc"]) == 2
+    assert "expected a complex index" in capsys.readouterr().err
+    assert main([*base, "--substrate", "1.5+7j", "--coating", "1.5"]) == 2
+    assert "--coating needs --thickness" in capsys.readouterr().err
+    assert main([*base, "--substrate", "1.5+7j", "--thickness", "100"]) == 2
+    assert "need --coating" in capsys.readouterr().err
+
+
+def test_report_command_writes_a_page_for_user_files(tmp_path, capsys):
+    out = tmp_path / "rep"
+    code = main(
+        ["report", str(FIXTURES_SCAN / "osr_specular.csv"), "--model", "smooth3", "-o", str(out)]
+    )
+    assert code == 0
+    html = (out / "index.html").read_text()
+    assert "data:image/png;base64," in html
+    assert json.loads((out / "results.json").read_text())["summary"]["fail"] == 0
+
+
+def test_report_command_records_an_unreadable_file_as_a_failed_check(tmp_path, capsys):
+    bad = tmp_path / "bad.xyz"
+    bad.write_text("x\n")
+    out = tmp_path / "rep"
+    assert main(["report", str(bad), "-o", str(out)]) == 1
+    results = json.loads((out / "results.json").read_text())
+    assert results["summary"]["fail"] == 1 and results["summary"]["pass"] == 0
+    assert "bad.xyz: " in (out / "index.html").read_text()
