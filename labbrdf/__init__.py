@@ -36,7 +36,18 @@ def __getattr__(name: str) -> Any:
     if name in _LAZY:
         mod, attr = _LAZY[name]
         return getattr(importlib.import_module(mod), attr)
-    if name in {"adapters", "dataset", "optics", "models", "fit", "integrate", "tracer",
-                "surface", "parallel", "cli", "report"}:
+    if name in {
+        "adapters",
+        "dataset",
+        "optics",
+        "models",
+        "fit",
+        "integrate",
+        "tracer",
+        "surface",
+        "parallel",
+        "cli",
+        "report",
+    }:
         return importlib.import_module(f"labbrdf.{name}")
     raise AttributeError(f"module 'labbrdf' has no attribute {name!r}")

@@ -29,6 +29,7 @@ def get(name: str, **options: Any) -> Model:
 def names() -> list[str]:
     return sorted(MODELS)
 
+
 from .smooth3 import Smooth3  # noqa: E402
 
 MODELS["smooth3"] = Smooth3
