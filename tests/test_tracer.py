@@ -231,7 +231,9 @@ def test_absorbing_coating_loses_energy_with_thickness_lossless_does_not():
 
 
 def test_same_seed_same_result_whatever_the_chunking():
-    cfg = TraceConfig(rays=9000, block_rays=1000, coating=Coating(), theta_step_deg=2.0)
+    cfg = TraceConfig(
+        rays=9000, block_rays=1000, fold_blocks=2, coating=Coating(), theta_step_deg=2.0
+    )
     a = trace(cfg, blocks_per_unit=1)
     b = trace(cfg, blocks_per_unit=4)
     c = trace(cfg, blocks_per_unit=9)
@@ -243,9 +245,19 @@ def test_same_seed_same_result_whatever_the_chunking():
     assert not np.array_equal(a.sums, d.sums)
 
 
+def test_fold_group_size_changes_only_the_rounding():
+    cfg = TraceConfig(rays=9000, block_rays=1000, fold_blocks=1, theta_step_deg=3.0)
+    a, b = trace(cfg), trace(cfg.replace(fold_blocks=3))
+    # same rays, sums added in another grouping: equal to float64 round-off of ~9 terms
+    np.testing.assert_allclose(a.sums, b.sums, rtol=1e-13, atol=1e-13 * np.abs(a.sums).max())
+    np.testing.assert_array_equal(a.counts, b.counts)
+
+
 def test_same_result_on_two_worker_processes():
     parallel = pytest.importorskip("labbrdf.parallel")
-    cfg = TraceConfig(rays=6000, block_rays=1000, theta_step_deg=3.0, phi_step_deg=3.0)
+    cfg = TraceConfig(
+        rays=6000, block_rays=1000, fold_blocks=1, theta_step_deg=3.0, phi_step_deg=3.0
+    )
     serial = trace(cfg)
     pmap = functools.partial(parallel.imap, scheduler="processes", workers=2)
     par = trace(cfg, map=pmap, blocks_per_unit=2)
@@ -254,12 +266,14 @@ def test_same_result_on_two_worker_processes():
 
 
 def test_out_of_order_map_is_rejected():
-    cfg = TraceConfig(rays=2000, block_rays=1000, theta_step_deg=10.0, phi_step_deg=10.0)
+    cfg = TraceConfig(
+        rays=2000, block_rays=1000, fold_blocks=1, theta_step_deg=10.0, phi_step_deg=10.0
+    )
 
     def backwards(func, items):
         return reversed([func(x) for x in items])
 
-    with pytest.raises(RuntimeError, match="map returned block 1, expected 0"):
+    with pytest.raises(RuntimeError, match="map returned fold group 1, expected 0"):
         trace(cfg, map=backwards)
 
 
@@ -346,7 +360,10 @@ def test_trace_summary_has_the_cli_keys():
 def test_config_json_round_trip():
     cfg = TraceConfig(coating=Coating(k=0.01), substrate=Substrate(alpha=0.3), seed=3)
     assert TraceConfig.from_json(cfg.to_json()) == cfg
-    assert work_units(cfg.replace(rays=100_000), 2)[0][1] == (0, 1)
+    # 100000 rays = 4 blocks = 1 fold group of 4; units hold whole groups
+    assert work_units(cfg.replace(rays=100_000), 2) == [(cfg.replace(rays=100_000), (0,))]
+    one = cfg.replace(rays=100_000, fold_blocks=1)
+    assert work_units(one, 2)[0][1] == (0, 1)
 
 
 # ------------------------------------------------------------------------------ errors

@@ -136,6 +136,12 @@ class TraceConfig:
         not an ideal mirror); the facets use the coating's alpha.
     block_rays : int
         Rays per random-number block (part of the definition of the random streams).
+    fold_blocks : int
+        Consecutive blocks that a worker adds up (in block order) before returning one
+        tally; the driver then adds these group tallies in group order. Part of the
+        definition of the floating-point sum, so the result depends on it (in the last
+        bits) but never on the scheduler, the worker count or the work-unit size. Larger
+        groups send fewer 8.6 MB tallies between processes.
     """
 
     wavelength_nm: float = 650.0
@@ -152,6 +158,7 @@ class TraceConfig:
     phi_step_deg: float = 1.0
     coherent: bool = False
     block_rays: int = 32768
+    fold_blocks: int = 4
 
     def __post_init__(self) -> None:
         if isinstance(self.substrate, dict):
@@ -216,6 +223,12 @@ class TraceConfig:
             self.block_rays,
         )
         _check(
+            isinstance(self.fold_blocks, int) and self.fold_blocks >= 1,
+            "fold_blocks",
+            "an integer >= 1",
+            self.fold_blocks,
+        )
+        _check(
             not self.coherent or self.coating is not None,
             "coherent",
             "False when there is no coating",
@@ -233,6 +246,16 @@ class TraceConfig:
     def n_blocks(self) -> int:
         """Number of random-number blocks."""
         return -(-self.rays // self.block_rays)
+
+    @property
+    def n_groups(self) -> int:
+        """Number of fold groups of ``fold_blocks`` consecutive blocks."""
+        return -(-self.n_blocks // self.fold_blocks)
+
+    def group_blocks(self, group: int) -> range:
+        """Block indices of fold group ``group``."""
+        start = group * self.fold_blocks
+        return range(start, min(start + self.fold_blocks, self.n_blocks))
 
     def block_size(self, block: int) -> int:
         """Rays in block ``block`` (the last one may be short)."""

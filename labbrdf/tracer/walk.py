@@ -58,7 +58,7 @@ from labbrdf.tracer.config import TraceConfig
 from labbrdf.tracer.interfaces import apply_fresnel, fresnel_abcs, rotate_frame, s_axis
 from labbrdf.tracer.sampling import sample_height, sample_vndf, smith_g1, smith_lambda
 
-__all__ = ["BlockTally", "run_unit", "trace_block"]
+__all__ = ["BlockTally", "GroupTally", "run_unit", "trace_block", "trace_group"]
 
 TOP, SUB = 0, 1
 
@@ -365,12 +365,64 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
     )
 
 
-def run_unit(cfg: TraceConfig, blocks: list[int] | tuple[int, ...]) -> list[BlockTally]:
-    """Work unit: trace the listed blocks (picklable, for ``map``)."""
-    return [trace_block(cfg, b) for b in blocks]
+@dataclass
+class GroupTally:
+    """The folded tallies of one fold group of consecutive blocks (see ``fold_blocks``).
+
+    ``sums`` etc. are ``((0 + t_first) + t_next) + ...`` in block order; ``block_hemi`` and
+    ``block_rays`` keep the per-block hemispherical sums for the block-to-block error.
+    """
+
+    group: int
+    blocks: tuple[int, ...]
+    sums: NDArray[np.float64]
+    sumsq: NDArray[np.float64]
+    counts: NDArray[np.int64]
+    exited: float
+    absorbed: float
+    terminated: float
+    hemi: NDArray[np.float64]
+    events: int
+    block_hemi: NDArray[np.float64]  # (n, 16) per-block hemispherical sums
+    block_rays: NDArray[np.int64]  # (n,)
 
 
-def _unit(args: tuple[TraceConfig, tuple[int, ...]]) -> list[BlockTally]:
+def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
+    """Trace fold group ``group`` and add its blocks' tallies in block order."""
+    if not 0 <= group < cfg.n_groups:
+        raise ValueError(f"group must be in [0, {cfg.n_groups}), got {group!r}")
+    blocks = tuple(cfg.group_blocks(group))
+    nb = _grid(cfg).n_bins
+    sums, sumsq = np.zeros((nb, 16)), np.zeros((nb, 16))
+    counts = np.zeros(nb, dtype=np.int64)
+    hemi = np.zeros(16)
+    exited = absorbed = terminated = 0.0
+    events = 0
+    bh = np.zeros((len(blocks), 16))
+    br = np.zeros(len(blocks), dtype=np.int64)
+    for i, b in enumerate(blocks):
+        t = trace_block(cfg, b)
+        sums = sums + t.sums
+        sumsq = sumsq + t.sumsq
+        counts = counts + t.counts
+        hemi = hemi + t.hemi
+        exited = exited + t.exited
+        absorbed = absorbed + t.absorbed
+        terminated = terminated + t.terminated
+        events += t.events
+        bh[i] = t.hemi
+        br[i] = t.rays
+    return GroupTally(
+        group, blocks, sums, sumsq, counts, exited, absorbed, terminated, hemi, events, bh, br
+    )
+
+
+def run_unit(cfg: TraceConfig, groups: list[int] | tuple[int, ...]) -> list[GroupTally]:
+    """Work unit: trace the listed fold groups (picklable, for ``map``)."""
+    return [trace_group(cfg, g) for g in groups]
+
+
+def _unit(args: tuple[TraceConfig, tuple[int, ...]]) -> list[GroupTally]:
     """Single-argument form of :func:`run_unit` for ``map(func, items)``."""
-    cfg, blocks = args
-    return run_unit(cfg, blocks)
+    cfg, groups = args
+    return run_unit(cfg, groups)
