@@ -10,10 +10,15 @@ this process, the median of ``--repeat`` runs of
 * ``labbrdf.read(path)``: dispatch, decoding, parsing, unit conversion, the long table
   (2 rows per line) and its validation;
 * ``pandas.read_csv(path, sep="\\t", header=None, skiprows=4)``: the bare numeric block;
-* ``labbrdf.adapters._numblock.parse_block`` alone (the parser inside the reader);
+* ``labbrdf.adapters._numblock.parse_block`` alone (the parser inside the reader, on the
+  file's bytes in place as the reader calls it);
+* ``labbrdf.dataset.validate`` alone (on the long table as the reader builds it, string
+  columns categorical);
 
-and prints lines/s, MB/s and the ratio labbrdf/pandas. Aim (issue 3): labbrdf at least half
-pandas' speed (ratio >= 0.5). Not a timed test: numbers depend on the machine and its load.
+and prints lines/s, MB/s and the ratio labbrdf/pandas. The runs are interleaved (one of each
+per round), so a change of machine load hits all of them alike. Aim (issue 3): labbrdf at
+least half pandas' speed (ratio >= 0.5). Not a timed test: numbers depend on the machine and
+its load (and on the state of the allocator: pandas alone varies by up to 2x between runs).
 """
 
 from __future__ import annotations
@@ -22,13 +27,15 @@ import argparse
 import statistics
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 import labbrdf
-from labbrdf.adapters._numblock import parse_block, split_head
+from labbrdf.adapters._numblock import build_frame, head_lines, parse_block
+from labbrdf.dataset import validate
 
 HEADER = (
     "10102006 Ta Metal 02\r\n"
@@ -64,13 +71,15 @@ def write_file(path: Path, megabytes: float, seed: int = 0) -> int:
     return n
 
 
-def median_time(fn, repeat: int) -> float:
-    times = []
+def median_times(fns: dict[str, Callable[[], object]], repeat: int) -> dict[str, float]:
+    """Median wall time [s] of each function, run in interleaved rounds."""
+    times: dict[str, list[float]] = {name: [] for name in fns}
     for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+        for name, fn in fns.items():
+            t0 = time.perf_counter()
+            fn()
+            times[name].append(time.perf_counter() - t0)
+    return {name: statistics.median(t) for name, t in times.items()}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -90,22 +99,41 @@ def main(argv: list[str] | None = None) -> int:
 
         m = labbrdf.read(path)  # warm-up, and a check of what is timed
         assert len(m) == 2 * n, (len(m), n)
-        t_lab = median_time(lambda: labbrdf.read(path), args.repeat)
-        t_pd = median_time(
-            lambda: pd.read_csv(path, sep="\t", header=None, skiprows=4), args.repeat
+        raw = path.read_bytes()
+        _, offset = head_lines(raw.decode("ascii"), 4)
+        d = m.data  # the long table as the reader hands it to validate: categorical text
+        table = build_frame(
+            sample=d["sample"].iloc[0],
+            instrument=d["instrument"].iloc[0],
+            source=d["source"].iloc[0],
+            quantity=pd.Categorical(d["quantity"]),
+            value=d["value"],
+            sigma=d["sigma"],
+            unit=pd.Categorical(d["unit"]),
+            wavelength_nm=d["wavelength_nm"],
+            theta_i_deg=d["theta_i_deg"],
+            theta_r_deg=d["theta_r_deg"],
+            phi_r_deg=d["phi_r_deg"],
         )
-        text = path.read_text()
-        _, body = split_head(text, 4)
-        t_parse = median_time(lambda: parse_block(path, body, 5, 8, tagged=True), args.repeat)
+        t = median_times(
+            {
+                "labbrdf.read": lambda: labbrdf.read(path),
+                "pandas.read_csv (block)": lambda: pd.read_csv(
+                    path, sep="\t", header=None, skiprows=4
+                ),
+                "_numblock.parse_block": lambda: parse_block(
+                    path, None, 5, 8, tagged=True, data=raw, data_start=offset
+                ),
+                "dataset.validate": lambda: validate(table),
+            },
+            args.repeat,
+        )
 
     print(f"{'':28s} {'time [s]':>9s} {'lines/s':>12s} {'MB/s':>8s}")
-    for name, t in (
-        ("labbrdf.read", t_lab),
-        ("pandas.read_csv (block)", t_pd),
-        ("_numblock.parse_block", t_parse),
-    ):
-        print(f"{name:28s} {t:9.3f} {n / t:12.0f} {size_mb / t:8.1f}")
-    ratio = t_pd / t_lab
+    for name, ti in t.items():
+        print(f"{name:28s} {ti:9.3f} {n / ti:12.0f} {size_mb / ti:8.1f}")
+    t_lab = t["labbrdf.read"]
+    ratio = t["pandas.read_csv (block)"] / t_lab
     print(f"speed ratio labbrdf/pandas: {ratio:.2f} (aim >= 0.5)")
     print(f"labbrdf.read rows/s (long table, 2 rows per line): {2 * n / t_lab:.0f}")
     return 0

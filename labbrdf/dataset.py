@@ -101,6 +101,8 @@ QUANTITIES: dict[str, tuple[str, ...]] = {
     **{m: ("1",) for m in _MUELLER},
 }
 
+_QUANTITY_DTYPE = pd.CategoricalDtype(list(QUANTITIES))
+
 _META_KEY = b"labbrdf.meta"
 _CSV_META_PREFIX = "# labbrdf-meta: "
 
@@ -114,6 +116,73 @@ def _rows(mask: np.ndarray, limit: int = 8) -> str:
     shown = ", ".join(str(i) for i in idx[:limit])
     more = f" and {idx.size - limit} more" if idx.size > limit else ""
     return f"rows {shown}{more}"
+
+
+def _copy_on_write() -> bool:
+    """True when pandas' Copy-on-Write is active (always from pandas 3)."""
+    if int(pd.__version__.split(".")[0]) >= 3:
+        return True
+    return pd.get_option("mode.copy_on_write") is True  # pragma: no cover - pandas 2
+
+
+def _in_range(a: np.ndarray, lo: float, hi: float, *, hi_open: bool = False) -> bool:
+    """True when every value is finite and within [lo, hi] ([lo, hi) with ``hi_open``).
+
+    Two reductions (min, max; NaN propagates into both) instead of several masks: the
+    fast path of the range checks in :func:`validate`, which compute the exact row masks
+    only when this says no.
+    """
+    if a.size == 0:
+        return True
+    mn, mx = float(a.min()), float(a.max())
+    return (
+        math.isfinite(mn) and math.isfinite(mx) and mn >= lo and (mx < hi if hi_open else mx <= hi)
+    )
+
+
+def _codes(col: pd.Series) -> tuple[np.ndarray, np.ndarray]:
+    """Integer codes and the distinct values of a column (as ``pd.factorize``).
+
+    A categorical without missing values gives its own codes and categories (no hashing
+    of a million strings); anything else goes through :func:`pandas.factorize`, with
+    missing values as a value of their own.
+    """
+    if isinstance(col.dtype, pd.CategoricalDtype):
+        codes = col.cat.codes.to_numpy()
+        if codes.size == 0 or codes.min() >= 0:
+            return codes, np.asarray(col.cat.categories, dtype=object)
+    codes, uniq = pd.factorize(col, use_na_sentinel=False)
+    return codes, np.asarray(uniq, dtype=object)
+
+
+def _is_code(codes: np.ndarray, which: np.ndarray) -> np.ndarray | None:
+    """Row mask ``which[codes]`` (``which``: one flag per distinct value), None if all False.
+
+    One integer comparison when a single distinct value is flagged (the usual case).
+    """
+    ks = np.flatnonzero(which)
+    if ks.size == 0:
+        return None
+    return codes == ks[0] if ks.size == 1 else which[codes]
+
+
+def _as_object(col: pd.Series) -> pd.Series:
+    """A column as plain Python strings (dtype object) on a fresh RangeIndex.
+
+    Categoricals are expanded by one take of their categories (much faster than
+    ``astype(object)``); the Series wrapper keeps pandas >= 3 from re-inferring ``str``.
+    """
+    if isinstance(col.dtype, pd.CategoricalDtype):
+        codes = col.cat.codes.to_numpy()
+        if codes.size == 0 or codes.min() >= 0:
+            cats = np.asarray(col.cat.categories, dtype=object)
+            if cats.size == 1:  # one value (sample, source, ...): a fill, no gather
+                values = np.empty(codes.size, dtype=object)
+                values[:] = cats[0]
+            else:
+                values = cats.take(codes.astype(np.intp))
+            return pd.Series(values, index=col.index, dtype=object, copy=False)
+    return col.astype(object)
 
 
 def validate(df: pd.DataFrame) -> pd.DataFrame:
@@ -133,6 +202,15 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
     ------
     DatasetError
         Naming the column and the offending rows (positions in ``df``).
+
+    Notes
+    -----
+    Written for tables of millions of rows (issue 3, ``benchmarks/bench_ingest.py``):
+    string columns are checked on their distinct values when categorical, range checks
+    first try two reductions and build the row masks only when a value is out of range,
+    and columns that already have their canonical dtype are not copied (pandas'
+    Copy-on-Write keeps the result independent of ``df``; without it, on pandas 2, the
+    table is copied as before). Every check runs on every row.
     """
     if not isinstance(df, pd.DataFrame):
         raise DatasetError(f"expected a pandas DataFrame, got {type(df).__name__}")
@@ -144,11 +222,18 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
         raise DatasetError(
             f"unknown column(s) {extra}; optional columns are {list(OPTIONAL_COLUMNS)}"
         )
+    if not df.columns.is_unique:
+        dup = sorted({str(c) for c in df.columns[df.columns.duplicated()]})
+        raise DatasetError(f"duplicate column(s) {dup}; each column must appear once")
     if len(df) == 0:
         raise DatasetError("the table has no rows")
-    out = df.reset_index(drop=True)
+    idx = df.index
+    fresh = isinstance(idx, pd.RangeIndex) and idx.start == 0 and idx.step == 1
+    out = df if fresh else df.reset_index(drop=True)
     cols = list(COLUMNS) + [c for c in OPTIONAL_COLUMNS if c in out.columns]
-    out = out[cols].copy()
+    out = out[cols]
+    if not _copy_on_write():  # pragma: no cover - pandas 2 without Copy-on-Write
+        out = out.copy()
 
     unit_col = out["unit"]  # before the conversion below: factorizes fast if categorical
     for name in ("sample", "instrument", "source", "unit"):
@@ -156,80 +241,97 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
         bad = _not_str(col, nonempty=True)
         if bad.any():
             raise DatasetError(f"column {name!r}: expected a non-empty string in {_rows(bad)}")
-        out[name] = col.astype(object)
+        out[name] = _as_object(col)
     if "channel" in out.columns:
         col = out["channel"]
         bad = _not_str(col, nonempty=False)
         if bad.any():
             raise DatasetError(f"column 'channel': expected a string in {_rows(bad)}")
-        out["channel"] = col.astype(object)
+        out["channel"] = _as_object(col)
 
     floats = [c for c, t in {**COLUMNS, **OPTIONAL_COLUMNS}.items() if t == "float64"]
     for name in floats:
-        if name not in out.columns:
+        if name not in out.columns or out[name].dtype == np.float64:
             continue
         try:
             out[name] = pd.to_numeric(out[name], errors="raise").astype("float64")
         except (TypeError, ValueError) as exc:
             raise DatasetError(f"column {name!r}: expected numbers ({exc})") from None
 
-    # quantity and unit checks work on the distinct values (factorize), not row by row
-    qcodes, quniq = pd.factorize(out["quantity"], use_na_sentinel=False)
+    # quantity and unit checks work on the distinct values, not row by row
+    qcodes, quniq = _codes(out["quantity"])
     quniq = np.array([str(v) for v in quniq], dtype=object)
-    q = quniq[qcodes]
-    bad = ~np.isin(quniq, list(QUANTITIES))[qcodes]
-    if bad.any():
-        raise DatasetError(
-            f"column 'quantity': unknown quantity {sorted(set(q[bad]))} in {_rows(bad)}; "
-            f"allowed are {list(QUANTITIES)}"
-        )
-    unit = out["unit"].to_numpy(dtype=object)
-    ucodes, uuniq = pd.factorize(unit_col, use_na_sentinel=False)
-    pair = qcodes.astype(np.int64) * len(uuniq) + ucodes
-    pairs, inverse = np.unique(pair, return_inverse=True)
+    known = np.isin(quniq, list(QUANTITIES))
+    if not known.all():
+        bad = ~known[qcodes]
+        if bad.any():
+            q = quniq[qcodes]
+            raise DatasetError(
+                f"column 'quantity': unknown quantity {sorted(set(q[bad]))} in {_rows(bad)}; "
+                f"allowed are {list(QUANTITIES)}"
+            )
+    ucodes, uuniq = _codes(unit_col)
+    nu = len(uuniq)
     pair_bad = np.array(
-        [uuniq[k % len(uuniq)] not in QUANTITIES[quniq[k // len(uuniq)]] for k in pairs]
-    )
-    bad = pair_bad[inverse.ravel()]
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        raise DatasetError(
-            f"column 'unit': {unit[i]!r} does not fit quantity {q[i]!r} "
-            f"(expected {QUANTITIES[q[i]]}) in {_rows(bad)}"
-        )
+        [[k and u not in QUANTITIES[q] for u in uuniq] for q, k in zip(quniq, known, strict=True)],
+        dtype=bool,
+    ).reshape(-1)
+    if pair_bad.any():
+        bad = pair_bad[qcodes.astype(np.int64) * nu + ucodes]
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            unit = out["unit"].to_numpy(dtype=object)
+            q_i = quniq[qcodes[i]]
+            raise DatasetError(
+                f"column 'unit': {unit[i]!r} does not fit quantity {q_i!r} "
+                f"(expected {QUANTITIES[q_i]}) in {_rows(bad)}"
+            )
 
     value = out["value"].to_numpy()
-    bad = ~np.isfinite(value)
-    if bad.any():
-        raise DatasetError(f"column 'value': expected finite numbers, NaN/inf in {_rows(bad)}")
+    if not _in_range(value, -math.inf, math.inf):
+        bad = ~np.isfinite(value)
+        if bad.any():
+            raise DatasetError(f"column 'value': expected finite numbers, NaN/inf in {_rows(bad)}")
     sigma = out["sigma"].to_numpy()
-    bad = np.isinf(sigma) | (sigma < 0)
-    if bad.any():
-        raise DatasetError(f"column 'sigma': expected >= 0 or NaN in {_rows(bad)}")
+    if not _in_range(sigma, 0.0, math.inf):
+        bad = np.isinf(sigma) | (sigma < 0)
+        if bad.any():
+            raise DatasetError(f"column 'sigma': expected >= 0 or NaN in {_rows(bad)}")
     wl = out["wavelength_nm"].to_numpy()
-    bad = ~(np.isfinite(wl) & (wl > 0))
-    if bad.any():
-        raise DatasetError(f"column 'wavelength_nm': expected finite > 0 in {_rows(bad)}")
+    if not (_in_range(wl, 0.0, math.inf) and wl.min() > 0):
+        bad = ~(np.isfinite(wl) & (wl > 0))
+        if bad.any():
+            raise DatasetError(f"column 'wavelength_nm': expected finite > 0 in {_rows(bad)}")
     for name in ("theta_i_deg", "theta_r_deg"):
         a = out[name].to_numpy()
-        bad = np.isinf(a) | (a < 0) | (a > 90)
-        if bad.any():
-            raise DatasetError(f"column {name!r}: expected [0, 90] deg or NaN in {_rows(bad)}")
+        if not _in_range(a, 0.0, 90.0):
+            bad = np.isinf(a) | (a < 0) | (a > 90)
+            if bad.any():
+                raise DatasetError(f"column {name!r}: expected [0, 90] deg or NaN in {_rows(bad)}")
     a = out["phi_r_deg"].to_numpy()
-    bad = np.isinf(a) | (a < 0) | (a >= 360)
-    if bad.any():
-        raise DatasetError(f"column 'phi_r_deg': expected [0, 360) deg or NaN in {_rows(bad)}")
-    psi = (quniq == "psi")[qcodes]
-    bad = psi & ((value < 0) | (value > 90))
-    if bad.any():
-        raise DatasetError(f"column 'value': psi outside [0, 90] deg in {_rows(bad)}")
-    bad = (quniq == "delta")[qcodes] & ((value < 0) | (value >= 360))
-    if bad.any():
-        raise DatasetError(
-            f"column 'value': delta outside [0, 360) deg (Nebraska convention) in {_rows(bad)}"
-        )
-    cat_index = np.array([list(QUANTITIES).index(v) for v in quniq], dtype=np.int64)
-    out["quantity"] = pd.Categorical.from_codes(cat_index[qcodes], categories=list(QUANTITIES))
+    if not _in_range(a, 0.0, 360.0, hi_open=True):
+        bad = np.isinf(a) | (a < 0) | (a >= 360)
+        if bad.any():
+            raise DatasetError(f"column 'phi_r_deg': expected [0, 360) deg or NaN in {_rows(bad)}")
+    psi = _is_code(qcodes, quniq == "psi") if not _in_range(value, 0.0, 90.0) else None
+    if psi is not None and not _in_range(value[psi], 0.0, 90.0):
+        bad = psi & ((value < 0) | (value > 90))
+        if bad.any():
+            raise DatasetError(f"column 'value': psi outside [0, 90] deg in {_rows(bad)}")
+    delta = None
+    if not _in_range(value, 0.0, 360.0, hi_open=True):
+        delta = _is_code(qcodes, quniq == "delta")
+    if delta is not None and not _in_range(value[delta], 0.0, 360.0, hi_open=True):
+        bad = delta & ((value < 0) | (value >= 360))
+        if bad.any():
+            raise DatasetError(
+                f"column 'value': delta outside [0, 360) deg (Nebraska convention) in {_rows(bad)}"
+            )
+    cat_index = np.array(
+        [list(QUANTITIES).index(v) if k else -1 for v, k in zip(quniq, known, strict=True)],
+        dtype=np.int8,
+    )
+    out["quantity"] = pd.Categorical.from_codes(cat_index[qcodes], dtype=_QUANTITY_DTYPE)
     return out
 
 
@@ -246,10 +348,17 @@ def _not_str(col: pd.Series, *, nonempty: bool) -> np.ndarray:
         codes = col.cat.codes.to_numpy()
         if ok.size == 0:
             return np.ones(len(col), dtype=bool)
+        if ok.all() and (codes.size == 0 or codes.min() >= 0):
+            return np.zeros(len(col), dtype=bool)
         return np.where(codes < 0, True, ~ok[np.maximum(codes, 0)])
-    if isinstance(col.dtype, pd.StringDtype) or (
-        col.dtype == object and pd.api.types.infer_dtype(col, skipna=False) == "string"
-    ):
+    if col.dtype == object and pd.api.types.infer_dtype(col, skipna=False) == "string":
+        # only str objects (no missing value): look for "" among the distinct values
+        if not nonempty:
+            return np.zeros(len(col), dtype=bool)
+        codes, uniq = pd.factorize(col.to_numpy(dtype=object))
+        empty = np.array([v == "" for v in uniq], dtype=bool)
+        return empty[codes] if empty.any() else np.zeros(len(col), dtype=bool)
+    if isinstance(col.dtype, pd.StringDtype):
         bad = col.isna().to_numpy(bool)
         if nonempty:
             bad = bad | (col == "").fillna(False).to_numpy(bool)
@@ -449,7 +558,10 @@ def write_csv(m: Measurement, path: str | os.PathLike[str]) -> Path:
     """
     with atomic_output(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
         fh.write(_CSV_META_PREFIX + json.dumps(m.meta, allow_nan=False) + "\n")
-        m.data.to_csv(fh, index=False, lineterminator="\n")
+        # pandas formats floats through numpy's printing, which an imported package may
+        # have switched to its 12-digit legacy mode (colour-science sets legacy="1.13")
+        with np.printoptions(legacy=False):
+            m.data.to_csv(fh, index=False, lineterminator="\n")
     return Path(path)
 
 

@@ -36,6 +36,7 @@ __all__ = [
     "measurement",
     "parse_block",
     "split_head",
+    "within",
 ]
 
 #: What a number may look like in an export: decimal point only, optional exponent,
@@ -64,6 +65,9 @@ class Block:
     nfields : numpy.ndarray or None
         ``(n,)`` number of fields as written (separator count + 1, tag included), for
         TAB-separated blocks; None for whitespace-separated ones.
+    tag_codes : tuple or None
+        ``(codes, names)`` with ``tags == names[codes]`` when the parser knows them without
+        hashing every tag (an untagged block: all codes 0, names ``[""]``); else None.
     """
 
     values: np.ndarray
@@ -71,6 +75,7 @@ class Block:
     tags: np.ndarray | None
     blank_lines: int
     nfields: np.ndarray | None = None
+    tag_codes: tuple[np.ndarray, list[str]] | None = None
 
 
 _EOL = re.compile(r"\r\n|\n|\r")
@@ -192,36 +197,57 @@ def _fields_per_line(arr: np.ndarray, starts: np.ndarray, sep: str) -> np.ndarra
 
 
 def _fast(
-    body: str,
+    body: str | None,
     data: bytes,
     first_line: int,
     ncols: int,
     sep: str | None,
     tagged: bool,
     count_fields: bool,
+    start: int = 0,
 ) -> Block | None:
-    """pandas C-engine parse; None when anything looks off (the caller then goes slow).
+    """pandas C-engine parse of ``data[start:]``; None when anything looks off.
 
-    Lone CR line ends, form feeds and the like make pandas and the line count disagree;
-    the row-count cross-check below sends such blocks to the slow parser.
+    The caller then goes slow. Lone CR line ends, form feeds and the like make pandas and
+    the line count disagree; the row-count cross-check below sends such blocks to the slow
+    parser. A tagged block is first read as numbers only (the common untagged file): a
+    line that starts with a letter either fails that parse or gives a non-finite first
+    field (``inf``, ``nan``), and only then are the line starts inspected for tags.
     """
-    if re.search(rb"\S", data) is None:
+    if _NONSPACE.search(data, start) is None:
         return Block(np.empty((0, ncols)), np.empty(0, dtype=np.int64), None, 0)
-    arr = np.frombuffer(data, dtype=np.uint8)
-    starts = _line_starts(arr)
-    with_tags = tagged and _line_starts_alpha(arr, starts)
-    width = ncols + 1 if with_tags else ncols
-    kw = dict(_READ_KW)
-    kw["sep"] = sep if sep is not None else r"\s+"
+    starts: np.ndarray | None = None
+
+    def line_starts() -> np.ndarray:
+        nonlocal starts
+        if starts is None:
+            starts = _line_starts(np.frombuffer(data, dtype=np.uint8, offset=start))
+        return starts
+
+    def has_tags() -> bool:
+        return tagged and _line_starts_alpha(
+            np.frombuffer(data, dtype=np.uint8, offset=start), line_starts()
+        )
+
+    # read only as many columns as the first line has (fewer empty columns to fill); a
+    # longer line further on makes pandas fail, and the block is read again at full width
+    width = _first_line_fields(data, start, sep, ncols)
+    df = None
+    if sep is not None and not _first_line_has_empty_field(data, start, sep):
+        # no missing-value detection: faster; any empty or NaN field makes it fail
+        df = _read_csv(data, start, width, sep, False, na_filter=False)
+    # a failed numbers-only parse may be due to tags: then go straight to the tagged parse
+    with_tags = df is None and has_tags()
+    if not with_tags:
+        if df is None:
+            df = _read_csv(data, start, width, sep, False)
+        if df is None and width < ncols:
+            df = _read_csv(data, start, ncols, sep, False)
+        if df is not None and tagged and not np.isfinite(df[0].to_numpy(np.float64)).all():
+            with_tags = has_tags()  # "inf"/"nan" in the first field: a tag, or a number?
     if with_tags:
-        kw["dtype"] = {0: object, **{k: np.float64 for k in range(1, width)}}
-    else:
-        kw["dtype"] = np.float64
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("error")
-            df = pd.read_csv(io.BytesIO(data), names=list(range(width)), **kw)
-    except (ValueError, TypeError, pd.errors.ParserError, pd.errors.ParserWarning):
+        df = _read_csv(data, start, ncols, sep, True)
+    if df is None:
         return None
     if with_tags:
         col0 = df[0].to_numpy(dtype=object)
@@ -241,30 +267,124 @@ def _fast(
             return None
         tags = np.where(is_tag, col0, "").astype(object)
     else:
-        vals = df.to_numpy(dtype=np.float64)
+        vals = _columns(df, ncols)
         tags = None
-    blank = np.isnan(vals).all(axis=1)
-    if tags is not None:
-        blank &= tags == ""
     n = len(vals)
     # pandas skips a whitespace-separated block's leading-space lines differently; cross-check
     # the number of rows against the number of lines so that line numbers stay exact.
-    nlines = len(body.splitlines()) if sep is None else starts.size
+    if sep is None:
+        nlines = len(_body(body, data, start).splitlines())
+    else:  # = line_starts().size: lines end with LF, a last line may lack it
+        nlines = _count_lf(data, start) + (not data.endswith(b"\n", start))
     if n != nlines:
         return None
-    keep = ~blank
-    linenos = first_line + np.flatnonzero(keep)
+    # a blank line is NaN in every field, so in the first one: test that column first
+    blank = np.isnan(vals[:, 0]) if n else np.zeros(0, dtype=bool)
+    if blank.any():
+        blank &= np.isnan(vals).all(axis=1)
+        if tags is not None:
+            blank &= tags == ""
     nfields = None
     if count_fields and sep is not None:
-        nfields = _fields_per_line(arr, starts, sep)[keep]
+        nfields = _fields_per_line(np.frombuffer(data, np.uint8, offset=start), line_starts(), sep)
+    if not blank.any():  # the usual case: no copies
+        return Block(vals, first_line + np.arange(n), tags, 0, nfields)
+    keep = ~blank
+    linenos = first_line + np.flatnonzero(keep)
     return Block(
-        vals[keep], linenos, None if tags is None else tags[keep], int(blank.sum()), nfields
+        vals[keep],
+        linenos,
+        None if tags is None else tags[keep],
+        int(blank.sum()),
+        None if nfields is None else nfields[keep],
     )
+
+
+_NONSPACE = re.compile(rb"\S")
+
+
+def _first_line(data: bytes, start: int) -> bytes:
+    """The first line of ``data[start:]``, without its line end."""
+    end = data.find(b"\n", start)
+    return (data[start:] if end < 0 else data[start:end]).rstrip(b"\r")
+
+
+def _first_line_fields(data: bytes, start: int, sep: str | None, ncols: int) -> int:
+    """Fields on the first line of ``data[start:]`` (``sep``-separated), within [1, ncols]."""
+    if sep is None:
+        return ncols
+    return max(1, min(ncols, _first_line(data, start).count(sep.encode()) + 1))
+
+
+def _first_line_has_empty_field(data: bytes, start: int, sep: str) -> bool:
+    """Whether the first line has an empty field (then missing values are to be expected)."""
+    line, s = _first_line(data, start), sep.encode()
+    return not line.strip() or s + s in line or line.startswith(s) or line.endswith(s)
+
+
+def _columns(df: pd.DataFrame, ncols: int) -> np.ndarray:
+    """The float columns of ``df`` as an ``(n, ncols)`` array, NaN beyond ``df``'s columns.
+
+    Column-major (each column one contiguous copy, no interleaving): rows are read as
+    ``values[i]`` and columns as ``values[:, j]`` alike.
+    """
+    out = np.empty((ncols, len(df)))
+    for j in range(df.shape[1]):
+        out[j] = df.iloc[:, j].to_numpy(dtype=np.float64)
+    out[df.shape[1] :] = np.nan
+    return out.T
+
+
+def _count_lf(data: bytes, start: int, chunk: int = 1 << 20) -> int:
+    """Number of LF bytes in ``data[start:]``; numpy on cache-sized chunks (4x bytes.count)."""
+    arr = np.frombuffer(data, dtype=np.uint8, offset=start)
+    return sum(int(np.count_nonzero(arr[i : i + chunk] == 10)) for i in range(0, arr.size, chunk))
+
+
+def _body(body: str | None, data: bytes, start: int) -> str:
+    """The block as text: ``body`` when given, else ``data[start:]`` (ASCII) decoded."""
+    return body if body is not None else data[start:].decode("ascii")
+
+
+def _read_csv(
+    data: bytes,
+    start: int,
+    ncols: int,
+    sep: str | None,
+    with_tags: bool,
+    *,
+    na_filter: bool = True,
+) -> pd.DataFrame | None:
+    """``pandas.read_csv`` of ``data[start:]`` without copying it; None on any complaint.
+
+    With ``na_filter=False`` pandas skips its missing-value detection (about 15 % faster);
+    an empty field or a ``NaN`` then fails the float conversion, so the result, when there
+    is one, is the same as with detection.
+    """
+    width = ncols + 1 if with_tags else ncols
+    kw = dict(_READ_KW)
+    if not na_filter:
+        kw["na_filter"] = False
+    kw["sep"] = sep if sep is not None else r"\s+"
+    if with_tags:
+        kw["dtype"] = {0: object, **{k: np.float64 for k in range(1, width)}}
+        # a first field "nan" is a tag to the strict parser: keep it as text
+        kw["na_values"] = {0: [""], **{k: _READ_KW["na_values"] for k in range(1, width)}}
+    else:
+        kw["dtype"] = np.float64
+    buf = io.BytesIO(data)  # shares the bytes object's buffer
+    buf.seek(start)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            return pd.read_csv(buf, names=list(range(width)), **kw)
+    except (ValueError, TypeError, pd.errors.ParserError, pd.errors.ParserWarning):
+        return None
 
 
 def parse_block(
     path: str | os.PathLike[str],
-    body: str,
+    body: str | None,
     first_line: int,
     ncols: int,
     *,
@@ -272,6 +392,7 @@ def parse_block(
     tagged: bool = False,
     count_fields: bool = False,
     data: bytes | None = None,
+    data_start: int = 0,
 ) -> Block:
     """Parse a block of delimited numbers.
 
@@ -279,8 +400,9 @@ def parse_block(
     ----------
     path : str or path-like
         The file (for error messages).
-    body : str
-        The block's text, starting at a line start.
+    body : str or None
+        The block's text, starting at a line start. None when ``data`` is given and is
+        pure ASCII: the text is then decoded from it only if needed (slow path).
     first_line : int
         1-based line number of the block's first line in the file.
     ncols : int
@@ -293,8 +415,10 @@ def parse_block(
     count_fields : bool
         Fill :attr:`Block.nfields` (TAB-separated blocks only).
     data : bytes, optional
-        ``body`` encoded in an ASCII-compatible encoding, when the caller has it (saves
-        re-encoding a large block).
+        The block encoded in an ASCII-compatible encoding, from ``data_start`` on, when the
+        caller has it (saves re-encoding and copying a large block).
+    data_start : int
+        Offset of the block in ``data`` [bytes].
 
     Returns
     -------
@@ -307,17 +431,23 @@ def parse_block(
         A row with too many fields or a field that is not a number, naming its line.
     """
     if data is None:
+        if body is None:
+            raise TypeError("parse_block needs body or data")
         data = body.encode("utf-8")
-    block = _fast(body, data, first_line, ncols, sep, tagged, count_fields)
+        data_start = 0
+    block = _fast(body, data, first_line, ncols, sep, tagged, count_fields, data_start)
     if block is None:
-        block = _slow(path, body, first_line, ncols, sep, tagged)
+        block = _slow(path, _body(body, data, data_start), first_line, ncols, sep, tagged)
     elif tagged and block.tags is None:
+        n = len(block.lines)
+        tags = np.broadcast_to(np.array([""], dtype=object), (n,))  # read-only, no memory
         block = Block(
             block.values,
             block.lines,
-            np.full(len(block.lines), "", dtype=object),
+            tags,
             block.blank_lines,
             block.nfields,
+            (np.zeros(n, dtype=np.intp), [""]),
         )
     return block
 
@@ -454,7 +584,26 @@ def check_rows(path: str | os.PathLike[str], block: Block, mask: np.ndarray, mes
 def delta_range(delta: np.ndarray) -> list[float] | None:
     """[min, max] of the Delta values as written in the file (JSON-safe), None if empty."""
     d = np.asarray(delta, dtype=float)
+    if within(d):
+        return [float(d.min()), float(d.max())]
     d = d[np.isfinite(d)]
     if d.size == 0:
         return None
     return [float(d.min()), float(d.max())]
+
+
+def within(
+    a: np.ndarray, lo: float = -np.inf, hi: float = np.inf, *, hi_open: bool = False
+) -> bool:
+    """True when every value of ``a`` is finite and within [lo, hi] ([lo, hi) with ``hi_open``).
+
+    Two reductions (NaN propagates into min and max) instead of several full-length masks:
+    the fast path of a range check; when it says no, the caller builds the exact row mask
+    to name the first offending line. True for an empty array.
+    """
+    if a.size == 0:
+        return True
+    mn, mx = float(np.min(a)), float(np.max(a))
+    if not (np.isfinite(mn) and np.isfinite(mx)):
+        return False
+    return mn >= lo and (mx < hi if hi_open else mx <= hi)

@@ -60,6 +60,7 @@ from ._numblock import (
     labels,
     measurement,
     parse_block,
+    within,
 )
 
 __all__ = [
@@ -248,12 +249,13 @@ def _header(path: str | os.PathLike[str], text: str) -> tuple[dict[str, Any], in
 def _to_nm(
     path: str | os.PathLike[str], x: np.ndarray, unit: str, block: Block, rows: np.ndarray
 ) -> np.ndarray:
-    check_rows(
-        path,
-        block,
-        rows & ~(np.isfinite(x) & (x > 0)),
-        f"spectral value must be a finite number > 0 [{unit}]",
-    )
+    if not (within(x, 0.0, np.inf) and x.min() > 0):
+        check_rows(
+            path,
+            block,
+            rows & ~(np.isfinite(x) & (x > 0)),
+            f"spectral value must be a finite number > 0 [{unit}]",
+        )
     with np.errstate(divide="ignore", invalid="ignore"):
         if unit == "nm":
             return x
@@ -320,24 +322,36 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
       not seen in a real file); the first copy of each is used.
     """
     raw = read_bytes(path)
-    text, encoding = decode(raw, path)
-    meta, offset, first = _header(path, text)
     p = Path(path)
+    if raw.isascii() and b"\x00" not in raw:
+        # pure ASCII (every real export seen) decodes alike in every accepted encoding, so
+        # only the header is decoded and the block is parsed from the bytes in place
+        meta, offset, first = _header(path, _ascii_head(raw, 8))
+        encoding, body, data, start = "utf-8", None, raw, offset
+    else:
+        text, encoding = decode(raw, path)
+        meta, offset, first = _header(path, text)
+        body, data, start = text[offset:], body_bytes(raw, text, offset, encoding), 0
     meta = {"source_file": p.name, "encoding": encoding, **meta}
-    data = body_bytes(raw, text, offset, encoding)
-    block = parse_block(path, text[offset:], first, 8, sep="\t", tagged=True, data=data)
+    block = parse_block(path, body, first, 8, sep="\t", tagged=True, data=data, data_start=start)
     if len(block.lines) == 0:
         raise AdapterError(path, "no data rows after the header")
     v = block.values
     assert block.tags is not None
     # tags as small integer codes: comparisons on 10^6 object strings are slow
-    tcodes, tuniq = pd.factorize(block.tags)
-    utags = [str(t) for t in tuniq]
+    if block.tag_codes is not None:
+        tcodes, utags = block.tag_codes
+    else:
+        tcodes, tuniq = pd.factorize(block.tags)
+        utags = [str(t) for t in tuniq]
     code = {t: k for k, t in enumerate(utags)}
+    n = len(tcodes)
 
     def is_tag(*names: str) -> np.ndarray:
         ks = [code[t] for t in names if t in code]
-        return np.isin(tcodes, ks) if ks else np.zeros(len(tcodes), dtype=bool)
+        if len(ks) == len(utags):
+            return np.ones(n, dtype=bool)
+        return np.isin(tcodes, ks) if ks else np.zeros(n, dtype=bool)
 
     # ---- tags and field counts
     unknown = [t for t in utags if t not in _NFIELDS]
@@ -349,62 +363,60 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
             f"unsupported data tag {unknown[0]!r}; supported are {_SUPPORTED} "
             "and untagged Psi/Delta rows",
         )
-    nf = np.array([_NFIELDS[t] for t in utags], dtype=np.int64)[tcodes]
-    filled = ~np.isnan(v)
-    # required fields: all of the first nf must be present ...
-    idx = np.arange(v.shape[1])
-    need = idx[None, :] < nf[:, None]
-    missing = need & ~filled
-    # an empty field is never a value: a missing number is an error, only a written
-    # inf/NaN counts as "not measured" (dropped and reported below)
+    # required fields: all of the first nf must be present; an empty field is never a
+    # value: a missing number is an error, only a written inf/NaN counts as "not
+    # measured" (dropped and reported below)
+    missing, extra = _field_counts(v, tcodes, [_NFIELDS[t] for t in utags])
     check_rows(
         path,
         block,
-        missing.any(axis=1),
+        missing,
         "missing field(s): expected x, AOI and the values of this row type "
         "(6 fields for Psi/Delta, 4 for dpolE/uR/pR/sR)",
     )
     dynamic = bool(meta["dynamic"])
-    extra = filled & ~need
     if dynamic:
         # untagged dynamic rows: x AOI Psi Delta sPsi sDelta <empty> time_min
         untagged = is_tag("")
         check_rows(
             path,
             block,
-            untagged & ~filled[:, 7],
+            untagged & np.isnan(v[:, 7]),
             "dynamic data: expected the time [min] in field 8",
         )
-        extra[untagged, 7] = False
+        extra[untagged] = ~np.isnan(v[untagged, _NFIELDS[""] : 7]).all(axis=1)
     check_rows(
         path,
         block,
-        extra.any(axis=1),
+        extra,
         "too many fields for this row type (6 for Psi/Delta, 4 for dpolE/uR/pR/sR)",
     )
 
     x = v[:, 0]
     unit = meta["spectral_unit"]
-    wl = _to_nm(path, x, unit, block, np.ones(len(x), dtype=bool))
-    aoi = v[:, 1].copy()
-    check_rows(
-        path,
-        block,
-        ~(np.isfinite(aoi) & (aoi >= 0) & (aoi <= 90)),
-        "angle of incidence must be within [0, 90] deg",
-    )
+    wl = _to_nm(path, x, unit, block, np.ones(n, dtype=bool))
+    aoi = v[:, 1]
+    if not within(aoi, 0.0, 90.0):
+        check_rows(
+            path,
+            block,
+            ~(np.isfinite(aoi) & (aoi >= 0) & (aoi <= 90)),
+            "angle of incidence must be within [0, 90] deg",
+        )
     time_s = v[:, 7] * 60.0 if dynamic else None
 
     # ---- CompleteEASE 3.x: tagged rows with AOI 0 after a Psi/Delta row of the same x
-    is_pd = is_tag(*_PSI_DELTA)
     reassigned = 0
-    zero = ~is_pd & (aoi == 0)
-    if zero.any() and is_pd.any():
-        last_pd = np.where(is_pd, np.arange(len(tcodes)), -1)
+    only_pd = all(t in _PSI_DELTA for t in utags)  # then there is nothing to reassign
+    is_pd = is_tag(*_PSI_DELTA) if not only_pd else None
+    zero = ~is_pd & (aoi == 0) if is_pd is not None else None
+    if zero is not None and is_pd is not None and zero.any() and is_pd.any():
+        last_pd = np.where(is_pd, np.arange(n), -1)
         last_pd = np.maximum.accumulate(last_pd)
         ok = zero & (last_pd >= 0)
         j = np.where(ok, last_pd, 0)
-        same = ok & (x[j] == x) & (np.arange(len(tcodes)) - j <= 2)
+        same = ok & (x[j] == x) & (np.arange(n) - j <= 2)
+        aoi = aoi.copy()
         aoi[same] = aoi[j[same]]
         reassigned = int(same.sum())
     if reassigned:
@@ -417,10 +429,9 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
     parts: list[dict[str, Any]] = []
     dropped: list[dict[str, Any]] = []
     rt = meta["method"] == "RTmethod"
-    n = len(tcodes)
 
     def add(
-        rows: np.ndarray,
+        rows: np.ndarray | None,
         quantity: str,
         value: np.ndarray,
         sigma: np.ndarray,
@@ -428,13 +439,20 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
         channel: str,
         tag: str,
     ) -> None:
-        """Collect one quantity of the rows ``rows`` (full-length mask); drop non-finite."""
-        bad_sigma = np.zeros(n, dtype=bool)
-        bad_sigma[rows] = ~np.isnan(sigma) & ~(np.isfinite(sigma) & (sigma >= 0))
-        check_rows(path, block, bad_sigma, "sigma must be a finite number >= 0")
-        good = np.isfinite(value)
-        nbad = int((~good).sum())
-        if nbad:
+        """Collect one quantity of the rows ``rows`` (full-length mask, None: every row).
+
+        Non-finite values are dropped and reported in ``dropped``.
+        """
+        if not within(sigma, 0.0, np.inf):  # NaN (no sigma) is fine, inf or < 0 is not
+            bad_sigma = np.zeros(n, dtype=bool)
+            bad_sigma[slice(None) if rows is None else rows] = ~np.isnan(sigma) & ~(
+                np.isfinite(sigma) & (sigma >= 0)
+            )
+            check_rows(path, block, bad_sigma, "sigma must be a finite number >= 0")
+        r = None if rows is None else np.flatnonzero(rows)
+        if not within(value):
+            good = np.isfinite(value)
+            nbad = int((~good).sum())
             kind = "inf" if np.isinf(value[~good]).all() else "NaN/inf"
             dropped.append(
                 {
@@ -444,12 +462,15 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
                     "reason": f"value is {kind}: not measured",
                 }
             )
+            r = (np.arange(n) if r is None else r)[good]
+            value, sigma = value[good], sigma[good]
         parts.append(
             {
-                "r": np.flatnonzero(rows)[good],
+                "r": r,
+                "count": n if r is None else len(r),
                 "quantity": quantity,
-                "value": value[good],
-                "sigma": sigma[good],
+                "value": value,
+                "sigma": sigma,
                 "unit": unit_,
                 "channel": channel,
             }
@@ -457,47 +478,53 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
 
     delta_seen: list[np.ndarray] = []
     for t in sorted(utags):
-        rows = tcodes == code[t]
+        rows = None if len(utags) == 1 else tcodes == code[t]
+
+        def col(j: int, rows: np.ndarray | None = rows) -> np.ndarray:
+            return v[:, j] if rows is None else v[rows, j]
+
         if t in _PSI_DELTA:
-            psi, delta = v[:, 2], v[:, 3]
-            check_rows(
-                path,
-                block,
-                rows & np.isfinite(psi) & ((psi < 0) | (psi > 90)),
-                "psi must be within [0, 90] deg",
-            )
-            psi, delta = psi[rows], delta[rows]
+            psi, delta = col(2), col(3)
+            psi_ok = within(psi, 0.0, 90.0)
+            if not psi_ok:
+                check_rows(
+                    path,
+                    block,
+                    (True if rows is None else rows)
+                    & np.isfinite(v[:, 2])
+                    & ((v[:, 2] < 0) | (v[:, 2] > 90)),
+                    "psi must be within [0, 90] deg",
+                )
             delta_seen.append(delta)
             ch = _PSI_DELTA[t]
             # psi and delta of one line share its fate: both kept or both dropped
-            both = np.isfinite(psi) & np.isfinite(delta)
-            add(rows, "psi", np.where(both, psi, np.nan), v[rows, 4], "deg", ch, t)
-            add(
-                rows,
-                "delta",
-                np.where(both, wrap_delta(np.where(both, delta, 0.0)), np.nan),
-                v[rows, 5],
-                "deg",
-                ch,
-                t,
-            )
+            if psi_ok and within(delta):
+                psi_v, delta_v = psi, _wrap(delta)
+            else:
+                both = np.isfinite(psi) & np.isfinite(delta)
+                psi_v = np.where(both, psi, np.nan)
+                delta_v = np.where(both, wrap_delta(np.where(both, delta, 0.0)), np.nan)
+            add(rows, "psi", psi_v, col(4), "deg", ch, t)
+            add(rows, "delta", delta_v, col(5), "deg", ch, t)
         elif t in _DEPOL:
-            add(rows, "depolarization", v[rows, 2] / 100.0, v[rows, 3] / 100.0, "1", "", t)
+            add(rows, "depolarization", col(2) / 100.0, col(3) / 100.0, "1", "", t)
         elif t in _REFL:
             q = "reflectance" if rt else "specular_intensity"
-            add(rows, q, v[rows, 2], v[rows, 3], "1", _REFL[t], t)
+            add(rows, q, col(2), col(3), "1", _REFL[t], t)
         else:  # Mueller
-            add(rows, _MM[t], v[rows, 2], v[rows, 4], "1", "", t)
+            add(rows, _MM[t], col(2), col(4), "1", "", t)
 
-    if not parts or sum(len(pp["r"]) for pp in parts) == 0:
+    counts = [pp["count"] for pp in parts]
+    if sum(counts) == 0:
         raise AdapterError(
             path,
             "no finite data values in the file" + (f" (dropped: {dropped})" if dropped else ""),
         )
 
     # rows come grouped by tag and quantity (file order within each group)
-    r = np.concatenate([pp["r"] for pp in parts])
-    counts = [len(pp["r"]) for pp in parts]
+    def take(a: np.ndarray) -> np.ndarray:
+        """The per-line array ``a`` at the rows of every part, parts one after another."""
+        return np.concatenate([a if pp["r"] is None else a[pp["r"]] for pp in parts])
 
     def num(key: str) -> np.ndarray:
         return np.concatenate([pp[key] for pp in parts])
@@ -506,10 +533,10 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
         return labels([pp[key] for pp in parts], counts)
 
     optional: dict[str, Any] = {}
-    if any(pp["channel"] and len(pp["r"]) for pp in parts):
+    if any(pp["channel"] and pp["count"] for pp in parts):
         optional["channel"] = lab("channel")
     if time_s is not None:
-        optional["time_s"] = time_s[r]
+        optional["time_s"] = take(time_s)
     sample = meta["title"] or p.stem
     software = meta.get("software", "")
     instrument = (
@@ -523,9 +550,9 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
         value=num("value"),
         sigma=num("sigma"),
         unit=lab("unit"),
-        wavelength_nm=wl[r],
-        theta_i_deg=aoi[r],
-        theta_r_deg=aoi[r],
+        wavelength_nm=take(wl),
+        theta_i_deg=take(aoi),
+        theta_r_deg=take(aoi),  # a second array: the columns must not share memory
         phi_r_deg=180.0,
         **optional,
     )
@@ -543,6 +570,64 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
     meta["angles_deg"] = group_angles(aoi)
     meta["wavelength_nm"] = [float(np.min(wl)), float(np.max(wl))]
     return measurement(path, frame, meta)
+
+
+def _ascii_head(raw: bytes, nlines: int) -> str:
+    """The first ``nlines`` LF-ended lines of an ASCII file, decoded (all of it if shorter).
+
+    Ends right after an LF, so a CRLF is never split; lone-CR files give at least as many
+    lines. Enough for :func:`_header`, which looks at the first 7 lines.
+    """
+    pos = -1
+    for _ in range(nlines):
+        pos = raw.find(b"\n", pos + 1)
+        if pos < 0:
+            return raw.decode("ascii")
+    return raw[: pos + 1].decode("ascii")
+
+
+def _field_counts(
+    v: np.ndarray, tcodes: np.ndarray, nfields: list[int]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Rows lacking one of their first ``nf`` fields, and rows with a field beyond them.
+
+    ``nfields[k]`` is the field count of tag code ``k``. Works per distinct field count,
+    so a file of one row type costs two passes over its values.
+    """
+    n = v.shape[0]
+    nf_u = np.asarray(nfields, dtype=np.int64)
+    missing = np.zeros(n, dtype=bool)
+    extra = np.zeros(n, dtype=bool)
+    for k in np.unique(nf_u):
+        ks = np.flatnonzero(nf_u == k)
+        sel = slice(None) if ks.size == nf_u.size else np.isin(tcodes, ks)
+        sub = v[sel]
+        # fast path: a sum is NaN when a field is (or when inf meets -inf: then look closer)
+        with np.errstate(invalid="ignore"):
+            fields_nan = np.isnan(sub[:, :k].sum())
+        if fields_nan:
+            missing[sel] = np.isnan(sub[:, :k]).any(axis=1)
+        if not np.isnan(sub[:, k:]).all():
+            extra[sel] = ~np.isnan(sub[:, k:]).all(axis=1)
+    return missing, extra
+
+
+def _wrap(delta: np.ndarray) -> np.ndarray:
+    """:func:`~labbrdf.dataset.wrap_delta` of finite values, without the division.
+
+    Notes
+    -----
+    For -360 <= d < 0, ``np.mod(d, 360)`` is the single rounding of d + 360 (fmod is exact
+    there) and for 0 <= d < 360 it is d (with -0 made +0), so adding 360 where d < 0 gives
+    the same bits; other values go through ``wrap_delta``.
+    """
+    if delta.size == 0 or not (delta.min() >= -360.0 and delta.max() < 360.0):
+        return wrap_delta(delta)
+    out = delta + 0.0  # a copy, with -0.0 -> +0.0 as np.mod gives
+    np.add(out, 360.0, out=out, where=out < 0)
+    if out.max() >= 360.0:  # d + 360 rounds to 360 for tiny negative d
+        out = np.where(out >= 360.0, out - 360.0, out)
+    return out
 
 
 def _variant(meta: dict[str, Any], untagged_rows: bool) -> str:
