@@ -8,6 +8,7 @@ Subcommands: ``ingest``, ``formats``, ``fit``, ``hemispherical``, ``trace``, ``v
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import os
@@ -73,6 +74,22 @@ def _check_executor(args: argparse.Namespace) -> None:
         raise UsageError(f"--scheduler: {exc}") from None
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be >= 1, got {args.workers}")
+
+
+def _executor_errors(cmd: Any) -> Any:
+    """A run abandoned by the executor (dead workers, unreachable scheduler): exit code 2
+    with the reason, not a traceback; nothing partial has been written."""
+
+    @functools.wraps(cmd)
+    def wrapper(args: argparse.Namespace) -> int:
+        from .parallel import ParallelError
+
+        try:
+            return cmd(args)
+        except ParallelError as exc:
+            raise UsageError(str(exc)) from None
+
+    return wrapper
 
 
 # ------------------------------------------------------------------------------- ingest
@@ -195,6 +212,7 @@ def cmd_formats(args: argparse.Namespace) -> int:
 # ------------------------------------------------------------------------------- fit
 
 
+@_executor_errors
 def cmd_fit(args: argparse.Namespace) -> int:
     from . import adapters
     from .fit import fit_many
@@ -281,8 +299,8 @@ def _complex(text: str, what: str) -> complex:
         raise UsageError(f"{what} {text!r}: expected a complex index like 1.55+7.71j") from None
 
 
+@_executor_errors
 def cmd_trace(args: argparse.Namespace) -> int:
-    import functools
 
     from . import tracer
     from .parallel import imap
@@ -346,6 +364,7 @@ def cmd_trace(args: argparse.Namespace) -> int:
 # ------------------------------------------------------------------------------- report
 
 
+@_executor_errors
 def cmd_validate(args: argparse.Namespace) -> int:
     from .report import validate
 

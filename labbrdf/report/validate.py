@@ -127,6 +127,10 @@ def validate(
         shared = default_shared_dir()
     else:
         shared = Path(shared_dir) if Path(shared_dir).is_dir() else None
+    if scheduler is not None:
+        from labbrdf.parallel import check_scheduler
+
+        check_scheduler(scheduler)  # a bad name or missing dask fails here, not per section
     todo = list(SECTIONS if sections_to_run is None else sections_to_run)
     unknown = [s for s in todo if s not in SECTIONS]
     if unknown:
