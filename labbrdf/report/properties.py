@@ -128,27 +128,21 @@ def colour_section(ctx: Context) -> None:
             "near-normal reflectance) ingested"
         )
     b = ctx.b
-    cmfs = colour.MSDS_CMFS[CMFS_NAME]
-    ill = colour.SDS_ILLUMINANTS["D65"]
-    white = colour.sd_to_XYZ(
-        colour.SpectralDistribution({360: 1.0, 830: 1.0}).align(
-            colour.SpectralShape(360, 780, 1), interpolator=colour.LinearInterpolator
-        ),
-        cmfs,
-        ill,
-    )
+    shape = colour.SpectralShape(360, 780, 1)
+    grid = np.asarray(shape.wavelengths, float)
+    # observer and illuminant on the computation grid up front, so colour-science has
+    # nothing to re-align (and no warnings to print)
+    cmfs = colour.MSDS_CMFS[CMFS_NAME].copy().align(shape)
+    ill = colour.SDS_ILLUMINANTS["D65"].copy().align(shape)
+    white = colour.sd_to_XYZ(colour.SpectralDistribution(np.ones_like(grid), grid), cmfs, ill)
     rows = []
     for (sample, src), g in spec.groupby(["sample", "source"], sort=True):
         g = g.groupby("wavelength_nm", as_index=False)["value"].mean()
         wl = g["wavelength_nm"].to_numpy(float)
         v = g["value"].to_numpy(float)
-        sd = colour.SpectralDistribution(dict(zip(wl, v, strict=True)), name=str(sample))
-        shape = colour.SpectralShape(360, 780, 1)
-        used = sd.copy().align(
-            shape,
-            interpolator=colour.LinearInterpolator,
-            extrapolator_kwargs={"method": "Constant", "left": None, "right": None},
-        )
+        # linear interpolation between the measured points, end values held outside them
+        # (np.interp), evaluated on the uniform 1 nm grid
+        used = colour.SpectralDistribution(np.interp(grid, wl, v), grid, name=str(sample))
         xyz = colour.sd_to_XYZ(used, cmfs, ill)
         rgb = np.asarray(colour.XYZ_to_sRGB(xyz / 100.0), float)
         rgb_c = np.clip(rgb, 0.0, 1.0)
