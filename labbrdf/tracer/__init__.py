@@ -142,9 +142,10 @@ def trace(
         for t in tallies:
             if t.group != expected:
                 raise RuntimeError(f"map returned fold group {t.group}, expected {expected}")
-            sums = sums + t.sums
-            sumsq = sumsq + t.sumsq
-            counts = counts + t.counts
+            # sparse: the bins outside t.bins receive + 0.0, which changes no bit
+            sums[t.bins] = sums[t.bins] + t.sums
+            sumsq[t.bins] = sumsq[t.bins] + t.sumsq
+            counts[t.bins] = counts[t.bins] + t.counts
             hemi = hemi + t.hemi
             exited = exited + t.exited
             absorbed = absorbed + t.absorbed

@@ -371,13 +371,17 @@ class GroupTally:
 
     ``sums`` etc. are ``((0 + t_first) + t_next) + ...`` in block order; ``block_hemi`` and
     ``block_rays`` keep the per-block hemispherical sums for the block-to-block error.
+    Only the bins that rays left through are kept (``bins``): every other bin's sums are
+    exactly zero, so adding the sparse tally gives the same bits as adding the dense one,
+    and far less has to travel back from a worker.
     """
 
     group: int
     blocks: tuple[int, ...]
-    sums: NDArray[np.float64]
-    sumsq: NDArray[np.float64]
-    counts: NDArray[np.int64]
+    bins: NDArray[np.int64]  # flat indices of the bins with exiting rays
+    sums: NDArray[np.float64]  # (len(bins), 16)
+    sumsq: NDArray[np.float64]  # (len(bins), 16)
+    counts: NDArray[np.int64]  # (len(bins),)
     exited: float
     absorbed: float
     terminated: float
@@ -412,8 +416,21 @@ def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
         events += t.events
         bh[i] = t.hemi
         br[i] = t.rays
+    nz = np.flatnonzero(counts)
     return GroupTally(
-        group, blocks, sums, sumsq, counts, exited, absorbed, terminated, hemi, events, bh, br
+        group,
+        blocks,
+        nz,
+        sums[nz],
+        sumsq[nz],
+        counts[nz],
+        exited,
+        absorbed,
+        terminated,
+        hemi,
+        events,
+        bh,
+        br,
     )
 
 
