@@ -580,7 +580,15 @@ def read_csv(path: str | os.PathLike[str]) -> Measurement:
             fh.seek(0)
         dtypes = {c: str for c in ("sample", "instrument", "source", "unit", "channel")}
         try:
-            df = pd.read_csv(fh, dtype=dtypes, keep_default_na=False, na_values=[""])
+            # "round_trip": pandas' default C float parser is not correctly rounded on
+            # every version (pandas 2.1 lost the last digit), the exact parser is
+            df = pd.read_csv(
+                fh,
+                dtype=dtypes,
+                keep_default_na=False,
+                na_values=[""],
+                float_precision="round_trip",
+            )
         except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
             raise DatasetError(f"{path}: not a labbrdf CSV table ({exc})") from None
     try:

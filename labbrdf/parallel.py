@@ -354,6 +354,26 @@ def _imap_pool(
         yield from _ordered(lambda i: ex.submit(func, items[i]), len(items), window, bar, result)
 
 
+class _Box:
+    """An opaque container that dask passes through without looking inside."""
+
+    __slots__ = ("item",)
+
+    def __init__(self, item: Any) -> None:
+        self.item = item
+
+    def __getstate__(self) -> Any:
+        return self.item
+
+    def __setstate__(self, state: Any) -> None:
+        self.item = state
+
+
+def _unbox_call(func: Callable[[Any], Any], box: _Box) -> Any:
+    """Run ``func`` on a boxed item (module level: picklable by reference)."""
+    return func(box.item)
+
+
 def _imap_dask(
     func: Callable[[T], R],
     items: list[T],
@@ -386,7 +406,10 @@ def _imap_dask(
     # this frame alive; the futures it names would keep their tasks on the cluster)
     def submit(start: int, stop: int) -> None:
         keys = [f"labbrdf-{run_id}-{i}" for i in range(start, stop)]
-        batch = client.map(func, items[start:stop], key=keys, pure=False)
+        # boxed: older dask (< 2024.12) executes any argument tuple whose first element is
+        # callable as a task spec, and our items are tuples that may start with a model
+        boxed = [_Box(it) for it in items[start:stop]]
+        batch = client.map(_unbox_call, [func] * len(boxed), boxed, key=keys, pure=False)
         index.update({f.key: i for i, f in enumerate(batch, start=start)})
         futures.extend(batch)
         stream.update(batch)
