@@ -47,6 +47,16 @@ def to_uri(fig: Figure, dpi: int = DPI) -> str:
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
+def _finish(fig: Any, ax: Any, title: str | None) -> str:
+    """Grid, legend and title, then the figure as a PNG data URI."""
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    if title:
+        ax.set_title(_text(title), fontsize=10)
+    fig.tight_layout()
+    return to_uri(fig)
+
+
 def _text(s: Any) -> str:
     # matplotlib mathtext interprets $...$: show file text literally
     return str(s).replace("$", r"\$")
@@ -247,12 +257,7 @@ def hemispherical_figure(
         )
     ax.set_xlabel("wavelength [nm]")
     ax.set_ylabel("hemispherical reflectance [%]")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    if title:
-        ax.set_title(_text(title), fontsize=10)
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish(fig, ax, title)
 
 
 def spectrum_figure(
@@ -276,12 +281,7 @@ def spectrum_figure(
     ax.plot(wavelength, 100 * np.asarray(value, float), "o", color="k", ms=4, label="measured")
     ax.set_xlabel("wavelength [nm]")
     ax.set_ylabel(ylabel)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    if title:
-        ax.set_title(_text(title), fontsize=10)
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish(fig, ax, title)
 
 
 def xy_figure(
@@ -308,12 +308,7 @@ def xy_figure(
     ax.set_ylabel(ylabel)
     if logy:
         ax.set_yscale("log")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    if title:
-        ax.set_title(_text(title), fontsize=10)
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish(fig, ax, title)
 
 
 def polar_maps_figure(
