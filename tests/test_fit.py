@@ -18,7 +18,6 @@ import pytest
 from numpy.typing import NDArray
 from scipy import integrate, optimize, special, stats
 
-import labbrdf
 from labbrdf.dataset import Measurement, make_frame
 from labbrdf.fit import FitData, FitError, fit, fit_many, parse_method
 from labbrdf.fit.objective import _bounded_lsq, _guess_smooth3
@@ -237,8 +236,6 @@ def test_format_with_uncertainty_keeps_two_significant_digits() -> None:
 
 
 def test_three_vs_five_parameter_fits_at_45_deg() -> None:
-    if "five_param" not in labbrdf.models.MODELS:
-        pytest.skip("five_param model not written yet (lead: remove this skip when it lands)")
     fd = noisy(ZOU2013["OSR"][550], seed=1)
     fd = fd.take(np.asarray(fd.theta_i_deg) == 45.0)
     r3 = fit("smooth3", fd)
