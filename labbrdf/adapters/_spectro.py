@@ -20,26 +20,10 @@ import pandas as pd
 from ..dataset import DatasetError, Measurement, make_frame
 from ._base import AdapterError
 
-__all__ = ["finish", "number", "spectrum_frame", "text_lines"]
+__all__ = ["finish", "number", "spectrum_frame"]
 
 #: factor from a percentage to the canonical fraction (unit "1")
 PERCENT = 0.01
-
-_EOL = re.compile(r"\r\n|\r|\n")
-
-
-def text_lines(text: str) -> list[str]:
-    """Split on CRLF, LF or CR only (a missing final newline is fine).
-
-    Unlike :meth:`str.splitlines`, form feeds, vertical tabs, the FS/GS/RS controls
-    (0x1C-0x1E), NEL and the Unicode separators do not end a line: in a corrupted file
-    they must show up as bad characters in a row, not as an extra row.
-    """
-    parts = _EOL.split(text)
-    if parts and parts[-1] == "":
-        parts.pop()
-    return parts
-
 
 _NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 

@@ -38,8 +38,8 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, decode, read_bytes
-from ._spectro import PERCENT, finish, number, spectrum_frame, text_lines
+from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_cary_csv"]
 
@@ -93,7 +93,7 @@ def read_cary_csv(path: str | os.PathLike[str]) -> Measurement:
     """
     raw = read_bytes(path)
     text, encoding = decode(raw, path)
-    lines = text_lines(text)
+    lines = split_lines(text)
     if len(lines) < 3:
         raise AdapterError(path, "expected sample names, column titles and data rows")
     titles = lines[1].split(",")

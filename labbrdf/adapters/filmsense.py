@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..dataset import Measurement, wrap_delta
-from ._base import AdapterError, Format, decode, read_bytes
+from ._base import AdapterError, Format, decode, read_bytes, split_lines
 from ._numblock import NUMBER, build_frame, group_angles, measurement
 
 __all__ = ["FORMATS", "filmsense_psi_delta", "read_filmsense", "sniff_filmsense"]
@@ -155,7 +155,7 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
     """
     raw = read_bytes(path)
     text, encoding = decode(raw, path)
-    lines = text.splitlines()
+    lines = split_lines(text)
     p = Path(path)
     magic = lines[0].strip() if lines else ""
     if magic not in _MAGIC:

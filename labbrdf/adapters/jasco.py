@@ -49,8 +49,8 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, decode, read_bytes
-from ._spectro import PERCENT, finish, number, spectrum_frame, text_lines
+from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_jasco_jws", "read_jasco_text"]
 
@@ -158,7 +158,7 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
             raise
         # report where cp932 fails, not where UTF-8 did (a valid cp932 footer is not UTF-8)
         text, encoding = decode(raw, path, ("cp932",))
-    lines = text_lines(text)
+    lines = split_lines(text)
     if not lines or not lines[0].startswith("TITLE"):
         raise AdapterError(path, "expected a JASCO text export starting with 'TITLE'", 1)
     sep = "\t" if "\t" in lines[0] else ","

@@ -53,8 +53,8 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, decode, read_bytes
-from ._spectro import PERCENT, finish, number, spectrum_frame, text_lines
+from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_jcamp"]
 
@@ -354,7 +354,7 @@ def read_jcamp(path: str | os.PathLike[str]) -> Measurement:
     """
     raw = read_bytes(path)
     text, encoding = decode(raw, path, ("utf-8", "cp1252"))
-    root = _parse_blocks(path, text_lines(text))
+    root = _parse_blocks(path, split_lines(text))
     if root.records.get("DATATYPE", "").strip().upper() == "LINK":
         spectra = root.children
         if "BLOCKS" in root.records:

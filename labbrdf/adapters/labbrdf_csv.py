@@ -84,8 +84,8 @@ from pathlib import Path
 from typing import Any
 
 from ..dataset import Measurement, make_frame
-from ._base import AdapterError, Format, decode, read_bytes
-from ._spectro import finish, number, text_lines
+from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._spectro import finish, number
 
 __all__ = ["FORMATS", "read_hemispherical", "read_specular_scan"]
 
@@ -132,7 +132,7 @@ def _parse(
     """Magic, ``# key: value`` header, column header and raw data rows (line, cells)."""
     raw = read_bytes(path)
     text, _ = decode(raw, path, ("utf-8",))
-    lines = text_lines(text)
+    lines = split_lines(text)
     m = _MAGIC.fullmatch(lines[0].strip()) if lines else None
     if m is None or m.group(1) != layout:
         raise AdapterError(path, f"expected the first line '# labbrdf {layout} v1'", 1)

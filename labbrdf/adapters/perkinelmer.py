@@ -34,8 +34,8 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, decode, read_bytes
-from ._spectro import PERCENT, finish, number, spectrum_frame, text_lines
+from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_perkinelmer_asc"]
 
@@ -110,7 +110,7 @@ def read_perkinelmer_asc(path: str | os.PathLike[str]) -> Measurement:
     """
     raw = read_bytes(path)
     text, encoding = decode(raw, path)
-    lines = text_lines(text)
+    lines = split_lines(text)
     m = _MAGIC.fullmatch(lines[0]) if lines else None
     if m is None:
         raise AdapterError(
