@@ -565,6 +565,14 @@ def write_csv(m: Measurement, path: str | os.PathLike[str]) -> Path:
     return Path(path)
 
 
+#: pandas before 3.0 parses CSV floats with a fast parser that is not correctly rounded
+#: (2.1 lost the last digit), so the exact "round_trip" parser is asked for; pandas 3 made
+#: the correctly rounded parser the default and deprecated the option
+_EXACT_FLOATS: dict[str, Any] = (
+    {"float_precision": "round_trip"} if int(pd.__version__.split(".")[0]) < 3 else {}
+)
+
+
 def read_csv(path: str | os.PathLike[str]) -> Measurement:
     """Read a CSV file written by :func:`write_csv` (a plain schema CSV works too)."""
     path = Path(path)
@@ -580,14 +588,8 @@ def read_csv(path: str | os.PathLike[str]) -> Measurement:
             fh.seek(0)
         dtypes = {c: str for c in ("sample", "instrument", "source", "unit", "channel")}
         try:
-            # "round_trip": pandas' default C float parser is not correctly rounded on
-            # every version (pandas 2.1 lost the last digit), the exact parser is
             df = pd.read_csv(
-                fh,
-                dtype=dtypes,
-                keep_default_na=False,
-                na_values=[""],
-                float_precision="round_trip",
+                fh, dtype=dtypes, keep_default_na=False, na_values=[""], **_EXACT_FLOATS
             )
         except (pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
             raise DatasetError(f"{path}: not a labbrdf CSV table ({exc})") from None

@@ -22,7 +22,16 @@ from .objective import GUESSES, Objective
 from .result import FitResult
 from .uncertainty import AT_BOUND_FRAC, _jacobian, _uncertainties
 
-__all__ = ["ALGORITHMS", "CONSTRAINED", "SPECULAR_LINE_SHAPE", "fit", "parse_method"]
+__all__ = [
+    "ALGORITHMS",
+    "CHI2_TOL",
+    "EXACT_RTOL",
+    "CONSTRAINED",
+    "LOCAL_ROUNDS",
+    "SPECULAR_LINE_SHAPE",
+    "fit",
+    "parse_method",
+]
 
 #: every nlopt algorithm, by name (``GN_CRS2_LM`` ...), read from the nlopt module itself
 ALGORITHMS: dict[str, int] = {
@@ -61,7 +70,19 @@ SPECULAR_LINE_SHAPE = {"smooth3": ("k2", "k3")}
 # default stage settings (tuned with benchmarks/bench_fit.py)
 _GLOBAL_MAXEVAL_GUESSED = 30  # x (n + 1) when a data-driven starting point exists
 _GLOBAL_MAXEVAL_BLIND = 100  # x (n + 1) otherwise
-_LOCAL_MAXEVAL_PER_DIM = 400
+_LOCAL_MAXEVAL_PER_DIM = 400  # x n for one round of a local stage
+#: a local stage that stops at its round budget restarts from its best point, with a fresh
+#: trust region, up to this many rounds in all (a total of 5 x 400 n evaluations)
+LOCAL_ROUNDS = 5
+#: a round that lowers chi-square by less than this, in units of the noise scale (1 with
+#: sigma, chi-square / nfree without), has converged in chi-square: far below the
+#: Delta chi-square = t^2 (about 4) that sets the 95 % intervals, so the remaining motion
+#: along a flat valley cannot change any reported number beyond its uncertainty
+CHI2_TOL = 1e-6
+#: a round whose residuals are below this fraction of the data's RMS has converged: the
+#: model reproduces the data beyond the 6 significant digits instrument files print, so
+#: what is left is round-off (noise-free data along a flat valley)
+EXACT_RTOL = 1e-6
 _LOCAL_XTOL_REL = 1e-10
 _LOCAL_FTOL_REL = 1e-13
 _OK_CODES = (nlopt.SUCCESS, nlopt.STOPVAL_REACHED, nlopt.FTOL_REACHED, nlopt.XTOL_REACHED)
@@ -217,6 +238,72 @@ def _run_stage(
     return np.asarray(x, float), info
 
 
+#: stage code of a local stage that met :data:`CHI2_TOL` over a whole round (not an nlopt code)
+CHI2_CONVERGED = 100
+
+
+def _run_local(
+    obj: Objective,
+    name: str,
+    budget: int,
+    x: NDArray,
+    seed: int,
+    cons: Callable[[NDArray], float] | None,
+    nfree: int,
+    weighted: bool,
+) -> tuple[NDArray, dict[str, Any]]:
+    """A local stage in rounds: restart from the best point while a round ends at maxeval.
+
+    ``budget`` is the total for the stage; a round gets ``400 n`` evaluations (or the
+    whole budget where that is smaller, so an explicit small ``maxeval`` runs one round as
+    nlopt would). Each round that stops at its maxeval is followed by a fresh one from its
+    best point (a new trust region or simplex), until nlopt's own tolerances are met, a round
+    improves chi-square by less than :data:`CHI2_TOL` noise units or leaves residuals below
+    :data:`EXACT_RTOL` of the data (converged: a flat valley, reported as such), or the
+    total budget is spent (``maxeval reached``, not a success). The record holds every round.
+    """
+    per_round = max(1, min(budget, _LOCAL_MAXEVAL_PER_DIM * obj.n))
+    rounds: list[dict[str, Any]] = []
+    spent = 0
+    while True:
+        this = min(per_round, budget - spent)
+        f_start = obj.solve(obj.from_vector(np.clip(x, *obj.bounds())))[1]
+        x, info = _run_stage(obj, name, this, x, seed, cons)
+        rounds.append(info)
+        spent += info["nfev"]
+        if info["code"] != nlopt.MAXEVAL_REACHED:
+            break
+        scale = 1.0 if weighted else max(info["chisqr"] / max(nfree, 1), 1e-300)
+        gain = (f_start - info["chisqr"]) / scale
+        vals, _ = obj.solve(obj.from_vector(x))
+        resid = obj.y - obj.model_values(vals)
+        exact = float(np.sqrt(np.mean(resid**2)) / max(np.sqrt(np.mean(obj.y**2)), 1e-300))
+        why = None
+        if math.isfinite(gain) and gain < CHI2_TOL:
+            why = (
+                f"converged in chi-square: the last round of {info['nfev']} evaluations "
+                f"lowered it by {gain:.2g} noise units (< {CHI2_TOL:g}); flat valley"
+            )
+        elif exact < EXACT_RTOL:
+            why = (
+                f"converged: the model reproduces the data to {exact:.2g} of their RMS "
+                f"(< {EXACT_RTOL:g}); what is left is round-off along a flat valley"
+            )
+        if why is not None:
+            info = {**info, "code": CHI2_CONVERGED, "message": why}
+            break
+        if spent >= budget:
+            info = {
+                **info,
+                "message": f"maxeval reached ({spent} evaluations in "
+                f"{len(rounds)} rounds, chi-square still falling by {gain:.3g} noise "
+                "units per round)",
+            }
+            break
+    out = {**info, "nfev": spent, "rounds": rounds}
+    return x, out
+
+
 def fit(
     model: Model | str,
     data: Measurement | pd.DataFrame | FitData,
@@ -268,10 +355,16 @@ def fit(
         upper bound on it, exact and usable with any algorithm; otherwise every stage must
         take constraints (:data:`CONSTRAINED`, e.g. ``"GN_ISRES+LN_COBYLA"``).
     maxeval : int or sequence, optional
-        Evaluation budget per stage (one number for all stages, or one per stage).
+        Total evaluation budget per stage (one number for all stages, or one per stage).
         Default: ``30 (n + 1)`` for a global stage that starts from a :data:`GUESSES` point,
-        ``100 (n + 1)`` without one, and ``400 n`` for a local stage, where ``n`` is the
-        number of searched (non-profiled) parameters (tuned with benchmarks/bench_fit.py).
+        ``100 (n + 1)`` without one, and ``LOCAL_ROUNDS x 400 n`` (2000 n) for a local
+        stage, where ``n`` is the number of searched (non-profiled) parameters (tuned with
+        benchmarks/bench_fit.py). A local stage runs in rounds of at most ``400 n``
+        evaluations: a round that stops at its maxeval is restarted from its best point
+        until nlopt's tolerances are met, a whole round lowers chi-square by less than
+        :data:`CHI2_TOL` noise units (converged in chi-square along a flat valley, a
+        success whose parameters the flags mark as not identifiable), or the total is
+        spent (``success`` False, "maxeval reached").
     quantity, unit : str, optional
         Which rows to fit when the data mix quantities or units.
     use_sigma : bool, optional
@@ -373,7 +466,12 @@ def fit(
         for name, budget in zip(stages, budgets, strict=True):
             if obj.n == 0:
                 break
-            x, info = _run_stage(obj, name, budget, x, int(seed), cons)
+            if _is_global(name):
+                x, info = _run_stage(obj, name, budget, x, int(seed), cons)
+            else:
+                x, info = _run_local(
+                    obj, name, budget, x, int(seed), cons, n_pts - nvarys, use_sigma
+                )
             stage_info.append(info)
             last_code, message = info["code"], info["message"]
 
@@ -404,8 +502,10 @@ def fit(
                 except (ValueError, RuntimeError) as exc:  # keep the Wald interval
                     warn.append(f"{k}: profile interval not found ({exc}); Wald interval kept")
     if finite:
-        ok = last_code in _OK_CODES or (
-            bool(stages) and _is_global(stages[-1]) and last_code == nlopt.MAXEVAL_REACHED
+        ok = (
+            last_code in _OK_CODES
+            or last_code == CHI2_CONVERGED
+            or (bool(stages) and _is_global(stages[-1]) and last_code == nlopt.MAXEVAL_REACHED)
         )
         success = ok or obj.n == 0
     else:
@@ -459,6 +559,9 @@ def fit(
         warnings=warn,
         ci_method=ci,
         cond=cond,
+        nlopt_version=".".join(
+            str(v) for v in (nlopt.version_major(), nlopt.version_minor(), nlopt.version_bugfix())
+        ),
         residual=resid,
         best_fit=best,
     )
@@ -643,7 +746,7 @@ def _budgets(
     return [
         int(b)
         if b is not None
-        else (per * (n + 1) if _is_global(s) else _LOCAL_MAXEVAL_PER_DIM * n)
+        else (per * (n + 1) if _is_global(s) else LOCAL_ROUNDS * _LOCAL_MAXEVAL_PER_DIM * n)
         for s, b in zip(stages, given, strict=True)
     ]
 

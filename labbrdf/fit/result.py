@@ -106,7 +106,8 @@ class FitResult:
     ndropped : int
         Points dropped by ``nan_policy='omit'``.
     stages : list of dict
-        Per stage: algorithm, nfev, chisqr, nlopt return code and message.
+        Per stage: algorithm, nfev, chisqr, nlopt return code and message; a local stage
+        also lists its ``rounds`` (restarts from the best point, see :func:`labbrdf.fit`).
     energy : dict or None
         The energy constraint: incidence grid [deg] and max rho at the optimum.
     warnings : list of str
@@ -114,6 +115,10 @@ class FitResult:
     ci_method : str
         ``wald`` (value +- t stderr, Student t with ``nfree`` degrees of freedom) or
         ``profile`` (profile of chi-square); see :func:`labbrdf.fit.fit`.
+    cond : float or None
+        Condition number of the scaled Jacobian at the optimum.
+    nlopt_version : str or None
+        The nlopt library that ran the fit (its search paths differ between releases).
     residual : ndarray
         ``y - f`` at the optimum [data units].
     best_fit : ndarray
@@ -160,6 +165,7 @@ class FitResult:
     warnings: list[str] = field(default_factory=list)
     ci_method: str = "wald"
     cond: float | None = None
+    nlopt_version: str | None = None
     residual: NDArray | None = field(default=None, repr=False)
     best_fit: NDArray | None = field(default=None, repr=False)
 
@@ -225,6 +231,7 @@ class FitResult:
             "warnings": self.warnings,
             "cond": self.cond,
             "ci_method": self.ci_method,
+            "nlopt_version": self.nlopt_version,
         }
         return _jsonable(out)
 

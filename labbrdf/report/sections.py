@@ -55,6 +55,8 @@ class Context:
     progress: bool = False
     method: str = METHOD
     seed: int = 0
+    #: further :func:`labbrdf.fit` keywords for every fit of the report (e.g. ``maxeval``)
+    fit_options: dict[str, Any] = field(default_factory=dict)
     files: list[dict[str, Any]] = field(default_factory=list)
     frames: list[pd.DataFrame] = field(default_factory=list)
     fits: dict[str, list[FitRecord]] = field(default_factory=dict)
@@ -146,14 +148,16 @@ def rmse_abs(summary: Mapping[str, Any]) -> float | None:
     return _num(v)
 
 
-def fit_task(task: tuple[str, dict[str, Any], pd.DataFrame, str, int]) -> dict[str, Any]:
+def fit_task(
+    task: tuple[str, dict[str, Any], pd.DataFrame, str, int, dict[str, Any]],
+) -> dict[str, Any]:
     """Fit one group (module level, so that process and dask schedulers can pickle it)."""
     import labbrdf
     from labbrdf import models
 
-    name, options, df, method, seed = task
+    name, options, df, method, seed, fit_options = task
     model = models.get(name, **options)
-    res = labbrdf.fit(model, df, method=method, seed=seed)
+    res = labbrdf.fit(model, df, method=method, seed=seed, **fit_options)
     return dict(res.summary())
 
 
@@ -301,7 +305,10 @@ def run_fits(
     ]
     out: dict[str, list[FitRecord]] = {}
     for name, options in models:
-        tasks = [(name, dict(options), g, ctx.method, ctx.seed) for _, _, g in groups]
+        tasks = [
+            (name, dict(options), g, ctx.method, ctx.seed, dict(ctx.fit_options))
+            for _, _, g in groups
+        ]
         ctx.b.log(f"  fitting {name} to {len(tasks)} groups ({group})")
         summaries = _run(ctx, fit_task, tasks, f"fit {name}")
         recs = []

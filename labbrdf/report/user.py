@@ -13,6 +13,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..provenance import versions
 from . import figure_sections, html, properties, sections
 from ._common import Builder, write_report
 
@@ -93,6 +94,7 @@ def user_report(
             "method": method,
             "seed": seed,
             "files": [str(p) for p in paths],
+            "environment": versions(),
         },
     )
     ctx = sections.Context(

@@ -16,10 +16,11 @@ from __future__ import annotations
 
 import os
 import platform
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from ..provenance import versions
 from . import figure_sections, html, paper, properties, sections, tracer_sections
 from ._common import Builder, Unavailable, write_report
 
@@ -89,6 +90,7 @@ def validate(
     shared_dir: str | os.PathLike[str] | None | bool = None,
     sections_to_run: Sequence[str] | None = None,
     extra_checks: Sequence[Callable[[Builder], Any]] = (),
+    fit_options: Mapping[str, Any] | None = None,
 ) -> int:
     """Run the validation and write the report folder ``out``.
 
@@ -113,6 +115,9 @@ def validate(
     extra_checks : sequence of callables
         ``f(builder)`` each adding checks to a final "extra checks" section (tests inject a
         failing check here).
+    fit_options : mapping, optional
+        Further :func:`labbrdf.fit` keywords for every fit (tests starve ``maxeval`` to
+        show that the fits' success check can fail).
 
     Returns
     -------
@@ -147,12 +152,20 @@ def validate(
             "fixtures_dir": str(fx),
             "shared_dir": str(shared) if shared else None,
             "python": platform.python_version(),
+            "environment": versions(),
             "scheduler": scheduler or "serial",
             "workers": workers,
             "sections_run": todo,
         },
     )
-    ctx = sections.Context(b, quick=quick, scheduler=scheduler, workers=workers, progress=progress)
+    ctx = sections.Context(
+        b,
+        quick=quick,
+        scheduler=scheduler,
+        workers=workers,
+        progress=progress,
+        fit_options=dict(fit_options or {}),
+    )
     ctx.extra.update({"scale": SCALES[scale_name], "shared": shared, "fixtures": fx})
 
     def want(sid: str) -> bool:
