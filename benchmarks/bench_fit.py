@@ -195,13 +195,45 @@ def bench_batch(workers: int) -> None:
     print(f"serial: {time.perf_counter() - t0:.2f} s")
 
 
+def bench_convergence(groups: list[tuple[str, FitData]], seeds: int) -> None:
+    """Success, evaluations and time of the default five_param fit over several seeds.
+
+    nlopt's random sequence differs between releases and machines, so the seeds stand in
+    for them: a fit that converges only for the seed it was tuned on is fragile.
+    """
+    print(f"\nfive_param default fit over seeds 0..{seeds - 1} (per group)")
+    print(f"{'group':<16}{'success':>9}{'nfev median':>13}{'nfev max':>10}{'ms median':>11}")
+    n_ok = n_all = 0
+    for label, fd in groups:
+        nfev, ms, ok = [], [], 0
+        for seed in range(seeds):
+            t0 = time.perf_counter()
+            r = fit("five_param", fd, seed=seed)
+            ms.append(1e3 * (time.perf_counter() - t0))
+            nfev.append(r.nfev)
+            ok += bool(r.success)
+        n_ok, n_all = n_ok + ok, n_all + seeds
+        print(
+            f"{label:<16}{ok:>5}/{seeds:<3}{np.median(nfev):>13.0f}{max(nfev):>10d}"
+            f"{np.median(ms):>11.1f}"
+        )
+    print(f"all groups: {n_ok}/{n_all} successful")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5, help="timing repeats per fit (best of)")
     ap.add_argument("--workers", type=int, default=2, help="process-pool workers for fit_many")
     ap.add_argument("--skip-batch", action="store_true", help="skip the 761-wavelength batch")
+    ap.add_argument("--seeds", type=int, default=8, help="seeds for the convergence table")
+    ap.add_argument(
+        "--only-convergence", action="store_true", help="print only the convergence table"
+    )
     args = ap.parse_args()
     groups = fixture_groups()
+    bench_convergence(groups, args.seeds)
+    if args.only_convergence:
+        return
     bench_model("smooth3", groups, args.repeat)
     if "five_param" in MODELS:
         bench_model("five_param", groups, max(1, args.repeat // 2))
