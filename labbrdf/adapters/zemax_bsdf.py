@@ -159,8 +159,10 @@ def scatter_to_direction(
 def _direction_angles(d: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """(theta [deg] from +z, phi [deg] in [0, 360)) of unit vectors ``d`` (3, ...)."""
     x, y, z = d
-    theta = np.degrees(np.arctan2(np.hypot(x, y), z))
-    phi = np.mod(np.degrees(np.arctan2(y, x)), 360.0)
+    # rounded to 1e-12 deg (2e-14 rad, below the last bit of a file's angle) so that exact
+    # cases come out exact: the specular direction of 20 deg is 20.0, not 20.000000000000007
+    theta = np.round(np.degrees(np.arctan2(np.hypot(x, y), z)), 12)
+    phi = np.mod(np.round(np.degrees(np.arctan2(y, x)), 12), 360.0)
     phi = np.where(phi >= 360.0, 0.0, phi)
     return theta, phi
 
