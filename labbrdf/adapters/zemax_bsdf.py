@@ -43,8 +43,9 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
-from ..dataset import Measurement, atomic_output, make_frame
+from ..dataset import Measurement, atomic_output
 from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._numblock import build_frame
 
 __all__ = [
     "FORMATS",
@@ -145,15 +146,16 @@ def scatter_to_direction(
     the radial angle ``r`` about the axis ``s x (cos a e0 + sin a e90)`` (Rodrigues' formula
     with an axis perpendicular to ``s``), exact for any ``r``.
     """
-    ts, r, a = np.broadcast_arrays(
-        np.asarray(theta_s_deg, float),
-        np.asarray(radial_deg, float),
-        np.asarray(azimuth_deg, float),
-    )
-    s, e0, e90 = _frame(ts)
+    # trigonometry on the inputs as given (1-D grids broadcast later), components written out
+    ts, r, a = (np.asarray(x, float) for x in (theta_s_deg, radial_deg, azimuth_deg))
+    ct, st = _cosd(ts), _sind(ts)
     cr, sr = _cosd(r), _sind(r)
     ca, sa = _cosd(a), _sind(a)
-    return cr * s + sr * (ca * e0 + sa * e90)
+    u = sr * ca  # component along e0 = (cos ts, 0, sin ts)
+    x = u * ct - cr * st
+    y = sr * sa
+    z = cr * ct + u * st
+    return np.stack(np.broadcast_arrays(x, y, z))
 
 
 def _direction_angles(d: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -423,12 +425,14 @@ def _parse_numbers(
         raise AdapterError(
             path, f"expected numbers, found the character {bad.group()!r}", lines[i]
         )
+    counts = np.fromiter((len(r.split()) for r in rows), dtype=np.int64, count=len(rows))
+    wrong = np.flatnonzero(counts != ncols)
+    if wrong.size:
+        i = int(wrong[0])
+        raise AdapterError(
+            path, f"expected {ncols} values in the row, found {counts[i]}", lines[i]
+        )
     toks = text.split()
-    if len(toks) != len(rows) * ncols:
-        for row, ln in zip(rows, lines, strict=True):
-            k = len(row.split())
-            if k != ncols:
-                raise AdapterError(path, f"expected {ncols} values in the row, found {k}", ln)
     try:
         vals = np.array(toks, dtype=np.float64)
     except ValueError:
@@ -541,18 +545,22 @@ def _table_frame(
 ) -> tuple[pd.DataFrame, int]:
     """Rows above the horizon in the dataset schema, and the number dropped below it."""
     nrot, nch, naoi, naz, nrad = t.values.shape
-    ri, ci, ai, zi, qi = np.indices(t.values.shape).reshape(5, -1)
-    theta_r, phi_r, above = scatter_to_angles(
-        t.theta_i_deg[ai], t.radial_deg[qi], t.azimuth_deg[zi]
+    full = t.values.shape
+    theta_r, phi_r, above = (
+        np.broadcast_to(x, full).reshape(-1)
+        for x in scatter_to_angles(
+            t.theta_i_deg[:, None, None], t.radial_deg[None, None, :], t.azimuth_deg[None, :, None]
+        )
     )
-    keep = above
+    keep = np.flatnonzero(above)
+    ti = np.broadcast_to(t.theta_i_deg[:, None, None], full).reshape(-1)
     optional: dict[str, Any] = {}
     if nrot > 1 or t.rotation_deg[0] != 0:
-        optional["sample_rotation_deg"] = t.rotation_deg[ri[keep]]
+        optional["sample_rotation_deg"] = np.repeat(t.rotation_deg, nch * naoi * naz * nrad)[keep]
     if t.spectral == "XYZ":
-        names = np.array([_CHANNEL[c] for c in t.channels], dtype=object)
-        optional["channel"] = names[ci[keep]]
-    frame = make_frame(
+        codes = np.repeat(np.tile(np.arange(nch, dtype=np.int8), nrot), naoi * naz * nrad)
+        optional["channel"] = pd.Categorical.from_codes(codes[keep], categories=["X", "Y", "Z"])
+    frame = build_frame(
         sample=Path(path).stem,
         instrument=INSTRUMENT,
         source=os.path.basename(os.fspath(path)),
@@ -560,12 +568,12 @@ def _table_frame(
         value=t.values.reshape(-1)[keep],
         unit="sr-1",
         wavelength_nm=wavelength_nm,
-        theta_i_deg=t.theta_i_deg[ai[keep]],
+        theta_i_deg=ti[keep],
         theta_r_deg=theta_r[keep],
         phi_r_deg=phi_r[keep],
         **optional,
     )
-    return frame, int((~keep).sum())
+    return frame, int(above.size - keep.size)
 
 
 def _tis_meta(t: BsdfTable) -> list[dict[str, Any]]:
