@@ -23,9 +23,12 @@ column              dtype     meaning
 
 Optional columns (:data:`OPTIONAL_COLUMNS`) carry what some instruments add: ``time_s``
 (time stamp of a kinetic series [s]), ``channel`` (polarisation or generalized-ellipsometry
-channel: ``p``, ``s``, ``pp``, ``ps``, ``sp``), ``x_mm``/``y_mm`` (stage position of the
-spot [mm]). Canonical units: angles in degrees, Delta in [0, 360) (Nebraska convention),
-reflectance, transmittance and depolarization as fractions.
+channel: ``p``, ``s``, ``pp``, ``ps``, ``sp``; tristimulus channel ``X``, ``Y``, ``Z``),
+``x_mm``/``y_mm`` (stage position of the spot [mm]), ``sample_rotation_deg`` (rotation of
+an anisotropic sample about its normal [deg]). Canonical units: angles in degrees, Delta in
+[0, 360) (Nebraska convention), reflectance, transmittance and depolarization as fractions.
+Quantity ``btdf`` [sr-1]: theta_r is measured from the back normal and phi_r is the
+azimuth of the transmitted direction.
 """
 
 from __future__ import annotations
@@ -83,6 +86,7 @@ OPTIONAL_COLUMNS: dict[str, str] = {
     "channel": "object",
     "x_mm": "float64",
     "y_mm": "float64",
+    "sample_rotation_deg": "float64",
 }
 
 _MUELLER = tuple(f"mueller_{i}{j}" for i in range(1, 5) for j in range(1, 5))
@@ -97,6 +101,7 @@ QUANTITIES: dict[str, tuple[str, ...]] = {
     "transmittance": ("1",),
     "absorbance": ("1",),
     "brdf": ("sr-1",),
+    "btdf": ("sr-1",),
     "depolarization": ("1",),
     **{m: ("1",) for m in _MUELLER},
 }
@@ -435,7 +440,8 @@ def make_frame(
 ) -> pd.DataFrame:
     """Build a schema table from arrays and scalars (broadcast to one length).
 
-    Optional columns (``time_s``, ``channel``, ``x_mm``, ``y_mm``) go in ``optional``.
+    Optional columns (``time_s``, ``channel``, ``x_mm``, ``y_mm``, ``sample_rotation_deg``)
+    go in ``optional``.
     The result is not validated; wrap it in :class:`Measurement` to do so.
     """
     unknown = set(optional) - set(OPTIONAL_COLUMNS)

@@ -35,6 +35,7 @@ _MODULES = (
     "spc",
     "labbrdf_csv",
     "native",
+    "zemax_bsdf",
 )
 
 #: name -> Format

@@ -1,0 +1,1087 @@
+"""Zemax / Radiant "BSDF Data Interchange" tabular text files (``.bsdf``): reader and writer.
+
+The format (Radiant Imaging, "BSDF Data Interchange File Format Specification", 2008; the
+"Zemax Tabular BSDF data file format" article of the Zemax knowledge base) is a header::
+
+    #<comment lines anywhere>
+    Source  Measured
+    Symmetry  PlaneSymmetrical | Asymmetrical | Asymmetrical4D
+    SpectralContent  Monochrome | XYZ
+    ScatterType  BRDF | BTDF
+    SampleRotation  <n>         then n rotations [deg]
+    AngleOfIncidence  <n>       then n angles [deg]
+    ScatterAzimuth  <n>         then n azimuths [deg]
+    ScatterRadial  <n>          then n radial angles [deg]
+
+followed, per spectral channel (``Monochrome``, or ``TristimulusX``, ``TristimulusY``,
+``TristimulusZ``), by the channel's name, ``DataBegin``, then for every sample rotation and
+every angle of incidence (rotation outermost) a ``TIS <value>`` line and one row per azimuth
+with one value per radial angle, and an optional ``DataEnd``. Cells are separated by tabs or
+spaces.
+
+Geometry (see ``docs/bsdf.md``): the scatter angles are given about the specular direction
+(the direction of direct transmission for BTDF): radial 0 is the specular direction, azimuth 0
+points from the specular direction towards the sample normal, azimuths increase
+counter-clockwise. The specification does not say from which side "counter-clockwise" is
+seen; labbrdf takes it as seen by an observer looking back at the sample along the specular
+direction, so azimuth 90 is the +y side when the source is at phi_i = 0. Every point is
+converted exactly (unit vectors, no small-angle approximation) to the dataset's
+``theta_i_deg``, ``theta_r_deg``, ``phi_r_deg``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from numpy.typing import ArrayLike, NDArray
+
+from ..dataset import Measurement, atomic_output
+from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._numblock import build_frame
+
+__all__ = [
+    "FORMATS",
+    "BsdfTable",
+    "angles_to_scatter",
+    "grid_integral",
+    "mirror_plane_symmetric",
+    "model_to_bsdf",
+    "read_table",
+    "read_zemax_bsdf",
+    "scatter_to_angles",
+    "scatter_to_direction",
+    "write_bsdf",
+]
+
+INSTRUMENT = "zemax-bsdf"
+SYMMETRIES = ("PlaneSymmetrical", "Asymmetrical", "Asymmetrical4D")
+SPECTRAL = {"Monochrome": ("Monochrome",), "XYZ": ("TristimulusX", "TristimulusY", "TristimulusZ")}
+#: channel column value per section name (Monochrome files have no channel column)
+_CHANNEL = {"Monochrome": "", "TristimulusX": "X", "TristimulusY": "Y", "TristimulusZ": "Z"}
+SCATTER_TYPES = {"BRDF": "brdf", "BTDF": "btdf"}
+
+#: Wavelength written in the dataset when the file states none [nm]: the photopic peak.
+#: The format has no wavelength field; Monochrome data of the imaging sphere are luminance
+#: (photopic) data and XYZ data are tristimulus values, so 555 nm is a label, not a
+#: measurement. ``meta["wavelength_stated"]`` is False; pass ``wavelength_nm=`` to override.
+DEFAULT_WAVELENGTH_NM = 555.0
+
+#: Hard caps: values per list, and values in the whole file.
+MAX_LIST = 100_000
+MAX_POINTS = 50_000_000
+
+_HEADER_LISTS = ("SampleRotation", "AngleOfIncidence", "ScatterAzimuth", "ScatterRadial")
+_HEADER_WORDS = ("Source", "Symmetry", "SpectralContent", "ScatterType")
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
+_INT = re.compile(r"\+?\d+", re.ASCII)
+_NOT_NUMERIC = re.compile(r"[^0-9eE+\-. \t\n]")
+_SNIFF = re.compile(rb"^\s*(Source|Symmetry|SpectralContent|ScatterType)\s", re.MULTILINE)
+
+
+# ------------------------------------------------------------------------------ geometry
+
+
+def _cosd(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """cos of degrees, exact (0, +-1) at multiples of 90 deg."""
+    a = np.asarray(a, dtype=float)
+    r = np.mod(a, 360.0)
+    out = np.cos(np.radians(a))
+    out = np.where(r == 90.0, 0.0, out)
+    out = np.where(r == 270.0, 0.0, out)
+    out = np.where(r == 0.0, 1.0, out)
+    return np.where(r == 180.0, -1.0, out)
+
+
+def _sind(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """sin of degrees, exact (0, +-1) at multiples of 90 deg."""
+    return _cosd(np.asarray(a, dtype=float) - 90.0)
+
+
+def _frame(theta_s_deg: ArrayLike) -> tuple[NDArray[np.float64], ...]:
+    """Specular unit vector ``s`` and the azimuth-0 and azimuth-90 unit vectors ``e0``, ``e90``.
+
+    Source at phi_i = 0, so the specular direction is ``s = (-sin ts, 0, cos ts)``;
+    ``e0 = (cos ts, 0, sin ts)`` is the tangent at ``s`` pointing towards the normal (spec:
+    "azimuth 0 points from the specular direction towards the sample normal") and
+    ``e90 = s x e0 = (0, 1, 0)`` (counter-clockwise seen from the specular direction).
+    """
+    ts = np.asarray(theta_s_deg, dtype=float)
+    c, s = _cosd(ts), _sind(ts)
+    zero = np.zeros_like(c)
+    return (
+        np.stack([-s, zero, c]),
+        np.stack([c, zero, s]),
+        np.stack([zero, zero + 1.0, zero]),
+    )
+
+
+def scatter_to_direction(
+    theta_s_deg: ArrayLike, radial_deg: ArrayLike, azimuth_deg: ArrayLike
+) -> NDArray[np.float64]:
+    """Unit vector of a scatter direction given about the specular direction.
+
+    Parameters
+    ----------
+    theta_s_deg : array_like
+        Polar angle of the specular direction [deg] (the file's "AngleOfIncidence").
+    radial_deg, azimuth_deg : array_like
+        Scatter radial and azimuth angles [deg]; broadcast with ``theta_s_deg``.
+
+    Returns
+    -------
+    ndarray
+        ``(3, ...)`` Cartesian components (x, y, z), z along the sample normal.
+
+    Notes
+    -----
+    ``d = cos(r) s + sin(r) (cos(a) e0 + sin(a) e90)``: the specular vector ``s`` rotated by
+    the radial angle ``r`` about the axis ``s x (cos a e0 + sin a e90)`` (Rodrigues' formula
+    with an axis perpendicular to ``s``), exact for any ``r``.
+    """
+    # trigonometry on the inputs as given (1-D grids broadcast later), components written out
+    ts, r, a = (np.asarray(x, float) for x in (theta_s_deg, radial_deg, azimuth_deg))
+    ct, st = _cosd(ts), _sind(ts)
+    cr, sr = _cosd(r), _sind(r)
+    ca, sa = _cosd(a), _sind(a)
+    u = sr * ca  # component along e0 = (cos ts, 0, sin ts)
+    x = u * ct - cr * st
+    y = sr * sa
+    z = cr * ct + u * st
+    return np.stack(np.broadcast_arrays(x, y, z))
+
+
+def _direction_angles(d: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """(theta [deg] from +z, phi [deg] in [0, 360)) of unit vectors ``d`` (3, ...)."""
+    x, y, z = d
+    # rounded to 1e-12 deg (2e-14 rad, below the last bit of a file's angle) so that exact
+    # cases come out exact: the specular direction of 20 deg is 20.0, not 20.000000000000007
+    theta = np.round(np.degrees(np.arctan2(np.hypot(x, y), z)), 12)
+    phi = np.mod(np.round(np.degrees(np.arctan2(y, x)), 12), 360.0)
+    phi = np.where(phi >= 360.0, 0.0, phi)
+    return theta, phi
+
+
+def scatter_to_angles(
+    theta_s_deg: ArrayLike, radial_deg: ArrayLike, azimuth_deg: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
+    """Dataset angles of scatter directions: ``(theta_r_deg, phi_r_deg, above)``.
+
+    Parameters
+    ----------
+    theta_s_deg, radial_deg, azimuth_deg : array_like
+        As in :func:`scatter_to_direction` [deg].
+
+    Returns
+    -------
+    theta_r_deg : ndarray
+        Polar angle from the normal [deg] (from the back normal for BTDF, whose frame is
+        the reflection frame mirrored in the sample plane).
+    phi_r_deg : ndarray
+        Azimuth of the outward direction [deg] in [0, 360), source at 0, the specular
+        direction at 180.
+    above : ndarray of bool
+        True where the direction is above the horizon (z > 0); elsewhere the point is not
+        a scatter direction of this hemisphere.
+    """
+    d = scatter_to_direction(theta_s_deg, radial_deg, azimuth_deg)
+    theta, phi = _direction_angles(d)
+    return theta, phi, d[2] > 0
+
+
+def angles_to_scatter(
+    theta_s_deg: ArrayLike, theta_r_deg: ArrayLike, phi_r_deg: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Inverse of :func:`scatter_to_angles`: ``(radial_deg, azimuth_deg in [0, 360))``.
+
+    ``r = atan2(|d x s|, d . s)`` and ``a = atan2(d . e90, d . e0)`` with the frame of
+    :func:`scatter_to_direction`; ``a`` is 0 at ``r = 0`` (undefined there).
+    """
+    ts, tr, pr = np.broadcast_arrays(
+        np.asarray(theta_s_deg, float),
+        np.asarray(theta_r_deg, float),
+        np.asarray(phi_r_deg, float),
+    )
+    st = _sind(tr)
+    d = np.stack([st * _cosd(pr), st * _sind(pr), _cosd(tr)])
+    s, e0, e90 = _frame(ts)
+    cos_r = np.sum(d * s, axis=0)
+    u, v = np.sum(d * e0, axis=0), np.sum(d * e90, axis=0)
+    radial = np.degrees(np.arctan2(np.hypot(u, v), cos_r))
+    az = np.mod(np.degrees(np.arctan2(v, u)), 360.0)
+    return radial, np.where(az >= 360.0, 0.0, az)
+
+
+# ------------------------------------------------------------------------------ table
+
+
+@dataclass
+class BsdfTable:
+    """The numbers of a ``.bsdf`` file on its own grid.
+
+    Attributes
+    ----------
+    symmetry, spectral, scatter_type : str
+        Header keywords (``spectral`` is ``Monochrome`` or ``XYZ``).
+    rotation_deg, theta_i_deg, azimuth_deg, radial_deg : ndarray
+        The header lists [deg].
+    values : ndarray
+        ``(rotation, channel, aoi, azimuth, radial)`` BSDF [sr^-1], as written (values
+        below the horizon included).
+    tis : ndarray
+        ``(rotation, channel, aoi)`` total integrated scatter from the ``TIS`` lines.
+    comments : list of str
+        Comment lines (without ``#``).
+    source : str
+        The ``Source`` keyword.
+    """
+
+    symmetry: str
+    spectral: str
+    scatter_type: str
+    rotation_deg: NDArray[np.float64]
+    theta_i_deg: NDArray[np.float64]
+    azimuth_deg: NDArray[np.float64]
+    radial_deg: NDArray[np.float64]
+    values: NDArray[np.float64]
+    tis: NDArray[np.float64]
+    comments: list[str] = field(default_factory=list)
+    source: str = "Measured"
+
+    @property
+    def channels(self) -> tuple[str, ...]:
+        """Section names: ``("Monochrome",)`` or ``("TristimulusX", ...)``."""
+        return SPECTRAL[self.spectral]
+
+
+class _Lines:
+    """Cursor over the significant lines (not blank, not ``#``) with their 1-based numbers."""
+
+    def __init__(self, lines: list[str]) -> None:
+        self.items = [(n, s) for n, s in ((i + 1, ln.strip()) for i, ln in enumerate(lines)) if s]
+        self.comments = [s[1:].strip() for _, s in self.items if s.startswith("#")]
+        self.items = [(n, s) for n, s in self.items if not s.startswith("#")]
+        self.pos = 0
+
+    def peek(self) -> tuple[int, str] | None:
+        return self.items[self.pos] if self.pos < len(self.items) else None
+
+    def next(self) -> tuple[int, str] | None:
+        item = self.peek()
+        self.pos += item is not None
+        return item
+
+    def last_line(self) -> int | None:
+        return self.items[-1][0] if self.items else None
+
+
+def _num(path: str | os.PathLike[str], text: str, line: int, what: str) -> float:
+    """One finite ASCII decimal number, else AdapterError."""
+    if not _NUMBER.fullmatch(text):
+        raise AdapterError(path, f"{what}: expected an ASCII decimal number, found {text!r}", line)
+    v = float(text)
+    if not math.isfinite(v):
+        raise AdapterError(path, f"{what}: {text!r} is not a finite number", line)
+    return v
+
+
+def _count(path: str | os.PathLike[str], text: str, line: int, key: str) -> int:
+    if not _INT.fullmatch(text):
+        raise AdapterError(path, f"{key}: expected a count (ASCII integer), found {text!r}", line)
+    n = int(text)
+    if not 1 <= n <= MAX_LIST:
+        raise AdapterError(path, f"{key}: count {n} outside 1..{MAX_LIST}", line)
+    return n
+
+
+def _header_list(
+    path: str | os.PathLike[str], cur: _Lines, key: str, n: int, rest: list[str], line: int
+) -> NDArray[np.float64]:
+    """The ``n`` numbers after a list keyword (same line or following lines)."""
+    toks: list[tuple[int, str]] = [(line, t) for t in rest]
+    while len(toks) < n:
+        item = cur.peek()
+        if item is None or not _NUMBER.match(item[1].split()[0]):
+            found = len(toks)
+            raise AdapterError(
+                path, f"{key} {n}: expected {n} values, found {found}", item[0] if item else line
+            )
+        cur.next()
+        toks.extend((item[0], t) for t in item[1].split())
+    if len(toks) != n:
+        raise AdapterError(path, f"{key} {n}: expected {n} values, found {len(toks)}", toks[-1][0])
+    return np.array([_num(path, t, ln, key) for ln, t in toks])
+
+
+def _check_list(
+    path: str | os.PathLike[str], key: str, a: NDArray[np.float64], lo: float, hi: float
+) -> None:
+    if a.min() < lo or a.max() > hi:
+        raise AdapterError(path, f"{key}: values must lie in [{lo:g}, {hi:g}] deg")
+    if a.size > 1 and not np.all(np.diff(a) > 0):
+        raise AdapterError(path, f"{key}: values must be strictly increasing")
+
+
+def _parse_header(path: str | os.PathLike[str], cur: _Lines) -> dict[str, Any]:
+    head: dict[str, Any] = {}
+    while True:
+        item = cur.peek()
+        if item is None:
+            raise AdapterError(path, "no data section: expected 'Monochrome' or 'TristimulusX'")
+        n, s = item
+        key, *rest = s.split()
+        if key in SPECTRAL["Monochrome"] + SPECTRAL["XYZ"] or key == "DataBegin":
+            break
+        cur.next()
+        if key in head:
+            raise AdapterError(path, f"header keyword {key!r} given twice", n)
+        if key in _HEADER_WORDS:
+            if len(rest) != 1:
+                raise AdapterError(path, f"{key}: expected one keyword after it", n)
+            head[key] = (rest[0], n)
+        elif key in _HEADER_LISTS:
+            if not rest:
+                raise AdapterError(path, f"{key}: expected a count after it", n)
+            count = _count(path, rest[0], n, key)
+            head[key] = _header_list(path, cur, key, count, rest[1:], n)
+        else:
+            raise AdapterError(
+                path,
+                f"unknown header keyword {key!r}; expected one of "
+                f"{list(_HEADER_WORDS + _HEADER_LISTS)}",
+                n,
+            )
+    return head
+
+
+def _keyword(
+    path: str | os.PathLike[str], head: dict[str, Any], key: str, allowed: Iterable[str]
+) -> str:
+    if key not in head:
+        raise AdapterError(path, f"missing header line '{key} <{'|'.join(allowed)}>'")
+    word, n = head[key]
+    # the specification spells "ASymmetrical" in one place: accept either capitalisation
+    canon = {a.lower(): a for a in allowed}
+    if word.lower() not in canon or (key != "Symmetry" and word not in canon.values()):
+        raise AdapterError(
+            path, f"{key}: unknown keyword {word!r}; expected one of {list(allowed)}", n
+        )
+    return canon[word.lower()]
+
+
+def _check_size(path: str | os.PathLike[str], shape: tuple[int, ...], nbytes: int) -> None:
+    total = math.prod(shape)
+    # every value needs at least one digit and one separator
+    if total > MAX_POINTS or 2 * total > nbytes:
+        raise AdapterError(
+            path,
+            f"the header announces {total} values ({' x '.join(map(str, shape))}), more than "
+            f"the file of {nbytes} bytes can hold (or the cap of {MAX_POINTS})",
+        )
+
+
+def _block_rows(
+    path: str | os.PathLike[str], cur: _Lines, nrows: int, ncols: int, where: str
+) -> tuple[list[str], list[int]]:
+    rows: list[str] = []
+    lines: list[int] = []
+    for _ in range(nrows):
+        item = cur.peek()
+        if item is None or not _is_data(item[1]):
+            raise AdapterError(
+                path,
+                f"{where}: expected {nrows} rows of {ncols} values, found {len(rows)} rows",
+                item[0] if item else cur.last_line(),
+            )
+        cur.next()
+        rows.append(item[1])
+        lines.append(item[0])
+    return rows, lines
+
+
+_STRUCTURE = ("TIS", "DataBegin", "DataEnd", *SPECTRAL["Monochrome"], *SPECTRAL["XYZ"])
+
+
+def _is_data(s: str) -> bool:
+    """Any line but a structure keyword is a data row (its numbers are checked later)."""
+    return s.split(None, 1)[0] not in _STRUCTURE
+
+
+def _parse_numbers(
+    path: str | os.PathLike[str], rows: list[str], lines: list[int], ncols: int
+) -> NDArray[np.float64]:
+    """Vectorised parse of rows of ``ncols`` numbers; strict, with the line of any error."""
+    text = "\n".join(rows)
+    bad = _NOT_NUMERIC.search(text)
+    if bad is not None:
+        i = text.count("\n", 0, bad.start())
+        raise AdapterError(
+            path, f"expected numbers, found the character {bad.group()!r}", lines[i]
+        )
+    counts = np.fromiter((len(r.split()) for r in rows), dtype=np.int64, count=len(rows))
+    wrong = np.flatnonzero(counts != ncols)
+    if wrong.size:
+        i = int(wrong[0])
+        raise AdapterError(
+            path, f"expected {ncols} values in the row, found {counts[i]}", lines[i]
+        )
+    toks = text.split()
+    try:
+        vals = np.array(toks, dtype=np.float64)
+    except ValueError:
+        vals = None
+    if vals is None or not np.isfinite(vals).all():
+        for row, ln in zip(rows, lines, strict=True):
+            for t in row.split():
+                _num(path, t, ln, "value")
+        raise AdapterError(path, "unreadable numbers in the data section")  # pragma: no cover
+    return vals.reshape(len(rows), ncols)
+
+
+def _parse_data(path: str | os.PathLike[str], cur: _Lines, t: BsdfTable) -> None:
+    nrot, nch, naoi, naz, nrad = t.values.shape
+    for c, name in enumerate(t.channels):
+        item = cur.next()
+        if item is None or item[1] != name:
+            raise AdapterError(
+                path,
+                f"expected the section line {name!r}",
+                item[0] if item else cur.last_line(),
+            )
+        item = cur.next()
+        if item is None or item[1] != "DataBegin":
+            raise AdapterError(path, "expected 'DataBegin'", item[0] if item else cur.last_line())
+        rows: list[str] = []
+        lines: list[int] = []
+        for k in range(nrot * naoi):
+            r, a = divmod(k, naoi)
+            where = (
+                f"{name} block {k + 1} (rotation {t.rotation_deg[r]:g}, "
+                f"incidence {t.theta_i_deg[a]:g})"
+            )
+            item = cur.next()
+            parts = item[1].split() if item else []
+            if not parts or parts[0] != "TIS" or len(parts) != 2:
+                found = "end of file" if item is None else repr(item[1][:40])
+                raise AdapterError(
+                    path,
+                    f"{where}: expected 'TIS <value>' followed by {naz} rows of {nrad} values, "
+                    f"found {found}",
+                    item[0] if item else cur.last_line(),
+                )
+            t.tis[r, c, a] = _num(path, parts[1], item[0], "TIS")
+            br, bl = _block_rows(path, cur, naz, nrad, where)
+            rows += br
+            lines += bl
+        vals = _parse_numbers(path, rows, lines, nrad).reshape(nrot, naoi, naz, nrad)
+        t.values[:, c] = vals
+        item = cur.peek()
+        if item is not None and item[1] == "DataEnd":
+            cur.next()
+    item = cur.peek()
+    if item is not None:
+        raise AdapterError(
+            path, f"expected the end of the file after the data, found {item[1][:40]!r}", item[0]
+        )
+
+
+def read_table(path: str | os.PathLike[str]) -> BsdfTable:
+    """Read a ``.bsdf`` file into a :class:`BsdfTable` (its own grid, nothing dropped).
+
+    Raises
+    ------
+    AdapterError
+        A header whose counts do not match its lists, a missing or unknown keyword, a block
+        with the wrong number of rows or values, a non-number (ASCII decimals only), NaN or
+        infinity, a missing ``DataBegin``, or more values announced than the file can hold.
+    """
+    raw = read_bytes(path)
+    text, _ = decode(raw, path)
+    cur = _Lines(split_lines(text))
+    head = _parse_header(path, cur)
+    symmetry = _keyword(path, head, "Symmetry", SYMMETRIES)
+    spectral = _keyword(path, head, "SpectralContent", tuple(SPECTRAL))
+    scatter = _keyword(path, head, "ScatterType", tuple(SCATTER_TYPES))
+    for key in _HEADER_LISTS[1:]:
+        if key not in head:
+            raise AdapterError(path, f"missing header line '{key} <count>' and its values")
+    rot = head.get("SampleRotation", np.zeros(1))
+    aoi, az, rad = (head[k] for k in _HEADER_LISTS[1:])
+    _check_list(path, "SampleRotation", rot, -360.0, 360.0)
+    _check_list(path, "AngleOfIncidence", aoi, 0.0, 90.0)
+    _check_list(path, "ScatterAzimuth", az, 0.0, 180.0 if symmetry == SYMMETRIES[0] else 360.0)
+    _check_list(path, "ScatterRadial", rad, 0.0, 180.0)
+    shape = (rot.size, len(SPECTRAL[spectral]), aoi.size, az.size, rad.size)
+    _check_size(path, shape, len(raw))
+    t = BsdfTable(
+        symmetry=symmetry,
+        spectral=spectral,
+        scatter_type=scatter,
+        rotation_deg=rot,
+        theta_i_deg=aoi,
+        azimuth_deg=az,
+        radial_deg=rad,
+        values=np.empty(shape),
+        tis=np.empty(shape[:3]),
+        comments=cur.comments,
+        source=head["Source"][0] if "Source" in head else "",
+    )
+    _parse_data(path, cur, t)
+    return t
+
+
+# ------------------------------------------------------------------------------ reader
+
+
+def _table_frame(
+    t: BsdfTable, path: str | os.PathLike[str], wavelength_nm: float
+) -> tuple[pd.DataFrame, int]:
+    """Rows above the horizon in the dataset schema, and the number dropped below it."""
+    nrot, nch, naoi, naz, nrad = t.values.shape
+    full = t.values.shape
+    theta_r, phi_r, above = (
+        np.broadcast_to(x, full).reshape(-1)
+        for x in scatter_to_angles(
+            t.theta_i_deg[:, None, None], t.radial_deg[None, None, :], t.azimuth_deg[None, :, None]
+        )
+    )
+    keep = np.flatnonzero(above)
+    ti = np.broadcast_to(t.theta_i_deg[:, None, None], full).reshape(-1)
+    optional: dict[str, Any] = {}
+    if nrot > 1 or t.rotation_deg[0] != 0:
+        optional["sample_rotation_deg"] = np.repeat(t.rotation_deg, nch * naoi * naz * nrad)[keep]
+    if t.spectral == "XYZ":
+        codes = np.repeat(np.tile(np.arange(nch, dtype=np.int8), nrot), naoi * naz * nrad)
+        optional["channel"] = pd.Categorical.from_codes(codes[keep], categories=["X", "Y", "Z"])
+    frame = build_frame(
+        sample=Path(path).stem,
+        instrument=INSTRUMENT,
+        source=os.path.basename(os.fspath(path)),
+        quantity=SCATTER_TYPES[t.scatter_type],
+        value=t.values.reshape(-1)[keep],
+        unit="sr-1",
+        wavelength_nm=wavelength_nm,
+        theta_i_deg=ti[keep],
+        theta_r_deg=theta_r[keep],
+        phi_r_deg=phi_r[keep],
+        **optional,
+    )
+    return frame, int(above.size - keep.size)
+
+
+def _tis_meta(t: BsdfTable) -> list[dict[str, Any]]:
+    out = []
+    for r, rot in enumerate(t.rotation_deg):
+        for c, name in enumerate(t.channels):
+            for a, ti in enumerate(t.theta_i_deg):
+                out.append(
+                    {
+                        "theta_i_deg": float(ti),
+                        "rotation_deg": float(rot),
+                        "channel": _CHANNEL[name],
+                        "tis": float(t.tis[r, c, a]),
+                    }
+                )
+    return out
+
+
+def read_zemax_bsdf(
+    path: str | os.PathLike[str], *, wavelength_nm: float | None = None
+) -> Measurement:
+    """Read a Zemax / Radiant ``.bsdf`` tabular file into a :class:`Measurement`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    wavelength_nm : float, optional
+        Wavelength to record [nm]; the format has no wavelength field, so by default
+        :data:`DEFAULT_WAVELENGTH_NM` (555 nm, a photopic label) is written and
+        ``meta["wavelength_stated"]`` is False.
+
+    Returns
+    -------
+    Measurement
+        One row per grid point above the horizon: quantity ``brdf`` or ``btdf`` [sr-1],
+        ``theta_i_deg``, ``theta_r_deg``, ``phi_r_deg`` from the exact conversion of the
+        scatter angles; ``channel`` ``X``/``Y``/``Z`` for tristimulus files;
+        ``sample_rotation_deg`` when the file has a rotation other than 0. PlaneSymmetrical
+        files keep the measured half only (azimuths 0..180, i.e. phi_r in [0, 180] or 180..,
+        see :func:`mirror_plane_symmetric`). ``meta`` holds the header, ``tis`` (one entry
+        per block), ``grid`` (the file's lists), ``dropped_below_horizon`` and
+        ``zero_values_kept`` (zeros above the horizon, kept as data).
+
+    Raises
+    ------
+    AdapterError
+        See :func:`read_table`.
+    """
+    t = read_table(path)
+    stated = wavelength_nm is not None
+    wl = float(wavelength_nm) if stated else DEFAULT_WAVELENGTH_NM
+    if not (math.isfinite(wl) and wl > 0):
+        raise AdapterError(path, f"wavelength_nm={wavelength_nm!r}: expected a finite number > 0")
+    frame, dropped = _table_frame(t, path, wl)
+    meta: dict[str, Any] = {
+        "format": "zemax-bsdf",
+        "source_keyword": t.source,
+        "symmetry": t.symmetry,
+        "spectral_content": t.spectral,
+        "scatter_type": t.scatter_type,
+        "wavelength_stated": stated,
+        "wavelength_nm": wl,
+        "grid": {
+            "rotation_deg": t.rotation_deg.tolist(),
+            "theta_i_deg": t.theta_i_deg.tolist(),
+            "azimuth_deg": t.azimuth_deg.tolist(),
+            "radial_deg": t.radial_deg.tolist(),
+            "channels": [_CHANNEL[c] for c in t.channels],
+        },
+        "tis": _tis_meta(t),
+        "dropped_below_horizon": dropped,
+        "zero_values_kept": int((frame["value"].to_numpy() == 0).sum()),
+        "comments": t.comments,
+    }
+    if t.symmetry == "PlaneSymmetrical":
+        meta["mirror"] = (
+            "the other half of the scatter hemisphere is the mirror image of the rows given, "
+            "phi_r -> 360 - phi_r (see mirror_plane_symmetric)"
+        )
+    try:
+        return Measurement(frame, meta)
+    except ValueError as exc:
+        raise AdapterError(path, f"invalid data: {exc}") from None
+
+
+def mirror_plane_symmetric(m: Measurement) -> Measurement:
+    """The full hemisphere of a PlaneSymmetrical measurement: rows plus their mirror images.
+
+    Rows off the plane of incidence (0 < phi_r < 180 or 180 < phi_r < 360, and theta_r > 0)
+    are copied with ``phi_r -> 360 - phi_r``; rows in the plane are their own mirror image
+    and are not duplicated. ``meta["mirrored"]`` is set to the number of rows added.
+
+    Raises
+    ------
+    ValueError
+        ``meta["symmetry"]`` is not ``PlaneSymmetrical`` or the data are already mirrored.
+    """
+    if m.meta.get("symmetry") != "PlaneSymmetrical":
+        raise ValueError("mirror_plane_symmetric needs meta['symmetry'] == 'PlaneSymmetrical'")
+    if "mirrored" in m.meta:
+        raise ValueError("the measurement is already mirrored")
+    d = m.data
+    phi = d["phi_r_deg"].to_numpy()
+    tol = 1e-9
+    in_plane = (
+        (np.abs(phi) < tol)
+        | (np.abs(phi - 180.0) < tol)
+        | (np.abs(phi - 360.0) < tol)
+        | (d["theta_r_deg"].to_numpy() < tol)
+    )
+    extra = d[~in_plane].copy()
+    extra["phi_r_deg"] = np.mod(360.0 - extra["phi_r_deg"].to_numpy(), 360.0)
+    data = pd.concat(
+        [
+            d.assign(quantity=d["quantity"].astype(str)),
+            extra.assign(quantity=extra["quantity"].astype(str)),
+        ],
+        ignore_index=True,
+    )
+    meta = dict(m.meta)
+    meta["mirrored"] = int(len(extra))
+    return Measurement(data, meta)
+
+
+# ------------------------------------------------------------------------------ quadrature
+
+
+def _edges(a: NDArray[np.float64], lo: float, hi: float) -> NDArray[np.float64]:
+    """Cell edges around nodes ``a``: midpoints inside, ``lo``/``hi`` clipped at the ends."""
+    mid = 0.5 * (a[1:] + a[:-1])
+    return np.concatenate([[max(lo, a[0])], mid, [min(hi, a[-1])]])
+
+
+def _radial_weights(radial_deg: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Solid-angle weights of the radial cells: ``int sin r dr = cos r_lo - cos r_hi`` [sr/rad]."""
+    e = np.radians(_edges(radial_deg, 0.0, 180.0))
+    return np.cos(e[:-1]) - np.cos(e[1:])
+
+
+def _azimuth_weights(azimuth_deg: NDArray[np.float64], symmetry: str) -> NDArray[np.float64]:
+    """Azimuth cell widths [rad]; a full circle wraps, a PlaneSymmetrical half counts twice."""
+    a = np.asarray(azimuth_deg, float)
+    if symmetry == "PlaneSymmetrical":
+        return 2.0 * np.radians(np.diff(_edges(a, 0.0, 180.0)))
+    if a.size == 1:
+        return np.array([2.0 * np.pi])
+    if a[-1] - a[0] >= 360.0 - 1e-9:  # the first node is repeated at +360
+        return np.radians(np.diff(_edges(a, -np.inf, np.inf)))
+    ext = np.concatenate([[a[-1] - 360.0], a, [a[0] + 360.0]])
+    mid = 0.5 * (ext[1:] + ext[:-1])
+    return np.radians(np.diff(mid))
+
+
+def _table_of(obj: BsdfTable | Measurement | Mapping[str, Any]) -> BsdfTable:
+    if isinstance(obj, BsdfTable):
+        return obj
+    if isinstance(obj, Measurement):
+        return _table_from_measurement(obj)
+    v = np.asarray(obj["values"], dtype=float)
+    theta_i = np.atleast_1d(np.asarray(obj["theta_i_deg"], float))
+    az = np.atleast_1d(np.asarray(obj["azimuth_deg"], float))
+    rad = np.atleast_1d(np.asarray(obj["radial_deg"], float))
+    v = v.reshape((-1, v.shape[-4] if v.ndim >= 4 else 1, theta_i.size, az.size, rad.size))
+    spectral = "XYZ" if v.shape[1] == 3 else "Monochrome"
+    return BsdfTable(
+        symmetry=obj.get("symmetry", "Asymmetrical"),
+        spectral=spectral,
+        scatter_type=obj.get("scatter_type", "BRDF"),
+        rotation_deg=np.arange(v.shape[0], dtype=float),
+        theta_i_deg=theta_i,
+        azimuth_deg=az,
+        radial_deg=rad,
+        values=v,
+        tis=np.full(v.shape[:3], np.nan),
+    )
+
+
+def _table_from_measurement(m: Measurement) -> BsdfTable:
+    """Put the rows of a reader's Measurement back on the file's grid (0 below the horizon).
+
+    The reader writes the rows in the file's order (rotation, channel, incidence, azimuth,
+    radial), skipping the points below the horizon; this checks that the rows are still
+    those (same count, same angles to 1e-9 deg) and refuses a filtered or mirrored table.
+    """
+    g = m.meta.get("grid")
+    if not g:
+        raise ValueError("the measurement has no meta['grid'] (not read from a .bsdf file)")
+    rot, aoi = np.array(g["rotation_deg"], float), np.array(g["theta_i_deg"], float)
+    az, rad = np.array(g["azimuth_deg"], float), np.array(g["radial_deg"], float)
+    nch = len(g["channels"])
+    shape = (rot.size, nch, aoi.size, az.size, rad.size)
+    _, _, ai, zi, qi = np.indices(shape).reshape(5, -1)
+    theta_r, phi_r, above = scatter_to_angles(aoi[ai], rad[qi], az[zi])
+    d = m.data
+    same = len(d) == int(above.sum()) and "mirrored" not in m.meta
+    if same:
+        dphi = np.abs(d["phi_r_deg"].to_numpy() - phi_r[above])
+        same = bool(
+            np.all(np.abs(d["theta_r_deg"].to_numpy() - theta_r[above]) < 1e-9)
+            and np.all(np.minimum(dphi, 360.0 - dphi) < 1e-9)
+            and np.all(d["theta_i_deg"].to_numpy() == aoi[ai[above]])
+        )
+    if not same:
+        raise ValueError(
+            "the rows are not those read from the file (filtered, mirrored or reordered); "
+            "pass the BsdfTable of read_table() instead"
+        )
+    v = np.zeros(shape)
+    v.reshape(-1)[above] = d["value"].to_numpy()
+    return BsdfTable(
+        symmetry=m.meta.get("symmetry", "Asymmetrical"),
+        spectral=m.meta.get("spectral_content", "Monochrome"),
+        scatter_type=m.meta.get("scatter_type", "BRDF"),
+        rotation_deg=rot,
+        theta_i_deg=aoi,
+        azimuth_deg=az,
+        radial_deg=rad,
+        values=v,
+        tis=np.array([e["tis"] for e in m.meta.get("tis", [])] or np.nan, float).reshape(shape[:3])
+        if m.meta.get("tis")
+        else np.full(shape[:3], np.nan),
+    )
+
+
+def _cos_weights(t: BsdfTable) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(w, cos_r)``: solid-angle weights [sr] and projected cosines (0 below the horizon),
+    each ``(aoi, azimuth, radial)``."""
+    w = _azimuth_weights(t.azimuth_deg, t.symmetry)[:, None] * _radial_weights(t.radial_deg)
+    ti = t.theta_i_deg[:, None, None]
+    d = scatter_to_direction(ti, t.radial_deg[None, None, :], t.azimuth_deg[None, :, None])
+    return np.broadcast_to(w, d.shape[1:]), np.clip(d[2], 0.0, None)
+
+
+def grid_integral(obj: BsdfTable | Measurement | Mapping[str, Any]) -> dict[str, Any]:
+    """Hemispherical integral ``int f cos(theta_r) d omega`` of each block on its own grid.
+
+    Parameters
+    ----------
+    obj : BsdfTable, Measurement or mapping
+        A table from :func:`read_table`, a Measurement from :func:`read_zemax_bsdf`, or a
+        mapping with ``values`` ``(rotation, channel, aoi, azimuth, radial)`` [sr^-1],
+        ``theta_i_deg``, ``azimuth_deg``, ``radial_deg`` [deg] and optional ``symmetry``.
+
+    Returns
+    -------
+    dict
+        ``integral`` ``(rotation, channel, aoi)`` [1]; ``uncovered_fraction`` ``(aoi,)``: the
+        fraction of the projected solid angle of the hemisphere (pi sr) that the grid does
+        not cover; ``tis`` (the file's values, NaN when unknown) and ``ratio`` = tis /
+        integral.
+
+    Notes
+    -----
+    Each grid node owns a cell bounded by the midpoints to its neighbours (the end nodes
+    own half cells; a full azimuth circle wraps; a PlaneSymmetrical half counts twice).
+    The solid angle of a cell about the specular direction is exactly
+    ``(cos r_lo - cos r_hi) (a_hi - a_lo)``, and the projection factor is ``cos theta_r`` at
+    the node, 0 below the horizon (the definition of the hemispherical reflectance, e.g.
+    Nicodemus et al., NBS Monograph 160, 1977). This is a first-order rule, so a file's
+    TIS (integrated by the instrument on its own, finer native sampling) need not agree:
+    on the Radiant imaging-sphere export the TIS is 4-20 % above this integral. Causes:
+    coarse radial steps (10 deg beyond 20 deg) across a curved lobe, the part of the
+    hemisphere beyond the largest radial angle that the grid does not cover
+    (``uncovered_fraction``), the zeros the instrument writes at directions next to the
+    horizon, and the cells that straddle the horizon (cut at the node, not at z = 0).
+    """
+    t = _table_of(obj)
+    w, cz = _cos_weights(t)
+    integral = np.einsum("rcazq,azq->rca", t.values, w * cz)
+    covered = np.sum(w * cz, axis=(1, 2)) / np.pi
+    tis = np.asarray(t.tis, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = tis / integral
+    return {
+        "integral": integral,
+        "uncovered_fraction": 1.0 - covered,
+        "tis": tis,
+        "ratio": ratio,
+    }
+
+
+# ------------------------------------------------------------------------------ writer
+
+
+def _fmt(v: float, digits: int) -> str:
+    return f"{v:.{digits - 1}E}"
+
+
+def _check_grid(name: str, a: NDArray[np.float64], lo: float, hi: float) -> None:
+    if a.ndim != 1 or a.size == 0 or not np.isfinite(a).all():
+        raise ValueError(f"{name}: expected a non-empty 1-D list of finite angles [deg]")
+    if a.min() < lo or a.max() > hi or (a.size > 1 and not np.all(np.diff(a) > 0)):
+        raise ValueError(f"{name}: expected strictly increasing values in [{lo:g}, {hi:g}] deg")
+
+
+def write_bsdf(
+    path: str | os.PathLike[str],
+    *,
+    theta_i_deg: ArrayLike,
+    radial_deg: ArrayLike,
+    azimuth_deg: ArrayLike,
+    values: ArrayLike,
+    tis: ArrayLike | None = None,
+    symmetry: str = "Asymmetrical",
+    spectral: str | None = None,
+    scatter_type: str = "BRDF",
+    rotation_deg: ArrayLike = (0,),
+    channels: Sequence[str] | None = None,
+    comments: Iterable[str] = (),
+    digits: int = 6,
+    overwrite: bool = False,
+) -> Path:
+    """Write a Zemax / Radiant ``.bsdf`` tabular file, atomically.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Output file; an existing file is refused unless ``overwrite``.
+    theta_i_deg, radial_deg, azimuth_deg : array_like
+        The grid [deg]: angles of incidence (specular angles), scatter radial and azimuth
+        angles (strictly increasing; azimuths within [0, 180] for PlaneSymmetrical).
+    values : array_like
+        ``(rotation, channel, aoi, azimuth, radial)`` BSDF [sr^-1], finite.
+    tis : array_like, optional
+        ``(rotation, channel, aoi)`` total integrated scatter; by default computed with
+        :func:`grid_integral`.
+    symmetry : {"PlaneSymmetrical", "Asymmetrical", "Asymmetrical4D"}
+    spectral : {"Monochrome", "XYZ"}, optional
+        By default from ``channels`` or from the channel axis of ``values`` (1 or 3).
+    scatter_type : {"BRDF", "BTDF"}
+    rotation_deg : array_like
+        Sample rotations [deg].
+    channels : sequence of str, optional
+        ``("X", "Y", "Z")`` for tristimulus data, ``("",)`` or None for monochrome.
+    comments : iterable of str
+        Written as ``#`` lines at the top.
+    digits : int
+        Significant digits of each value (and TIS), 1..17.
+    overwrite : bool
+        Replace an existing file.
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
+    target = Path(path)
+    if target.exists() and not overwrite:
+        raise FileExistsError(f"{target} exists; pass overwrite=True to replace it")
+    if symmetry not in SYMMETRIES:
+        raise ValueError(f"symmetry {symmetry!r}: expected one of {list(SYMMETRIES)}")
+    if scatter_type not in SCATTER_TYPES:
+        raise ValueError(f"scatter_type {scatter_type!r}: expected one of {list(SCATTER_TYPES)}")
+    if not (isinstance(digits, int) and 1 <= digits <= 17):
+        raise ValueError(f"digits={digits!r}: expected an integer in 1..17")
+    ti = np.atleast_1d(np.asarray(theta_i_deg, float))
+    rad = np.atleast_1d(np.asarray(radial_deg, float))
+    az = np.atleast_1d(np.asarray(azimuth_deg, float))
+    rot = np.atleast_1d(np.asarray(rotation_deg, float))
+    _check_grid("theta_i_deg", ti, 0.0, 90.0)
+    _check_grid("radial_deg", rad, 0.0, 180.0)
+    _check_grid("azimuth_deg", az, 0.0, 180.0 if symmetry == SYMMETRIES[0] else 360.0)
+    _check_grid("rotation_deg", rot, -360.0, 360.0)
+    v = np.asarray(values, float)
+    if v.ndim != 5:
+        raise ValueError(
+            f"values: expected 5 axes (rotation, channel, aoi, azimuth, radial), got {v.ndim}"
+        )
+    if spectral is None:
+        if channels is not None:
+            spectral = "XYZ" if tuple(channels) == ("X", "Y", "Z") else "Monochrome"
+        else:
+            spectral = "XYZ" if v.shape[1] == 3 else "Monochrome"
+    if spectral not in SPECTRAL:
+        raise ValueError(f"spectral {spectral!r}: expected one of {list(SPECTRAL)}")
+    want_ch = ("X", "Y", "Z") if spectral == "XYZ" else ("",)
+    if channels is not None and tuple(channels) not in (want_ch, ("Monochrome",)):
+        raise ValueError(f"channels {tuple(channels)} do not fit spectral {spectral!r}")
+    shape = (rot.size, len(want_ch), ti.size, az.size, rad.size)
+    if v.shape != shape:
+        raise ValueError(f"values: expected shape {shape}, got {v.shape}")
+    if not np.isfinite(v).all():
+        raise ValueError("values: expected finite numbers (no NaN or inf)")
+    if tis is None:
+        tis_a = grid_integral(
+            {
+                "values": v,
+                "theta_i_deg": ti,
+                "azimuth_deg": az,
+                "radial_deg": rad,
+                "symmetry": symmetry,
+            }
+        )["integral"]
+    else:
+        tis_a = np.asarray(tis, float)
+        if tis_a.shape != shape[:3] or not np.isfinite(tis_a).all():
+            raise ValueError(f"tis: expected finite numbers of shape {shape[:3]}")
+    head = [f"#{c}" for c in comments]
+    head += [
+        "Source  Measured",
+        f"Symmetry  {symmetry}",
+        f"SpectralContent  {spectral}",
+        f"ScatterType  {scatter_type}",
+    ]
+    for key, a in zip(_HEADER_LISTS, (rot, ti, az, rad), strict=True):
+        head += [f"{key}  {a.size}", "\t".join(f"{x:.15g}" for x in a)]
+    head.append("")
+    parts = ["\n".join(head)]
+    for c, name in enumerate(SPECTRAL[spectral]):
+        sec = [name, "DataBegin"]
+        for r in range(rot.size):
+            for a in range(ti.size):
+                sec.append(f"TIS {_fmt(tis_a[r, c, a], digits)}")
+                block = v[r, c, a]
+                sec += ["\t".join(_fmt(x, digits) for x in row) for row in block.tolist()]
+        sec.append("DataEnd")
+        parts.append("\n".join(sec))
+    with atomic_output(target) as tmp, open(tmp, "w", encoding="ascii", newline="\n") as fh:
+        fh.write("\n".join(parts) + "\n")
+    return target
+
+
+def model_to_bsdf(
+    model: Any,
+    params: Mapping[str, float] | Any,
+    path: str | os.PathLike[str],
+    *,
+    theta_i_deg: ArrayLike,
+    radial_deg: ArrayLike,
+    azimuth_deg: ArrayLike,
+    wavelength_nm: float | None = None,
+    symmetry: str = "PlaneSymmetrical",
+    digits: int = 6,
+    comments: Iterable[str] = (),
+    overwrite: bool = False,
+) -> Path:
+    """Evaluate a labbrdf model on a scatter grid and write it as a ``.bsdf`` file.
+
+    Each grid point (specular angle, radial, azimuth) is converted to (theta_i, theta_r,
+    phi_r) by :func:`scatter_to_angles` (the reader's geometry); below-horizon points get
+    0; the TIS of each block is the :func:`grid_integral` of the values written.
+
+    Parameters
+    ----------
+    model : labbrdf.models.Model
+        E.g. ``labbrdf.models.get("smooth3")``.
+    params : mapping or Parameters
+        Parameter values (None: the model's current values).
+    path : str or path-like
+        Output file (see :func:`write_bsdf`).
+    theta_i_deg, radial_deg, azimuth_deg : array_like
+        The grid [deg].
+    wavelength_nm : float, optional
+        Passed to the model's ``evaluate`` [nm].
+    symmetry : str
+        ``PlaneSymmetrical`` (azimuths 0..180) for an isotropic model, else
+        ``Asymmetrical``.
+    digits, comments, overwrite
+        As in :func:`write_bsdf`.
+    """
+    ti = np.atleast_1d(np.asarray(theta_i_deg, float))
+    rad = np.atleast_1d(np.asarray(radial_deg, float))
+    az = np.atleast_1d(np.asarray(azimuth_deg, float))
+    tr, pr, above = scatter_to_angles(ti[:, None, None], rad[None, None, :], az[None, :, None])
+    tib = np.broadcast_to(ti[:, None, None], tr.shape)
+    f = model.evaluate(
+        np.radians(tib),
+        np.radians(np.where(above, tr, 0.0)),
+        np.radians(pr),
+        wavelength=wavelength_nm,
+        params=params,
+    )
+    vals = np.where(above, np.asarray(f, float), 0.0)[None, None]
+    name = getattr(model, "name", type(model).__name__)
+    return write_bsdf(
+        path,
+        theta_i_deg=ti,
+        radial_deg=rad,
+        azimuth_deg=az,
+        values=vals,
+        symmetry=symmetry,
+        comments=(f"labbrdf model {name}", *comments),
+        digits=digits,
+        overwrite=overwrite,
+    )
+
+
+# ------------------------------------------------------------------------------ registry
+
+
+def _sniff(head: bytes) -> bool:
+    """Two of the header keywords at line starts within the first bytes; never raises."""
+    try:
+        found = {m.group(1) for m in _SNIFF.finditer(head[:4096])}
+        return len(found) >= 3 or (len(found) >= 2 and b"AngleOfIncidence" in head)
+    except Exception:  # pragma: no cover - defensive: a sniffer must not raise
+        return False
+
+
+FORMATS = (
+    Format(
+        "zemax-bsdf",
+        "Zemax / Radiant BSDF Data Interchange tabular text (.bsdf): BRDF/BTDF on a "
+        "specular-centred grid",
+        (".bsdf",),
+        _sniff,
+        read_zemax_bsdf,
+        ("brdf", "btdf"),
+    ),
+)
