@@ -1,0 +1,602 @@
+"""Optical constants from a dataset's psi/Delta rows: tables, JSON and model predictions.
+
+The dataset layer of :mod:`labbrdf.ellipsometry`: it pairs the ``psi`` and ``delta`` rows of
+a :class:`~labbrdf.dataset.Measurement` (or its tidy DataFrame), inverts every point to the
+two-phase pseudo-index ``<N> = n + ik`` with propagated uncertainties, combines the angles
+of incidence per wavelength, and predicts reflectances (Fresnel, microfacet) to compare with
+measured reflectance rows.
+
+Grouping
+--------
+Points are grouped by ``sample`` and ``source``. Within one file, a kinetic series
+(``time_s``) or a map (``x_mm``, ``y_mm``) is grouped further, but only when it really is
+one: ``time_s`` when some (wavelength, angle) was measured at more than one time, and the
+stage position when some (wavelength, angle) was measured at more than one spot. Stage
+positions closer than :data:`POSITION_TOL_MM` (chained) count as one spot, because stage
+read-backs jitter by about 0.01 mm from angle to angle. Wavelengths are matched after
+rounding to 1e-6 nm.
+
+Only ordinary psi/Delta rows are used: rows without a ``channel`` (missing or empty) or with
+channel ``pp``
+(generalized ellipsometry's ``ps``/``sp`` channels are cross-polarization ratios, not a
+two-phase quantity).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from . import ellipsometry as ell
+from .dataset import Measurement
+
+__all__ = [
+    "POSITION_TOL_MM",
+    "combined_table",
+    "compare_reflectance",
+    "microfacet_hemispherical",
+    "nk_at",
+    "nk_json",
+    "nk_table",
+]
+
+#: Stage positions closer than this (chained, per coordinate) are the same spot [mm].
+POSITION_TOL_MM = 0.5
+
+_WL_DECIMALS = 6
+_POINT_COLUMNS = [
+    "sample",
+    "source",
+    "wavelength_nm",
+    "theta_i_deg",
+    "n",
+    "k",
+    "n_sigma",
+    "k_sigma",
+    "cond",
+    "nk_cov",
+    "psi_deg",
+    "delta_deg",
+]
+_COMBINED_COLUMNS = [
+    "wavelength_nm",
+    "n",
+    "k",
+    "n_sigma",
+    "k_sigma",
+    "nk_cov",
+    "chi2",
+    "dof",
+    "p_value",
+    "angle_dependent",
+    "method",
+    "n_points",
+    "n_angles",
+]
+_JSON_COMBINED = [
+    "wavelength_nm",
+    "n",
+    "k",
+    "n_sigma",
+    "k_sigma",
+    "chi2",
+    "dof",
+    "p_value",
+    "angle_dependent",
+]
+
+
+def _frame(data: Measurement | pd.DataFrame) -> pd.DataFrame:
+    if isinstance(data, Measurement):
+        return data.data
+    if isinstance(data, pd.DataFrame):
+        return data
+    raise TypeError(f"expected a labbrdf Measurement or a DataFrame; got {type(data).__name__}")
+
+
+def _cluster(values: np.ndarray, tol: float) -> np.ndarray:
+    """Integer labels of 1-d single-linkage clusters (gap > ``tol`` starts a new one)."""
+    labels = np.full(values.shape, -1, dtype=np.int64)
+    ok = np.isfinite(values)
+    if not ok.any():
+        return labels
+    uniq = np.unique(values[ok])
+    ids = np.concatenate([[0], np.cumsum(np.diff(uniq) > tol)])
+    labels[ok] = ids[np.searchsorted(uniq, values[ok])]
+    return labels
+
+
+def _series_keys(df: pd.DataFrame) -> list[str]:
+    """The extra group keys of one (sample, source): time and/or spot, where they vary."""
+    keys: list[str] = []
+    base = ["_wl", "theta_i_deg"]
+    if {"x_mm", "y_mm"} <= set(df.columns):
+        if df.groupby(base, dropna=False)[["_x", "_y"]].nunique().to_numpy().max(initial=0) > 1:
+            keys += ["x_mm", "y_mm"]
+    if "time_s" in df.columns:
+        by = base + (["_x", "_y"] if keys else [])
+        if df.groupby(by, dropna=False)["time_s"].nunique().max() > 1:
+            keys.insert(0, "time_s")
+    return keys
+
+
+def nk_table(
+    data: Measurement | pd.DataFrame,
+    *,
+    theta_sigma_deg: float = 0.0,
+    n_ambient: float = 1.0,
+    on_ill_conditioned: ell.OnIll = "raise",
+) -> pd.DataFrame:
+    """Two-phase pseudo-optical constants of every psi/Delta point of a dataset.
+
+    Parameters
+    ----------
+    data : Measurement or pandas.DataFrame
+        A labbrdf dataset; its ``psi`` and ``delta`` rows are used (others are ignored).
+    theta_sigma_deg : float, optional
+        1-sigma error of the angle of incidence [deg], propagated with the file's sigmas.
+        Default 0 (the file's sigmas alone).
+    n_ambient : float, optional
+        Real index of the ambient [1]. Default 1.
+    on_ill_conditioned : {"raise", "warn", "ignore"}
+        Passed to :func:`labbrdf.ellipsometry.pseudo_nk`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (psi, Delta) pair: ``sample, source, wavelength_nm, theta_i_deg, n, k,
+        n_sigma, k_sigma, cond, nk_cov, psi_deg, delta_deg`` [1 or deg], plus ``time_s``,
+        ``x_mm``, ``y_mm`` where they identify a series (module Grouping). Sigmas are NaN
+        where the file has none. ``attrs["unpaired"]`` counts psi or delta rows without a
+        partner (dropped).
+
+    Raises
+    ------
+    ValueError
+        No psi/Delta rows, or an invalid or ill-conditioned point (see ``pseudo_nk``).
+
+    Notes
+    -----
+    psi and delta rows are paired on every identifying column and, among rows that share
+    them (e.g. the nulling zones of an Accurion file), by order of appearance.
+    """
+    df = _frame(data)
+    sel = df[df["quantity"].isin(["psi", "delta"])]
+    if "channel" in sel.columns:
+        ch = sel["channel"].astype(object)
+        sel = sel[ch.isna() | ch.isin(["", "pp"])]
+    if sel.empty:
+        raise ValueError("no psi/delta rows (ordinary ellipsometry) in the data")
+    sel = sel.assign(_wl=sel["wavelength_nm"].round(_WL_DECIMALS))
+    keys = ["sample", "source", "_wl", "theta_i_deg"]
+    keys += [c for c in ("time_s", "x_mm", "y_mm") if c in sel.columns]
+    cols = keys + ["wavelength_nm", "value", "sigma"]
+    psi = sel.loc[sel["quantity"] == "psi", cols]
+    delta = sel.loc[sel["quantity"] == "delta", cols]
+    psi = psi.assign(_i=psi.groupby(keys, dropna=False, sort=False).cumcount())
+    delta = delta.assign(_i=delta.groupby(keys, dropna=False, sort=False).cumcount())
+    pair = psi.merge(
+        delta.drop(columns="wavelength_nm"), on=keys + ["_i"], suffixes=("_psi", "_delta")
+    )
+    pair = pair[np.isfinite(pair["value_psi"]) & np.isfinite(pair["value_delta"])]
+    unpaired = len(psi) + len(delta) - 2 * len(pair)
+    if pair.empty:
+        raise ValueError("no psi row has a matching delta row")
+    res = ell.pseudo_nk(
+        pair["value_psi"].to_numpy(float),
+        pair["value_delta"].to_numpy(float),
+        pair["theta_i_deg"].to_numpy(float),
+        pair["sigma_psi"].to_numpy(float),
+        pair["sigma_delta"].to_numpy(float),
+        theta_sigma_deg=theta_sigma_deg,
+        n_ambient=n_ambient,
+        on_ill_conditioned=on_ill_conditioned,
+    )
+    out = pd.DataFrame(
+        {
+            "sample": pair["sample"].astype(object).to_numpy(),
+            "source": pair["source"].astype(object).to_numpy(),
+            "wavelength_nm": pair["wavelength_nm"].to_numpy(float),
+            "theta_i_deg": pair["theta_i_deg"].to_numpy(float),
+            "n": res.n,
+            "k": res.k,
+            "n_sigma": res.n_sigma,
+            "k_sigma": res.k_sigma,
+            "cond": res.cond,
+            "nk_cov": res.nk_cov,
+            "psi_deg": pair["value_psi"].to_numpy(float),
+            "delta_deg": pair["value_delta"].to_numpy(float),
+        }
+    )
+    extra = [c for c in ("time_s", "x_mm", "y_mm") if c in pair.columns]
+    if extra:
+        probe = out.assign(
+            _wl=out["wavelength_nm"].round(_WL_DECIMALS),
+            **{c: pair[c].to_numpy(float) for c in extra},
+        )
+        parts = []
+        for _, g in probe.groupby(["sample", "source"], sort=False):
+            if {"x_mm", "y_mm"} <= set(g.columns):
+                g = g.assign(
+                    _x=_cluster(g["x_mm"].to_numpy(float), POSITION_TOL_MM),
+                    _y=_cluster(g["y_mm"].to_numpy(float), POSITION_TOL_MM),
+                )
+            parts.append(_series_keys(g))
+        used = [c for c in extra if any(c in p for p in parts)]
+        for c in used:
+            out[c] = pair[c].to_numpy(float)
+    out = out.sort_values(["sample", "source", "wavelength_nm", "theta_i_deg"], kind="stable")
+    out = out.reset_index(drop=True)
+    out.attrs["unpaired"] = int(unpaired)
+    return out
+
+
+def _group_keys(table: pd.DataFrame) -> list[str]:
+    return ["sample", "source"] + [c for c in ("time_s", "x_mm", "y_mm") if c in table.columns]
+
+
+def _spot_labels(table: pd.DataFrame) -> pd.DataFrame:
+    """Replace jittering stage positions by cluster labels for grouping."""
+    if not {"x_mm", "y_mm"} <= set(table.columns):
+        return table
+    t = table.copy()
+    for c in ("x_mm", "y_mm"):
+        lab = np.empty(len(t), dtype=float)
+        for _, idx in t.groupby(["sample", "source"], sort=False).groups.items():
+            pos = t.index.get_indexer(idx)
+            values = t[c].to_numpy(float)[pos]
+            ids = _cluster(values, POSITION_TOL_MM)
+            # label each cluster by its mean position (a readable key)
+            for i in np.unique(ids):
+                m = ids == i
+                lab[pos[m]] = np.nan if i < 0 else round(float(values[m].mean()), 3)
+        t[c] = lab
+    return t
+
+
+def combined_table(
+    data: Measurement | pd.DataFrame,
+    *,
+    alpha: float = ell.P_ANGLE_DEPENDENT,
+    **nk_options: Any,
+) -> pd.DataFrame:
+    """Per-wavelength combination of all angles of incidence.
+
+    Parameters
+    ----------
+    data : Measurement or pandas.DataFrame
+        A dataset with psi/delta rows, or a table from :func:`nk_table`.
+    alpha : float, optional
+        Significance level of ``angle_dependent``. Default 0.01.
+    **nk_options
+        Passed to :func:`nk_table` when ``data`` is a dataset.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per (sample, source[, time_s, x_mm, y_mm], wavelength):
+        ``wavelength_nm, n, k, n_sigma, k_sigma, nk_cov, chi2, dof, p_value,
+        angle_dependent, method, n_points, n_angles`` after the group keys; see
+        :func:`labbrdf.ellipsometry.combine_angles` for the sigma and scatter rules. A
+        wavelength mixing points with and without sigma uses the scatter rule.
+    """
+    table = data if "n" in _frame(data).columns else nk_table(data, **nk_options)
+    table = _spot_labels(_frame(table))
+    keys = _group_keys(table)
+    table = table.assign(_wl=table["wavelength_nm"].round(_WL_DECIMALS))
+    rows = []
+    for key, g in table.groupby(keys + ["_wl"], sort=True, dropna=False):
+        cov = np.stack(
+            [
+                np.stack([g["n_sigma"] ** 2, g["nk_cov"]], axis=-1),
+                np.stack([g["nk_cov"], g["k_sigma"] ** 2], axis=-1),
+            ],
+            axis=-2,
+        )
+        c = ell.combine_angles(
+            g["n"].to_numpy(float),
+            g["k"].to_numpy(float),
+            g["theta_i_deg"].to_numpy(float),
+            cov,
+            alpha=alpha,
+        )
+        row = dict(zip(keys, key[:-1], strict=True))
+        row["wavelength_nm"] = float(g["wavelength_nm"].mean())
+        row.update({f: getattr(c, f) for f in _COMBINED_COLUMNS[1:]})
+        rows.append(row)
+    out = pd.DataFrame(rows, columns=keys + _COMBINED_COLUMNS)
+    return out.astype({"dof": "int64", "angle_dependent": bool, "n_points": "int64"})
+
+
+def _json_value(v: Any) -> Any:
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return None if not math.isfinite(float(v)) else float(v)
+    return v
+
+
+def _json_list(s: pd.Series) -> list:
+    return [_json_value(v) for v in s.tolist()]
+
+
+def nk_json(
+    data: Measurement | pd.DataFrame,
+    *,
+    alpha: float = ell.P_ANGLE_DEPENDENT,
+    **nk_options: Any,
+) -> dict[str, Any]:
+    """JSON-safe optical constants: every point and the per-wavelength combination.
+
+    Parameters
+    ----------
+    data : Measurement or pandas.DataFrame
+        A dataset with psi/delta rows, or a table from :func:`nk_table`.
+    alpha : float, optional
+        Significance level of ``angle_dependent``. Default 0.01.
+    **nk_options
+        Passed to :func:`nk_table`.
+
+    Returns
+    -------
+    dict
+        For one (sample, source): ``{"wavelength_nm", "theta_i_deg", "n", "k", "n_sigma",
+        "k_sigma"}`` as equal-length lists (one entry per measured point) and
+        ``"combined": {"wavelength_nm", "n", "k", "n_sigma", "k_sigma", "chi2", "dof",
+        "p_value", "angle_dependent"}`` (one entry per wavelength). A kinetic series or a
+        map adds ``time_s`` / ``x_mm``, ``y_mm`` lists at both levels. NaN becomes None
+        (``null``). Several (sample, source) pairs: ``{"groups": [{"sample": ...,
+        "source": ..., "data": <the object above>}, ...]}``.
+    """
+    table = data if "n" in _frame(data).columns else nk_table(data, **nk_options)
+    table = _frame(table)
+    combined = combined_table(table, alpha=alpha)
+    extra = [c for c in ("time_s", "x_mm", "y_mm") if c in table.columns]
+    groups = []
+    for (sample, source), g in table.groupby(["sample", "source"], sort=False):
+        cg = combined[(combined["sample"] == sample) & (combined["source"] == source)]
+        obj: dict[str, Any] = {
+            c: _json_list(g[c])
+            for c in ["wavelength_nm", "theta_i_deg", "n", "k", "n_sigma", "k_sigma"] + extra
+        }
+        obj["combined"] = {c: _json_list(cg[c]) for c in _JSON_COMBINED + extra}
+        groups.append({"sample": sample, "source": source, "data": obj})
+    if len(groups) == 1:
+        return groups[0]["data"]
+    return {"groups": groups}
+
+
+def _single(
+    table: pd.DataFrame, sample: str | None, source: str | None, what: str
+) -> pd.DataFrame:
+    if sample is not None:
+        table = table[table["sample"] == sample]
+    if source is not None:
+        table = table[table["source"] == source]
+    pairs = table[["sample", "source"]].drop_duplicates()
+    if len(pairs) != 1:
+        found = [tuple(r) for r in pairs.itertuples(index=False)]
+        raise ValueError(
+            f"{what}: expected one (sample, source), found {len(pairs)}: {found[:5]}; "
+            "pass sample= and source="
+        )
+    series = [c for c in ("time_s", "x_mm", "y_mm") if c in table.columns]
+    if series and len(table[series].drop_duplicates()) > 1:
+        raise ValueError(f"{what}: the table holds a series ({series}); select one member")
+    return table
+
+
+def nk_at(
+    table: pd.DataFrame,
+    wavelength_nm: float | Sequence[float] | np.ndarray,
+    *,
+    sample: str | None = None,
+    source: str | None = None,
+) -> dict[str, np.ndarray]:
+    """Combined ``n, k`` and uncertainties at given wavelengths, by linear interpolation.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A :func:`combined_table` (or an :func:`nk_table`, combined first).
+    wavelength_nm : float or array_like
+        Wavelength(s) [nm], within the measured range.
+    sample, source : str, optional
+        Select one (sample, source) when the table holds several.
+
+    Returns
+    -------
+    dict
+        ``{"wavelength_nm", "n", "k", "n_sigma", "k_sigma", "nk_cov"}`` as float arrays
+        shaped like ``wavelength_nm`` (for the tracer's ``Substrate(n=, k=)`` or
+        ``models.get("microfacet", n=, k=)``).
+
+    Raises
+    ------
+    ValueError
+        A wavelength outside the measured range (no extrapolation), or an ambiguous table.
+
+    Notes
+    -----
+    Linear interpolation between the two neighbouring measured wavelengths; the sigmas
+    and the covariance are interpolated the same way (exact at the nodes, an
+    approximation in between that neglects the interpolation error itself).
+    """
+    if "theta_i_deg" in table.columns:
+        table = combined_table(table)
+    t = _single(table, sample, source, "nk_at").sort_values("wavelength_nm")
+    wl = t["wavelength_nm"].to_numpy(float)
+    x = np.asarray(wavelength_nm, dtype=float)
+    lo, hi = float(wl[0]), float(wl[-1])
+    if not np.all(np.isfinite(x)) or np.any((x < lo) | (x > hi)):
+        bad = x[~((x >= lo) & (x <= hi))]
+        raise ValueError(
+            f"wavelength_nm: {bad.ravel()[:5].tolist()} outside the measured range "
+            f"[{lo:.6g}, {hi:.6g}] nm; n, k are not extrapolated"
+        )
+    out = {"wavelength_nm": x}
+    for c in ("n", "k", "n_sigma", "k_sigma", "nk_cov"):
+        out[c] = np.interp(x, wl, t[c].to_numpy(float))
+    return out
+
+
+def compare_reflectance(
+    nk: pd.DataFrame,
+    reflectance: Measurement | pd.DataFrame,
+    *,
+    sample: str | None = None,
+    source: str | None = None,
+    theta_if_missing_deg: float = 0.0,
+    n_ambient: float = 1.0,
+) -> pd.DataFrame:
+    """Measured specular reflectance against the Fresnel prediction from ``n, k``.
+
+    Parameters
+    ----------
+    nk : pandas.DataFrame
+        A :func:`combined_table` or :func:`nk_table` of one (sample, source) (or select one).
+    reflectance : Measurement or pandas.DataFrame
+        Data with ``quantity == "reflectance"`` rows: ellipsometer ``sR``/``pR``/``uR``
+        (``channel`` ``s``/``p``/``u`` and ``theta_i_deg``) or spectrophotometer
+        reflectance (no channel, ``theta_i_deg`` NaN).
+    sample, source : str, optional
+        Select the (sample, source) of ``nk``.
+    theta_if_missing_deg : float, optional
+        Angle of incidence used where ``theta_i_deg`` is NaN (spectrophotometers) [deg].
+        Default 0 (normal incidence; at the usual 8 deg the difference is below 1e-3 of R).
+    n_ambient : float, optional
+        Real index of the ambient [1]. Default 1.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per reflectance row inside the wavelength range of ``nk``: ``sample,
+        source, wavelength_nm, theta_i_deg, channel, measured, measured_sigma, predicted,
+        predicted_sigma, difference, difference_sigma, z`` [1]. ``predicted`` is ``R_s``,
+        ``R_p`` or their mean for channel ``s``, ``p``, anything else;
+        ``difference = measured - predicted``; ``difference_sigma`` adds the two sigmas in
+        quadrature, and is the predicted sigma alone (a lower bound) where the measurement
+        has none. ``attrs["outside_range"]`` counts the rows outside the ``nk`` range
+        (dropped: no extrapolation).
+    """
+    df = _frame(reflectance)
+    rows = df[df["quantity"] == "reflectance"]
+    if rows.empty:
+        raise ValueError("no reflectance rows in the data to compare with")
+    nkc = combined_table(nk) if "theta_i_deg" in nk.columns else nk
+    nkc = _single(nkc, sample, source, "compare_reflectance")
+    wl = rows["wavelength_nm"].to_numpy(float)
+    lo, hi = nkc["wavelength_nm"].min(), nkc["wavelength_nm"].max()
+    inside = (wl >= lo) & (wl <= hi)
+    rows = rows[inside]
+    if rows.empty:
+        raise ValueError(f"no reflectance row within the n, k range [{lo:.6g}, {hi:.6g}] nm")
+    at = nk_at(nkc, rows["wavelength_nm"].to_numpy(float))
+    theta = rows["theta_i_deg"].to_numpy(float)
+    theta = np.where(np.isnan(theta), theta_if_missing_deg, theta)
+    pred = ell.fresnel_reflectances(
+        np.maximum(at["n"], 0.0),
+        np.maximum(at["k"], 0.0),
+        theta,
+        n_sigma=at["n_sigma"],
+        k_sigma=at["k_sigma"],
+        nk_cov=at["nk_cov"],
+        n_ambient=n_ambient,
+    )
+    if "channel" in rows.columns:
+        channel = rows["channel"].astype(object).to_numpy()
+    else:
+        channel = np.full(len(rows), None, dtype=object)
+    is_s = channel == "s"
+    is_p = channel == "p"
+    predicted = np.where(is_s, pred.rs, np.where(is_p, pred.rp, pred.r))
+    predicted_sigma = np.where(is_s, pred.rs_sigma, np.where(is_p, pred.rp_sigma, pred.r_sigma))
+    measured = rows["value"].to_numpy(float)
+    measured_sigma = rows["sigma"].to_numpy(float)
+    diff = measured - predicted
+    diff_sigma = np.where(
+        np.isnan(measured_sigma), predicted_sigma, np.hypot(measured_sigma, predicted_sigma)
+    )
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = diff / diff_sigma
+    out = pd.DataFrame(
+        {
+            "sample": rows["sample"].astype(object).to_numpy(),
+            "source": rows["source"].astype(object).to_numpy(),
+            "wavelength_nm": rows["wavelength_nm"].to_numpy(float),
+            "theta_i_deg": theta,
+            "channel": channel,
+            "measured": measured,
+            "measured_sigma": measured_sigma,
+            "predicted": predicted,
+            "predicted_sigma": predicted_sigma,
+            "difference": diff,
+            "difference_sigma": diff_sigma,
+            "z": z,
+        }
+    )
+    out.attrs["outside_range"] = int((~inside).sum())
+    return out
+
+
+def microfacet_hemispherical(
+    n: float,
+    k: float,
+    alpha: float,
+    theta_i_deg: float | Sequence[float] | np.ndarray,
+    *,
+    n_sigma: float = float("nan"),
+    k_sigma: float = float("nan"),
+    nk_cov: float = 0.0,
+    rtol: float = 1e-6,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Directional-hemispherical reflectance of the GGX microfacet pBRDF for ``N = n + ik``.
+
+    Parameters
+    ----------
+    n, k : float
+        Substrate index [1] (e.g. from :func:`nk_at`).
+    alpha : float
+        GGX roughness of ``models.get("microfacet")`` [1].
+    theta_i_deg : float or array_like
+        Angle(s) of incidence in [0, 90) [deg].
+    n_sigma, k_sigma, nk_cov : float, optional
+        Uncertainties and covariance of n, k [1]; NaN sigma (default): the returned sigma
+        is NaN and no extra quadratures are run.
+    rtol : float, optional
+        Quadrature tolerance of :func:`labbrdf.integrate.hemispherical_reflectance`.
+
+    Returns
+    -------
+    rho, rho_sigma : ndarray of float
+        Albedo (scale 1) [1] and its first-order 1-sigma uncertainty [1], from central
+        differences of the quadrature in n and k with steps ``h = 0.01 max(|N|, 1)``:
+        the truncation error is O(h^2) relative, and the quadrature error ``rtol``
+        divided by ``h`` stays below 1e-3 of the derivative for ``rtol = 1e-6``.
+    """
+    from . import integrate, models  # the physics/model layer, imported where needed
+
+    theta = np.asarray(theta_i_deg, dtype=float)
+
+    def albedo(nn: float, kk: float) -> np.ndarray:
+        model = models.get("microfacet", n=nn, k=kk)
+        return integrate.hemispherical_reflectance(
+            model, {"alpha": alpha, "scale": 1.0}, theta, rtol=rtol
+        )
+
+    rho = albedo(n, k)
+    if not (np.isfinite(n_sigma) and np.isfinite(k_sigma)):
+        return rho, np.full(rho.shape, np.nan)
+    h = 0.01 * max(abs(complex(n, k)), 1.0)
+    hn = min(h, n) if n > 0 else h  # stay at n >= 0 (one-sided if needed)
+    hk = min(h, k) if k > 0 else h
+    g_n = (albedo(n + h, k) - albedo(n - hn, k)) / (h + hn)
+    g_k = (albedo(n, k + h) - albedo(n, k - hk)) / (h + hk)
+    var = (g_n * n_sigma) ** 2 + (g_k * k_sigma) ** 2 + 2.0 * g_n * g_k * nk_cov
+    return rho, np.sqrt(np.maximum(var, 0.0))

@@ -1,0 +1,304 @@
+"""Pseudo-optical constants with uncertainties (labbrdf.ellipsometry)."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy import optimize
+
+import labbrdf
+from labbrdf import ellipsometry as ell
+from labbrdf import optics
+
+# --------------------------------------------------------------------------------------
+# an independent two-phase inversion: forward Fresnel written here, solved numerically
+# --------------------------------------------------------------------------------------
+
+
+def _rho_of_w(w: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
+    """rp/rs of a bare substrate in air as a rational function of ``w = N cos(theta_t)``.
+
+    Born and Wolf 1.5.2 with exp(-i omega t): ``rs = (c - w)/(c + w)``,
+    ``rp = (N^2 c - w)/(N^2 c + w)`` and ``N^2 = w^2 + sin^2(theta)`` (Snell). Written in
+    ``w`` there is no square root, hence no branch cut for the solver to trip over; the
+    two roots ``+-w`` of one ``N^2`` give ``rho`` and ``1/rho``, so exactly one solves.
+    """
+    t = np.radians(theta_deg)
+    c, s = np.cos(t), np.sin(t)
+    eps = w * w + s * s
+    return ((eps * c - w) / (eps * c + w)) * ((c + w) / (c - w))
+
+
+def _independent_nk(psi_deg, delta_deg, theta_deg) -> tuple[np.ndarray, np.ndarray]:
+    """Solve rho(w) = tan(psi) exp(-i Delta) for w (grid start, secant), then N."""
+    psi, delta, theta = (np.asarray(a, dtype=float) for a in (psi_deg, delta_deg, theta_deg))
+    target = np.tan(np.radians(psi)) * np.exp(-1j * np.radians(delta))
+    radius, phase = np.meshgrid(np.geomspace(0.01, 50.0, 160), np.linspace(0, 2 * np.pi, 120))
+    grid = (radius * np.exp(1j * phase)).ravel()  # polar grid: |w| from 0.01 to 50
+    start = np.empty(psi.shape, dtype=complex)
+    with np.errstate(all="ignore"):
+        for th in np.unique(theta):
+            idx = np.flatnonzero(theta == th)
+            rho_grid = np.nan_to_num(_rho_of_w(grid, np.full(grid.shape, th)), nan=1e300)
+            for chunk in np.array_split(idx, max(1, idx.size // 200)):
+                dist = np.abs(rho_grid[None, :] - target[chunk, None])
+                start[chunk] = grid[np.argmin(dist, axis=1)]
+        w = optimize.newton(
+            lambda x: _rho_of_w(x, theta) - target, start, tol=1e-14, maxiter=200, disp=False
+        )
+        residual = np.abs(_rho_of_w(w, theta) - target)
+    big_n = np.sqrt(w * w + np.sin(np.radians(theta)) ** 2)
+    big_n = np.where(big_n.real + big_n.imag < 0, -big_n, big_n)  # N and -N: same rho
+    return big_n, residual < 1e-12 * np.maximum(1.0, np.abs(target))
+
+
+def _psi_delta_files(real_exports: Path) -> list[Path]:
+    out = []
+    for p in sorted(real_exports.rglob("*")):
+        if p.is_dir() or p.suffix == ".md" or "topography" in p.parts:
+            continue
+        try:
+            m = labbrdf.read(p)
+        except Exception:  # noqa: BLE001 - not a supported export
+            continue
+        if (m.data["quantity"] == "psi").any():
+            out.append(p)
+    return out
+
+
+def test_inversion_matches_independent_solver_on_every_real_psi_delta_file(real_exports):
+    from labbrdf import nk
+
+    files = _psi_delta_files(real_exports)
+    assert len(files) >= 10
+    worst = 0.0
+    for path in files:
+        t = nk.nk_table(labbrdf.read(path), on_ill_conditioned="warn")
+        root, converged = _independent_nk(t["psi_deg"], t["delta_deg"], t["theta_i_deg"])
+        assert converged.all(), path.name
+        ours = t["n"].to_numpy() + 1j * t["k"].to_numpy()
+        err = np.abs(root - ours) / np.maximum(1.0, np.abs(ours))
+        worst = max(worst, float(err.max()))
+        assert err.max() < 1e-9, (path.name, float(err.max()))
+    print(f"worst relative difference from the independent solver: {worst:.2e}")
+
+
+# --------------------------------------------------------------------------------------
+# Jacobian and Monte Carlo
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("big_n", [1.5, 3.88 + 0.02j, 2.0 + 3.0j, 0.2 + 3.5j])
+def test_jacobian_matches_central_differences(big_n):
+    theta = np.array([45.0, 65.0, 75.0])
+    psi, delta = optics.psi_delta(big_n, theta)
+    _, d_psi, d_delta, d_theta = ell.nk_jacobian(psi, delta, theta)
+    h = 1e-5  # [deg]; truncation O(h^2 N''') ~ 1e-12, round-off 1e-16/h ~ 1e-11
+
+    def fd(dp, dd, dt):
+        up = optics.nk_from_psi_delta(psi + h * dp, delta + h * dd, theta + h * dt)
+        dn = optics.nk_from_psi_delta(psi - h * dp, delta - h * dd, theta - h * dt)
+        return (up - dn) / (2 * h)
+
+    np.testing.assert_allclose(d_psi, fd(1, 0, 0), rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(d_delta, fd(0, 1, 0), rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(d_theta, fd(0, 0, 1), rtol=1e-6, atol=1e-9)
+
+
+def _mc(psi, delta, theta, s_psi, s_delta, s_theta, draws, seed):
+    rng = np.random.default_rng(seed)
+    p = psi + s_psi * rng.standard_normal(draws)
+    d = delta + s_delta * rng.standard_normal(draws)
+    t = theta + s_theta * rng.standard_normal(draws)
+    big_n = optics.nk_from_psi_delta(p, d, t)
+    return big_n.real, big_n.imag
+
+
+@pytest.mark.parametrize(
+    ("big_n", "theta", "s_psi", "s_delta", "s_theta"),
+    [
+        (2.0 + 3.0j, 70.0, 0.03, 0.05, 0.0),  # Ta-like, file-like sigmas
+        (3.88 + 0.02j, 60.0, 0.02, 0.1, 0.0),  # Si, weak absorber
+        (0.2 + 3.5j, 75.0, 0.01, 0.03, 0.02),  # Ag-like, with an AOI error
+    ],
+)
+def test_sigmas_match_monte_carlo(big_n, theta, s_psi, s_delta, s_theta):
+    draws = 40_000  # standard error of a std estimate: sigma/sqrt(2N) = 0.35 %
+    psi, delta = optics.psi_delta(big_n, theta)
+    res = ell.pseudo_nk(psi, delta, theta, s_psi, s_delta, theta_sigma_deg=s_theta)
+    n, k = _mc(psi, delta, theta, s_psi, s_delta, s_theta, draws, seed=1)
+    ratio_n = float(np.std(n, ddof=1) / res.n_sigma)
+    ratio_k = float(np.std(k, ddof=1) / res.k_sigma)
+    assert abs(ratio_n - 1) < 0.05 and abs(ratio_k - 1) < 0.05, (ratio_n, ratio_k)
+    corr_mc = np.corrcoef(n, k)[0, 1]
+    corr = float(res.nk_cov / (res.n_sigma * res.k_sigma))
+    assert abs(corr_mc - corr) < 0.03  # SE of r is (1 - r^2)/sqrt(N) < 0.005
+
+
+def test_sigmas_match_monte_carlo_on_real_ta_points(real_exports):
+    m = labbrdf.read(real_exports / "woollam-wvase-ascii" / "w2_10102006.dat")
+    d = m.data
+    psi = d[d["quantity"] == "psi"].iloc[[0, 300, 700, 1500, 2000]]
+    delta = d[d["quantity"] == "delta"].iloc[[0, 300, 700, 1500, 2000]]
+    ratios = []
+    for (_, p), (_, q) in zip(psi.iterrows(), delta.iterrows(), strict=True):
+        assert p["wavelength_nm"] == q["wavelength_nm"]
+        res = ell.pseudo_nk(p["value"], q["value"], p["theta_i_deg"], p["sigma"], q["sigma"])
+        n, k = _mc(p["value"], q["value"], p["theta_i_deg"], p["sigma"], q["sigma"], 0, 40_000, 2)
+        ratios += [np.std(n, ddof=1) / res.n_sigma, np.std(k, ddof=1) / res.k_sigma]
+    ratios = np.asarray(ratios)
+    print(f"MC/analytic sigma ratios on Ta: {ratios.min():.4f} .. {ratios.max():.4f}")
+    assert np.all(np.abs(ratios - 1) < 0.05)
+
+
+def test_no_sigma_gives_nan_sigma():
+    psi, delta = optics.psi_delta(2 + 3j, 70.0)
+    res = ell.pseudo_nk(psi, delta, 70.0)
+    assert np.isnan(res.n_sigma) and np.isnan(res.k_sigma) and np.isfinite(res.n)
+
+
+# --------------------------------------------------------------------------------------
+# conditioning near normal incidence
+# --------------------------------------------------------------------------------------
+
+
+def test_near_normal_incidence_raises_with_condition_number_and_angle():
+    psi, delta = optics.psi_delta(3.88 + 0.02j, 3.0)
+    with pytest.raises(ValueError, match=r"condition number .* at theta_i = 3 deg"):
+        ell.pseudo_nk(psi, delta, 3.0)
+    with pytest.warns(ell.IllConditionedWarning):
+        res = ell.pseudo_nk(psi, delta, 3.0, on_ill_conditioned="warn")
+    assert res.cond > ell.COND_MAX
+    np.testing.assert_allclose(res.n + 1j * res.k, 3.88 + 0.02j, rtol=1e-9)
+
+
+def test_moderate_angle_warns_and_oblique_is_silent():
+    big_n = 3.88 + 0.02j
+    psi, delta = optics.psi_delta(big_n, 15.0)
+    with pytest.warns(ell.IllConditionedWarning, match="15 deg"):
+        ell.pseudo_nk(psi, delta, 15.0)
+    psi, delta = optics.psi_delta(big_n, 70.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ell.pseudo_nk(psi, delta, 70.0)
+
+
+def test_condition_number_grows_as_inverse_square_of_angle():
+    big_n = 2.0 + 3.0j
+    th = np.array([1.0, 2.0])
+    psi, delta = optics.psi_delta(big_n, th)
+    cond = ell.condition_number(psi, delta, th)
+    assert cond[0] / cond[1] == pytest.approx(4.0, rel=0.01)
+    psi, delta = optics.psi_delta(big_n, 70.0)
+    assert ell.condition_number(psi, delta, 70.0) < 5
+
+
+# --------------------------------------------------------------------------------------
+# combining angles
+# --------------------------------------------------------------------------------------
+
+
+def _film_psi_delta(n_film, n_sub, d_nm, wl_nm, theta):
+    rs, rp = optics.film_amplitudes(1.0, n_film, n_sub, d_nm, wl_nm, theta)
+    psi = np.degrees(np.arctan2(np.abs(rp), np.abs(rs)))
+    delta = np.mod(np.degrees(np.angle(rs * np.conj(rp))), 360.0)
+    return psi, delta
+
+
+def _combined(d_nm, s_psi, s_delta, rng=None):
+    theta = np.array([65.0, 70.0, 75.0])
+    psi, delta = _film_psi_delta(1.46, 3.88 + 0.02j, d_nm, 633.0, theta)  # SiO2 on Si
+    if rng is not None:
+        psi = psi + s_psi * rng.standard_normal(3)
+        delta = delta + s_delta * rng.standard_normal(3)
+    r = ell.pseudo_nk(psi, delta, theta, s_psi, s_delta)
+    return ell.combine_angles(r.n, r.k, theta, r.covariance())
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_bare_substrate_is_not_angle_dependent(seed):
+    c = _combined(0.0, 0.02, 0.05, np.random.default_rng(seed))
+    assert c.dof == 4 and c.method == "sigma" and not c.angle_dependent
+    assert abs(c.n - 3.88) < 4 * c.n_sigma and abs(c.k - 0.02) < 4 * c.k_sigma
+
+
+def test_thin_oxide_shifts_pseudo_constants_but_hardly_their_angle_dependence():
+    # 5 nm SiO2 on Si at 633 nm, 65/70/75 deg: <k> moves from 0.02 to 0.37 (> 100 sigma),
+    # yet the angle-to-angle spread is 0.0014, so with sigma(psi, Delta) = 0.02, 0.05 deg
+    # the noise-free chi2 is 0.19: the consistency test does not see a thin film.
+    c = _combined(5.0, 0.02, 0.05)
+    assert c.k - 0.02 > 100 * c.k_sigma
+    assert c.chi2 < 1 and not c.angle_dependent
+    # twenty times smaller sigmas (a repeatability-limited instrument) see it
+    fine = _combined(5.0, 0.001, 0.0025, np.random.default_rng(0))
+    assert fine.angle_dependent, fine
+    # and a 100 nm film is flagged at the ordinary sigmas
+    thick = _combined(100.0, 0.02, 0.05, np.random.default_rng(0))
+    assert thick.angle_dependent and thick.p_value < 1e-6
+
+
+def test_combination_is_the_weighted_mean_with_chi2():
+    n = np.array([2.0, 2.1])
+    k = np.array([3.0, 3.0])
+    cov = np.array([np.diag([0.01, 0.01]), np.diag([0.04, 0.04])]) ** 1
+    c = ell.combine_angles(n, k, [60.0, 70.0], cov)
+    # 1-d weighted mean of n with weights 100 and 25
+    assert c.n == pytest.approx((2.0 * 100 + 2.1 * 25) / 125)
+    assert c.n_sigma == pytest.approx(125**-0.5)
+    assert c.chi2 == pytest.approx(100 * (2.0 - c.n) ** 2 + 25 * (2.1 - c.n) ** 2)
+    assert c.dof == 2
+
+
+def test_scatter_rule_without_sigma():
+    theta = np.array([55.0, 60.0, 65.0, 70.0, 75.0])
+    rng = np.random.default_rng(3)
+    flat = ell.combine_angles(2 + 0.01 * rng.standard_normal(5), np.full(5, 3.0), theta)
+    assert flat.method == "scatter" and np.isnan(flat.chi2) and flat.dof == 3
+    assert not flat.angle_dependent
+    trend = ell.combine_angles(2 + 0.01 * (theta - 65) + 1e-4 * rng.standard_normal(5),
+                               np.full(5, 3.0), theta)  # fmt: skip
+    assert trend.angle_dependent
+    one = ell.combine_angles([2.0], [3.0], [70.0])
+    assert one.method == "single" and one.dof == 0 and np.isnan(one.p_value)
+
+
+# --------------------------------------------------------------------------------------
+# Fresnel predictions
+# --------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("n", "k"), [(1.5, 0.0), (3.88, 0.02), (2.0, 3.0), (0.2, 3.5)])
+def test_normal_incidence_reflectance_formula(n, k):
+    expected = ((n - 1) ** 2 + k**2) / ((n + 1) ** 2 + k**2)
+    r, _ = ell.normal_reflectance(n, k)
+    assert r == pytest.approx(expected, rel=1e-13)
+    res = ell.fresnel_reflectances(n, k, 0.0)
+    assert res.rs == pytest.approx(expected, rel=1e-13)
+    assert res.rp == pytest.approx(expected, rel=1e-13)
+
+
+@pytest.mark.parametrize(("n", "k"), [(1.5, 0.0), (3.88, 0.02), (2.0, 3.0), (0.2, 3.5)])
+def test_reflectance_sigma_matches_finite_differences(n, k):
+    theta = np.array([0.0, 30.0, 60.0, 80.0])
+    s_n, s_k, cov = 0.01, 0.02, 0.5 * 0.01 * 0.02
+    res = ell.fresnel_reflectances(n, k, theta, n_sigma=s_n, k_sigma=s_k, nk_cov=cov)
+    rs0, rp0 = optics.reflectance(1.0, n + 1j * k, theta)
+    np.testing.assert_allclose(res.rs, rs0, rtol=1e-14)
+    np.testing.assert_allclose(res.rp, rp0, rtol=1e-14)
+    h = 1e-6
+    k_lo = max(k - h, 0.0)
+
+    def grad(which):
+        up = np.asarray(optics.reflectance(1.0, n + h + 1j * k, theta)[which])
+        dn = np.asarray(optics.reflectance(1.0, n - h + 1j * k, theta)[which])
+        ku = np.asarray(optics.reflectance(1.0, n + 1j * (k + h), theta)[which])
+        kd = np.asarray(optics.reflectance(1.0, n + 1j * k_lo, theta)[which])
+        return (up - dn) / (2 * h), (ku - kd) / (k + h - k_lo)
+
+    for which, sig in ((0, res.rs_sigma), (1, res.rp_sigma)):
+        gn, gk = grad(which)
+        expect = np.sqrt((gn * s_n) ** 2 + (gk * s_k) ** 2 + 2 * gn * gk * cov)
+        np.testing.assert_allclose(sig, expect, rtol=1e-5, atol=1e-12)
