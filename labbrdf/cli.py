@@ -55,6 +55,84 @@ def _parse_assignments(items: Sequence[str] | None, what: str) -> dict[str, floa
     return out
 
 
+def _value(text: str) -> float | bool | str:
+    """A model option's value: a number, true/false, or a word."""
+    t = text.strip()
+    if t.lower() in ("true", "yes", "on"):
+        return True
+    if t.lower() in ("false", "no", "off"):
+        return False
+    try:
+        x = float(t)
+    except ValueError:
+        return t
+    if not (t.isascii() and math.isfinite(x)):
+        raise UsageError(f"{t!r}: expected a finite ASCII number")
+    return x
+
+
+def _model_options(name: str) -> set[str]:
+    """Option names the model's constructor takes (its signature is the contract)."""
+    import inspect
+
+    from . import models
+
+    if name not in models.MODELS:
+        raise UsageError(f"--model {name!r}: models are {models.names()}")
+    sig = inspect.signature(models.MODELS[name].__init__)
+    return {
+        k
+        for k, v in sig.parameters.items()
+        if k != "self" and v.kind not in (v.VAR_KEYWORD, v.VAR_POSITIONAL)
+    }
+
+
+def _split_params(
+    model: str, items: Sequence[str] | None
+) -> tuple[dict[str, Any], dict[str, float]]:
+    """``--param NAME=VALUE``: model options (e.g. microfacet's n, k) and parameter values."""
+    opts_names = _model_options(model)
+    options: dict[str, Any] = {}
+    values: dict[str, float] = {}
+    for item in items or ():
+        name, sep, raw = item.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise UsageError(f"--param {item!r}: expected NAME=VALUE")
+        v = _value(raw)
+        if name in opts_names:
+            options[name] = v
+        elif isinstance(v, float):
+            values[name] = v
+        else:
+            raise UsageError(f"--param {item!r}: {raw!r} is not a number")
+    return options, values
+
+
+def _add_selection(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("selection")
+    g.add_argument("--wavelength", default=None, metavar="MIN:MAX", help="[nm], e.g. 400:700")
+    g.add_argument("--theta-i", default=None, metavar="MIN:MAX", help="[deg], e.g. 40:60")
+    g.add_argument("--quantity", default=None, help="comma-separated quantities")
+    g.add_argument("--sample", default=None, help="comma-separated sample names")
+
+
+def _selected(args: argparse.Namespace, m: Any) -> Any:
+    """The Measurement ``m`` restricted to the selection options (meta kept)."""
+    from .dataset import Measurement
+    from .selection import select
+
+    if all(
+        getattr(args, k, None) is None for k in ("wavelength", "theta_i", "quantity", "sample")
+    ):
+        return m
+    df = select(
+        m, wavelength=args.wavelength, theta_i=args.theta_i, quantity=args.quantity,
+        sample=args.sample,
+    )  # fmt: skip
+    return Measurement(df, m.meta)
+
+
 def _add_scheduler(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--scheduler",
@@ -214,25 +292,62 @@ def cmd_formats(args: argparse.Namespace) -> int:
 
 @_executor_errors
 def cmd_fit(args: argparse.Namespace) -> int:
-    from . import adapters
+    import pandas as pd
+
+    from . import adapters, models
     from .fit import fit_many
 
     _check_executor(args)
-    data = adapters.read_many(args.files)
+    data = _selected(args, adapters.read_many(args.files))
     fix = _parse_assignments(args.fix, "--fix")
+    options, start = _split_params(args.model, args.param)
     by = [c.strip() for c in args.by.split(",") if c.strip()]
-    table, results = fit_many(
-        data,
-        args.model,
-        by=by,
-        method=args.method,
-        seed=args.seed,
-        fix=fix or None,
-        scheduler=args.scheduler,
-        workers=args.workers,
-        progress=not args.json,
-        return_results=True,
-    )
+    params: dict[str, Any] = {k: {"value": v} for k, v in start.items()}
+    for name in args.free or ():
+        params.setdefault(name, {})["vary"] = True
+    kw: dict[str, Any] = {
+        "by": by,
+        "method": args.method,
+        "seed": args.seed,
+        "fix": fix or None,
+        "params": params or None,
+        "scheduler": args.scheduler,
+        "workers": args.workers,
+        "progress": not args.json,
+        "return_results": True,
+        "mask_zeros": not args.keep_zeros,
+        "relative_floor": args.relative_floor,
+    }
+    if args.weighting != "auto":
+        kw["weighting"] = args.weighting
+    elif not _all_have_sigma(data.data):
+        kw["weighting"] = "relative"
+    if args.nk_from:
+        if "n" not in _model_options(args.model):
+            raise UsageError(f"--nk-from: model {args.model!r} takes no index n, k")
+        tables, results = [], []
+        nk = _nk_combined(args.nk_from)
+        unstated = [
+            str(m.get("source", "?")) for m in _metas(data) if m.get("wavelength_stated") is False
+        ]
+        if unstated and args.nk_wavelength is None:
+            raise UsageError(
+                f"--nk-from: {', '.join(unstated)} state(s) no wavelength (the format has "
+                "no field for it); say at which wavelength to take n, k with --nk-wavelength NM"
+            )
+        for wl, part in data.data.groupby("wavelength_nm", sort=True):
+            at = _nk_at(nk, float(args.nk_wavelength or wl), args.nk_from)
+            model = models.get(args.model, **{**options, "n": at[0], "k": at[1]})
+            t, r = fit_many(part, model, **kw)
+            tables.append(t.assign(n=at[0], k=at[1]))
+            results.extend(r)
+        table = pd.concat(tables, ignore_index=True)
+    else:
+        try:
+            model = models.get(args.model, **options)
+        except models.ModelError as exc:
+            raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
+        table, results = fit_many(data, model, **kw)
     if args.output:
         from .dataset import atomic_output
 
@@ -255,8 +370,13 @@ def cmd_fit(args: argparse.Namespace) -> int:
                         for name, p in s["params"].items()
                     },
                     "rmse": s["rmse"],
+                    "redchi": s["redchi"],
+                    "weighting": s["weighting"],
+                    "nmasked": s["nmasked"],
+                    "flags": {k: v["flags"] for k, v in s["params"].items() if v["flags"]},
                     "nfev": s["nfev"],
                     "success": s["success"],
+                    "message": s["message"],
                 }
             )
         _emit_json(out)
@@ -266,6 +386,136 @@ def cmd_fit(args: argparse.Namespace) -> int:
         with pd.option_context("display.width", 200, "display.max_columns", 50):
             print(table.to_string(index=False))
     return 0
+
+
+def _metas(m: Any) -> list[dict[str, Any]]:
+    """The per-file metas of a (concatenated) Measurement, each with its ``source``."""
+    parts = m.meta.get("parts")
+    if not parts:
+        return [m.meta]
+    return [{**p.get("meta", {}), "source": p.get("source")} for p in parts]
+
+
+def _all_have_sigma(df: Any) -> bool:
+    import numpy as np
+
+    sig = df["sigma"].to_numpy(float)
+    return bool(sig.size) and bool(np.all(np.isfinite(sig) & (sig > 0)))
+
+
+def _nk_combined(path: str) -> Any:
+    """Per-wavelength combined n, k of an ellipsometer file (``--nk-from``)."""
+    from . import adapters
+    from .nk import combined_table
+
+    m = adapters.read(path)
+    try:
+        return combined_table(m)
+    except ValueError as exc:
+        raise UsageError(f"--nk-from {path}: {exc}") from None
+
+
+def _nk_at(table: Any, wavelength_nm: float, path: str) -> tuple[float, float]:
+    from .nk import nk_at
+
+    try:
+        at = nk_at(table, wavelength_nm)
+    except ValueError as exc:
+        raise UsageError(f"--nk-from {path}: {exc}") from None
+    n, k = float(at["n"]), float(at["k"])
+    if not (n > 0 and k >= 0):
+        raise UsageError(
+            f"--nk-from {path}: the pseudo-index at {wavelength_nm:g} nm is n={n:.4g}, "
+            f"k={k:.4g}, not a physical bulk index (a film on the sample?)"
+        )
+    return n, k
+
+
+def cmd_nk(args: argparse.Namespace) -> int:
+    from . import adapters
+    from .nk import combined_table, nk_json, nk_table
+
+    data = _selected(args, adapters.read_many(args.files))
+    on_ill = "warn" if args.allow_ill_conditioned else "raise"
+    table = nk_table(data, on_ill_conditioned=on_ill, theta_sigma_deg=args.theta_sigma)
+    if args.output:
+        from .dataset import atomic_output
+
+        out = combined_table(table) if args.combined else table
+        with atomic_output(args.output) as tmp:
+            out.to_csv(tmp, index=False)
+    if args.json:
+        _emit_json(nk_json(table))
+        return 0
+    import pandas as pd
+
+    comb = combined_table(table)
+    cols = [c for c in ("sample", "wavelength_nm", "n", "n_sigma", "k", "k_sigma", "chi2",
+                        "dof", "p_value", "angle_dependent") if c in comb.columns]  # fmt: skip
+    with pd.option_context("display.width", 200, "display.max_rows", 40):
+        print(comb[cols].to_string(index=False))
+    flagged = int(comb["angle_dependent"].fillna(False).astype(bool).sum())
+    if flagged:
+        print(
+            f"{flagged} of {len(comb)} wavelengths have angle-dependent pseudo-constants "
+            "(p < 0.01): a film or roughness, not a bulk material"
+        )
+    return 0
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from . import models
+    from .adapters.zemax_bsdf import model_to_bsdf
+
+    if args.format != "zemax-bsdf":
+        raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
+    options, values = _split_params(args.model, args.param)
+    if args.nk_from:
+        if args.wavelength is None:
+            raise UsageError("--nk-from needs --wavelength NM")
+        options["n"], options["k"] = _nk_at(
+            _nk_combined(args.nk_from), args.wavelength, args.nk_from
+        )
+    try:
+        model = models.get(args.model, **options)
+    except models.ModelError as exc:
+        raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
+    unknown = [k for k in values if k not in model.params]
+    if unknown:
+        raise UsageError(f"--param {unknown}: {args.model} parameters are {list(model.params)}")
+    out = Path(args.output)
+    if out.exists() and not args.overwrite:
+        raise UsageError(f"-o {out}: exists; pass --overwrite to replace it")
+    model_to_bsdf(
+        model,
+        values,
+        out,
+        theta_i_deg=np.asarray(args.theta_i, float),
+        radial_deg=_grid(args.radial, "--radial"),
+        azimuth_deg=_grid(args.azimuth, "--azimuth"),
+        overwrite=args.overwrite,
+    )
+    print(f"wrote {out}")
+    return 0
+
+
+def _grid(text: str, option: str) -> Any:
+    """``START:STOP:STEP`` (inclusive) or a comma-separated list, as an array [deg]."""
+    import numpy as np
+
+    try:
+        if ":" in text:
+            a, b, c = (float(x) for x in text.split(":"))
+            if not c > 0 or b < a:
+                raise ValueError
+            return np.round(np.arange(a, b + c / 2, c), 9)
+        return np.array([float(x) for x in text.split(",")], float)
+    except ValueError:
+        raise UsageError(
+            f"{option} {text!r}: expected START:STOP:STEP or a comma-separated list"
+        ) from None
 
 
 def cmd_hemispherical(args: argparse.Namespace) -> int:
@@ -419,10 +669,66 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--method", default="GN_CRS2_LM+LN_BOBYQA", help="nlopt GLOBAL[+LOCAL]")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--fix", action="append", metavar="NAME=VALUE", help="fix a parameter")
+    s.add_argument(
+        "--param",
+        action="append",
+        metavar="NAME=VALUE",
+        help="a model option (microfacet n=, k=, diffuse=true; five_param shadowing=mb) "
+        "or a parameter's starting value",
+    )
+    s.add_argument(
+        "--free", action="append", metavar="NAME", help="vary a parameter fixed by default"
+    )
+    s.add_argument(
+        "--nk-from", default=None, metavar="FILE", help="n, k from psi/Delta (microfacet)"
+    )
+    s.add_argument(
+        "--nk-wavelength",
+        type=float,
+        default=None,
+        metavar="NM",
+        help="take --nk-from's n, k at this wavelength (for files that state none)",
+    )
+    s.add_argument(
+        "--weighting",
+        choices=["auto", "sigma", "relative", "uniform"],
+        default="auto",
+        help="auto: 1/sigma^2 where every point has sigma, else relative",
+    )
+    s.add_argument("--relative-floor", type=float, default=1e-3, help="of max |y| (relative)")
+    s.add_argument("--keep-zeros", action="store_true", help="fit points with value 0 too")
     s.add_argument("-o", "--output", default=None, help="write the parameter table (CSV)")
     s.add_argument("--json", action="store_true")
+    _add_selection(s)
     _add_scheduler(s)
     s.set_defaults(func=cmd_fit)
+
+    s = sub.add_parser("nk", help="optical constants n, k from ellipsometer psi/Delta")
+    s.add_argument("files", nargs="+", metavar="FILE")
+    s.add_argument("-o", "--output", default=None, help="write the table (CSV)")
+    s.add_argument("--combined", action="store_true", help="-o writes the per-wavelength table")
+    s.add_argument("--theta-sigma", type=float, default=0.0, help="angle uncertainty [deg]")
+    s.add_argument(
+        "--allow-ill-conditioned",
+        action="store_true",
+        help="warn, not fail, near normal incidence",
+    )
+    s.add_argument("--json", action="store_true")
+    _add_selection(s)
+    s.set_defaults(func=cmd_nk)
+
+    s = sub.add_parser("export", help="write a model BRDF in an exchange format")
+    s.add_argument("--format", default="zemax-bsdf", help="zemax-bsdf")
+    s.add_argument("--model", required=True)
+    s.add_argument("--param", action="append", metavar="NAME=VALUE")
+    s.add_argument("--nk-from", default=None, metavar="FILE")
+    s.add_argument("--wavelength", type=float, default=None, help="[nm] for --nk-from")
+    s.add_argument("--theta-i", type=float, nargs="+", required=True, metavar="DEG")
+    s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")
+    s.add_argument("--azimuth", default="0:180:5", help="START:STOP:STEP [deg]")
+    s.add_argument("-o", "--output", required=True)
+    s.add_argument("--overwrite", action="store_true")
+    s.set_defaults(func=cmd_export)
 
     s = sub.add_parser("hemispherical", help="directional-hemispherical reflectance of a model")
     s.add_argument("--model", required=True)
@@ -476,6 +782,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         # AdapterError, DatasetError, ModelError, FitError are ValueErrors with a message
         print(f"labbrdf {args.command}: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # the reader of our output stopped early (`labbrdf ingest --json | head`): not an
+        # error of ours; point stdout at devnull so that Python's exit flush stays quiet
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 141
     except KeyboardInterrupt:  # pragma: no cover
         return 130
 

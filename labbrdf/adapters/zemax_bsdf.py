@@ -624,6 +624,8 @@ def read_zemax_bsdf(
         See :func:`read_table`.
     """
     t = read_table(path)
+    if wavelength_nm is None:
+        wavelength_nm = _own_wavelength(t.comments)
     stated = wavelength_nm is not None
     wl = float(wavelength_nm) if stated else DEFAULT_WAVELENGTH_NM
     if not (math.isfinite(wl) and wl > 0):
@@ -658,6 +660,22 @@ def read_zemax_bsdf(
         return Measurement(frame, meta)
     except ValueError as exc:
         raise AdapterError(path, f"invalid data: {exc}") from None
+
+
+#: comment labbrdf writes for the wavelength of a model it exports (the format has no field)
+_WAVELENGTH_COMMENT = "labbrdf wavelength_nm "
+
+
+def _own_wavelength(comments: list[str]) -> float | None:
+    """The wavelength [nm] of a ``#labbrdf wavelength_nm W`` comment (our exports), if any."""
+    for c in comments:
+        if c.startswith(_WAVELENGTH_COMMENT):
+            try:
+                w = float(c[len(_WAVELENGTH_COMMENT) :].strip())
+            except ValueError:
+                return None
+            return w if math.isfinite(w) and w > 0 and c.isascii() else None
+    return None
 
 
 def mirror_plane_symmetric(m: Measurement) -> Measurement:
@@ -1056,7 +1074,11 @@ def model_to_bsdf(
         azimuth_deg=az,
         values=vals,
         symmetry=symmetry,
-        comments=(f"labbrdf model {name}", *comments),
+        comments=(
+            f"labbrdf model {name}",
+            *([f"{_WAVELENGTH_COMMENT}{float(wavelength_nm):.17g}"] if wavelength_nm else []),
+            *comments,
+        ),
         digits=digits,
         overwrite=overwrite,
     )

@@ -28,6 +28,7 @@ __all__ = [
     "EXACT_RTOL",
     "CONSTRAINED",
     "LOCAL_ROUNDS",
+    "RELATIVE_FLOOR",
     "SPECULAR_LINE_SHAPE",
     "fit",
     "parse_method",
@@ -79,13 +80,25 @@ LOCAL_ROUNDS = 5
 #: Delta chi-square = t^2 (about 4) that sets the 95 % intervals, so the remaining motion
 #: along a flat valley cannot change any reported number beyond its uncertainty
 CHI2_TOL = 1e-6
+#: default floor of ``weighting="relative"``, as a fraction of the largest value: a 1000:1
+#: dynamic range, what BRDF instruments resolve between a specular peak and the floor
+RELATIVE_FLOOR = 1e-3
 #: a round whose residuals are below this fraction of the data's RMS has converged: the
 #: model reproduces the data beyond the 6 significant digits instrument files print, so
 #: what is left is round-off (noise-free data along a flat valley)
 EXACT_RTOL = 1e-6
 _LOCAL_XTOL_REL = 1e-10
 _LOCAL_FTOL_REL = 1e-13
-_OK_CODES = (nlopt.SUCCESS, nlopt.STOPVAL_REACHED, nlopt.FTOL_REACHED, nlopt.XTOL_REACHED)
+#: stop codes that mean converged. ROUNDOFF_LIMITED: the optimiser can no longer lower
+#: chi-square at double precision (nlopt: "the optimization still typically returns a useful
+#: result"); it happens where the optimum sits on a bound, which the at_bound flag then shows
+_OK_CODES = (
+    nlopt.SUCCESS,
+    nlopt.STOPVAL_REACHED,
+    nlopt.FTOL_REACHED,
+    nlopt.XTOL_REACHED,
+    nlopt.ROUNDOFF_LIMITED,
+)
 
 
 def parse_method(method: str) -> list[str]:
@@ -219,7 +232,7 @@ def _run_stage(
         code = opt.last_optimize_result()
         message = _code_message(code)
     except nlopt.RoundoffLimited:
-        code, message = nlopt.ROUNDOFF_LIMITED, "roundoff limited (best point kept)"
+        code, message = nlopt.ROUNDOFF_LIMITED, "roundoff limited (converged; best point kept)"
         x = obj.best_x if obj.best_x is not None else x0
     except (nlopt.runtime_error, RuntimeError) as exc:  # NLOPT_FAILURE: keep the best point
         code, message = nlopt.FAILURE, f"nlopt failure ({name}): {exc or 'generic'}"
@@ -321,6 +334,9 @@ def fit(
     nan_policy: str = "raise",
     guess: bool = True,
     ci: str = "wald",
+    weighting: str | None = None,
+    relative_floor: float = RELATIVE_FLOOR,
+    mask_zeros: bool = False,
 ) -> FitResult:
     """Fit a reflectance/BRDF model: an nlopt global stage inside the bounds, then a local one.
 
@@ -383,6 +399,22 @@ def fit(
         parameters rises by ``t^2`` (times ``redchi`` without sigma); about 20 local fits
         per parameter, better coverage when parameters are strongly correlated). Not
         combined with ``energy_constraint``.
+    weighting : {None, "sigma", "relative", "uniform"}
+        How points are weighted. None: as ``use_sigma`` says (1/sigma^2 where every point
+        has a sigma, else uniform). ``"relative"``: for data without sigma that span orders
+        of magnitude (a BRDF lobe over a diffuse floor): sigma_i = max(|y_i|, floor) with
+        ``floor = relative_floor x max|y|``, i.e. a constant relative error above the floor;
+        the covariance is rescaled by ``redchi`` (the scatter estimates that relative
+        error, reported as ``redchi``).
+    relative_floor : float
+        The floor of ``weighting="relative"`` as a fraction of the largest value
+        (default :data:`RELATIVE_FLOOR`): points far below the peak do not get weights
+        beyond what an instrument's dynamic range supports.
+    mask_zeros : bool
+        Exclude points whose value is exactly 0, counted in ``FitResult.nmasked`` and named
+        in ``warnings``. BRDF instruments write 0 where a direction was masked (next to
+        the horizon or the source port); a measured BRDF of a real surface is not exactly 0
+        at the printed precision, so the rule removes masked points and nothing else.
 
     Returns
     -------
@@ -421,9 +453,17 @@ def fit(
     if ci == "profile" and energy_constraint not in (False, None):
         raise FitError("ci='profile' is not combined with energy_constraint; use ci='wald'")
     fd, ndropped = _clean(_as_fit_data(data, quantity, unit), nan_policy)
+    nmasked = 0
+    if mask_zeros:
+        zero = np.asarray(fd.value) == 0.0
+        nmasked = int(zero.sum())
+        if nmasked == len(fd):
+            raise FitError(f"data: all {nmasked} points are 0 (masked); nothing to fit")
+        if nmasked:
+            fd = fd.take(~zero)
     p = _setup_params(model, params, fix)
     guessed = guess and _apply_guess(model, fd, p, set(params or ()))
-    weights, use_sigma = _weights(fd, use_sigma)
+    weights, use_sigma, weighting = _weighting(fd, use_sigma, weighting, relative_floor)
     varying = p.varying()
     _check_design(model, fd, varying)
     n_pts, nvarys = len(fd), len(varying)
@@ -490,6 +530,8 @@ def fit(
     out, flags = _fitted_params(p, vals, stderr, correl, reasons, nfree)
     warn = [f"{ndropped} point(s) with NaN/inf values dropped (nan_policy='omit')"] * (
         ndropped > 0
+    ) + [f"{nmasked} point(s) with value 0 excluded as instrument-masked (mask_zeros)"] * (
+        nmasked > 0
     )
     if ci == "profile" and finite:
         delta = float(special.stdtrit(nfree, 0.975)) ** 2 * (1.0 if use_sigma else redchi)
@@ -548,6 +590,8 @@ def fit(
         rmse=float(np.sqrt(np.mean(resid**2))),
         rmse_pct=rmse_pct,
         weighted=bool(use_sigma),
+        weighting=weighting,
+        nmasked=nmasked,
         success=bool(success),
         message=message,
         elapsed_s=time.perf_counter() - t0,
@@ -668,6 +712,27 @@ def _weights(fd: FitData, use_sigma: bool | None) -> tuple[NDArray, bool]:
     if not has.all() or np.any(sig <= 0):
         raise FitError("data: use_sigma needs a finite sigma > 0 on every point")
     return 1.0 / sig**2, True
+
+
+def _weighting(
+    fd: FitData, use_sigma: bool | None, weighting: str | None, floor: float
+) -> tuple[NDArray, bool, str]:
+    """Weights, whether sigma is used, and a one-line description of the weighting."""
+    if weighting is None or weighting == "sigma":
+        w, used = _weights(fd, True if weighting == "sigma" else use_sigma)
+        return w, used, "1/sigma^2 (the data's sigma)" if used else "uniform"
+    if weighting == "uniform":
+        return np.ones(len(fd)), False, "uniform"
+    if weighting == "relative":
+        if not (math.isfinite(floor) and 0 < floor < 1):
+            raise FitError(f"relative_floor must be in (0, 1), got {floor!r}")
+        y = np.abs(np.asarray(fd.value, float))
+        ymax = float(y.max())
+        if not ymax > 0:
+            raise FitError("weighting='relative' needs a value > 0")
+        s = np.maximum(y, floor * ymax)
+        return 1.0 / s**2, False, f"relative: sigma = max(|y|, {floor:g} x max|y|)"
+    raise FitError(f"weighting must be None, 'sigma', 'relative' or 'uniform', got {weighting!r}")
 
 
 def _check_design(model: Model, fd: FitData, varying: list[str]) -> None:

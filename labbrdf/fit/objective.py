@@ -198,7 +198,10 @@ class Objective:
         vals = dict(self.base)
         for (k, scaled, lo, span, log), xi in zip(self._spec, x, strict=True):
             t = lo + float(xi) * span if scaled else float(xi)
-            vals[k] = math.exp(t) if log else t
+            v = math.exp(t) if log else t
+            if scaled and not 0.0 < xi < 1.0:  # exp(log(max)) can miss max by an ulp
+                v = self.params[k].max if xi >= 1.0 else self.params[k].min
+            vals[k] = v
         return vals
 
     def bounds(self) -> tuple[NDArray, NDArray]:

@@ -98,6 +98,10 @@ class FitResult:
         when a measured value is 0.
     weighted : bool
         Whether the data carried sigma (weights 1/sigma^2, covariance not rescaled).
+    weighting : str
+        The weighting used, in words (``uniform``, ``1/sigma^2 ...``, ``relative: ...``).
+    nmasked : int
+        Points with value 0 excluded as instrument-masked (``mask_zeros``).
     success : bool
         The last stage converged and every parameter and chisqr is finite.
     message : str
@@ -160,6 +164,8 @@ class FitResult:
     quantity: str = "brdf"
     unit: str = "sr-1"
     ndropped: int = 0
+    weighting: str = "uniform"
+    nmasked: int = 0
     stages: list[dict[str, Any]] = field(default_factory=list)
     energy: dict[str, Any] | None = None
     warnings: list[str] = field(default_factory=list)
@@ -226,6 +232,8 @@ class FitResult:
             "message": self.message,
             "elapsed_s": self.elapsed_s,
             "ndropped": self.ndropped,
+            "weighting": self.weighting,
+            "nmasked": self.nmasked,
             "stages": self.stages,
             "energy": self.energy,
             "warnings": self.warnings,

@@ -128,9 +128,14 @@ class Microfacet(Model):
         F = 1 (rs = -1, rp = +1, the limit N -> i infinity).
     shadowing : {"smith", "none"}, default "smith"
         Separable Smith ``G1(w_i) G1(w_o)`` or G = 1.
+    diffuse : bool, default False
+        Add a Lambertian floor ``kd / pi`` [sr^-1] (unpolarized: Mueller ``kd / pi`` times
+        diag(1, 0, 0, 0)), for painted, polymer or other surfaces whose subsurface scatter
+        the facets do not describe.
 
     Parameters: ``alpha`` [1] in [1e-3, 1.5] (log), ``scale`` [1] in [0, 10], fixed at 1
-    (free it for relative data; it enters linearly).
+    (free it for relative data; it enters linearly); with ``diffuse``, ``kd`` [1] in
+    [0, 1], the directional-hemispherical albedo of the floor (linear).
 
     Notes
     -----
@@ -155,13 +160,17 @@ class Microfacet(Model):
         psi_delta: tuple[float, float, float] | None = None,
         ideal_mirror: bool = False,
         shadowing: str = "smith",
+        diffuse: bool = False,
         **options: Any,
     ) -> None:
         if options:
             raise ModelError(
-                f"model 'microfacet' got unknown options {sorted(options)}; "
-                "options are ['n', 'k', 'psi_delta', 'ideal_mirror', 'shadowing']"
+                f"model 'microfacet' got unknown options {sorted(options)}; options are "
+                "['n', 'k', 'psi_delta', 'ideal_mirror', 'shadowing', 'diffuse']"
             )
+        self._diffuse = bool(diffuse)
+        if self._diffuse:
+            self.linear = ("scale", "kd")
         if shadowing not in _SHADOWING:
             raise ModelError(
                 f"microfacet option 'shadowing' must be one of "
@@ -203,6 +212,8 @@ class Microfacet(Model):
             self.N = None
             opts.update(ideal_mirror=True)
         self._shadowing = shadowing
+        if self._diffuse:
+            opts["diffuse"] = True
         super().__init__(**opts)
 
     def default_params(self) -> Parameters:
@@ -218,6 +229,8 @@ class Microfacet(Model):
             units="1",
             description="overall factor (relative data)",
         )
+        if self._diffuse:
+            p.add("kd", 0.0, 0.0, 1.0, units="1", description="Lambertian albedo")
         return p
 
     def lobe_width(self, p: Mapping[str, float]) -> float:
@@ -275,7 +288,16 @@ class Microfacet(Model):
         _, _, _, cos_d, cos_h = self._geometry(theta_i, theta_r, phi_r)
         rs, rp = self._amplitudes(cos_d)
         fres = 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
-        return self._scalar_factor(p, theta_i, theta_r, cos_h) * fres
+        out = self._scalar_factor(p, theta_i, theta_r, cos_h) * fres
+        if self._diffuse:
+            out = out + p["kd"] * self._lambert(theta_i, theta_r)
+        return out
+
+    @staticmethod
+    def _lambert(theta_i: NDArray, theta_r: NDArray) -> NDArray:
+        """``1 / pi`` [sr^-1] where both directions are above the surface, else 0."""
+        up = (np.cos(theta_i) > 0) & (np.cos(theta_r) > 0)
+        return np.where(up, 1.0 / np.pi, 0.0)
 
     def linear_components(
         self,
@@ -285,9 +307,15 @@ class Microfacet(Model):
         phi_r: NDArray,
         wavelength: NDArray | None,
     ) -> dict[str, NDArray] | None:
-        """``{"scale": f / scale}``."""
+        """``{"scale": specular part / scale}`` (and ``"kd": 1 / pi`` with ``diffuse``)."""
         q = dict(p, scale=1.0)
-        return {"scale": self._evaluate(q, theta_i, theta_r, phi_r, wavelength)}
+        if not self._diffuse:
+            return {"scale": self._evaluate(q, theta_i, theta_r, phi_r, wavelength)}
+        q["kd"] = 0.0
+        return {
+            "scale": self._evaluate(q, theta_i, theta_r, phi_r, wavelength),
+            "kd": np.broadcast_to(self._lambert(theta_i, theta_r), np.shape(theta_r)).copy(),
+        }
 
     # ------------------------------------------------------------------ polarization
     def mueller(
@@ -355,4 +383,7 @@ class Microfacet(Model):
         jf = np.zeros((*rs.shape, 2, 2), dtype=complex)
         jf[..., 0, 0], jf[..., 1, 1] = rs, rp
         m = stokes_from_jones(b_out @ jf @ b_in)
-        return self._scalar_factor(p, ti, tr, cos_h)[..., None, None] * m
+        out = self._scalar_factor(p, ti, tr, cos_h)[..., None, None] * m
+        if self._diffuse:
+            out[..., 0, 0] += p["kd"] * self._lambert(ti, tr)
+        return out

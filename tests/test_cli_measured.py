@@ -1,0 +1,191 @@
+"""The command line on a lab's measured files: BRDF fits, optical constants, export,
+selection options and a closed output pipe."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import labbrdf
+from labbrdf.cli import main
+from labbrdf.selection import Range, SelectionError, parse_range, select
+
+BSDF = "zemax-bsdf/test_13_planesymmetric_brdf_zemax.bsdf"
+TA = "woollam-wvase-ascii/w2_10102006.dat"
+
+
+def _json(capsys: pytest.CaptureFixture[str]) -> object:
+    return json.loads(capsys.readouterr().out)
+
+
+# ------------------------------------------------------------------ selection
+
+
+def test_parse_range_forms():
+    assert parse_range("400:700") == Range(400.0, 700.0)
+    assert parse_range("400:").hi == np.inf
+    assert parse_range(":700").lo == -np.inf
+    r = parse_range("550")
+    assert r.lo < 550 < r.hi and r.hi - r.lo == pytest.approx(2e-6)
+
+
+@pytest.mark.parametrize("bad", ["700:400", "a:b", "１２:20", "nan", "1e999", "1:2:3"])
+def test_parse_range_refuses(bad):
+    with pytest.raises(SelectionError):
+        parse_range(bad, "--wavelength")
+
+
+def test_select_empty_result_names_what_the_data_hold(fixtures_dir: Path):
+    m = labbrdf.read(fixtures_dir / "specular" / "osr_specular.csv")
+    assert set(select(m, wavelength="500:560").wavelength_nm) == {500.0, 550.0}
+    with pytest.raises(SelectionError, match="360 to 860"):
+        select(m, wavelength="1000:2000")
+    with pytest.raises(SelectionError, match="OSR"):
+        select(m, sample="mirror")
+
+
+def test_cli_selection_error_is_exit_2(fixtures_dir: Path, capsys):
+    scan = str(fixtures_dir / "specular" / "osr_specular.csv")
+    assert main(["fit", scan, "--model", "smooth3", "--wavelength", "1000:", "--json"]) == 2
+    assert "no row left" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ BRDF fits
+
+
+@pytest.mark.slow
+def test_fit_measured_bsdf_per_incidence_with_microfacet(real_exports: Path, capsys):
+    path = str(real_exports / BSDF)
+    argv = ["fit", path, "--model", "microfacet", "--param", "n=1.5", "--param", "k=0",
+            "--param", "diffuse=true", "--by", "theta_i_deg", "--scheduler", "serial",
+            "--json"]  # fmt: skip
+    assert main(argv) == 0
+    out = _json(capsys)
+    assert [g["group"]["theta_i_deg"] for g in out] == list(range(15, 80, 5))
+    assert all(g["success"] for g in out)
+    # the file has no sigma: relative weights, and the zeros the sphere wrote next to the
+    # horizon are excluded by the documented rule (88 zeros over the 13 blocks)
+    assert {g["weighting"] for g in out} == {"relative: sigma = max(|y|, 0.001 x max|y|)"}
+    assert sum(g["nmasked"] for g in out) == 88
+    for g in out:
+        lo, hi = g["params"]["alpha"]["ci95"]
+        assert lo <= g["params"]["alpha"]["value"] <= hi
+
+
+def test_exported_model_is_fitted_back_exactly(tmp_path: Path, capsys):
+    out = tmp_path / "vinyl.bsdf"
+    argv = ["export", "--model", "microfacet", "--param", "n=1.5", "--param", "k=0",
+            "--param", "diffuse=true", "--param", "alpha=0.25", "--param", "kd=0.1",
+            "--theta-i", "15", "45", "75", "--radial", "0:80:5", "--azimuth", "0:180:10",
+            "-o", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    capsys.readouterr()
+    assert main(argv) == 2  # never over an existing file without --overwrite
+    assert "exists" in capsys.readouterr().err
+    fit = ["fit", str(out), "--model", "microfacet", "--param", "n=1.5", "--param", "k=0",
+           "--param", "diffuse=true", "--scheduler", "serial", "--json"]  # fmt: skip
+    assert main(fit) == 0
+    (g,) = _json(capsys)
+    # written to 6 significant digits: the fit recovers the truth to that precision
+    assert g["params"]["alpha"]["value"] == pytest.approx(0.25, rel=1e-5)
+    assert g["params"]["kd"]["value"] == pytest.approx(0.1, rel=1e-5)
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--param", "alpha=0.2"], "microfacet needs exactly one of"),
+        (["--param", "n=1.5", "--param", "beta=1"], "parameters are"),
+        (["--param", "n=1.5", "--radial", "0:x:1"], "START:STOP:STEP"),
+        (["--param", "n=1.5", "--nk-from", "x.dat"], "needs --wavelength"),
+        (["--param", "n=1.5", "--format", "csv"], "export writes zemax-bsdf"),
+    ],
+)
+def test_export_errors_are_exit_2(tmp_path: Path, capsys, argv, message):
+    base = ["export", "--model", "microfacet", "--theta-i", "30", "-o", str(tmp_path / "o.bsdf")]
+    assert main(base + argv) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "o.bsdf").exists()
+
+
+def test_fit_with_an_unknown_model_option_is_exit_2(fixtures_dir: Path, capsys):
+    scan = str(fixtures_dir / "specular" / "osr_specular.csv")
+    assert main(["fit", scan, "--model", "five_param", "--param", "shadowing=xyz"]) == 2
+    assert "shadowing" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ optical constants
+
+
+def test_nk_json_on_the_ta_file(real_exports: Path, capsys):
+    assert main(["nk", str(real_exports / TA), "--wavelength", "500:510", "--json"]) == 0
+    out = _json(capsys)
+    keys = ("wavelength_nm", "theta_i_deg", "n", "k", "n_sigma", "k_sigma")
+    lengths = {len(out[k]) for k in keys}
+    assert len(lengths) == 1 and lengths.pop() > 0
+    assert all(500 <= w <= 510 for w in out["wavelength_nm"])
+    assert {"wavelength_nm", "n", "k", "chi2", "angle_dependent"} <= set(out["combined"])
+    # tantalum near 500 nm: n ~ 2.3, k ~ 3.0 (pseudo-constants of the metal)
+    assert np.median(out["combined"]["n"]) == pytest.approx(2.3, abs=0.1)
+    assert np.median(out["combined"]["k"]) == pytest.approx(3.0, abs=0.1)
+
+
+def test_nk_writes_csv_and_refuses_files_without_psi_delta(
+    real_exports: Path, fixtures_dir: Path, tmp_path: Path, capsys
+):
+    out = tmp_path / "nk.csv"
+    assert main(["nk", str(real_exports / TA), "--wavelength", "500:510", "-o", str(out)]) == 0
+    head = out.read_text().splitlines()[0].split(",")
+    assert {"wavelength_nm", "theta_i_deg", "n", "k", "n_sigma", "k_sigma"} <= set(head)
+    capsys.readouterr()
+    scan = str(fixtures_dir / "specular" / "osr_specular.csv")
+    assert main(["nk", scan]) == 2
+    assert capsys.readouterr().err.strip()
+
+
+def test_fit_nk_from_a_psi_delta_file(real_exports: Path, tmp_path: Path, capsys):
+    # a microfacet BRDF at 500 nm written with the Ta file's own n, k is fitted back with
+    # --nk-from that file: the index comes from the ellipsometer, alpha from the BRDF
+    from labbrdf.adapters.zemax_bsdf import model_to_bsdf
+    from labbrdf.nk import combined_table, nk_at
+
+    at = nk_at(combined_table(labbrdf.read(real_exports / TA)), 500.0)
+    m = labbrdf.models.get("microfacet", n=float(at["n"]), k=float(at["k"]))
+    path = tmp_path / "ta.bsdf"
+    model_to_bsdf(m, {"alpha": 0.15}, path, theta_i_deg=[30, 60], radial_deg=np.arange(0, 41, 2),
+                  azimuth_deg=np.arange(0, 181, 10), wavelength_nm=500.0)  # fmt: skip
+    argv = ["fit", str(path), "--model", "microfacet", "--nk-from", str(real_exports / TA),
+            "--scheduler", "serial", "--json"]  # fmt: skip
+    assert main(argv) == 0
+    (g,) = _json(capsys)
+    assert g["params"]["alpha"]["value"] == pytest.approx(0.15, rel=1e-5)
+
+
+def test_fit_nk_from_needs_a_wavelength_for_files_that_state_none(real_exports: Path, capsys):
+    argv = ["fit", str(real_exports / BSDF), "--model", "microfacet", "--nk-from",
+            str(real_exports / TA), "--scheduler", "serial"]  # fmt: skip
+    assert main(argv) == 2
+    assert "--nk-wavelength" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ pipes
+
+
+def test_closed_output_pipe_is_not_a_traceback(fixtures_dir: Path):
+    scan = str(fixtures_dir / "specular" / "osr_specular.csv")
+    p = subprocess.Popen(
+        [sys.executable, "-m", "labbrdf.cli", "fit", scan, "--model", "smooth3", "--json",
+         "--scheduler", "serial"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    )  # fmt: skip
+    assert p.stdout is not None and p.stderr is not None
+    p.stdout.close()  # the reader goes away before we write
+    err = p.stderr.read().decode()
+    p.wait(timeout=60)
+    assert "Traceback" not in err
+    assert p.returncode == 141
