@@ -13,7 +13,20 @@ from pathlib import Path
 
 from ..dataset import Measurement
 
-__all__ = ["AdapterError", "Format", "decode", "read_bytes", "split_lines"]
+__all__ = [
+    "MAX_POINTS",
+    "AdapterError",
+    "Format",
+    "check_count",
+    "decode",
+    "read_bytes",
+    "split_lines",
+]
+
+#: Largest number of points (per spectrum, or in total for a multi-spectrum binary file) a
+#: declared count may announce. UV-Vis-NIR spectra have at most a few 10^4 points; the cap
+#: keeps a corrupt or crafted count from allocating gigabytes before any other check.
+MAX_POINTS = 2_000_000
 
 
 class AdapterError(ValueError):
@@ -73,6 +86,66 @@ class Format:
     sniff: Callable[[bytes], bool]
     read: Callable[[str | os.PathLike[str]], Measurement]
     quantities: tuple[str, ...] = field(default=())
+
+
+def check_count(
+    path: str | os.PathLike[str],
+    what: str,
+    count: int,
+    *,
+    line: int | None = None,
+    unit: str = "line",
+    file_size: int | None = None,
+    bytes_per_point: int = 0,
+) -> int:
+    """Check a point count declared in a file before anything is allocated for it.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (for the message).
+    what : str
+        The count's name in the file, e.g. ``"NPOINTS"``.
+    count : int
+        The declared count.
+    line : int, optional
+        Where the count is written (line, or byte offset with ``unit="byte"``).
+    unit : str
+        ``"line"`` or ``"byte"``.
+    file_size : int, optional
+        Size of the file [bytes]; with ``bytes_per_point`` > 0 the data cannot hold more
+        than ``file_size // bytes_per_point`` points.
+    bytes_per_point : int
+        Least number of bytes one point takes in the file (0: no size check).
+
+    Returns
+    -------
+    int
+        ``count``.
+
+    Raises
+    ------
+    AdapterError
+        The count is negative, above :data:`MAX_POINTS`, or more than the file can hold.
+    """
+    if count < 0:
+        raise AdapterError(path, f"{what} = {count}: expected a count >= 0", line, unit=unit)
+    if count > MAX_POINTS:
+        raise AdapterError(
+            path,
+            f"{what} = {count} exceeds the limit of {MAX_POINTS} points (corrupt count?)",
+            line,
+            unit=unit,
+        )
+    if file_size is not None and bytes_per_point > 0 and count * bytes_per_point > file_size:
+        raise AdapterError(
+            path,
+            f"{what} = {count} needs at least {count * bytes_per_point} bytes of data, but the "
+            f"file has {file_size} (corrupt count or truncated file)",
+            line,
+            unit=unit,
+        )
+    return count
 
 
 def read_bytes(path: str | os.PathLike[str]) -> bytes:
