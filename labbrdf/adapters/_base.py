@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,6 +19,7 @@ __all__ = [
     "AdapterError",
     "Format",
     "check_count",
+    "check_regular_file",
     "decode",
     "read_bytes",
     "split_lines",
@@ -148,8 +150,41 @@ def check_count(
     return count
 
 
+def check_regular_file(path: str | os.PathLike[str]) -> None:
+    """Refuse anything but an existing regular file, before it is opened.
+
+    A character device (``/dev/zero``) never ends and a FIFO blocks ``open`` until a writer
+    comes, so both are refused from their ``stat`` alone (symbolic links are followed).
+
+    Raises
+    ------
+    AdapterError
+        No such file, a directory, or not a regular file (device, FIFO, socket).
+    """
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        raise AdapterError(path, f"cannot be read ({exc.strerror or exc})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise AdapterError(path, "is a directory, expected a file")
+    if not stat.S_ISREG(st.st_mode):
+        kind = (
+            "a character device"
+            if stat.S_ISCHR(st.st_mode)
+            else "a FIFO (named pipe)"
+            if stat.S_ISFIFO(st.st_mode)
+            else "a block device"
+            if stat.S_ISBLK(st.st_mode)
+            else "a socket"
+            if stat.S_ISSOCK(st.st_mode)
+            else "not a regular file"
+        )
+        raise AdapterError(path, f"is {kind}, expected a regular file")
+
+
 def read_bytes(path: str | os.PathLike[str]) -> bytes:
-    """Read a whole file; an unreadable or empty file raises :class:`AdapterError`."""
+    """Read a whole regular file; anything else, or an empty file, raises AdapterError."""
+    check_regular_file(path)
     p = Path(path)
     try:
         raw = p.read_bytes()
