@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, read_bytes
+from ._base import AdapterError, Format, check_count, read_bytes
 from ._spectro import finish, spectrum_frame
 
 __all__ = ["FORMATS", "read_spc"]
@@ -121,10 +121,24 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
         raise fail("subfiles with their own X arrays (TXYXYS) are not supported", 0)
     if not flags & _TMULTI:
         nsub = 1
-    if not 0 < npts <= 10_000_000:
+    if npts <= 0:
         raise fail(f"fnpts {npts}: expected a positive point count", 4)
-    if not 0 < nsub <= 100_000:
+    if nsub <= 0:
         raise fail(f"fnsub {nsub}: expected a positive number of subfiles", 24)
+    width = 2 if flags & _TSPREC else 4
+    # before anything is allocated: the total against the cap and what the file can hold
+    check_count(
+        path, "fnpts", npts, line=4, unit="byte", file_size=len(raw), bytes_per_point=width
+    )
+    check_count(
+        path,
+        "fnpts * fnsub",
+        npts * nsub,
+        line=24,
+        unit="byte",
+        file_size=len(raw),
+        bytes_per_point=width,
+    )
     if xtype not in _XUNITS:
         raise fail(f"x type {xtype}: only nm (3) and micrometers (2) are supported", 28)
     if ytype not in _YTYPES:
@@ -133,7 +147,6 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
             "reflectance do not say fraction or percent)",
             29,
         )
-    width = 2 if flags & _TSPREC else 4
     xbytes = 4 * npts if flags & _TXVALS else 0
     end = _HEADER + xbytes + nsub * (_SUBHEADER + width * npts)
     if len(raw) < end:
