@@ -384,6 +384,12 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
             untagged & np.isnan(v[:, 7]),
             "dynamic data: expected the time [min] in field 8",
         )
+        check_rows(
+            path,
+            block,
+            untagged & np.isinf(v[:, 7]),
+            "dynamic data: the time [min] in field 8 must be finite",
+        )
         extra[untagged] = ~np.isnan(v[untagged, _NFIELDS[""] : 7]).all(axis=1)
     check_rows(
         path,
