@@ -5,6 +5,7 @@ Adapters import only :mod:`labbrdf.dataset` and this module.
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import stat
@@ -15,15 +16,27 @@ from pathlib import Path
 from ..dataset import Measurement
 
 __all__ = [
+    "DECIMAL",
     "MAX_POINTS",
+    "NONFINITE",
     "AdapterError",
     "Format",
     "check_count",
     "check_regular_file",
     "decode",
+    "parse_number",
     "read_bytes",
     "split_lines",
 ]
+
+#: A decimal number as instrument files write it: ASCII digits only, optional sign, decimal
+#: point and exponent. Python's ``float`` also accepts full-width and other Unicode digits
+#: (``'１２'``), underscores (``'1_000'``) and ``inf``/``nan`` spellings; instrument files are
+#: ASCII, so every text reader checks a field against this before converting it.
+DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+#: The non-finite spellings accepted where a format has them (CompleteEASE ``inf``,
+#: Accurion ``NaN``).
+NONFINITE = re.compile(r"[+-]?(?:inf(?:inity)?|nan)", re.IGNORECASE)
 
 #: Largest number of points (per spectrum, or in total for a multi-spectrum binary file) a
 #: declared count may announce. UV-Vis-NIR spectra have at most a few 10^4 points; the cap
@@ -88,6 +101,43 @@ class Format:
     sniff: Callable[[bytes], bool]
     read: Callable[[str | os.PathLike[str]], Measurement]
     quantities: tuple[str, ...] = field(default=())
+
+
+def parse_number(
+    text: str,
+    path: str | os.PathLike[str],
+    line: int | None,
+    what: str,
+    *,
+    nonfinite: bool = False,
+) -> float:
+    """Parse one number field of a text export, ASCII digits only.
+
+    Parameters
+    ----------
+    text : str
+        The field; surrounding blanks are allowed.
+    path, line
+        For the error message (``line`` 1-based, or None).
+    what : str
+        What the field is, e.g. ``"NPOINTS"``.
+    nonfinite : bool
+        Accept ``inf``/``nan`` spellings (only for formats that write them); otherwise the
+        value must be finite, and a number that overflows a float is refused too.
+
+    Raises
+    ------
+    AdapterError
+        Not an ASCII decimal number (full-width digits, ``1_000``, words), or not finite.
+    """
+    s = text.strip()
+    if DECIMAL.fullmatch(s) is None and not (nonfinite and NONFINITE.fullmatch(s)):
+        shown = s if len(s) <= 40 else s[:37] + "..."
+        raise AdapterError(path, f"{what}: expected a number, found {shown!r}", line)
+    v = float(s)
+    if not nonfinite and not math.isfinite(v):
+        raise AdapterError(path, f"{what}: {s[:40]!r} overflows a float", line)
+    return v
 
 
 def check_count(

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import DatasetError, Measurement
-from ._base import AdapterError
+from ._base import DECIMAL, NONFINITE, AdapterError
 
 __all__ = [
     "Block",
@@ -39,11 +39,9 @@ __all__ = [
     "within",
 ]
 
-#: What a number may look like in an export: decimal point only, optional exponent,
+#: What a number may look like in an export: ASCII digits (:data:`._base.DECIMAL`), or
 #: ``inf``/``Infinity``/``nan`` in any case (CompleteEASE writes ``inf``, Accurion ``NaN``).
-NUMBER = re.compile(
-    r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.IGNORECASE
-)
+NUMBER = re.compile(f"(?:{DECIMAL.pattern})|(?:{NONFINITE.pattern})", re.IGNORECASE)
 _TAG = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 
 

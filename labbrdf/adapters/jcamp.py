@@ -77,10 +77,10 @@ _SQZ = {c: i for i, c in enumerate("@ABCDEFGHI")} | {c: -i for i, c in enumerate
 _DIF = {c: i for i, c in enumerate("%JKLMNOPQR")} | {c: -i for i, c in enumerate("%jklmnopqr")}
 _DUP = {c: i for i, c in enumerate("STUVWXYZs", start=1)}
 _TOKEN = re.compile(
-    r"(?P<affn>[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]\d+)?)"
-    r"|(?P<sqz>[@A-Ia-i]\d*\.?\d*)"
-    r"|(?P<dif>[%J-Rj-r]\d*\.?\d*)"
-    r"|(?P<dup>[S-Zs]\d*)"
+    r"(?P<affn>[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-][0-9]+)?)"
+    r"|(?P<sqz>[@A-Ia-i][0-9]*\.?[0-9]*)"
+    r"|(?P<dif>[%J-Rj-r][0-9]*\.?[0-9]*)"
+    r"|(?P<dup>[S-Zs][0-9]*)"
     r"|(?P<missing>\?)"
     r"|(?P<sep>[\s,;]+)"
 )

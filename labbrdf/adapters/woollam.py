@@ -48,7 +48,7 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import Measurement, wrap_delta
-from ._base import AdapterError, Format, decode, read_bytes
+from ._base import DECIMAL, AdapterError, Format, decode, read_bytes
 from ._numblock import (
     Block,
     body_bytes,
@@ -140,13 +140,15 @@ def sniff_completeease(head: bytes) -> bool:
 
 
 def _number_or_text(v: str) -> float | int | str:
+    if DECIMAL.fullmatch(v) is None:
+        return v
     try:
         f = float(v)
     except ValueError:
         return v
     if not np.isfinite(f):
         return v
-    return int(f) if re.fullmatch(r"[+-]?\d+", v) else f
+    return int(f) if re.fullmatch(r"[+-]?[0-9]+", v) else f
 
 
 def parse_method(line: str) -> dict[str, Any]:
