@@ -123,10 +123,13 @@ def _reflectance_quantity(quantity: str, accessory: str) -> str:
 
 
 def _sniff_text(head: bytes) -> bool:
+    """``TITLE`` first (after a UTF-8 BOM, if any), ``NPOINTS`` and ``XYDATA`` lines; line
+    ends CRLF, LF or CR alike."""
+    head = head.removeprefix(b"\xef\xbb\xbf")
     return (
         head.startswith(b"TITLE")
-        and re.search(rb"\nXYDATA[ \t,]*\r?\n", head) is not None
-        and re.search(rb"\nNPOINTS[\t,]", head) is not None
+        and re.search(rb"[\r\n]XYDATA[ \t,]*[\r\n]", head) is not None
+        and re.search(rb"[\r\n]NPOINTS[\t,]", head) is not None
     )
 
 
