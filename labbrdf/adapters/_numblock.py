@@ -547,6 +547,26 @@ def build_frame(
     return pd.DataFrame(cols, copy=False)
 
 
+#: Mueller elements whose sign differs between the vendors' convention (Woollam, SENTECH:
+#: ``M12 = M21 = -cos 2psi`` for an isotropic sample, i.e. ``S1 = Ip - Is``) and
+#: :mod:`labbrdf.optics` (``S1 = Is - Ip``, ``M12 = M21 = +cos 2psi``, ``M33 = sin 2psi cos
+#: Delta``, ``M34 = sin 2psi sin Delta``): ``M_optics = D M_vendor D`` with ``D = diag(1, -1,
+#: 1, 1)`` flips every element with exactly one index 2.
+MUELLER_S1_FLIP = frozenset(
+    {"mueller_12", "mueller_21", "mueller_23", "mueller_24", "mueller_32", "mueller_42"}
+)
+
+
+def mueller_convention(vendor: str) -> dict[str, str]:
+    """The ``meta["mueller_convention"]`` record of a reader that converted Mueller data."""
+    return {
+        "vendor": f"{vendor}: S1 = Ip - Is, M12 = M21 = -cos 2psi for an isotropic sample",
+        "converted": "labbrdf.optics: S1 = Is - Ip, M12 = M21 = +cos 2psi, M33 = sin 2psi "
+        "cos Delta, M34 = sin 2psi sin Delta; M = D M_vendor D, D = diag(1, -1, 1, 1) "
+        "(M12, M21, M23, M24, M32, M42 change sign)",
+    }
+
+
 def labels(names: list[str], counts: list[int] | np.ndarray) -> pd.Categorical:
     """``names[k]`` repeated ``counts[k]`` times, as a categorical (no per-row strings)."""
     uniq = list(dict.fromkeys(names))
