@@ -23,12 +23,13 @@ column              dtype     meaning
 
 Optional columns (:data:`OPTIONAL_COLUMNS`) carry what some instruments add: ``time_s``
 (time stamp of a kinetic series [s]), ``channel`` (polarisation or generalized-ellipsometry
-channel: ``p``, ``s``, ``pp``, ``ps``, ``sp``; tristimulus channel ``X``, ``Y``, ``Z``),
-``x_mm``/``y_mm`` (stage position of the spot [mm]), ``sample_rotation_deg`` (rotation of
-an anisotropic sample about its normal [deg]). Canonical units: angles in degrees, Delta in
-[0, 360) (Nebraska convention), reflectance, transmittance and depolarization as fractions.
-Quantity ``btdf`` [sr-1]: theta_r is measured from the back normal and phi_r is the
-azimuth of the transmitted direction.
+channel: ``p``, ``s``, ``pp``, ``ps``, ``sp``; tristimulus channel ``X``, ``Y``, ``Z``;
+``""`` for none, and a missing value, as when files with and without the column are
+concatenated, becomes ``""``), ``x_mm``/``y_mm`` (stage position of the spot [mm]),
+``sample_rotation_deg`` (rotation of an anisotropic sample about its normal [deg]).
+Canonical units: angles in degrees, Delta in [0, 360) (Nebraska convention), reflectance,
+transmittance and depolarization as fractions. Quantity ``btdf`` [sr-1]: theta_r is
+measured from the back normal and phi_r is the azimuth of the transmitted direction.
 """
 
 from __future__ import annotations
@@ -249,6 +250,11 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
         out[name] = _as_object(col)
     if "channel" in out.columns:
         col = out["channel"]
+        # a missing channel (NaN/None/NA, e.g. rows of a file without the column after
+        # concat) is the empty string, as readers write it for rows without a channel
+        missing = col.isna().to_numpy(bool)
+        if missing.any():
+            col = col.astype(object).where(~missing, "")
         bad = _not_str(col, nonempty=False)
         if bad.any():
             raise DatasetError(f"column 'channel': expected a string in {_rows(bad)}")

@@ -18,7 +18,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from ..dataset import Measurement, concat
-from ._base import AdapterError, Format
+from ._base import AdapterError, Format, check_regular_file
 
 __all__ = ["AdapterError", "Format", "READERS", "formats", "read", "read_many", "sniff"]
 
@@ -70,6 +70,7 @@ def _by_extension(path: Path) -> list[str]:
 
 def sniff(path: str | os.PathLike[str]) -> list[str]:
     """Names of the formats whose sniffer claims the file."""
+    check_regular_file(path)
     try:
         with open(path, "rb") as fh:
             head = fh.read(_SNIFF_BYTES)
@@ -103,14 +104,14 @@ def read(path: str | os.PathLike[str], format: str | None = None) -> Measurement
         The file cannot be read, or the format is ambiguous or unknown.
     """
     p = Path(path)
+    if format is not None and format not in READERS:
+        raise AdapterError(
+            path, f"unknown format {format!r}; supported formats are {sorted(READERS)}"
+        )
+    # before any reader opens it: /dev/zero never ends, a FIFO blocks open()
+    check_regular_file(p)
     if format is not None:
-        if format not in READERS:
-            raise AdapterError(
-                path, f"unknown format {format!r}; supported formats are {sorted(READERS)}"
-            )
         return _read_with(format, p)
-    if not p.is_file():
-        raise AdapterError(path, "no such file" if not p.exists() else "not a regular file")
     by_ext = _by_extension(p)
     if len(by_ext) == 1:
         return _read_with(by_ext[0], p)

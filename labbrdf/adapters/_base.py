@@ -5,15 +5,43 @@ Adapters import only :mod:`labbrdf.dataset` and this module.
 
 from __future__ import annotations
 
+import math
 import os
 import re
+import stat
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..dataset import Measurement
 
-__all__ = ["AdapterError", "Format", "decode", "read_bytes", "split_lines"]
+__all__ = [
+    "DECIMAL",
+    "MAX_POINTS",
+    "NONFINITE",
+    "AdapterError",
+    "Format",
+    "check_count",
+    "check_regular_file",
+    "decode",
+    "parse_number",
+    "read_bytes",
+    "split_lines",
+]
+
+#: A decimal number as instrument files write it: ASCII digits only, optional sign, decimal
+#: point and exponent. Python's ``float`` also accepts full-width and other Unicode digits
+#: (``'１２'``), underscores (``'1_000'``) and ``inf``/``nan`` spellings; instrument files are
+#: ASCII, so every text reader checks a field against this before converting it.
+DECIMAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+#: The non-finite spellings accepted where a format has them (CompleteEASE ``inf``,
+#: Accurion ``NaN``).
+NONFINITE = re.compile(r"[+-]?(?:inf(?:inity)?|nan)", re.IGNORECASE)
+
+#: Largest number of points (per spectrum, or in total for a multi-spectrum binary file) a
+#: declared count may announce. UV-Vis-NIR spectra have at most a few 10^4 points; the cap
+#: keeps a corrupt or crafted count from allocating gigabytes before any other check.
+MAX_POINTS = 2_000_000
 
 
 class AdapterError(ValueError):
@@ -75,8 +103,138 @@ class Format:
     quantities: tuple[str, ...] = field(default=())
 
 
+def parse_number(
+    text: str,
+    path: str | os.PathLike[str],
+    line: int | None,
+    what: str,
+    *,
+    nonfinite: bool = False,
+) -> float:
+    """Parse one number field of a text export, ASCII digits only.
+
+    Parameters
+    ----------
+    text : str
+        The field; surrounding blanks are allowed.
+    path, line
+        For the error message (``line`` 1-based, or None).
+    what : str
+        What the field is, e.g. ``"NPOINTS"``.
+    nonfinite : bool
+        Accept ``inf``/``nan`` spellings (only for formats that write them); otherwise the
+        value must be finite, and a number that overflows a float is refused too.
+
+    Raises
+    ------
+    AdapterError
+        Not an ASCII decimal number (full-width digits, ``1_000``, words), or not finite.
+    """
+    s = text.strip()
+    if DECIMAL.fullmatch(s) is None and not (nonfinite and NONFINITE.fullmatch(s)):
+        shown = s if len(s) <= 40 else s[:37] + "..."
+        raise AdapterError(path, f"{what}: expected a number, found {shown!r}", line)
+    v = float(s)
+    if not nonfinite and not math.isfinite(v):
+        raise AdapterError(path, f"{what}: {s[:40]!r} overflows a float", line)
+    return v
+
+
+def check_count(
+    path: str | os.PathLike[str],
+    what: str,
+    count: int,
+    *,
+    line: int | None = None,
+    unit: str = "line",
+    file_size: int | None = None,
+    bytes_per_point: int = 0,
+) -> int:
+    """Check a point count declared in a file before anything is allocated for it.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (for the message).
+    what : str
+        The count's name in the file, e.g. ``"NPOINTS"``.
+    count : int
+        The declared count.
+    line : int, optional
+        Where the count is written (line, or byte offset with ``unit="byte"``).
+    unit : str
+        ``"line"`` or ``"byte"``.
+    file_size : int, optional
+        Size of the file [bytes]; with ``bytes_per_point`` > 0 the data cannot hold more
+        than ``file_size // bytes_per_point`` points.
+    bytes_per_point : int
+        Least number of bytes one point takes in the file (0: no size check).
+
+    Returns
+    -------
+    int
+        ``count``.
+
+    Raises
+    ------
+    AdapterError
+        The count is negative, above :data:`MAX_POINTS`, or more than the file can hold.
+    """
+    if count < 0:
+        raise AdapterError(path, f"{what} = {count}: expected a count >= 0", line, unit=unit)
+    if count > MAX_POINTS:
+        raise AdapterError(
+            path,
+            f"{what} = {count} exceeds the limit of {MAX_POINTS} points (corrupt count?)",
+            line,
+            unit=unit,
+        )
+    if file_size is not None and bytes_per_point > 0 and count * bytes_per_point > file_size:
+        raise AdapterError(
+            path,
+            f"{what} = {count} needs at least {count * bytes_per_point} bytes of data, but the "
+            f"file has {file_size} (corrupt count or truncated file)",
+            line,
+            unit=unit,
+        )
+    return count
+
+
+def check_regular_file(path: str | os.PathLike[str]) -> None:
+    """Refuse anything but an existing regular file, before it is opened.
+
+    A character device (``/dev/zero``) never ends and a FIFO blocks ``open`` until a writer
+    comes, so both are refused from their ``stat`` alone (symbolic links are followed).
+
+    Raises
+    ------
+    AdapterError
+        No such file, a directory, or not a regular file (device, FIFO, socket).
+    """
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        raise AdapterError(path, f"cannot be read ({exc.strerror or exc})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise AdapterError(path, "is a directory, expected a file")
+    if not stat.S_ISREG(st.st_mode):
+        kind = (
+            "a character device"
+            if stat.S_ISCHR(st.st_mode)
+            else "a FIFO (named pipe)"
+            if stat.S_ISFIFO(st.st_mode)
+            else "a block device"
+            if stat.S_ISBLK(st.st_mode)
+            else "a socket"
+            if stat.S_ISSOCK(st.st_mode)
+            else "not a regular file"
+        )
+        raise AdapterError(path, f"is {kind}, expected a regular file")
+
+
 def read_bytes(path: str | os.PathLike[str]) -> bytes:
-    """Read a whole file; an unreadable or empty file raises :class:`AdapterError`."""
+    """Read a whole regular file; anything else, or an empty file, raises AdapterError."""
+    check_regular_file(path)
     p = Path(path)
     try:
         raw = p.read_bytes()

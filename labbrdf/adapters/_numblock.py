@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import DatasetError, Measurement
-from ._base import AdapterError
+from ._base import DECIMAL, NONFINITE, AdapterError
 
 __all__ = [
     "Block",
@@ -39,11 +39,9 @@ __all__ = [
     "within",
 ]
 
-#: What a number may look like in an export: decimal point only, optional exponent,
+#: What a number may look like in an export: ASCII digits (:data:`._base.DECIMAL`), or
 #: ``inf``/``Infinity``/``nan`` in any case (CompleteEASE writes ``inf``, Accurion ``NaN``).
-NUMBER = re.compile(
-    r"[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)", re.IGNORECASE
-)
+NUMBER = re.compile(f"(?:{DECIMAL.pattern})|(?:{NONFINITE.pattern})", re.IGNORECASE)
 _TAG = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 
 
@@ -547,6 +545,26 @@ def build_frame(
     for k, v in optional.items():
         cols[k] = text(v) if k == "channel" else num(v)
     return pd.DataFrame(cols, copy=False)
+
+
+#: Mueller elements whose sign differs between the vendors' convention (Woollam, SENTECH:
+#: ``M12 = M21 = -cos 2psi`` for an isotropic sample, i.e. ``S1 = Ip - Is``) and
+#: :mod:`labbrdf.optics` (``S1 = Is - Ip``, ``M12 = M21 = +cos 2psi``, ``M33 = sin 2psi cos
+#: Delta``, ``M34 = sin 2psi sin Delta``): ``M_optics = D M_vendor D`` with ``D = diag(1, -1,
+#: 1, 1)`` flips every element with exactly one index 2.
+MUELLER_S1_FLIP = frozenset(
+    {"mueller_12", "mueller_21", "mueller_23", "mueller_24", "mueller_32", "mueller_42"}
+)
+
+
+def mueller_convention(vendor: str) -> dict[str, str]:
+    """The ``meta["mueller_convention"]`` record of a reader that converted Mueller data."""
+    return {
+        "vendor": f"{vendor}: S1 = Ip - Is, M12 = M21 = -cos 2psi for an isotropic sample",
+        "converted": "labbrdf.optics: S1 = Is - Ip, M12 = M21 = +cos 2psi, M33 = sin 2psi "
+        "cos Delta, M34 = sin 2psi sin Delta; M = D M_vendor D, D = diag(1, -1, 1, 1) "
+        "(M12, M21, M23, M24, M32, M42 change sign)",
+    }
 
 
 def labels(names: list[str], counts: list[int] | np.ndarray) -> pd.Categorical:

@@ -10,7 +10,6 @@ validated :class:`~labbrdf.dataset.Measurement`, turning a schema violation into
 from __future__ import annotations
 
 import os
-import re
 from collections.abc import Sequence
 from typing import Any
 
@@ -18,18 +17,16 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import DatasetError, Measurement, make_frame
-from ._base import AdapterError
+from ._base import AdapterError, parse_number
 
 __all__ = ["finish", "number", "spectrum_frame"]
 
 #: factor from a percentage to the canonical fraction (unit "1")
 PERCENT = 0.01
 
-_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
-
 
 def number(text: str, path: str | os.PathLike[str], line: int | None, what: str) -> float:
-    """Parse one finite decimal number (no ``nan``/``inf``/``1_000``), or raise AdapterError.
+    """Parse one finite ASCII decimal number (no ``nan``/``inf``/``1_000``/``１２``), or raise.
 
     Parameters
     ----------
@@ -40,13 +37,7 @@ def number(text: str, path: str | os.PathLike[str], line: int | None, what: str)
     what : str
         What the field is, e.g. ``"NPOINTS"``.
     """
-    s = text.strip()
-    if not _NUMBER.fullmatch(s):
-        raise AdapterError(path, f"{what}: expected a number, found {s[:40]!r}", line)
-    v = float(s)
-    if not np.isfinite(v):
-        raise AdapterError(path, f"{what}: {s[:40]!r} overflows a float", line)
-    return v
+    return parse_number(text, path, line, what)
 
 
 def spectrum_frame(

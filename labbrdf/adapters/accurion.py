@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement, wrap_delta
-from ._base import AdapterError, Format, decode, read_bytes
+from ._base import AdapterError, Format, decode, read_bytes, split_lines
 from ._numblock import (
     build_frame,
     check_rows,
@@ -135,6 +135,36 @@ def _layout(
     return names, units, body, nhead + 1, meta
 
 
+def _check_empty_fields(
+    path: str | os.PathLike[str],
+    body: str,
+    first: int,
+    lines: np.ndarray,
+    values: np.ndarray,
+    names: list[str],
+) -> None:
+    """Refuse an empty field among the columns: only a written ``NaN`` is a missing value.
+
+    The block parser gives NaN for both, so the (few) rows with a NaN are looked at again
+    in the text: a row cut after a TAB must not be read with its last columns NaN.
+    """
+    rows = np.flatnonzero(np.isnan(values[:, : len(names)]).any(axis=1))
+    if rows.size == 0:
+        return
+    text_lines = split_lines(body)
+    for i in rows:
+        lineno = int(lines[i])
+        fields = text_lines[lineno - first].split("\t")
+        for k, name in enumerate(names):
+            if k >= len(fields) or not fields[k].strip():
+                raise AdapterError(
+                    path,
+                    f"field {k + 1} ({name or 'unnamed'}) is empty: expected a number "
+                    f"(or NaN) in each of the {len(names)} columns (row cut short?)",
+                    lineno,
+                )
+
+
 def read_accurion(path: str | os.PathLike[str]) -> Measurement:
     """Read an Accurion nanofilm EP3/EP4 export.
 
@@ -194,6 +224,7 @@ def read_accurion(path: str | os.PathLike[str]) -> Measurement:
         f"expected {ncol} TAB-separated fields ({', '.join(n or '?' for n in names)})",
     )
     v = block.values
+    _check_empty_fields(path, body, first, block.lines, v, names)
     col = {n: v[:, k] for k, n in enumerate(names) if n}
     wl, aoi, psi, delta = col["Lambda"], col["AOI"], col["Psi"], col["Delta"]
     check_rows(path, block, ~(np.isfinite(wl) & (wl > 0)), "Lambda must be a number > 0 [nm]")

@@ -38,7 +38,7 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._base import DECIMAL, AdapterError, Format, decode, read_bytes, split_lines
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_cary_csv"]
@@ -240,10 +240,9 @@ def _check_steps(
     interval = next((v for k, v in params.items() if "Data Interval" in k), None)
     if interval is None or xs.size < 2:
         return
-    try:
-        step = float(interval)
-    except ValueError:
+    if DECIMAL.fullmatch(interval.strip()) is None:
         return
+    step = float(interval)
     if not (np.isfinite(step) and step > 0):
         return
     with np.errstate(over="ignore", invalid="ignore"):

@@ -4,7 +4,8 @@ Layout (notes/formats.md section 4, checked on ``Filmsense_staticTest.txt`` and
 ``Filmsense_kineticTest.txt``), TAB separated:
 
 1. ``Film_Sense_Data`` (one measurement) or ``Film_Sense_Dyn_Data`` (a time series);
-2. ``n_wavelengths n_datasets AOI ...``: the AOI is written negative (``-70.012``); a static
+2. ``n_wavelengths n_datasets AOI ...``: 6 fields (static) or 4 (dynamic), enforced so that a
+   lost field cannot shift the AOI; the AOI is written negative (``-70.012``); a static
    file adds align X, align Y and the average intensity, a dynamic one one more number;
 3. ``n_wavelengths`` LED lines ``wavelength[nm] brightness ...`` (7 numbers);
 4. static: ``n_wavelengths`` lines ``N C S P I``; dynamic: a name row ``Time UV_N UV_C UV_S
@@ -35,6 +36,8 @@ __all__ = ["FORMATS", "filmsense_psi_delta", "read_filmsense", "sniff_filmsense"
 
 _MAGIC = {"Film_Sense_Data": False, "Film_Sense_Dyn_Data": True}
 _LED_COLUMNS = ["wavelength_nm", "brightness", "exp_l", "exp_r", "col5", "col6", "col7"]
+#: fields of line 2, static and dynamic files (both real files; other counts are refused)
+_COUNT_FIELDS = {False: 6, True: 4}
 
 
 def sniff_filmsense(head: bytes) -> bool:
@@ -167,7 +170,16 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
     dynamic = _MAGIC[magic]
     if len(lines) < 2:
         raise AdapterError(path, "file ends after line 1; expected the count line", 2)
-    head = _numbers(path, lines[1], 2, "count line (n_wavelengths n_datasets AOI ...)", at_least=3)
+    # line 2 has a fixed number of fields (static: n_wl n_sets AOI align_x align_y
+    # intensity; dynamic: n_wl n_sets AOI and one more): a lost field would shift the AOI
+    head = _numbers(
+        path,
+        lines[1],
+        2,
+        "count line (n_wavelengths n_datasets AOI "
+        + ("x)" if dynamic else "align_x align_y intensity)"),
+        count=_COUNT_FIELDS[dynamic],
+    )
     nwl, nsets, aoi_file = head[0], head[1], head[2]
     if nwl != int(nwl) or nwl < 1 or nsets != int(nsets) or nsets < 1:
         raise AdapterError(
@@ -207,6 +219,13 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
         row = _numbers(path, need(k, "an LED line"), k + 1, "LED line", at_least=2)
         if width is None:
             width = len(row)
+            if width != len(_LED_COLUMNS):
+                raise AdapterError(
+                    path,
+                    f"LED line: expected {len(_LED_COLUMNS)} numbers (wavelength, brightness, "
+                    f"...), found {width}",
+                    k + 1,
+                )
         elif len(row) != width:
             raise AdapterError(
                 path,

@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._base import AdapterError, Format, check_count, decode, read_bytes, split_lines
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_jasco_jws", "read_jasco_text"]
@@ -123,10 +123,13 @@ def _reflectance_quantity(quantity: str, accessory: str) -> str:
 
 
 def _sniff_text(head: bytes) -> bool:
+    """``TITLE`` first (after a UTF-8 BOM, if any), ``NPOINTS`` and ``XYDATA`` lines; line
+    ends CRLF, LF or CR alike."""
+    head = head.removeprefix(b"\xef\xbb\xbf")
     return (
         head.startswith(b"TITLE")
-        and re.search(rb"\nXYDATA[ \t,]*\r?\n", head) is not None
-        and re.search(rb"\nNPOINTS[\t,]", head) is not None
+        and re.search(rb"[\r\n]XYDATA[ \t,]*[\r\n]", head) is not None
+        and re.search(rb"[\r\n]NPOINTS[\t,]", head) is not None
     )
 
 
@@ -184,6 +187,13 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
     if yunits.upper() not in _TEXT_YUNITS:
         raise AdapterError(path, f"YUNITS {yunits!r} is not one of {sorted(_TEXT_YUNITS)}")
     quantity, scale = _TEXT_YUNITS[yunits.upper()]
+    npoints: float | None = None
+    if "NPOINTS" in header:
+        npoints = number(header["NPOINTS"], path, None, "NPOINTS")
+        if npoints != int(npoints):
+            raise AdapterError(path, f"NPOINTS {header['NPOINTS']!r}: expected an integer")
+        # a data row "x<TAB>y<LF>" takes at least 4 bytes
+        check_count(path, "NPOINTS", int(npoints), file_size=len(raw), bytes_per_point=4)
 
     xs: list[float] = []
     ys: list[float] = []
@@ -202,8 +212,7 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
     end_of_data = i
     footer, footer_en = _read_footer(path, lines, end_of_data, sep)
 
-    if "NPOINTS" in header:
-        npoints = number(header["NPOINTS"], path, None, "NPOINTS")
+    if npoints is not None:
         if npoints != len(xs):
             raise AdapterError(
                 path,
@@ -343,6 +352,7 @@ def read_jasco_jws(path: str | os.PathLike[str]) -> Measurement:
     (block,) = struct.unpack_from("<q", raw, 0xC8)
     if npoints <= 0:
         raise fail(f"NPOINTS {npoints}: expected a positive count", 0x84)
+    check_count(path, "NPOINTS", npoints, line=0x84, unit="byte")
     if block != 4 * npoints:
         raise fail(
             f"data-block length {block} bytes disagrees with NPOINTS {npoints} (expected "

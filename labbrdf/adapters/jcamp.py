@@ -53,7 +53,7 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._base import MAX_POINTS, AdapterError, Format, check_count, decode, read_bytes, split_lines
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_jcamp"]
@@ -77,10 +77,10 @@ _SQZ = {c: i for i, c in enumerate("@ABCDEFGHI")} | {c: -i for i, c in enumerate
 _DIF = {c: i for i, c in enumerate("%JKLMNOPQR")} | {c: -i for i, c in enumerate("%jklmnopqr")}
 _DUP = {c: i for i, c in enumerate("STUVWXYZs", start=1)}
 _TOKEN = re.compile(
-    r"(?P<affn>[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]\d+)?)"
-    r"|(?P<sqz>[@A-Ia-i]\d*\.?\d*)"
-    r"|(?P<dif>[%J-Rj-r]\d*\.?\d*)"
-    r"|(?P<dup>[S-Zs]\d*)"
+    r"(?P<affn>[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-][0-9]+)?)"
+    r"|(?P<sqz>[@A-Ia-i][0-9]*\.?[0-9]*)"
+    r"|(?P<dif>[%J-Rj-r][0-9]*\.?[0-9]*)"
+    r"|(?P<dup>[S-Zs][0-9]*)"
     r"|(?P<missing>\?)"
     r"|(?P<sep>[\s,;]+)"
 )
@@ -168,9 +168,13 @@ def _parse_blocks(path: str | os.PathLike[str], lines: list[str]) -> _Block:
 
 
 def _decode_line(
-    path: str | os.PathLike[str], n: int, text: str
+    path: str | os.PathLike[str], n: int, text: str, room: int = MAX_POINTS
 ) -> tuple[float, list[float], bool]:
-    """One ``(X++(Y..Y))`` line: X, the ordinates, whether the line ends in DIF form."""
+    """One ``(X++(Y..Y))`` line: X, the ordinates, whether the line ends in DIF form.
+
+    ``room`` is the most ordinates the line may hold (what NPOINTS leaves, plus a Y check
+    value): a DUP count that would go past it is refused before it is expanded.
+    """
     pos = 0
     toks: list[tuple[str, str]] = []
     while pos < len(text):
@@ -214,6 +218,13 @@ def _decode_line(
             if prev is None:
                 raise AdapterError(path, f"DUP count {tok!r} without a value to repeat", n)
             count = _DUP[tok[0]] if len(tok) == 1 else int(f"{_DUP[tok[0]]}{tok[1:]}")
+            if len(ys) + count - 1 > room:
+                raise AdapterError(
+                    path,
+                    f"DUP count {tok!r} repeats a value {count} times, past the "
+                    f"{room} ordinates that NPOINTS leaves for this line",
+                    n,
+                )
             for _ in range(count - 1):
                 ys.append(ys[-1] + prev[1] if prev[0] == "dif" else prev[1])
         else:  # missing
@@ -223,12 +234,18 @@ def _decode_line(
 
 
 def _decode_table(
-    path: str | os.PathLike[str], block: _Block, first: float, step: float, xfactor: float
+    path: str | os.PathLike[str],
+    block: _Block,
+    first: float,
+    step: float,
+    xfactor: float,
+    npoints: int,
 ) -> list[float]:
     ys: list[float] = []
     pending_check = False
     for n, text in block.data:
-        x, vals, ends_dif = _decode_line(path, n, text)
+        room = max(npoints - len(ys), 0) + int(pending_check)
+        x, vals, ends_dif = _decode_line(path, n, text, room)
         index = len(ys)
         if pending_check:
             if not vals:
@@ -289,7 +306,7 @@ def _spectrum(
     npoints = number(rec["NPOINTS"], path, where, "NPOINTS")
     if npoints < 2 or npoints != int(npoints):
         raise AdapterError(path, f"NPOINTS {rec['NPOINTS']!r}: expected an integer >= 2", where)
-    npoints = int(npoints)
+    npoints = check_count(path, "NPOINTS", int(npoints), line=where)
     xfactor = number(rec.get("XFACTOR", "1"), path, where, "XFACTOR")
     yfactor = number(rec.get("YFACTOR", "1"), path, where, "YFACTOR")
     step = (last - first) / (npoints - 1)
@@ -303,7 +320,7 @@ def _spectrum(
                 f"DELTAX {delta:g} disagrees with (LASTX - FIRSTX)/(NPOINTS - 1) = {step:g}",
                 where,
             )
-    ys = _decode_table(path, block, first, step, xfactor)
+    ys = _decode_table(path, block, first, step, xfactor, npoints)
     if np.isinf(ys).any():
         raise AdapterError(path, "DIF accumulation overflows a float", block.data_line)
     if len(ys) != npoints:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import os
 
 from ..dataset import DatasetError, Measurement, read_csv, read_parquet
-from ._base import AdapterError, Format
+from ._base import AdapterError, Format, check_regular_file
 
 
 def _sniff_parquet(head: bytes) -> bool:
@@ -23,6 +23,7 @@ def _sniff_csv(head: bytes) -> bool:
 
 def read_dataset_parquet(path: str | os.PathLike[str]) -> Measurement:
     """Read a labbrdf Parquet dataset."""
+    check_regular_file(path)
     try:
         return read_parquet(path)
     except DatasetError as exc:
@@ -31,6 +32,7 @@ def read_dataset_parquet(path: str | os.PathLike[str]) -> Measurement:
 
 def read_dataset_csv(path: str | os.PathLike[str]) -> Measurement:
     """Read a labbrdf CSV dataset (first line ``# labbrdf-meta: ...``)."""
+    check_regular_file(path)
     with open(path, "rb") as fh:
         if not _sniff_csv(fh.read(64)):
             raise AdapterError(path, "expected '# labbrdf-meta: {...}' (a labbrdf dataset CSV)", 1)

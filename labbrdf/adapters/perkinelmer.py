@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._base import AdapterError, Format, check_count, decode, read_bytes, split_lines
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_perkinelmer_asc"]
@@ -139,6 +139,8 @@ def read_perkinelmer_asc(path: str | os.PathLike[str]) -> Measurement:
     npoints = number(block[6], path, gr + 8, "NPOINTS")
     if npoints != int(npoints) or npoints < 1:
         raise AdapterError(path, f"NPOINTS {block[6]!r}: expected a positive integer", gr + 8)
+    # a data row "x<TAB>y<LF>" takes at least 4 bytes
+    check_count(path, "NPOINTS", int(npoints), line=gr + 8, file_size=len(raw), bytes_per_point=4)
 
     xs: list[float] = []
     ys: list[float] = []

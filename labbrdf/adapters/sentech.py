@@ -27,12 +27,14 @@ import numpy as np
 from ..dataset import Measurement, wrap_delta
 from ._base import AdapterError, Format, decode, read_bytes
 from ._numblock import (
+    MUELLER_S1_FLIP,
     NUMBER,
     build_frame,
     check_rows,
     delta_range,
     group_angles,
     measurement,
+    mueller_convention,
     parse_block,
     split_head,
 )
@@ -112,8 +114,8 @@ def read_sentech(path: str | os.PathLike[str], kind: str | None = None) -> Measu
     Film Sense check; and the Mueller file at 3484 nm has M12 = -cos 2psi = -0.938, M33 =
     sin 2psi cos Delta = -0.201 and M34 = +sin 2psi sin Delta = +0.282 with psi near 10.1
     and Delta near 125 deg, the values of the Psi/Delta file at 70.2 deg. That sign pattern
-    (M12 = -cos 2psi, M34 = +sin 2psi sin Delta) is recorded in ``meta`` for the Mueller
-    conventions of :mod:`labbrdf.optics`.
+    (M12 = -cos 2psi, M34 = +sin 2psi sin Delta) is the vendor's; the values are converted
+    to :mod:`labbrdf.optics` (M12 = +cos 2psi) and ``meta["mueller_convention"]`` says so.
     """
     if kind is not None and kind not in _KINDS:
         raise AdapterError(path, f"kind must be one of {_KINDS} or None, got {kind!r}")
@@ -184,14 +186,14 @@ def read_sentech(path: str | os.PathLike[str], kind: str | None = None) -> Measu
         meta["delta_range"] = "[0, 360)"
         meta["angles_deg"] = group_angles(aoi)
     else:
-        values = v[:, 1:].ravel()
+        # to the labbrdf.optics convention: SpectraRay writes M12 = -cos 2psi
+        flip = np.array([-1.0 if q in MUELLER_S1_FLIP else 1.0 for q in _MM])
+        values = (v[:, 1:] * flip).ravel()
         quantity = np.tile(_MM, rows)
         theta = np.full(values.size, angles[0])
         wl_rows = np.repeat(wl, 16)
-        meta["mueller"] = (
-            "row-major M11..M44 as written, normalised by M11; observed signs "
-            "M12 = -cos 2psi, M34 = +sin 2psi sin Delta"
-        )
+        meta["mueller"] = "row-major M11..M44, normalised by M11"
+        meta["mueller_convention"] = mueller_convention("SENTECH SpectraRay")
         meta["angles_deg"] = group_angles(angles[:1])
     frame = build_frame(
         sample=p.stem,

@@ -9,7 +9,8 @@ char[130] at 88, ``flogoff`` int32 at 248, ``fmethod`` char[48] at 264. Then, if
 TXVALS (0x80) is set, ``fnpts`` float32 X values; then per subfile a 32-byte sub-header
 (``subexp`` signed byte 1, ``subnpts`` int32 at 16) and ``fnpts`` Y values: float32 when the
 exponent is -128, else int32 (int16 with flag TSPREC 0x01) scaled by 2**(exp - 32)
-(2**(exp - 16)). X is evenly spaced from ``ffirst`` to ``flast`` unless TXVALS.
+(2**(exp - 16)). X is evenly spaced from ``ffirst`` to ``flast`` unless TXVALS; it must be strictly
+monotonic (ascending or descending) and within 1 nm to 1 mm, else the header is corrupt.
 
 Supported: one or several subfiles sharing one X axis (TMULTI without TXYXYS), X in nm
 (``fxtype`` 3) or micrometres (2), Y absorbance (``fytype`` 2). The file size must equal
@@ -40,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, read_bytes
+from ._base import AdapterError, Format, check_count, read_bytes
 from ._spectro import finish, spectrum_frame
 
 __all__ = ["FORMATS", "read_spc"]
@@ -52,6 +53,8 @@ _SUBHEADER = 32
 _TSPREC, _TMULTI, _TXYXYS, _TXVALS = 0x01, 0x04, 0x40, 0x80
 _XUNITS = {3: ("nm", 1.0), 2: ("micrometers", 1000.0)}
 _YTYPES = {2: ("absorbance", 1.0)}
+#: the wavelengths an optical spectrum can have [nm] (EUV to far infrared)
+_WAVELENGTH_RANGE_NM = (1.0, 1.0e6)
 
 
 def _sniff(head: bytes) -> bool:
@@ -121,10 +124,24 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
         raise fail("subfiles with their own X arrays (TXYXYS) are not supported", 0)
     if not flags & _TMULTI:
         nsub = 1
-    if not 0 < npts <= 10_000_000:
+    if npts <= 0:
         raise fail(f"fnpts {npts}: expected a positive point count", 4)
-    if not 0 < nsub <= 100_000:
+    if nsub <= 0:
         raise fail(f"fnsub {nsub}: expected a positive number of subfiles", 24)
+    width = 2 if flags & _TSPREC else 4
+    # before anything is allocated: the total against the cap and what the file can hold
+    check_count(
+        path, "fnpts", npts, line=4, unit="byte", file_size=len(raw), bytes_per_point=width
+    )
+    check_count(
+        path,
+        "fnpts * fnsub",
+        npts * nsub,
+        line=24,
+        unit="byte",
+        file_size=len(raw),
+        bytes_per_point=width,
+    )
     if xtype not in _XUNITS:
         raise fail(f"x type {xtype}: only nm (3) and micrometers (2) are supported", 28)
     if ytype not in _YTYPES:
@@ -133,7 +150,6 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
             "reflectance do not say fraction or percent)",
             29,
         )
-    width = 2 if flags & _TSPREC else 4
     xbytes = 4 * npts if flags & _TXVALS else 0
     end = _HEADER + xbytes + nsub * (_SUBHEADER + width * npts)
     if len(raw) < end:
@@ -166,6 +182,22 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
         x = x * xscale
     if not np.all(np.isfinite(x) & (x > 0)):
         raise fail("the X axis has non-finite or non-positive wavelengths", 8)
+    lo, hi = _WAVELENGTH_RANGE_NM
+    if not (x.min() >= lo and x.max() <= hi):
+        raise fail(
+            f"the X axis spans {x.min():.6g} to {x.max():.6g} nm, outside the {lo:g} to "
+            f"{hi:g} nm of an optical spectrum (corrupt ffirst/flast?)",
+            _HEADER if flags & _TXVALS else 8,
+        )
+    step = np.diff(x)
+    if npts > 1 and not (np.all(step > 0) or np.all(step < 0)):
+        k = int(np.flatnonzero(step * np.sign(x[-1] - x[0]) <= 0)[0])
+        raise fail(
+            "the X axis is not strictly monotonic"
+            + (f" (ffirst = flast = {first:g})" if not flags & _TXVALS else f" at point {k + 1}")
+            + ": wavelengths must be distinct",
+            _HEADER + 4 * (k + 1) if flags & _TXVALS else 8,
+        )
 
     quantity, scale = _YTYPES[ytype]
     comment = _text(raw, 88, 130)

@@ -48,8 +48,9 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import Measurement, wrap_delta
-from ._base import AdapterError, Format, decode, read_bytes
+from ._base import DECIMAL, AdapterError, Format, decode, read_bytes
 from ._numblock import (
+    MUELLER_S1_FLIP,
     Block,
     body_bytes,
     build_frame,
@@ -59,6 +60,7 @@ from ._numblock import (
     head_lines,
     labels,
     measurement,
+    mueller_convention,
     parse_block,
     within,
 )
@@ -140,13 +142,15 @@ def sniff_completeease(head: bytes) -> bool:
 
 
 def _number_or_text(v: str) -> float | int | str:
+    if DECIMAL.fullmatch(v) is None:
+        return v
     try:
         f = float(v)
     except ValueError:
         return v
     if not np.isfinite(f):
         return v
-    return int(f) if re.fullmatch(r"[+-]?\d+", v) else f
+    return int(f) if re.fullmatch(r"[+-]?[0-9]+", v) else f
 
 
 def parse_method(line: str) -> dict[str, Any]:
@@ -318,8 +322,11 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
     * Rows whose value is not finite (CompleteEASE 6.x writes a whole ``uR`` block of
       ``inf``: nothing was measured) are dropped, and each drop is listed in
       ``meta["dropped_rows"]`` with tag, count and reason; never silently.
-    * Mueller rows (``mm12`` ...) write the value twice and the sigma twice (formats.md 1,
-      not seen in a real file); the first copy of each is used.
+    * Mueller rows (``mm12`` ...) write the value twice and the sigma twice; the first copy
+      of each is used. Woollam's Stokes convention has ``S1 = Ip - Is`` (``mm12 = -cos 2psi``
+      for an isotropic sample); the values are converted to :mod:`labbrdf.optics`
+      (``M12 = +cos 2psi``) by flipping M12, M21, M23, M24, M32, M42, and
+      ``meta["mueller_convention"]`` says so.
     """
     raw = read_bytes(path)
     p = Path(path)
@@ -383,6 +390,12 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
             block,
             untagged & np.isnan(v[:, 7]),
             "dynamic data: expected the time [min] in field 8",
+        )
+        check_rows(
+            path,
+            block,
+            untagged & np.isinf(v[:, 7]),
+            "dynamic data: the time [min] in field 8 must be finite",
         )
         extra[untagged] = ~np.isnan(v[untagged, _NFIELDS[""] : 7]).all(axis=1)
     check_rows(
@@ -511,8 +524,9 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
         elif t in _REFL:
             q = "reflectance" if rt else "specular_intensity"
             add(rows, q, col(2), col(3), "1", _REFL[t], t)
-        else:  # Mueller
-            add(rows, _MM[t], col(2), col(4), "1", "", t)
+        else:  # Mueller, converted to the labbrdf.optics convention
+            sign = -1.0 if _MM[t] in MUELLER_S1_FLIP else 1.0
+            add(rows, _MM[t], sign * col(2), col(4), "1", "", t)
 
     counts = [pp["count"] for pp in parts]
     if sum(counts) == 0:
@@ -564,6 +578,8 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
     meta["data_lines"] = int(n)
     meta["blank_lines_skipped"] = block.blank_lines
     meta["dropped_rows"] = dropped
+    if any(t in _MM for t in utags):
+        meta["mueller_convention"] = mueller_convention("Woollam")
     meta["delta_convention"] = "Nebraska (Woollam): Delta = 180 deg at normal incidence"
     meta["delta_range_in_file"] = delta_range(np.concatenate(delta_seen)) if delta_seen else None
     meta["delta_range"] = "[0, 360)"

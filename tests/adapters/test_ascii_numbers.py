@@ -1,0 +1,81 @@
+"""Every text reader takes ASCII digits only: Python's float() also reads '１２'.
+
+One real file per text format, one data field turned into full-width digits (U+FF10..),
+'1_000'-style or a non-finite spelling the format does not have: each must raise
+AdapterError naming the line, never read a number.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from labbrdf.adapters import READERS, AdapterError
+from labbrdf.adapters._base import parse_number
+
+FULL = str.maketrans("0123456789", "０１２３４５６７８９")
+
+#: format -> (file, a field as written on a data line, its line number)
+CASES = {
+    "woollam-wvase": ("woollam-wvase-ascii/w2_10102006.dat", "26.418438", 5),
+    "woollam-completeease": ("woollam-completeease-ascii/Woolam_staticTest.dat", "21.4553", 4),
+    "accurion-ep4": ("accurion-ep4-dat/post synthesis.dat", "143.615", 3),
+    "filmsense": ("filmsense-txt/Filmsense_staticTest.txt", "14.32", 3),
+    "sentech-spectraray": ("sentech-spectraray-ascii/Si_SiO2_theta_50_60_70.txt", "47.53618", 3),
+    "jasco-spectramanager-text": ("jasco-spectramanager-text/uvvis_abs.txt", "-6.38777E-05", 19),
+    "perkinelmer-uvwinlab-asc": ("perkinelmer-uvwinlab-asc/KTF-D.Probe.Raw.asc", None, None),
+    "agilent-cary-winuv-csv": ("agilent-cary-winuv-csv/CuPCtS_H2O_vis.csv", "0.0340631865", 5),
+    "jcamp-dx": ("jcamp-dx/dupinc1.jdx", "2860", 22),
+}
+
+
+def _case(real_exports: Path, fmt: str) -> tuple[bytes, str, int]:
+    rel, field, line = CASES[fmt]
+    text = (real_exports / rel).read_bytes().decode("latin-1")
+    if field is None:  # PerkinElmer: the first data row after #DATA
+        lines = text.splitlines()
+        line = next(i for i, s in enumerate(lines, 1) if s.strip() == "#DATA") + 1
+        field = lines[line - 1].split("\t")[1].strip()
+    assert field in text.splitlines()[line - 1], (fmt, field, line)
+    return text.encode("latin-1"), field, line
+
+
+def _replace_on_line(raw: bytes, line: int, old: str, new: str) -> bytes:
+    lines = raw.split(b"\n")
+    lines[line - 1] = lines[line - 1].replace(old.encode(), new.encode("utf-8"), 1)
+    return b"\n".join(lines)
+
+
+@pytest.mark.parametrize("fmt", sorted(CASES))
+def test_full_width_digits_are_not_numbers(real_exports: Path, tmp_path: Path, fmt: str) -> None:
+    raw, field, line = _case(real_exports, fmt)
+    bad = tmp_path / Path(CASES[fmt][0]).name
+    bad.write_bytes(_replace_on_line(raw, line, field, field.translate(FULL)))
+    with pytest.raises(AdapterError, match=rf"line {line}\b"):
+        READERS[fmt].read(bad)
+
+
+@pytest.mark.parametrize(
+    "fmt", ["sentech-spectraray", "jasco-spectramanager-text", "agilent-cary-winuv-csv"]
+)
+@pytest.mark.parametrize("spelling", ["nan", "inf", "-Infinity", "1_0"])
+def test_non_finite_spellings_are_refused_where_the_format_has_none(
+    real_exports: Path, tmp_path: Path, fmt: str, spelling: str
+) -> None:
+    raw, field, line = _case(real_exports, fmt)
+    bad = tmp_path / Path(CASES[fmt][0]).name
+    bad.write_bytes(_replace_on_line(raw, line, field, spelling))
+    with pytest.raises(AdapterError, match=rf"line {line}\b"):
+        READERS[fmt].read(bad)
+
+
+@pytest.mark.parametrize("text", ["１２", "1_000", "٣", "nan", "inf", "1e999", "0x10", ""])
+def test_parse_number_refuses_what_float_would_take(text: str) -> None:
+    with pytest.raises(AdapterError):
+        parse_number(text, "f.txt", 1, "X")
+
+
+def test_parse_number_takes_nonfinite_only_when_asked() -> None:
+    assert parse_number(" -1.5e-3 ", "f", 1, "X") == -1.5e-3
+    assert parse_number("inf", "f", 1, "X", nonfinite=True) == float("inf")

@@ -1,0 +1,122 @@
+"""Declared point counts are checked before anything is allocated for them.
+
+Each crafted file is read in a child process whose address space is limited to 512 MB
+(``resource.setrlimit(RLIMIT_AS)``): a reader that trusts the count runs into MemoryError
+there (or is killed), one that checks it first raises AdapterError.
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+LIMIT = 512 << 20
+
+_CHILD = """
+import resource, sys
+resource.setrlimit(resource.RLIMIT_AS, ({limit}, {limit}))
+from labbrdf.adapters import READERS, AdapterError
+try:
+    READERS[sys.argv[1]].read(sys.argv[2])
+except AdapterError as exc:
+    print("AdapterError:", exc)
+else:
+    print("read without error")
+"""
+
+
+def _read_limited(fmt: str, path: Path) -> str:
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1"}
+    out = subprocess.run(
+        [sys.executable, "-c", _CHILD.format(limit=LIMIT), fmt, str(path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    return out.stdout.strip()
+
+
+def _jcamp_dup(real: Path, tmp: Path) -> Path:
+    raw = (real / "jcamp-dx/dupinc1.jdx").read_bytes()
+    i = raw.index(b"Tk69")
+    p = tmp / "dup.jdx"
+    p.write_bytes(raw[: i + 1] + b"99999999" + raw[i + 1 :])  # 3e8 repeats, NPOINTS 440
+    return p
+
+
+def _jcamp_npoints(real: Path, tmp: Path) -> Path:
+    raw = (real / "jcamp-dx/dupinc1.jdx").read_bytes()
+    p = tmp / "npoints.jdx"
+    p.write_bytes(raw.replace(b"##NPOINTS=  440", b"##NPOINTS=  999999999999"))
+    return p
+
+
+def _spc(real: Path, tmp: Path, npts: int, nsub: int | None = None) -> Path:
+    raw = bytearray((real / "galactic-spc/HOLMIUM.SPC").read_bytes())
+    struct.pack_into("<i", raw, 4, npts)
+    if nsub is not None:
+        raw[0] |= 0x04  # TMULTI
+        struct.pack_into("<i", raw, 24, nsub)
+    p = tmp / f"n{npts}_{nsub}.spc"
+    p.write_bytes(bytes(raw))
+    return p
+
+
+def _pe(real: Path, tmp: Path) -> Path:
+    src = real / "perkinelmer-uvwinlab-asc/KTF-D.Probe.Raw.asc"
+    lines = src.read_bytes().split(b"\n")
+    k = lines.index(b"#DATA") if b"#DATA" in lines else lines.index(b"#DATA\r")
+    # the #GR block ends "... FIRSTX, DELTAX, NPOINTS, ..." : NPOINTS is line gr + 7
+    gr = next(i for i, s in enumerate(lines) if s.rstrip(b"\r") == b"#GR")
+    lines[gr + 7] = b"1999999" + (b"\r" if lines[gr + 7].endswith(b"\r") else b"")
+    assert gr + 7 < k
+    p = tmp / "npoints.Probe.Raw.asc"
+    p.write_bytes(b"\n".join(lines))
+    return p
+
+
+def _jasco_text(real: Path, tmp: Path) -> Path:
+    raw = (real / "jasco-spectramanager-text/uvvis_abs.txt").read_bytes()
+    p = tmp / "npoints.txt"
+    p.write_bytes(raw.replace(b"NPOINTS\t61", b"NPOINTS\t1999999"))
+    assert p.read_bytes() != raw
+    return p
+
+
+def _jws(real: Path, tmp: Path) -> Path:
+    raw = bytearray((real / "jasco-jws-binary/uvvis_abs.jws").read_bytes())
+    struct.pack_into("<i", raw, 0x84, 2**31 - 1)
+    p = tmp / "npoints.jws"
+    p.write_bytes(bytes(raw))
+    return p
+
+
+CASES = {
+    "jcamp-dup-past-npoints": ("jcamp-dx", _jcamp_dup, "DUP count"),
+    "jcamp-npoints-above-cap": ("jcamp-dx", _jcamp_npoints, "exceeds the limit"),
+    "spc-fnpts-above-cap": ("galactic-spc", lambda r, t: _spc(r, t, 2**31 - 1), "exceeds"),
+    "spc-fnpts-beyond-file": ("galactic-spc", lambda r, t: _spc(r, t, 1_000_000), "bytes"),
+    "spc-fnsub-total": ("galactic-spc", lambda r, t: _spc(r, t, 901, 2**31 - 1), "exceeds"),
+    "perkinelmer-npoints": ("perkinelmer-uvwinlab-asc", _pe, "NPOINTS = 1999999 needs"),
+    "jasco-text-npoints": ("jasco-spectramanager-text", _jasco_text, "NPOINTS = 1999999"),
+    "jasco-jws-npoints": ("jasco-jws", _jws, "NPOINTS = 2147483647 exceeds"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_crafted_huge_count_raises_adaptererror_within_512_mb(
+    real_exports: Path, tmp_path: Path, case: str
+) -> None:
+    fmt, make, expected = CASES[case]
+    path = make(real_exports, tmp_path)
+    out = _read_limited(fmt, path)
+    assert out.startswith(f"AdapterError: {path}"), out
+    assert expected in out, out
