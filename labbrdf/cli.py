@@ -78,7 +78,7 @@ def _model_options(name: str) -> set[str]:
     from . import models
 
     if name not in models.MODELS:
-        raise UsageError(f"--model {name!r}: models are {models.names()}")
+        raise UsageError(f"unknown model {name!r}; models are {models.names()}")
     sig = inspect.signature(models.MODELS[name].__init__)
     return {
         k
