@@ -214,8 +214,8 @@ def autocorrelation(
     axes = tuple(range(z.ndim))
     fz = sfft.rfftn(zc, shape, axes=axes)
     fw = sfft.rfftn(w, shape, axes=axes)
-    num = sfft.irfftn(fz * fz.conj(), shape, axes=axes)
-    den = sfft.irfftn(fw * fw.conj(), shape, axes=axes)
+    num = sfft.irfftn(fz.real**2 + fz.imag**2, shape, axes=axes)
+    den = sfft.irfftn(fw.real**2 + fw.imag**2, shape, axes=axes)
     idx = np.ix_(*[np.r_[s - lag : s, 0 : lag + 1] for s, lag in zip(shape, max_lag, strict=True)])
     num, den = num[idx], den[idx]
     good = den > 0.5

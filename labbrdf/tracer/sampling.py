@@ -269,14 +269,17 @@ class TabulatedNDF:
         area = np.diff(xe)[:, None] * np.diff(ye)[None, :]
         self.density = self.mass / area  # P22 per cell [1]
         flat = self.mass.ravel()
-        self._cdf0 = np.cumsum(flat)
         # r_max per cell: largest |slope| over the cell's corners (bound of the weight)
         cx = np.maximum(np.abs(xe[:-1]), np.abs(xe[1:]))
         cy = np.maximum(np.abs(ye[:-1]), np.abs(ye[1:]))
         self._rmax = np.sqrt(cx[:, None] ** 2 + cy[None, :] ** 2).ravel()
         w1 = flat * self._rmax
         self._m1 = float(w1.sum())
-        self._cdf1 = np.cumsum(w1)
+        # cells sorted by r_max: the cells a direction from below can see form a suffix
+        self._order = np.argsort(self._rmax, kind="stable")
+        self._r_sorted = self._rmax[self._order]
+        self._cdf0s = np.cumsum(flat[self._order])
+        self._cdf1s = np.cumsum(w1[self._order])
         self.mean_slope = (
             float(np.sum(self.mass * (0.5 * (xe[:-1] + xe[1:]))[:, None])),
             float(np.sum(self.mass * (0.5 * (ye[:-1] + ye[1:]))[None, :])),
@@ -558,13 +561,21 @@ class TabulatedNDF:
             return np.where(w[2] > 0, 1.0 / (1.0 + np.where(w[2] > 0, lam, 0.0)), 0.0)
 
     # -- sampling ---------------------------------------------------------------------
-    def _cells(self, cdf: NDArray, u: NDArray, v: NDArray) -> tuple[NDArray, NDArray, NDArray]:
-        """Cell by inverse CDF of ``u``, uniform position in it from (u's remainder, v)."""
+    def _cells(
+        self, cdf: NDArray, u: NDArray, v: NDArray, start: NDArray | int = 0
+    ) -> tuple[NDArray, NDArray, NDArray]:
+        """Cell by inverse CDF of ``u`` over the sorted cells ``start..``, uniform position
+        in it from (u's remainder, v). Returns x, y and the (unsorted) cell index."""
         total = cdf[-1]
-        c = np.minimum(np.searchsorted(cdf, u * total, side="right"), cdf.size - 1)
-        lo = np.where(c > 0, cdf[np.maximum(c - 1, 0)], 0.0)
-        width = cdf[c] - lo
-        fx = np.clip((u * total - lo) / np.where(width > 0, width, 1.0), 0.0, 1.0)
+        start = np.asarray(start)
+        base = np.where(start > 0, cdf[np.maximum(start - 1, 0)], 0.0)
+        target = base + u * (total - base)
+        k = np.minimum(np.searchsorted(cdf, target, side="right"), cdf.size - 1)
+        k = np.maximum(k, start)
+        lo = np.where(k > 0, cdf[np.maximum(k - 1, 0)], 0.0)
+        width = cdf[k] - lo
+        fx = np.clip((target - lo) / np.where(width > 0, width, 1.0), 0.0, 1.0)
+        c = self._order[k]
         ny = self.mass.shape[1]
         i, j = np.divmod(c, ny)
         x = self.x_edges[i] + fx * (self.x_edges[i + 1] - self.x_edges[i])
@@ -574,7 +585,7 @@ class TabulatedNDF:
     def sample_slopes(self, n: int, rng: np.random.Generator) -> tuple[NDArray, NDArray]:
         """n slope pairs with density P22 [1]."""
         u = rng.random((2, n))
-        x, y, _ = self._cells(self._cdf0, u[0], u[1])
+        x, y, _ = self._cells(self._cdf0s, u[0], u[1])
         return x, y
 
     def sample_visible(
@@ -596,40 +607,59 @@ class TabulatedNDF:
 
         Notes
         -----
-        In slope space the target is ``P22(x, y) (w_z - w_x x - w_y y)^+``. The weight is
-        bounded in cell c by ``|w_z| + sin(theta) r_c`` (r_c = largest |slope| in c), so the
-        proposal is the mixture ``P22 (|w_z| + sin(theta) r_c)`` (two precomputed cell
-        CDFs, a uniform position in the cell) and a proposal is accepted with probability
-        ``weight / (|w_z| + sin(theta) r_c)``. This is exact for the table and stays
-        efficient for heavy-tailed tables at grazing angles (accepted share ~ the
-        projected area ``cos(theta)(1 + Lambda)`` over ``|w_z| + sin(theta) E[r_c]``),
-        where rejection against a single global bound would fail. Sampling the
-        visible slopes through the marginal along the azimuth of w (Heitz & d'Eon 2014)
-        would need the table rotated to every azimuth.
+        In slope space the target is ``P22(x, y) (w_z - w_x x - w_y y)^+``, i.e.
+        ``P22 (w_z - sin(theta) x_phi)^+`` with x_phi the slope along the azimuth of w and
+        |x_phi| <= r_c, the largest |slope| of cell c.
+
+        * w_z >= 0: the weight is at most ``w_z + sin(theta) r_c``; the proposal is the
+          mixture ``P22 (w_z + sin(theta) r_c)`` (two precomputed cell CDFs, a uniform
+          position in the cell), accepted with probability
+          ``weight / (w_z + sin(theta) r_c)``.
+        * w_z < 0 (a ray travelling up inside the walk): only cells with
+          ``r_c > |cot(theta)|`` can be seen. With the cells sorted by r_c they form a
+          suffix; the proposal is ``P22 r_c`` on that suffix, accepted with probability
+          ``weight / (sin(theta) r_c)``.
+
+        Both are exact for the table and efficient for heavy-tailed tables at grazing
+        angles, where rejection against one global bound would almost never accept.
+        (Sampling the visible slopes through the marginal along the azimuth of w, Heitz &
+        d'Eon 2014, would need the table rotated to every azimuth.) A direction that sees
+        no cell at all (possible only through the interpolation of Lambda in the walk) gets
+        a facet of the steepest cell.
         """
         n = wi.shape[1]
         xs = np.empty(n)
         ys = np.empty(n)
-        todo = np.arange(n)
         st_all = np.hypot(wi[0], wi[1])
+        down_all = wi[2] < 0
+        with np.errstate(divide="ignore"):
+            mu_abs = np.where(down_all, -wi[2] / np.where(st_all > 0, st_all, 0.0), 0.0)
+        start_all = np.where(
+            down_all, np.searchsorted(self._r_sorted, mu_abs, side="right"), 0
+        ).astype(np.int64)
+        blind_all = start_all >= self._r_sorted.size
+        start_all = np.minimum(start_all, self._r_sorted.size - 1)
+        todo = np.arange(n)
         for _ in range(max_rounds):
             if todo.size == 0:
                 break
             w = wi[:, todo]
             st = st_all[todo]
-            az = np.abs(w[2])
+            down = down_all[todo]
             u = rng.random((4, todo.size))
-            p0 = az / (az + st * self._m1)
+            p0 = np.where(down, 0.0, w[2] / (w[2] + st * self._m1))
             first = u[0] < p0
             x = np.empty(todo.size)
             y = np.empty(todo.size)
             c = np.empty(todo.size, dtype=np.int64)
-            for sel, cdf in ((first, self._cdf0), (~first, self._cdf1)):
+            for sel, cdf in ((first, self._cdf0s), (~first, self._cdf1s)):
                 if sel.any():
-                    x[sel], y[sel], c[sel] = self._cells(cdf, u[1, sel], u[2, sel])
+                    x[sel], y[sel], c[sel] = self._cells(
+                        cdf, u[1, sel], u[2, sel], start_all[todo[sel]]
+                    )
             weight = w[2] - w[0] * x - w[1] * y
-            bound = az + st * self._rmax[c]
-            acc = u[3] * bound < weight
+            bound = np.where(down, 0.0, w[2]) + st * self._rmax[c]
+            acc = (u[3] * bound < weight) | blind_all[todo]
             xs[todo[acc]] = x[acc]
             ys[todo[acc]] = y[acc]
             todo = todo[~acc]

@@ -100,7 +100,7 @@ def test_d_is_normalised_over_the_projected_hemisphere():
     assert abs(total - 1) < 5e-3
 
 
-@pytest.mark.parametrize("theta", [0.0, 45.0, 80.0])
+@pytest.mark.parametrize("theta", [0.0, 45.0, 80.0, 100.0, 120.0])
 def test_visible_normals_have_the_visible_distribution_of_the_table(theta):
     """Sample means of m against the exact expectation under <w, m>^+ D(m) of the table,
     within 4 standard errors."""
