@@ -7,6 +7,10 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
+import numpy as np
+
+from labbrdf.tracer.sampling import TabulatedNDF
+
 __all__ = ["Coating", "Substrate", "TraceConfig"]
 
 SCATTERING = ("single", "multiple")
@@ -24,25 +28,95 @@ def _finite(x: Any) -> bool:
 
 @dataclass(frozen=True)
 class Substrate:
-    """Opaque substrate: complex index N = n + ik and GGX roughness.
+    """Opaque substrate: complex index N = n + ik and GGX roughness (or a tabulated NDF).
 
     Parameters
     ----------
     n, k : float
         Real and imaginary parts of the index [1], k >= 0.
     alpha : float
-        GGX roughness [1] (0 = smooth).
+        GGX roughness [1] (0 = smooth). Not used by the tracer when ``ndf`` is given
+        (:meth:`from_surface` stores the maximum-likelihood GGX alpha there, for reference).
     mirror : bool
         Ideal mirror (|r_s| = |r_p| = 1, the perfect-conductor limit r_s = -1, r_p = +1);
         n and k are then ignored. For the white-furnace test.
+    ndf : TabulatedNDF or None
+        Tabulated slope distribution replacing GGX on the substrate (its D, Smith Lambda
+        and visible-normal sampling); None = GGX with ``alpha`` (the original path, bit for
+        bit). Not combinable with ``TraceConfig(coherent=True)``.
     """
 
     n: float = 1.55
     k: float = 7.71
     alpha: float = 0.2
     mirror: bool = False
+    ndf: TabulatedNDF | None = None
+
+    @classmethod
+    def from_surface(
+        cls,
+        heights: Any,
+        pixel_size: float | tuple[float, float] | None = None,
+        *,
+        degree: int = 1,
+        bins: int = 64,
+        **kw: Any,
+    ) -> Substrate:
+        """Substrate whose facets follow the slope distribution of a height map.
+
+        Parameters
+        ----------
+        heights : ndarray (M, N) or labbrdf.surface.Surface
+            Heights [m] (NaN = missing) or a generated surface (its spacing is used).
+        pixel_size : float or (float, float)
+            Grid spacing [m] (not needed for a Surface).
+        degree : int
+            Levelling polynomial (1 = mean plane), see :func:`labbrdf.topography.level`.
+        bins : int
+            Slope cells per axis of the table (:meth:`TabulatedNDF.from_slopes`).
+        **kw
+            ``n``, ``k``, ``mirror``.
+
+        Returns
+        -------
+        Substrate
+            ``ndf`` = the table; ``alpha`` = the ML GGX alpha of the same slopes.
+        """
+        from labbrdf.topography import fit_slope_distribution, level, slopes
+
+        if hasattr(heights, "z") and hasattr(heights, "spacing"):
+            pixel_size = heights.spacing
+            heights = heights.z
+        if pixel_size is None:
+            raise ValueError("pixel_size is needed for a plain height array")
+        z = level(heights, degree)
+        if z.ndim != 2:
+            raise ValueError("from_surface needs an areal height map (2-D), got a profile")
+        px = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (2,)))
+        sx, sy = slopes(z, px)
+        table = TabulatedNDF.from_slopes(sx, sy, bins=bins)
+        alpha = min(fit_slope_distribution(sx, sy).ggx.alpha, 10.0)
+        return cls(alpha=alpha, ndf=table, **kw)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe dict (the table, if any, as :meth:`TabulatedNDF.to_dict`)."""
+        return {
+            "n": self.n,
+            "k": self.k,
+            "alpha": self.alpha,
+            "mirror": self.mirror,
+            "ndf": None if self.ndf is None else self.ndf.to_dict(),
+        }
 
     def __post_init__(self) -> None:
+        if isinstance(self.ndf, dict):
+            object.__setattr__(self, "ndf", TabulatedNDF.from_dict(self.ndf))
+        _check(
+            self.ndf is None or isinstance(self.ndf, TabulatedNDF),
+            "substrate.ndf",
+            "a TabulatedNDF or None",
+            type(self.ndf).__name__,
+        )
         _check(_finite(self.n) and self.n >= 0, "substrate.n", "a finite number >= 0", self.n)
         _check(_finite(self.k) and self.k >= 0, "substrate.k", "a finite number >= 0", self.k)
         _check(
@@ -236,6 +310,12 @@ class TraceConfig:
         )
 
         _check(
+            not (self.coherent and self.substrate.ndf is not None),
+            "coherent",
+            "False with a tabulated substrate NDF (the coherent facets use the coating's alpha)",
+            self.coherent,
+        )
+        _check(
             not (self.coherent and self.substrate.mirror),
             "coherent",
             "False with an ideal-mirror substrate (the film needs n + ik)",
@@ -267,7 +347,11 @@ class TraceConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-safe dict."""
-        return asdict(self)
+        if self.substrate.ndf is None:
+            return asdict(self)
+        d = asdict(self.replace(substrate=Substrate()))
+        d["substrate"] = self.substrate.to_dict()
+        return d
 
     def to_json(self) -> str:
         """JSON text (sorted keys)."""

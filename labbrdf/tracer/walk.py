@@ -101,6 +101,35 @@ class _Setup:
         self.lam = cfg.wavelength_nm
         self.coat = coat
         self.n_above_sub = self.n_coat if self.layered else 1.0
+        # tabulated substrate distribution (None: GGX everywhere, the original path)
+        self.ndf_sub = None if cfg.coherent else sub.ndf
+
+    def lambda_of(
+        self,
+        k: NDArray[np.float64],
+        kz_loc: NDArray[np.float64],
+        on_sub: NDArray[np.bool_],
+        alpha: NDArray[np.float64],
+    ) -> NDArray[np.float64]:
+        """Smith Lambda of the travel directions (GGX, or the substrate's table)."""
+        lam = smith_lambda(kz_loc, alpha)
+        if self.ndf_sub is not None and on_sub.any():
+            # the substrate is always seen from above: its local frame is the global one
+            lam[on_sub] = self.ndf_sub.smith_lambda(k[:, on_sub])
+        return lam
+
+    def g1_of(
+        self,
+        k: NDArray[np.float64],
+        kz_loc: NDArray[np.float64],
+        on_sub: NDArray[np.bool_],
+        alpha: NDArray[np.float64],
+    ) -> NDArray[np.float64]:
+        """Smith G1 of the travel directions (GGX, or the substrate's table)."""
+        g = smith_g1(kz_loc, alpha)
+        if self.ndf_sub is not None and on_sub.any():
+            g[on_sub] = self.ndf_sub.smith_g1(k[:, on_sub])
+        return g
 
     def beer_lambert(self, kz: NDArray[np.float64]) -> NDArray[np.float64] | None:
         if self.k_coat == 0 or self.d == 0:
@@ -203,12 +232,12 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
                 terminated += float(M[0, 0, back].sum())
                 alive &= ~back
                 go = leave & ~back
-                g = np.where(go, smith_g1(kz_loc, alpha), 1.0)
+                g = np.where(go, su.g1_of(k, kz_loc, iface == SUB, alpha), 1.0)
                 terminated += float((M[0, 0] * (1.0 - g))[go].sum())
                 M *= g
                 leave = go
         else:
-            lam = smith_lambda(kz_loc, alpha)
+            lam = su.lambda_of(k, kz_loc, iface == SUB, alpha)
             leave, h_new = sample_height(kz_loc, lam, h, rng.random(m_))
             h = np.where(leave, h, h_new)
 
@@ -237,7 +266,7 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
                         # travels towards it)
                         kz_new = np.where(up, -k[2, ci], k[2, ci])
                         a_new = np.where(up, su.alpha_top, su.alpha_sub)
-                        lam_new = smith_lambda(kz_new, a_new)
+                        lam_new = su.lambda_of(k[:, ci], kz_new, ~up, a_new)
                         _, h[ci] = sample_height(
                             kz_new, lam_new, np.full(ci.size, np.inf), rng.random(ci.size)
                         )
@@ -264,6 +293,9 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
         wi = -k
         wi[2] = np.where(below, k[2], wi[2])
         m = sample_vndf(wi, a, u[0], u[1])
+        if su.ndf_sub is not None and not on_top.all():
+            on_sub = ~on_top
+            m[:, on_sub] = su.ndf_sub.sample_visible(wi[:, on_sub], rng)
         m[2] = np.where(below, -m[2], m[2])
         cos_i = np.clip(-(k[0] * m[0] + k[1] * m[1] + k[2] * m[2]), 0.0, 1.0)
         s_loc = s_axis(k, m, s)

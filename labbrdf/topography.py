@@ -1,0 +1,757 @@
+"""Roughness statistics of measured height maps and profiles, for the microfacet tracer.
+
+Pure NumPy/SciPy: the arrays come in already read (see :mod:`labbrdf.adapters.topography`
+for instrument files). Lengths are in metres throughout; slopes are dimensionless.
+
+Pipeline (derivations in ``docs/topography.md``):
+
+1. *Levelling* (form removal, ISO 25178-2 F-operator): the least-squares polynomial of total
+   degree ``degree`` in (x, y) over the valid points is subtracted (default 1, the mean
+   plane; 0 = mean only; 2 = the full quadric, SurfaceTopography's ``"curvature"``).
+2. *Heights*: sigma = RMS of the levelled heights (ISO Sq; Rq for a profile), skewness,
+   kurtosis (3 for a Gaussian) and the Kolmogorov-Smirnov distance to the Gaussian.
+3. *Slopes*: forward differences ``(h[i+1, j] - h[i, j]) / dx`` and
+   ``(h[i, j+1] - h[i, j]) / dy``, paired at the same corner ``(i, j)`` (the
+   ``(M-1) x (N-1)`` points where both exist; SurfaceTopography's default non-periodic
+   stencil); RMS per axis and total ``sqrt(<sx^2 + sy^2>)``.
+4. *Autocorrelation* rho(tau) of the levelled heights by a mask-normalised FFT:
+   ``rho = IFFT|FFT(w z)|^2 / IFFT|FFT(w)|^2``, normalised to 1 at tau = 0, with w the
+   valid-point indicator and zero padding (no wrap-around); lags up to half the map.
+   Correlation lengths: the 1/e crossing along x and y, and along the principal axes of
+   the inertia tensor of the central region rho > 1/e (anisotropy ratio and direction);
+   a Gaussian ``exp(-tau^2/c^2)`` and an exponential ``exp(-tau/c)`` fitted to the
+   axis ACFs, the one with the smaller residual is reported.
+5. ``alpha = sqrt(2) sigma / c`` (Dong et al. 2022, text after eq. (15); exact RMS slope
+   per axis of a Gaussian-correlated surface), and maximum-likelihood GGX and Beckmann
+   alphas of the slope distribution (:func:`fit_slope_distribution`).
+
+Uncertainties: delete-one-block jackknife. The valid area is cut into ``blocks x blocks``
+tiles (``blocks`` segments of a profile); each replicate repeats the *whole* pipeline
+(levelling included) with one tile marked invalid. The standard uncertainty is
+``sqrt((B-1)/B sum (theta_b - theta_mean)^2)``. A map only L/c correlation lengths wide
+holds about (L/c)^2 independent samples, far fewer than its pixels, and the jackknife over
+tiles several c wide captures this without a model of the correlation.
+
+References
+----------
+Dong Z. et al., Acta Optica Sinica 42(22), 2224001 (2022) (alpha = sqrt(2) sigma / c).
+Walter B. et al., "Microfacet models for refraction through rough surfaces", EGSR 2007
+(GGX and Beckmann slope distributions).
+Heitz E., "Understanding the masking-shadowing function in microfacet-based BRDFs",
+JCGT 3(2) (2014) (slope-space densities P22, marginals).
+ISO 25178-2:2012 (Sq, Ssk, Sku, Sdq); ISO 4287 (Rq, Rdq).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import fft as sfft
+from scipy import ndimage, optimize, special, stats
+
+__all__ = [
+    "KS_WARN",
+    "RoughnessStats",
+    "SlopeFit",
+    "SlopeFits",
+    "autocorrelation",
+    "fit_slope_distribution",
+    "level",
+    "roughness_statistics",
+    "slopes",
+]
+
+#: KS distance above which neither GGX nor Beckmann is said to describe the slopes.
+KS_WARN = 0.05
+
+_INV_E = math.exp(-1.0)
+
+
+# --------------------------------------------------------------------------- helpers
+def _as_heights(heights: ArrayLike, mask: ArrayLike | None) -> tuple[NDArray, NDArray]:
+    """Float heights and the valid-point indicator (finite and not masked)."""
+    z = np.ma.getdata(heights)
+    z = np.array(z, dtype=float)
+    valid = np.isfinite(z)
+    m = np.ma.getmaskarray(heights) if np.ma.isMaskedArray(heights) else None
+    if m is not None:
+        valid &= ~m
+    if mask is not None:
+        mk = np.asarray(mask, dtype=bool)
+        if mk.shape != z.shape:
+            raise ValueError(f"mask shape {mk.shape} differs from heights shape {z.shape}")
+        valid &= ~mk
+    if z.ndim not in (1, 2):
+        raise ValueError(f"heights must be a profile (1-D) or a map (2-D), got {z.ndim}-D")
+    if min(z.shape) < 8:
+        raise ValueError(f"heights need at least 8 points per axis, got shape {z.shape}")
+    return z, valid
+
+
+def _pixel(pixel_size: float | ArrayLike, ndim: int) -> tuple[float, ...]:
+    p = np.broadcast_to(np.asarray(pixel_size, dtype=float), (ndim,))
+    if not np.all(np.isfinite(p)) or np.any(p <= 0):
+        raise ValueError(f"pixel_size must be positive and finite [m], got {pixel_size!r}")
+    return tuple(float(v) for v in p)
+
+
+def _design(shape: tuple[int, ...], degree: int, valid: NDArray) -> NDArray:
+    """Monomials of total degree <= degree in normalised coordinates, at valid points."""
+    grids = np.meshgrid(*[np.arange(n) / n for n in shape], indexing="ij")
+    cols = []
+    if len(shape) == 1:
+        x = grids[0][valid]
+        cols = [x**p for p in range(degree + 1)]
+    else:
+        x, y = grids[0][valid], grids[1][valid]
+        for tot in range(degree + 1):
+            for py in range(tot + 1):
+                cols.append(x ** (tot - py) * y**py)
+    return np.column_stack(cols)
+
+
+def level(heights: ArrayLike, degree: int = 1, mask: ArrayLike | None = None) -> NDArray:
+    """Subtract the least-squares polynomial of total degree ``degree`` (form removal).
+
+    Parameters
+    ----------
+    heights : array_like, 1-D or 2-D
+        Heights [m]; NaN (or masked) points are invalid.
+    degree : int
+        0 = mean, 1 = mean plane (default, ISO 25178 F-operator; SurfaceTopography
+        ``detrend("height")``), 2 = full quadric (``detrend("curvature")``), higher on request.
+    mask : array_like of bool, optional
+        True where a point is invalid.
+
+    Returns
+    -------
+    ndarray
+        Levelled heights [m], NaN at invalid points.
+    """
+    z, valid = _as_heights(heights, mask)
+    return _level(z, valid, degree)
+
+
+def _level(z: NDArray, valid: NDArray, degree: int) -> NDArray:
+    if not (isinstance(degree, int | np.integer) and degree >= 0):
+        raise ValueError(f"degree must be an integer >= 0, got {degree!r}")
+    a = _design(z.shape, int(degree), valid)
+    if valid.sum() <= a.shape[1]:
+        raise ValueError(
+            f"{int(valid.sum())} valid points cannot fix a polynomial of degree {degree}"
+        )
+    coef = np.linalg.lstsq(a, z[valid], rcond=None)[0]
+    out = np.full(z.shape, np.nan)
+    out[valid] = z[valid] - a @ coef
+    return out
+
+
+def slopes(
+    z: NDArray, pixel_size: tuple[float, ...], valid: NDArray | None = None
+) -> tuple[NDArray, NDArray | None]:
+    """Forward-difference slopes at the valid corner points.
+
+    Parameters
+    ----------
+    z : ndarray
+        Heights [m], 1-D or 2-D.
+    pixel_size : tuple of float
+        Grid spacing [m] per axis.
+    valid : ndarray of bool, optional
+        Valid points (default: finite ones).
+
+    Returns
+    -------
+    sx, sy : ndarray
+        1-D arrays of dz/dx and dz/dy [1] at the points (i, j), i < M-1, j < N-1, where
+        h[i, j], h[i+1, j] and h[i, j+1] are all valid (``sy`` is None for a profile).
+    """
+    if valid is None:
+        valid = np.isfinite(z)
+    if z.ndim == 1:
+        ok = valid[1:] & valid[:-1]
+        return ((z[1:] - z[:-1]) / pixel_size[0])[ok], None
+    ok = valid[:-1, :-1] & valid[1:, :-1] & valid[:-1, 1:]
+    sx = (z[1:, :-1] - z[:-1, :-1]) / pixel_size[0]
+    sy = (z[:-1, 1:] - z[:-1, :-1]) / pixel_size[1]
+    return sx[ok], sy[ok]
+
+
+def autocorrelation(
+    z: NDArray, valid: NDArray | None = None, max_lag: tuple[int, ...] | None = None
+) -> NDArray:
+    """Normalised autocorrelation by a mask-normalised, zero-padded FFT.
+
+    Parameters
+    ----------
+    z : ndarray
+        Levelled heights, 1-D or 2-D (invalid points anything; they get weight 0).
+    valid : ndarray of bool, optional
+        Valid points (default: finite).
+    max_lag : tuple of int, optional
+        Largest lag per axis in pixels (default: half the extent).
+
+    Returns
+    -------
+    ndarray
+        rho(tau) for lags ``-max_lag..max_lag`` per axis (zero lag at the centre);
+        NaN where no pair of valid points exists.
+    """
+    if valid is None:
+        valid = np.isfinite(z)
+    if max_lag is None:
+        max_lag = tuple(n // 2 for n in z.shape)
+    w = valid.astype(float)
+    zc = np.where(valid, z, 0.0)
+    zc = np.where(valid, zc - zc[valid].mean(), 0.0)
+    shape = [
+        sfft.next_fast_len(n + lag, real=True) for n, lag in zip(z.shape, max_lag, strict=True)
+    ]
+    axes = tuple(range(z.ndim))
+    fz = sfft.rfftn(zc, shape, axes=axes)
+    fw = sfft.rfftn(w, shape, axes=axes)
+    num = sfft.irfftn(fz.real**2 + fz.imag**2, shape, axes=axes)
+    den = sfft.irfftn(fw.real**2 + fw.imag**2, shape, axes=axes)
+    idx = np.ix_(*[np.r_[s - lag : s, 0 : lag + 1] for s, lag in zip(shape, max_lag, strict=True)])
+    num, den = num[idx], den[idx]
+    good = den > 0.5
+    cov = np.full(num.shape, np.nan)
+    cov[good] = num[good] / np.round(den[good])
+    centre = tuple(max_lag)
+    return cov / cov[centre]
+
+
+def _crossing(r: NDArray, step: float) -> float:
+    """First 1/e crossing of a 1-D ACF starting at lag 0 (linear interpolation) [m]."""
+    below = np.nonzero(~(r > _INV_E))[0]
+    if below.size == 0 or below[0] == 0:
+        return float("nan")
+    i = below[0]
+    r0, r1 = r[i - 1], r[i]
+    if not np.isfinite(r1):
+        return float("nan")
+    return float((i - 1 + (r0 - _INV_E) / (r0 - r1)) * step)
+
+
+def _fit_acf(r: NDArray, step: float, c0: float) -> dict[str, float]:
+    """Least-squares Gaussian and exponential ACF models on lags where rho > 0.05."""
+    out = {}
+    if not np.isfinite(c0):
+        return {"gaussian": float("nan"), "exponential": float("nan")} | {
+            "rms_gaussian": float("nan"),
+            "rms_exponential": float("nan"),
+        }
+    stop = np.nonzero(~(r > 0.05))[0]
+    n = int(stop[0]) if stop.size else r.size
+    n = max(n, 3)
+    tau = np.arange(n) * step
+    rr = r[:n]
+    models = {
+        "gaussian": lambda c: np.exp(-((tau / c) ** 2)),
+        "exponential": lambda c: np.exp(-tau / c),
+    }
+    for name, f in models.items():
+        res = optimize.minimize_scalar(
+            lambda lc, f=f: float(np.sum((f(np.exp(lc)) - rr) ** 2)),
+            bounds=(math.log(c0) - 3, math.log(c0) + 3),
+            method="bounded",
+            options={"xatol": 1e-10},
+        )
+        out[name] = float(np.exp(res.x))
+        out["rms_" + name] = float(np.sqrt(res.fun / n))
+    return out
+
+
+def _ks_normal(x: NDArray) -> float:
+    """KS distance of standardised samples to N(0, 1) [1]."""
+    if x.size < 2:
+        return float("nan")
+    s = x.std()
+    if s == 0:
+        return float("nan")
+    return _ks_sorted(np.sort((x - x.mean()) / s), special.ndtr)
+
+
+def _ks_sorted(xs: NDArray, cdf: Any) -> float:
+    """Two-sided KS distance sup|F_n - F| of sorted samples to the CDF ``cdf``."""
+    n = xs.size
+    f = cdf(xs)
+    return float(max(np.max(np.arange(1, n + 1) / n - f), np.max(f - np.arange(n) / n)))
+
+
+def _shape_stats(x: NDArray) -> tuple[float, float, float]:
+    """Skewness, kurtosis (3 for a Gaussian) and KS distance to the Gaussian."""
+    if x.size < 3 or x.std() == 0:
+        return float("nan"), float("nan"), float("nan")
+    return (
+        float(stats.skew(x)),
+        float(stats.kurtosis(x, fisher=False)),
+        _ks_normal(x),
+    )
+
+
+# ------------------------------------------------------------------ slope-space fits
+@dataclass(frozen=True)
+class SlopeFit:
+    """Maximum-likelihood fit of one slope distribution.
+
+    Attributes
+    ----------
+    model : str
+        ``"ggx"`` or ``"beckmann"``.
+    alpha : float
+        Roughness [1].
+    alpha_u : float
+        Standard uncertainty [1] (observed Fisher information for independent slopes; the
+        block jackknife when fitted inside :func:`roughness_statistics`).
+    loglik : float
+        Log-likelihood at the optimum (densities in slope space).
+    aic : float
+        ``2 k - 2 loglik`` with k = 1.
+    ks : float
+        KS distance of the radial slope |s| (2-D) or of the slope (profile) [1].
+    n : int
+        Number of slopes.
+    """
+
+    model: str
+    alpha: float
+    alpha_u: float
+    loglik: float
+    aic: float
+    ks: float
+    n: int
+
+
+@dataclass(frozen=True)
+class SlopeFits:
+    """GGX and Beckmann fits to one slope sample; ``best`` has the smaller AIC."""
+
+    ggx: SlopeFit
+    beckmann: SlopeFit
+    best: str
+    warning: str | None
+    ks_threshold: float = KS_WARN
+
+    def to_dict(self) -> dict[str, Any]:
+        return _json_safe(asdict(self))
+
+
+def _ggx_s(q: NDArray, frac: float) -> float:
+    """Root in s = alpha^2 of ``mean(s / (s + q)) = frac`` (GGX score equation)."""
+    qpos = q[q > 0]
+    if qpos.size == 0:
+        return 0.0
+    lo, hi = float(np.min(qpos)) * 1e-6, float(np.max(q)) * 1e6
+
+    def g(s: float) -> float:
+        return float(np.mean(s / (s + q))) - frac
+
+    return float(optimize.brentq(g, lo, hi, xtol=1e-300, rtol=1e-13))
+
+
+def _fit_core(x: NDArray, y: NDArray | None) -> dict[str, float]:
+    """ML alphas, log-likelihoods and KS distances (no uncertainties)."""
+    n = x.size
+    if y is not None:
+        q = x * x + y * y
+        # 2-D: log P22 = ln s - 2 ln(s + q) - ln pi (GGX); -ln(pi s) - q/s (Beckmann)
+        sg = _ggx_s(q, 0.5)
+        sb = float(q.mean())
+        llg = float(n * math.log(sg) - 2 * np.sum(np.log(sg + q)) - n * math.log(math.pi))
+        llb = float(-n * math.log(math.pi * sb) - np.sum(q) / sb)
+        qs = np.sort(q)
+        ecdf_hi = np.arange(1, n + 1) / n
+        ecdf_lo = np.arange(n) / n
+        fg = qs / (sg + qs)
+        fb = -np.expm1(-qs / sb)
+    else:
+        q = x * x
+        # 1-D marginals: P2 = 1 / (2 a (1 + x^2/a^2)^(3/2)) (GGX); exp(-x^2/s)/sqrt(pi s)
+        sg = _ggx_s(q, 2.0 / 3.0)
+        sb = float(2 * q.mean())
+        llg = float(n * math.log(sg) - 1.5 * np.sum(np.log(sg + q)) - n * math.log(2.0))
+        llb = float(-0.5 * n * math.log(math.pi * sb) - np.sum(q) / sb)
+        xs = np.sort(x)
+        ecdf_hi = np.arange(1, n + 1) / n
+        ecdf_lo = np.arange(n) / n
+        fg = 0.5 + 0.5 * xs / np.sqrt(sg + xs * xs)
+        fb = 0.5 * (1 + special.erf(xs / math.sqrt(sb)))
+    ksg = float(max(np.max(ecdf_hi - fg), np.max(fg - ecdf_lo)))
+    ksb = float(max(np.max(ecdf_hi - fb), np.max(fb - ecdf_lo)))
+    return {
+        "ggx_alpha": math.sqrt(sg),
+        "beckmann_alpha": math.sqrt(sb),
+        "ggx_loglik": llg,
+        "beckmann_loglik": llb,
+        "ggx_ks": ksg,
+        "beckmann_ks": ksb,
+        "ggx_s": sg,
+        "beckmann_s": sb,
+    }
+
+
+def _fisher_u(x: NDArray, y: NDArray | None, core: dict[str, float]) -> tuple[float, float]:
+    """Observed-information standard uncertainties of the ML alphas (independent slopes)."""
+    n = x.size
+    sg, sb = core["ggx_s"], core["beckmann_s"]
+    q = x * x + (y * y if y is not None else 0.0)
+    k = 2.0 if y is not None else 1.5
+    jg = n / sg**2 - k * float(np.sum(1.0 / (sg + q) ** 2))
+    jb = n / sb**2 if y is not None else n / (2 * sb**2)
+    # alpha = sqrt(s): u(alpha) = u(s) / (2 alpha)
+    ug = (1.0 / math.sqrt(jg)) / (2 * math.sqrt(sg)) if jg > 0 else float("nan")
+    ub = (1.0 / math.sqrt(jb)) / (2 * math.sqrt(sb))
+    return ug, ub
+
+
+def _make_fits(core: dict[str, float], ug: float, ub: float, n: int) -> SlopeFits:
+    fits = {}
+    for m, u in (("ggx", ug), ("beckmann", ub)):
+        ll = core[m + "_loglik"]
+        fits[m] = SlopeFit(m, core[m + "_alpha"], u, ll, 2.0 - 2.0 * ll, core[m + "_ks"], n)
+    best = "ggx" if fits["ggx"].aic <= fits["beckmann"].aic else "beckmann"
+    warning = None
+    if min(fits["ggx"].ks, fits["beckmann"].ks) > KS_WARN:
+        warning = (
+            f"neither GGX (KS {fits['ggx'].ks:.3f}) nor Beckmann (KS "
+            f"{fits['beckmann'].ks:.3f}) describes the slope distribution: both KS "
+            f"distances exceed {KS_WARN}"
+        )
+    return SlopeFits(fits["ggx"], fits["beckmann"], best, warning)
+
+
+def fit_slope_distribution(x: ArrayLike, y: ArrayLike | None = None) -> SlopeFits:
+    """Fit GGX and Beckmann alphas to slopes by maximum likelihood.
+
+    Parameters
+    ----------
+    x : array_like
+        Slopes dz/dx [1].
+    y : array_like, optional
+        Slopes dz/dy [1] at the same points; without them the 1-D marginal densities are
+        fitted (a profile; the alpha then assumes an isotropic surface).
+
+    Returns
+    -------
+    SlopeFits
+        Both fits with observed-Fisher uncertainties (valid for independent slopes),
+        log-likelihood, AIC, KS distance; ``warning`` when both KS distances exceed
+        :data:`KS_WARN`.
+
+    Notes
+    -----
+    Slope-space densities (Walter et al. 2007; Heitz 2014, sec. 5.2):
+    GGX ``P22 = 1 / (pi a^2 (1 + r^2/a^2)^2)``, Beckmann ``P22 = exp(-r^2/a^2)/(pi a^2)``,
+    r^2 = x^2 + y^2. Their x marginals are ``1 / (2 a (1 + x^2/a^2)^(3/2))`` and
+    ``exp(-x^2/a^2) / (sqrt(pi) a)``. With s = a^2 the score equations are
+    ``mean(s/(s + r^2)) = 1/2`` (GGX 2-D), ``= 2/3`` (GGX 1-D), ``s = mean(r^2)``
+    (Beckmann 2-D), ``s = 2 mean(x^2)`` (Beckmann 1-D). GGX has infinite slope variance,
+    so its alpha is not a moment; the ML fit is what defines it.
+    """
+    xa = np.asarray(x, dtype=float).ravel()
+    ya = None if y is None else np.asarray(y, dtype=float).ravel()
+    ok = np.isfinite(xa) if ya is None else np.isfinite(xa) & np.isfinite(ya)
+    xa = xa[ok]
+    ya = None if ya is None else ya[ok]
+    if xa.size < 2 or not np.any(xa != 0) and (ya is None or not np.any(ya != 0)):
+        raise ValueError("need at least 2 finite, not all zero slopes")
+    core = _fit_core(xa, ya)
+    ug, ub = _fisher_u(xa, ya, core)
+    return _make_fits(core, ug, ub, xa.size)
+
+
+# ------------------------------------------------------------------------ statistics
+@dataclass(frozen=True)
+class RoughnessStats:
+    """Roughness statistics of one levelled height map or profile (lengths in metres).
+
+    Scalars are NaN where undefined (e.g. y quantities of a profile); ``uncertainty``
+    maps a field name to its standard uncertainty by the block jackknife.
+    """
+
+    kind: str  # "areal" or "profile"
+    shape: tuple[int, ...]
+    pixel_size: tuple[float, ...]  # [m]
+    levelling: str
+    n_valid: int
+    sigma: float  # RMS height [m]
+    slope_rms_x: float  # [1]
+    slope_rms_y: float  # [1]
+    slope_rms: float  # total sqrt(<sx^2 + sy^2>) (profile: along x) [1]
+    c_x: float  # 1/e ACF crossing along x [m]
+    c_y: float
+    c_major: float  # along the principal axes of the ACF inertia tensor [m]
+    c_minor: float
+    c: float  # sqrt(c_major c_minor) (profile: c_x) [m]
+    anisotropy_ratio: float  # c_major / c_minor [1]
+    anisotropy_angle_deg: float  # direction of c_major from +x towards +y [deg]
+    acf_model: str  # "gaussian" or "exponential" (smaller residual)
+    c_fit_x: float  # fitted length of that model along x [m]
+    c_fit_y: float
+    acf_rms_gaussian: float  # RMS residual of the Gaussian ACF fit [1]
+    acf_rms_exponential: float
+    height_skewness: float
+    height_kurtosis: float  # 3 for a Gaussian
+    height_ks: float
+    slope_skewness_x: float
+    slope_kurtosis_x: float
+    slope_ks_x: float
+    slope_skewness_y: float
+    slope_kurtosis_y: float
+    slope_ks_y: float
+    alpha: float  # Dong 2022: sqrt(2) sigma / c [1]
+    alpha_x: float  # sqrt(2) sigma / c_x
+    alpha_y: float
+    slope_fits: SlopeFits
+    uncertainty: dict[str, float] = field(default_factory=dict)
+    n_blocks: int = 0
+    notes: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe dict (NaN -> None, tuples -> lists)."""
+        return _json_safe(asdict(self))
+
+
+def _json_safe(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {str(k): _json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_json_safe(v) for v in obj]
+    if isinstance(obj, float | np.floating):
+        v = float(obj)
+        return v if math.isfinite(v) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
+
+
+_NAN = float("nan")
+
+
+def _principal(rho: NDArray, px: tuple[float, float]) -> tuple[float, float, float, float]:
+    """c_major, c_minor, ratio and angle [deg] from the inertia tensor of rho > 1/e."""
+    centre = tuple(n // 2 for n in rho.shape)
+    inside = np.nan_to_num(rho, nan=0.0) > _INV_E
+    lab, _ = ndimage.label(inside)
+    region = lab == lab[centre]
+    ii, jj = np.nonzero(region)
+    tx = (ii - centre[0]) * px[0]
+    ty = (jj - centre[1]) * px[1]
+    wgt = rho[ii, jj]
+    inertia = np.array(
+        [
+            [np.sum(wgt * tx * tx), np.sum(wgt * tx * ty)],
+            [np.sum(wgt * tx * ty), np.sum(wgt * ty * ty)],
+        ]
+    )
+    evals, evecs = np.linalg.eigh(inertia)
+    lengths = []
+    for k in (1, 0):  # major first
+        e = evecs[:, k]
+        step = min(px)
+        nmax = int(min(rho.shape[0] // 2 * px[0], rho.shape[1] // 2 * px[1]) / step)
+        t = np.arange(nmax) * step
+        coords = np.stack([centre[0] + t * e[0] / px[0], centre[1] + t * e[1] / px[1]])
+        prof = ndimage.map_coordinates(np.nan_to_num(rho, nan=0.0), coords, order=1)
+        lengths.append(_crossing(prof, step))
+    cmaj, cmin = lengths
+    ev = evecs[:, 1]
+    ang = math.degrees(math.atan2(ev[1], ev[0]))
+    ang = (ang + 90.0) % 180.0 - 90.0
+    if ang == -90.0:
+        ang = 90.0
+    return cmaj, cmin, cmaj / cmin if cmin > 0 else _NAN, ang
+
+
+def _core(z: NDArray, valid: NDArray, px: tuple[float, ...], degree: int) -> dict[str, Any]:
+    """All statistics of one (replicate) valid set; scalars only, plus the slope fits."""
+    if valid.sum() < 8:
+        raise ValueError("fewer than 8 valid points")
+    lz = _level(z, valid, degree)
+    h = lz[valid]
+    out: dict[str, Any] = {}
+    out["sigma"] = float(np.sqrt(np.mean(h * h)))
+    out["height_skewness"], out["height_kurtosis"], out["height_ks"] = _shape_stats(h)
+    sx, sy = slopes(lz, px, valid)
+    if sx.size < 2:
+        raise ValueError("fewer than 2 valid slopes")
+    out["slope_rms_x"] = float(np.sqrt(np.mean(sx * sx)))
+    sk = _shape_stats(sx)
+    out["slope_skewness_x"], out["slope_kurtosis_x"], out["slope_ks_x"] = sk
+    if sy is not None:
+        out["slope_rms_y"] = float(np.sqrt(np.mean(sy * sy)))
+        out["slope_rms"] = float(np.sqrt(np.mean(sx * sx + sy * sy)))
+        sk = _shape_stats(sy)
+    else:
+        out["slope_rms_y"] = _NAN
+        out["slope_rms"] = out["slope_rms_x"]
+        sk = (_NAN, _NAN, _NAN)
+    out["slope_skewness_y"], out["slope_kurtosis_y"], out["slope_ks_y"] = sk
+
+    rho = autocorrelation(lz, valid)
+    centre = tuple(n // 2 for n in rho.shape)
+    if z.ndim == 1:
+        rx = rho[centre[0] :]
+        out["c_x"] = _crossing(rx, px[0])
+        out["c_y"] = _NAN
+        out["c_major"] = out["c_minor"] = out["c"] = out["c_x"]
+        out["anisotropy_ratio"] = out["anisotropy_angle_deg"] = _NAN
+        fx = _fit_acf(rx, px[0], out["c_x"])
+        fy = None
+    else:
+        rx = rho[centre[0] :, centre[1]]
+        ry = rho[centre[0], centre[1] :]
+        out["c_x"] = _crossing(rx, px[0])
+        out["c_y"] = _crossing(ry, px[1])
+        cmaj, cmin, ratio, ang = _principal(rho, (px[0], px[1]))
+        out["c_major"], out["c_minor"] = cmaj, cmin
+        out["c"] = math.sqrt(cmaj * cmin)
+        out["anisotropy_ratio"], out["anisotropy_angle_deg"] = ratio, ang
+        fx = _fit_acf(rx, px[0], out["c_x"])
+        fy = _fit_acf(ry, px[1], out["c_y"])
+    rg = fx["rms_gaussian"] + (fy["rms_gaussian"] if fy else 0.0)
+    re = fx["rms_exponential"] + (fy["rms_exponential"] if fy else 0.0)
+    model = "exponential" if re < rg else "gaussian"
+    out["acf_model"] = model
+    out["acf_rms_gaussian"] = rg if fy is None else rg / 2
+    out["acf_rms_exponential"] = re if fy is None else re / 2
+    out["c_fit_x"] = fx[model]
+    out["c_fit_y"] = fy[model] if fy else _NAN
+    s2 = math.sqrt(2.0) * out["sigma"]
+    out["alpha"] = s2 / out["c"]
+    out["alpha_x"] = s2 / out["c_x"]
+    out["alpha_y"] = s2 / out["c_y"] if z.ndim == 2 else _NAN
+    fc = _fit_core(sx, sy)
+    out["_fit"] = fc
+    out["_n_slopes"] = sx.size
+    out["_slopes"] = (sx, sy)
+    out["ggx_alpha"] = fc["ggx_alpha"]
+    out["beckmann_alpha"] = fc["beckmann_alpha"]
+    return out
+
+
+def _tiles(valid: NDArray, blocks: int) -> list[NDArray]:
+    """Index masks of the jackknife tiles (equal shares of the grid per axis)."""
+    edges = [np.linspace(0, n, blocks + 1).round().astype(int) for n in valid.shape]
+    tiles = []
+    if valid.ndim == 1:
+        for a in range(blocks):
+            t = np.zeros(valid.shape, dtype=bool)
+            t[edges[0][a] : edges[0][a + 1]] = True
+            tiles.append(t)
+    else:
+        for a in range(blocks):
+            for b in range(blocks):
+                t = np.zeros(valid.shape, dtype=bool)
+                t[edges[0][a] : edges[0][a + 1], edges[1][b] : edges[1][b + 1]] = True
+                tiles.append(t)
+    return [t for t in tiles if (t & valid).any()]
+
+
+def roughness_statistics(
+    heights: ArrayLike,
+    pixel_size: float | ArrayLike,
+    *,
+    mask: ArrayLike | None = None,
+    degree: int = 1,
+    blocks: int | None = None,
+) -> RoughnessStats:
+    """Roughness statistics of an areal height map or a profile, with uncertainties.
+
+    Parameters
+    ----------
+    heights : array_like, shape (M, N) or (M,)
+        Heights [m]; ``heights[i, j]`` at ``(i dx, j dy)``. NaN or masked points are invalid.
+    pixel_size : float or (float, float)
+        Grid spacing (dx, dy) [m].
+    mask : array_like of bool, optional
+        True where a point is invalid (in addition to NaN / the array's own mask).
+    degree : int
+        Levelling polynomial (total degree; 1 = least-squares mean plane).
+    blocks : int, optional
+        Jackknife tiles per axis (default 5 for a map, 20 for a profile); 0 or 1 = no
+        uncertainties.
+
+    Returns
+    -------
+    RoughnessStats
+
+    Raises
+    ------
+    ValueError
+        Bad shapes or pixel sizes, too few valid points (e.g. a map full of NaN).
+
+    Notes
+    -----
+    ``alpha = sqrt(2) sigma / c`` (Dong et al. 2022) is the RMS slope per axis of a surface
+    with the Gaussian ACF ``sigma^2 exp(-tau^2/c^2)``; for other ACFs it is only a length
+    ratio. From a profile, alpha and the slope fits describe the surface only if it is
+    isotropic (one direction is measured).
+    """
+    z, valid = _as_heights(heights, mask)
+    px = _pixel(pixel_size, z.ndim)
+    if not valid.any():
+        raise ValueError("heights hold no valid (finite, unmasked) point")
+    if blocks is None:
+        blocks = 5 if z.ndim == 2 else 20
+    full = _core(z, valid, px, degree)
+    unc: dict[str, float] = {}
+    tiles = _tiles(valid, blocks) if blocks and blocks > 1 else []
+    scal = [
+        k
+        for k, v in full.items()
+        if not k.startswith("_") and isinstance(v, float) and math.isfinite(v)
+    ]
+    if len(tiles) > 1:
+        reps = {k: [] for k in scal}
+        for t in tiles:
+            rep = _core(z, valid & ~t, px, degree)
+            for k in scal:
+                reps[k].append(rep[k])
+        nb = len(tiles)
+        for k in scal:
+            v = np.asarray(reps[k], dtype=float)
+            if not np.all(np.isfinite(v)):
+                unc[k] = _NAN
+                continue
+            var = (nb - 1) / nb * float(np.sum((v - v.mean()) ** 2))
+            bias = (nb - 1) * (float(v.mean()) - full[k])
+            unc[k] = math.sqrt(var + bias * bias)
+    sx, sy = full["_slopes"]
+    fc = full["_fit"]
+    if tiles and len(tiles) > 1:
+        ug, ub = unc.get("ggx_alpha", _NAN), unc.get("beckmann_alpha", _NAN)
+    else:
+        ug, ub = _fisher_u(sx, sy, fc)
+    fits = _make_fits(fc, ug, ub, full["_n_slopes"])
+    notes = []
+    if z.ndim == 1:
+        notes.append(
+            "profile: alpha and the slope fits use one direction and assume an isotropic surface"
+        )
+    if fits.warning:
+        notes.append(fits.warning)
+    if not math.isfinite(full["c"]):
+        notes.append("the ACF does not fall below 1/e within half the map: c undefined")
+    names = {f for f in RoughnessStats.__dataclass_fields__}
+    kw = {k: v for k, v in full.items() if k in names}
+    lev = {0: "mean removed", 1: "least-squares mean plane removed"}.get(
+        degree, f"least-squares polynomial of total degree {degree} removed"
+    )
+    return RoughnessStats(
+        kind="areal" if z.ndim == 2 else "profile",
+        shape=tuple(int(n) for n in z.shape),
+        pixel_size=px,
+        levelling=lev,
+        n_valid=int(valid.sum()),
+        slope_fits=fits,
+        uncertainty=unc,
+        n_blocks=len(tiles) if len(tiles) > 1 else 0,
+        notes=tuple(notes),
+        **kw,
+    )

@@ -1,0 +1,292 @@
+"""Roughness statistics (labbrdf.topography) and the topography file reader."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from labbrdf.adapters._base import AdapterError
+from labbrdf.surface import gaussian_surface
+from labbrdf.topography import (
+    KS_WARN,
+    autocorrelation,
+    fit_slope_distribution,
+    level,
+    roughness_statistics,
+)
+
+TOPO = "topography"
+
+
+# ------------------------------------------------------------------ synthetic surfaces
+def _fd_slope_rms(sigma, c, d):
+    """Expected RMS forward-difference slope of a Gaussian-ACF surface on spacing d:
+    E[(h(x+d)-h(x))^2]/d^2 = 2 sigma^2 (1 - exp(-d^2/c^2)) / d^2 (-> 2 sigma^2/c^2)."""
+    return np.sqrt(2 * sigma**2 * (1 - np.exp(-(d**2) / c**2))) / d
+
+
+CASES = [
+    # (sigma [m], (c_x, c_y) [m], seed base): isotropic and anisotropic, several sigma/c
+    (1e-7, (4e-6, 4e-6), 1000),
+    (2e-8, (6e-6, 2.6667e-6), 2000),
+    (5e-7, (3e-6, 3e-6), 3000),
+]
+
+
+def test_sigma_c_and_rms_slope_come_back_within_their_uncertainties():
+    """20 seeded 128 x 128 maps per case (L/c = 21..48). The jackknife standard uncertainty u
+    (B = 9 tiles) gives the 95 % interval +- t_{0.975, B-1} u; the truth must fall inside it
+    in >= 90 % of the replicates, per quantity over all cases (60 replicates)."""
+    d, n, reps = 1e-6, 128, 20
+    hits: dict[str, list[bool]] = {}
+    for sigma, (cx, cy), base in CASES:
+        truth = {
+            "sigma": sigma,
+            "c_x": cx,
+            "c_y": cy,
+            "slope_rms_x": _fd_slope_rms(sigma, cx, d),
+            "slope_rms_y": _fd_slope_rms(sigma, cy, d),
+        }
+        for r in range(reps):
+            s = gaussian_surface(n, n * d, sigma, (cx, cy), rng=base + r)
+            st = roughness_statistics(s.z, d, blocks=3)
+            k = stats.t.ppf(0.975, st.n_blocks - 1)
+            for q, v in truth.items():
+                hits.setdefault(q, []).append(abs(getattr(st, q) - v) <= k * st.uncertainty[q])
+    rates = {q: float(np.mean(h)) for q, h in hits.items()}
+    print("coverage of the 95 % intervals:", rates)
+    assert all(r >= 0.9 for r in rates.values()), rates
+
+
+def test_anisotropy_ratio_and_direction():
+    s = gaussian_surface(256, 256e-6, 1e-7, (12e-6, 4e-6), rng=7)
+    st = roughness_statistics(s.z, 1e-6, blocks=0)
+    assert abs(st.anisotropy_ratio - 3) < 0.3
+    assert abs(st.anisotropy_angle_deg) < 5  # the long axis is x
+    t = roughness_statistics(s.z.T, 1e-6, blocks=0)
+    assert abs(abs(t.anisotropy_angle_deg) - 90) < 5
+    iso = roughness_statistics(gaussian_surface(256, 256e-6, 1e-7, 6e-6, rng=8).z, 1e-6, blocks=0)
+    assert iso.anisotropy_ratio < 1.15
+    assert iso.acf_model == "gaussian"
+    assert abs(iso.alpha - np.sqrt(2) * iso.sigma / iso.c) < 1e-15
+
+
+def test_exponential_acf_is_recognised():
+    rng = np.random.default_rng(4)
+    n, d, c = 256, 1.0, 5.0
+    k = 2 * np.pi * np.fft.fftfreq(n, d)
+    kk = np.hypot(k[:, None], k[None, :])
+    psd = (1 + (kk * c) ** 2) ** -1.5  # 2-D spectrum of exp(-r/c)
+    z = np.fft.ifft2(np.fft.fft2(rng.standard_normal((n, n))) * np.sqrt(psd)).real
+    st = roughness_statistics(z, d, blocks=0)
+    assert st.acf_model == "exponential"
+    assert abs(st.c_fit_x / c - 1) < 0.2
+
+
+def test_masked_points_are_ignored_and_acf_is_mask_normalised():
+    s = gaussian_surface(128, 128e-6, 1e-7, 5e-6, rng=3)
+    rng = np.random.default_rng(0)
+    holes = rng.random(s.z.shape) < 0.1
+    z = s.z.copy()
+    z[holes] = np.nan
+    full = roughness_statistics(s.z, 1e-6, blocks=0)
+    part = roughness_statistics(z, 1e-6, blocks=0)
+    assert part.n_valid == (~holes).sum()
+    assert abs(part.sigma / full.sigma - 1) < 0.02
+    assert abs(part.c / full.c - 1) < 0.02
+    # the same with a boolean mask or a masked array
+    m1 = roughness_statistics(s.z, 1e-6, mask=holes, blocks=0)
+    m2 = roughness_statistics(np.ma.masked_array(s.z, holes), 1e-6, blocks=0)
+    assert m1.sigma == part.sigma == m2.sigma
+    rho = autocorrelation(level(z), max_lag=(3, 3))
+    assert rho[3, 3] == 1.0
+
+
+def test_profile_gives_1d_quantities_and_says_alpha_assumes_isotropy():
+    s = gaussian_surface(512, 512e-6, 1e-7, 5e-6, rng=9)
+    st = roughness_statistics(s.z[:, 0], 1e-6)
+    assert st.kind == "profile"
+    assert np.isnan(st.slope_rms_y) and np.isnan(st.anisotropy_ratio)
+    assert st.c == st.c_x and st.slope_rms == st.slope_rms_x
+    assert any("isotropic" in n for n in st.notes)
+    json.dumps(st.to_dict())
+
+
+def test_levelling_removes_polynomials_of_the_given_degree():
+    x, y = np.meshgrid(np.arange(40.0), np.arange(30.0), indexing="ij")
+    plane = 3 + 0.2 * x - 0.1 * y
+    assert np.abs(level(plane)).max() < 1e-12
+    quad = plane + 0.01 * x * y - 0.02 * y**2
+    assert np.abs(level(quad, 2)).max() < 1e-11
+    assert np.abs(level(quad, 1)).max() > 1e-2
+    assert abs(np.nanmean(level(np.arange(50.0) ** 2, 0))) < 1e-9
+
+
+def test_to_dict_is_json_safe_and_frozen():
+    st = roughness_statistics(gaussian_surface(64, 64e-6, 1e-7, 4e-6, rng=1).z, 1e-6)
+    d = json.loads(json.dumps(st.to_dict(), allow_nan=False))
+    assert d["kind"] == "areal" and set(d["uncertainty"]) >= {"sigma", "c", "alpha"}
+    assert d["slope_fits"]["best"] in ("ggx", "beckmann")
+    with pytest.raises(AttributeError):
+        st.sigma = 1.0  # type: ignore[misc]
+
+
+@pytest.mark.parametrize(
+    ("heights", "kw", "match"),
+    [
+        (np.full((32, 32), np.nan), {}, "no valid"),
+        (np.zeros((3, 3)), {}, "at least 8"),
+        (np.zeros((4, 4, 4)), {}, "1-D"),
+        (np.ones((16, 16)), {"pixel_size": -1.0}, "pixel_size"),
+        (np.ones((16, 16)), {"mask": np.zeros((3, 3), bool)}, "mask shape"),
+    ],
+)
+def test_bad_arrays_raise_value_error(heights, kw, match):
+    kw.setdefault("pixel_size", 1e-6)
+    with pytest.raises(ValueError, match=match):
+        roughness_statistics(heights, **kw)
+
+
+# ------------------------------------------------------------------------ slope fits
+def _ggx_slopes(alpha, n, rng):
+    u = rng.random(n)
+    r = alpha * np.sqrt(u / (1 - u))  # radial CDF r^2 / (a^2 + r^2)
+    p = 2 * np.pi * rng.random(n)
+    return r * np.cos(p), r * np.sin(p)
+
+
+def test_ml_alpha_of_ggx_slopes_matches_the_truth_within_its_uncertainty():
+    """20 seeded samples of 5000 independent GGX slopes, 2-D and x-marginal (profile) fits:
+    every |z| < 3.5 (1 % chance for one of 20 standard normals to exceed it) and the mean
+    z^2 inside the 99.8 % chi^2_20 interval."""
+    alpha = 0.2
+    for dim in (2, 1):
+        z = []
+        for r in range(20):
+            x, y = _ggx_slopes(alpha, 5000, np.random.default_rng(500 + r))
+            f = fit_slope_distribution(x, y if dim == 2 else None)
+            z.append((f.ggx.alpha - alpha) / f.ggx.alpha_u)
+            assert f.best == "ggx"
+            assert f.ggx.ks < KS_WARN
+        z = np.array(z)
+        assert np.all(np.abs(z) < 3.5), z
+        lo, hi = stats.chi2.ppf([0.001, 0.999], 20) / 20
+        assert lo < np.mean(z**2) < hi, z
+
+
+def test_ml_alpha_of_beckmann_slopes_and_warning_for_neither():
+    rng = np.random.default_rng(3)
+    a = 0.15
+    x, y = rng.normal(0, a / np.sqrt(2), (2, 20000))  # Beckmann: per-axis variance a^2/2
+    f = fit_slope_distribution(x, y)
+    assert f.best == "beckmann" and f.warning is None
+    assert abs(f.beckmann.alpha - a) < 4 * f.beckmann.alpha_u
+    assert f.beckmann.aic < f.ggx.aic
+    u = rng.uniform(-1, 1, (2, 20000))  # flat slopes: neither model
+    g = fit_slope_distribution(u[0], u[1])
+    assert g.warning is not None and str(KS_WARN) in g.warning
+
+
+# -------------------------------------------------------------------------- real files
+pytest.importorskip("SurfaceTopography")
+
+
+@pytest.fixture(scope="module")
+def topo_dir(real_exports):
+    d = real_exports / TOPO
+    if not d.is_dir():
+        pytest.skip(f"{d} absent")
+    return d
+
+
+@pytest.mark.shared
+@pytest.mark.parametrize("name", ["metropro-1.dat", "di-1.di", "opdx-3.opdx"])
+@pytest.mark.parametrize(("degree", "mode"), [(1, "height"), (2, "curvature")])
+def test_real_files_agree_with_surface_topography(topo_dir, name, degree, mode):
+    """sigma and RMS slopes equal SurfaceTopography's own functions on the same levelling
+    (detrend "height" = mean plane, "curvature" = quadric) to 1e-9 relative, in metres."""
+    from SurfaceTopography import read_topography
+
+    from labbrdf.adapters.topography import read_height_map
+
+    path = topo_dir / name
+    hm = read_height_map(path)
+    ref = read_topography(str(path)).to_unit("m")
+    if ref.dim == 1 and degree == 2:
+        ref = ref.detrend("curvature")
+    else:
+        ref = ref.detrend(mode)
+    np.testing.assert_allclose(hm.physical_sizes, np.atleast_1d(ref.physical_sizes), rtol=1e-12)
+    st = roughness_statistics(hm.heights, hm.pixel_size, degree=degree, blocks=0)
+    if ref.dim == 2:
+        np.testing.assert_allclose(st.sigma, ref.rms_height_from_area(), rtol=1e-9)
+        np.testing.assert_allclose(st.slope_rms, ref.rms_gradient(), rtol=1e-9)
+        np.testing.assert_allclose(st.slope_rms_x, ref.rms_slope_from_profile(), rtol=1e-9)
+    else:
+        np.testing.assert_allclose(st.sigma, ref.rms_height_from_profile(), rtol=1e-9)
+        np.testing.assert_allclose(st.slope_rms, ref.rms_slope_from_profile(), rtol=1e-9)
+
+
+@pytest.mark.shared
+def test_real_files_units_and_channels(topo_dir):
+    from labbrdf.adapters.topography import read_height_map, topography_statistics
+
+    mp = read_height_map(topo_dir / "metropro-1.dat")
+    assert mp.heights.shape == (640, 480)
+    np.testing.assert_allclose(mp.physical_sizes, (0.70288e-3, 0.52716e-3), rtol=1e-4)
+    di = read_height_map(topo_dir / "di-1.di")
+    assert di.channels[:2] == ("Height", "Height") and len(di.channels) == 4
+    np.testing.assert_allclose(di.physical_sizes, (500e-9, 500e-9), rtol=1e-12)
+    st = topography_statistics(topo_dir / "di-1.di")
+    assert 1e-9 < st.sigma < 1e-7  # nanometre-scale AFM roughness, in metres
+    assert 1e-8 < st.c < 5e-7
+    pr = read_height_map(topo_dir / "opdx-3.opdx")
+    assert pr.is_profile and abs(pr.physical_sizes[0] - 49.98e-6) < 0.01e-6
+    with pytest.raises(AdapterError, match="opdx-3.opdx.*areal"):
+        topography_statistics(topo_dir / "opdx-3.opdx", require_areal=True)
+    with pytest.raises(AdapterError, match="di-1.di.*channel"):
+        read_height_map(topo_dir / "di-1.di", channel="Nope")
+
+
+def test_corrupt_unsupported_and_missing_files_name_the_file(tmp_path, real_exports):
+    from labbrdf.adapters.topography import read_height_map
+
+    trunc = tmp_path / "cut.di"
+    trunc.write_bytes((real_exports / TOPO / "di-1.di").read_bytes()[:30000])
+    with pytest.raises(AdapterError, match="cut.di"):
+        read_height_map(trunc)
+    junk = tmp_path / "junk.bin"
+    junk.write_bytes(bytes(range(256)) * 50)
+    with pytest.raises(AdapterError, match="junk.bin"):
+        read_height_map(junk)
+    with pytest.raises(AdapterError, match="nope.dat.*no such file"):
+        read_height_map(tmp_path / "nope.dat")
+    nan = tmp_path / "nan.txt"
+    nan.write_text("\n".join(" ".join(["nan"] * 10) for _ in range(10)))
+    with pytest.raises(AdapterError, match="nan.txt"):
+        read_height_map(nan, physical_sizes=(1.0, 1.0), unit="um")
+
+
+def test_matrix_ascii_needs_sizes_and_reads_in_metres(tmp_path):
+    from labbrdf.adapters.topography import read_height_map
+
+    z = np.random.default_rng(0).standard_normal((20, 16))
+    p = tmp_path / "m.asc"
+    np.savetxt(p, z)
+    with pytest.raises(AdapterError, match="m.asc.*physical_sizes"):
+        read_height_map(p)
+    hm = read_height_map(p, physical_sizes=(16.0, 20.0), unit="um")
+    np.testing.assert_allclose(hm.pixel_size, (1e-6, 1e-6))
+    np.testing.assert_allclose(np.sort(hm.heights.ravel()), np.sort(z.ravel() * 1e-6))
+
+
+def test_missing_surface_topography_names_the_extra(monkeypatch, tmp_path):
+    from labbrdf.adapters import topography as at
+
+    monkeypatch.setitem(sys.modules, "SurfaceTopography", None)
+    with pytest.raises(ImportError, match=r"labbrdf\[topography\]"):
+        at.read_height_map(tmp_path / "x.dat")
