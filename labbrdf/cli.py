@@ -518,6 +518,60 @@ def _grid(text: str, option: str) -> Any:
         ) from None
 
 
+def _height_map(path: str, channel: str | None) -> Any:
+    from .adapters.topography import read_height_map
+
+    ch: int | str | None = int(channel) if channel and channel.isdigit() else channel
+    return read_height_map(path, ch)
+
+
+def cmd_surface(args: argparse.Namespace) -> int:
+    from .topography import level, roughness_statistics
+
+    hm = _height_map(args.file, args.channel)
+    st = roughness_statistics(hm.heights, hm.pixel_size, degree=args.degree, blocks=args.blocks)
+    if args.png:
+        from .report.figures import save_surface_png, surface_figure
+
+        z = level(hm.heights, args.degree)
+        uri = surface_figure(z, hm.pixel_size, st, title=f"{Path(args.file).name} ({hm.channel})")
+        save_surface_png(uri, args.png)
+    d = st.to_dict()
+    d["file"] = str(args.file)
+    d["channel"] = hm.channel
+    if args.json:
+        _emit_json(d)
+        return 0
+    u = d.get("uncertainty") or {}
+
+    def row(label: str, key: str, scale: float, unit: str) -> None:
+        v = d.get(key)
+        if v is None:
+            print(f"{label:<28} undefined")
+            return
+        e = u.get(key)
+        err = f" +- {e * scale:.3g}" if e is not None else ""
+        print(f"{label:<28} {v * scale:.4g}{err} {unit}")
+
+    print(f"{args.file} ({d['kind']}, channel {hm.channel}, {d['levelling']})")
+    row("sigma (RMS height)", "sigma", 1e9, "nm")
+    row("RMS slope", "slope_rms", 1.0, "")
+    row("correlation length c", "c", 1e6, "um")
+    row("alpha = sqrt(2) sigma / c", "alpha", 1.0, "")
+    if d["kind"] == "areal":
+        row("anisotropy c_major/c_minor", "anisotropy_ratio", 1.0, "")
+    fits = d["slope_fits"]
+    for name in ("ggx", "beckmann"):
+        f = fits[name]
+        print(f"{name + ' alpha (ML)':<28} {f['alpha']:.4g}  KS {f['ks']:.3g}  AIC {f['aic']:.6g}")
+    print(f"best description of the slopes: {fits['best']}")
+    if fits.get("warning"):
+        print(f"warning: {fits['warning']}")
+    for note in d.get("notes") or ():
+        print(f"note: {note}")
+    return 0
+
+
 def cmd_hemispherical(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -556,11 +610,28 @@ def cmd_trace(args: argparse.Namespace) -> int:
     from .parallel import imap
 
     _check_executor(args)
-    sub = _complex(args.substrate, "--substrate")
+    if (args.substrate is None) == (args.nk_from is None):
+        raise UsageError("give the substrate index with --substrate N+Kj or --nk-from FILE")
+    if args.nk_from is not None:
+        n, k = _nk_at(_nk_combined(args.nk_from), args.wavelength, args.nk_from)
+        sub = complex(n, k)
+    else:
+        sub = _complex(args.substrate, "--substrate")
+    if args.surface is not None:
+        from .topography import level
+
+        hm = _height_map(args.surface, args.channel)
+        substrate = tracer.Substrate.from_surface(
+            level(hm.heights, 1), hm.pixel_size, n=sub.real, k=sub.imag
+        )
+    elif args.alpha is None:
+        raise UsageError("give the substrate roughness with --alpha A or --surface FILE")
+    else:
+        substrate = tracer.Substrate(n=sub.real, k=sub.imag, alpha=args.alpha)
     kw: dict[str, Any] = {
         "wavelength_nm": args.wavelength,
         "theta_i_deg": args.theta_i,
-        "substrate": tracer.Substrate(n=sub.real, k=sub.imag, alpha=args.alpha),
+        "substrate": substrate,
         "rays": args.rays,
         "seed": args.seed,
         "scattering": "single" if args.single_scattering else "multiple",
@@ -574,7 +645,7 @@ def cmd_trace(args: argparse.Namespace) -> int:
             n=coat.real,
             k=coat.imag,
             thickness_nm=args.thickness,
-            alpha=args.coating_alpha if args.coating_alpha is not None else args.alpha,
+            alpha=args.coating_alpha if args.coating_alpha is not None else substrate.alpha,
         )
     elif args.thickness is not None or args.coating_alpha is not None:
         raise UsageError("--thickness and --coating-alpha need --coating")
@@ -717,6 +788,15 @@ def build_parser() -> argparse.ArgumentParser:
     _add_selection(s)
     s.set_defaults(func=cmd_nk)
 
+    s = sub.add_parser("surface", help="roughness statistics of a height map or profile")
+    s.add_argument("file", metavar="FILE")
+    s.add_argument("--channel", default=None, help="channel name or index (default: height)")
+    s.add_argument("--degree", type=int, default=1, help="levelling polynomial (1 = plane)")
+    s.add_argument("--blocks", type=int, default=None, help="tiles per axis for uncertainties")
+    s.add_argument("--png", default=None, help="write map, ACF and slope histogram (.png)")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_surface)
+
     s = sub.add_parser("export", help="write a model BRDF in an exchange format")
     s.add_argument("--format", default="zemax-bsdf", help="zemax-bsdf")
     s.add_argument("--model", required=True)
@@ -738,8 +818,13 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_hemispherical)
 
     s = sub.add_parser("trace", help="Monte Carlo polarization ray tracing (pBRDF)")
-    s.add_argument("--substrate", required=True, help="complex index, e.g. 1.55+7.71j")
-    s.add_argument("--alpha", type=float, required=True, help="GGX roughness of the substrate")
+    s.add_argument("--substrate", default=None, help="complex index, e.g. 1.55+7.71j")
+    s.add_argument("--nk-from", default=None, metavar="FILE", help="substrate n, k from psi/Delta")
+    s.add_argument("--alpha", type=float, default=None, help="GGX roughness of the substrate")
+    s.add_argument(
+        "--surface", default=None, metavar="FILE", help="measured height map: its slope table"
+    )
+    s.add_argument("--channel", default=None, help="height channel of --surface")
     s.add_argument("--coating", default=None, help="coating index, e.g. 1.5")
     s.add_argument("--thickness", type=float, default=None, help="coating thickness [nm]")
     s.add_argument("--coating-alpha", type=float, default=None)

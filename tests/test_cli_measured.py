@@ -189,3 +189,54 @@ def test_closed_output_pipe_is_not_a_traceback(fixtures_dir: Path):
     p.wait(timeout=60)
     assert "Traceback" not in err
     assert p.returncode == 141
+
+
+# ------------------------------------------------------------------ topography
+
+
+def test_surface_json_and_png_on_the_afm_file(real_exports: Path, tmp_path: Path, capsys):
+    png = tmp_path / "di.png"
+    path = str(real_exports / "topography" / "di-1.di")
+    assert main(["surface", path, "--blocks", "0", "--json", "--png", str(png)]) == 0
+    d = _json(capsys)
+    assert d["kind"] == "areal" and d["channel"] == "Height"
+    # 512 x 512 points over 500 nm: heights of nanometres, lengths of tens of nanometres
+    assert 1e-9 < d["sigma"] < 1e-7
+    assert 1e-8 < d["c"] < 5e-7
+    assert d["slope_fits"]["best"] in ("ggx", "beckmann")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_surface_of_an_unreadable_file_is_exit_2(tmp_path: Path, capsys):
+    bad = tmp_path / "x.opdx"
+    bad.write_bytes(b"not a profile")
+    assert main(["surface", str(bad)]) == 2
+    assert str(bad) in capsys.readouterr().err
+
+
+def test_trace_takes_nk_from_an_ellipsometer_and_slopes_from_a_height_map(
+    real_exports: Path, capsys
+):
+    argv = ["trace", "--nk-from", str(real_exports / TA), "--surface",
+            str(real_exports / "topography" / "di-1.di"), "--theta-i", "45",
+            "--wavelength", "600", "--rays", "20000", "--scheduler", "serial",
+            "--json"]  # fmt: skip
+    assert main(argv) == 0
+    s = _json(capsys)
+    # tantalum absorbs: the albedo lies well below 1, and the energy ledger closes
+    assert 0.2 < s["albedo"] < 0.9
+    e = s["energy"]
+    assert e["exited"] + e["absorbed"] + e["terminated"] == pytest.approx(1.0, abs=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--alpha", "0.2"], "--substrate N+Kj or --nk-from"),
+        (["--substrate", "1.5+0j"], "--alpha A or --surface"),
+    ],
+)
+def test_trace_needs_an_index_and_a_roughness(capsys, argv, message):
+    base = ["trace", "--theta-i", "45", "--wavelength", "600", "--rays", "100"]
+    assert main(base + argv) == 2
+    assert message in capsys.readouterr().err

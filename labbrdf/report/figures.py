@@ -411,3 +411,116 @@ def save_trace_maps_png(result: Any, path: str | Any, stokes_in: Any = (1, 0, 0,
     p = Path(path)
     p.write_bytes(base64.b64decode(uri.split(",", 1)[1]))
     return p
+
+
+def surface_figure(
+    heights_m: Any, pixel_size_m: Sequence[float], stats: Any, title: str = ""
+) -> str:
+    """Height map (or profile), autocorrelation and slope histogram of a measured surface.
+
+    Parameters
+    ----------
+    heights_m : ndarray (M, N) or (M,)
+        Levelled heights [m] (NaN = missing).
+    pixel_size_m : sequence of float
+        Grid spacing per axis [m].
+    stats : labbrdf.topography.RoughnessStats
+        Its correlation lengths and slope fits are drawn.
+    title : str
+        Figure title.
+
+    Returns
+    -------
+    str
+        PNG data URI.
+
+    Notes
+    -----
+    The slope panel of an areal map shows the slope magnitude ``q = |grad z|`` against the
+    densities of the fitted 2-D slope distributions in q: GGX ``2 q / (a^2 (1 + q^2/a^2)^2)``
+    and Beckmann ``2 q / a^2 exp(-q^2/a^2)`` (the slope-space densities times ``2 pi q``). A
+    profile shows dz/dx against the 1-D densities of its fits, GGX
+    ``1 / (2 a (1 + x^2/a^2)^(3/2))`` and Beckmann ``exp(-x^2/a^2) / (a sqrt(pi))``.
+    """
+    from labbrdf.topography import autocorrelation, slopes
+
+    z = np.asarray(heights_m, float)
+    px = tuple(float(p) for p in pixel_size_m)
+    valid = np.isfinite(z)
+    fig, axes = plt.subplots(1, 3, figsize=(13.5, 4.0))
+    ax = axes[0]
+    if z.ndim == 2:
+        ext = [0, z.shape[1] * px[1] * 1e6, z.shape[0] * px[0] * 1e6, 0]
+        im = ax.imshow(z * 1e9, extent=ext, cmap="viridis", aspect="equal")
+        fig.colorbar(im, ax=ax, label="height [nm]")
+        ax.set_xlabel("y [\u00b5m]")
+        ax.set_ylabel("x [\u00b5m]")
+        ax.set_title("levelled height map")
+    else:
+        ax.plot(np.arange(z.size) * px[0] * 1e6, z * 1e9, lw=0.7)
+        ax.set_xlabel("x [\u00b5m]")
+        ax.set_ylabel("height [nm]")
+        ax.set_title("levelled profile")
+    ax = axes[1]
+    r = autocorrelation(z, valid)  # zero lag at the centre
+    if r.ndim == 2:
+        i0, j0 = (n // 2 for n in r.shape)
+        rx, ry = r[i0:, j0], r[i0, j0:]
+        ax.plot(np.arange(rx.size) * px[0] * 1e6, rx, label="along x")
+        ax.plot(np.arange(ry.size) * px[1] * 1e6, ry, label="along y")
+    else:
+        r1 = r[r.size // 2 :]
+        ax.plot(np.arange(r1.size) * px[0] * 1e6, r1, label="along x")
+    ax.axhline(np.exp(-1.0), color="0.5", ls=":", lw=1, label="1/e")
+    ax.set_xlabel("lag [\u00b5m]")
+    ax.set_ylabel("normalised ACF")
+    c = stats.c * 1e6 if np.isfinite(stats.c) else float("nan")
+    ax.set_title(f"autocorrelation (c = {c:.3g} \u00b5m)")
+    ax.legend(fontsize=8)
+    ax = axes[2]
+    sx, sy = slopes(z, px, valid)
+    areal = sy is not None
+    q = np.hypot(sx, sy) if areal else sx
+    fits = stats.slope_fits
+    if q.size:
+        hi = float(np.quantile(np.abs(q), 0.995)) or 1.0
+        lo = 0.0 if areal else -hi
+        ax.hist(q, bins=60, range=(lo, hi), density=True, color="0.75", label="measured")
+        x = np.linspace(lo, hi, 400)
+        for fit, style in ((fits.ggx, "-"), (fits.beckmann, "--")):
+            a = fit.alpha
+            if not (np.isfinite(a) and a > 0):
+                continue
+            t = (x / a) ** 2
+            if areal:  # density of the slope magnitude |grad z| for the 2-D fit
+                d = (
+                    2 * x / a**2 / (1 + t) ** 2
+                    if fit.model == "ggx"
+                    else 2 * x / a**2 * np.exp(-t)
+                )
+            else:  # 1-D marginal density of the fit to a profile
+                d = (
+                    1 / (2 * a * (1 + t) ** 1.5)
+                    if fit.model == "ggx"
+                    else np.exp(-t) / (a * np.sqrt(np.pi))
+                )
+            ax.plot(x, d, style, label=f"{fit.model} \u03b1 = {a:.3g} (KS {fit.ks:.2f})")
+    ax.set_xlabel("slope magnitude |grad z| [1]" if areal else "slope dz/dx [1]")
+    ax.set_ylabel("density")
+    ax.set_title("slope distribution")
+    ax.legend(fontsize=8)
+    fig.suptitle(_text(title))
+    fig.tight_layout()
+    return to_uri(fig)
+
+
+def save_surface_png(uri: str, path: Any) -> Any:
+    """Write a figure data URI of :func:`surface_figure` to a PNG file (atomically)."""
+    from pathlib import Path
+
+    from labbrdf.dataset import atomic_output
+
+    data = base64.b64decode(uri.split(",", 1)[1])
+    with atomic_output(path) as tmp:
+        Path(tmp).write_bytes(data)
+    return Path(path)
