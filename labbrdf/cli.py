@@ -191,9 +191,12 @@ def cmd_ingest(args: argparse.Namespace) -> int:
         for f in args.files:
             if _samefile(out, Path(f)) or out.resolve() == Path(f).resolve():
                 raise UsageError(f"-o {out} is one of the input files; refusing to overwrite it")
+    from .selection import SelectionError
+
     rows: list[dict[str, Any]] = []
     measurements = []
     failures: list[dict[str, str]] = []
+    unselected: list[str] = []
     for f in args.files:
         try:
             m = adapters.read(f, args.format)
@@ -202,6 +205,11 @@ def cmd_ingest(args: argparse.Namespace) -> int:
                 print(f"labbrdf ingest: {exc}", file=sys.stderr)
                 return 2
             failures.append({"file": str(f), "error": str(exc)})
+            continue
+        try:
+            m = _selected(args, m)
+        except SelectionError as exc:
+            unselected.append(f"{f}: {exc}")
             continue
         s = m.summary()
         measurements.append(m)
@@ -216,6 +224,8 @@ def cmd_ingest(args: argparse.Namespace) -> int:
                 "theta_i_deg": s["theta_i_deg"],
             }
         )
+    if unselected and not measurements and not failures:
+        raise UsageError("; ".join(unselected))
     if out is not None and measurements:
         write(concat(measurements), out)
     if args.json:
@@ -229,6 +239,8 @@ def cmd_ingest(args: argparse.Namespace) -> int:
             print(f"wrote {out} ({sum(r['rows'] for r in rows)} rows)")
     for f in failures:
         print(f"labbrdf ingest: FAILED {f['error']}", file=sys.stderr)
+    for u in unselected:
+        print(f"labbrdf ingest: nothing selected in {u}", file=sys.stderr)
     return 2 if failures else 0
 
 
@@ -727,6 +739,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-o", "--output", default=None, help="write OUT.parquet or OUT.csv")
     s.add_argument("--json", action="store_true", help="print a JSON list, one object per file")
     s.add_argument("--keep-going", action="store_true", help="read the rest after a failure")
+    _add_selection(s)
     s.set_defaults(func=cmd_ingest)
 
     s = sub.add_parser("formats", help="list the supported export formats")

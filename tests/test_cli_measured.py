@@ -240,3 +240,17 @@ def test_trace_needs_an_index_and_a_roughness(capsys, argv, message):
     base = ["trace", "--theta-i", "45", "--wavelength", "600", "--rays", "100"]
     assert main(base + argv) == 2
     assert message in capsys.readouterr().err
+
+
+def test_ingest_selects_rows_and_refuses_an_empty_selection(fixtures_dir: Path, tmp_path, capsys):
+    scan = str(fixtures_dir / "specular" / "osr_specular.csv")
+    out = tmp_path / "sel.csv"
+    assert (
+        main(["ingest", scan, "--wavelength", "500:560", "--theta-i", "45", "-o", str(out)]) == 0
+    )
+    d = labbrdf.read(out).data
+    assert set(d.wavelength_nm) == {500.0, 550.0} and set(d.theta_i_deg) == {45.0}
+    assert len(d) == 2 * 21
+    capsys.readouterr()
+    assert main(["ingest", scan, "--sample", "mirror"]) == 2
+    assert "no row left" in capsys.readouterr().err
