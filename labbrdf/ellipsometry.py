@@ -77,8 +77,8 @@ P_ANGLE_DEPENDENT = 0.01
 OnIll = Literal["raise", "warn", "ignore"]
 
 
-class IllConditionedWarning(UserWarning):
-    """The inversion psi, Delta -> n, k is ill-conditioned (near normal incidence)."""
+#: the warning class of the optics core (one class, whichever layer warns)
+IllConditionedWarning = optics.IllConditionedWarning
 
 
 # --------------------------------------------------------------------------------------
@@ -132,7 +132,7 @@ def nk_jacobian(
     derivatives; they are checked against central differences in the tests.
     """
     psi, delta, theta = _inputs(psi_deg, delta_deg, theta_deg)
-    big_n = np.asarray(optics.nk_from_psi_delta(psi, delta, theta, n_ambient))
+    big_n = np.asarray(optics.nk_from_psi_delta(psi, delta, theta, n_ambient, warn=False))
     p, d, t = np.radians(psi), np.radians(delta), np.radians(theta)
     rho = np.tan(p) * np.exp(-1j * d)
     u = (1.0 - rho) / (1.0 + rho)

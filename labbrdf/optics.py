@@ -62,6 +62,8 @@ References
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -633,11 +635,49 @@ def psi_delta(
     return _arrays(psi, delta)
 
 
+#: Condition number [1/rad] of the inversion above which :func:`nk_from_psi_delta` warns:
+#: 0.02 deg of psi or Delta error (a rotating-element ellipsometer's accuracy) then moves
+#: ``|N|`` by more than 10 %. It grows as ``1/theta^2`` towards normal incidence (about 6 deg
+#: for Si or Ta, 4 deg for glass).
+NK_COND_MAX = 300.0
+
+
+class IllConditionedWarning(UserWarning):
+    """The inversion psi, Delta -> n, k is ill-conditioned (near normal incidence)."""
+
+
+def nk_condition_number(
+    psi_deg: ArrayLike, delta_deg: ArrayLike, theta_deg: ArrayLike, n_ambient: ArrayLike = 1.0
+) -> NDArray[np.float64]:
+    """Relative condition number ``|dN/dpsi| / |N|`` [1/rad] of :func:`nk_from_psi_delta`.
+
+    ``dN/dpsi = (d eps/d psi) / (2 N)`` with ``eps`` as in :func:`nk_from_psi_delta`,
+    ``d eps/d rho = -4 n0^2 sin^2 t tan^2 t u / (1 + rho)^2`` and
+    ``d rho/d psi = exp(-i Delta) / cos^2 psi``; ``|dN/dDelta| <= |dN/dpsi| / 2``, so this is
+    the largest relative change of N per radian of psi/Delta error.
+    """
+    psi = np.radians(np.asarray(psi_deg, float))
+    delta = np.radians(np.asarray(delta_deg, float))
+    theta = np.radians(np.asarray(theta_deg, float))
+    n0 = np.asarray(n_ambient, float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rho = np.tan(psi) * np.exp(-1j * delta)
+        u = (1.0 - rho) / (1.0 + rho)
+        s2, t2 = np.sin(theta) ** 2, np.tan(theta) ** 2
+        big_n = np.sqrt((n0**2 * s2 * (1.0 + t2 * u * u)) + 0j)
+        deps = (
+            -4.0 * n0**2 * s2 * t2 * u / (1.0 + rho) ** 2 * np.exp(-1j * delta) / np.cos(psi) ** 2
+        )
+        return np.asarray(np.abs(deps / (2.0 * big_n)) / np.abs(big_n))
+
+
 def nk_from_psi_delta(
     psi_deg: ArrayLike,
     delta_deg: ArrayLike,
     theta_deg: ArrayLike,
     n_ambient: ArrayLike = 1.0,
+    *,
+    warn: bool = True,
 ) -> ComplexArray:
     """Two-phase (bare substrate) inversion of psi, Delta to ``N = n + ik``.
 
@@ -653,6 +693,11 @@ def nk_from_psi_delta(
         substrate gives the same (psi, Delta).
     n_ambient : array_like of float, optional
         Real index of the lossless ambient, > 0 [1]. Default 1.
+    warn : bool, optional
+        Issue :class:`IllConditionedWarning`, with the condition number
+        (:func:`nk_condition_number`) and the angle, where it exceeds :data:`NK_COND_MAX`
+        (near normal incidence, where every sample gives psi -> 45, Delta -> 180 deg and
+        the index is not determined by the data). Default True.
 
     Returns
     -------
@@ -690,6 +735,20 @@ def nk_from_psi_delta(
     sin_t = np.sin(theta)
     u = (1.0 - rho) / (1.0 + rho)
     eps = (n0 * sin_t) ** 2 * (1.0 + np.tan(theta) ** 2 * u * u)
+    if warn:
+        cond = nk_condition_number(psi_deg, delta_deg, theta_deg, n_ambient)
+        bad = ~(cond <= NK_COND_MAX)
+        if np.any(bad):
+            i = int(np.argmax(np.where(bad, cond, -np.inf)))
+            at = np.ravel(np.degrees(theta) * np.ones_like(cond))[i]
+            warnings.warn(
+                f"psi/Delta -> n, k is ill-conditioned at {int(np.count_nonzero(bad))} "
+                f"point(s): condition number up to {np.ravel(cond)[i]:.3g} /rad (> "
+                f"{NK_COND_MAX:g}) at theta = {at:.4g} deg; near normal incidence the "
+                "index is not determined by psi and Delta",
+                IllConditionedWarning,
+                stacklevel=2,
+            )
     return np.asarray(_physical_root(eps + 0j))
 
 

@@ -309,6 +309,16 @@ class TraceConfig:
             self.coherent,
         )
 
+        # the incoherent walk treats the coating as a separate rough layer between two
+        # interfaces, which never reduces to the bare substrate; a 0 nm layer is no layer
+        _check(
+            self.coherent or self.coating is None or self.coating.thickness_nm > 0,
+            "coating.thickness_nm",
+            "> 0 in the incoherent model (a 0 nm coating is the bare substrate: leave the "
+            "coating out, or pass coherent=True, where a 0 nm film is exactly the bare "
+            "substrate)",
+            None if self.coating is None else self.coating.thickness_nm,
+        )
         _check(
             not (self.coherent and self.substrate.ndf is not None),
             "coherent",
