@@ -117,6 +117,6 @@ def user_report(
         properties.colour_section(ctx)
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
-    write_report(out, b.results, page)
+    write_report(out, b.results, page, inputs=paths)
     b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
     return code

@@ -253,6 +253,6 @@ def validate(
         b.results["meta"]["sections_not_run"] = skipped
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
-    write_report(out, b.results, page)
+    write_report(out, b.results, page, inputs=[fx])
     b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
     return code
