@@ -1,8 +1,11 @@
 """The ``labbrdf`` command: a thin argparse layer over the library.
 
 Subcommands: ``ingest``, ``formats``, ``fit``, ``hemispherical``, ``trace``, ``validate``,
-``report``. Every subcommand returns an exit code: 0 success, 1 a validation check failed,
-2 bad input (unreadable file, unknown name, ...), with the error on stderr.
+``report``. Every subcommand returns an exit code: 0 success, 1 a check of a report
+(``validate``, ``report``) failed, 2 a usage, input or output error (unreadable file,
+unknown name, an output path that is refused or cannot be written, ...), 3 ``fit``: some
+groups could not be fitted or did not converge (listed with ``success`` false and the
+reason); the error is on stderr. Every output path goes through :mod:`labbrdf.outputs`.
 """
 
 from __future__ import annotations
@@ -11,7 +14,6 @@ import argparse
 import functools
 import json
 import math
-import os
 import sys
 import time
 from collections.abc import Sequence
@@ -95,24 +97,15 @@ def _executor_errors(cmd: Any) -> Any:
 # ------------------------------------------------------------------------------- ingest
 
 
-def _samefile(a: Path, b: Path) -> bool:
-    try:
-        return a.exists() and b.exists() and os.path.samefile(a, b)
-    except OSError:
-        return False
-
-
 def cmd_ingest(args: argparse.Namespace) -> int:
     from . import adapters
     from .dataset import concat, write
+    from .outputs import check_file_output, check_input_files
 
-    out = Path(args.output) if args.output else None
-    if out is not None:
-        if out.suffix.lower() not in {".parquet", ".csv"}:
-            raise UsageError(f"-o {out}: use a .parquet or .csv file name")
-        for f in args.files:
-            if _samefile(out, Path(f)) or out.resolve() == Path(f).resolve():
-                raise UsageError(f"-o {out} is one of the input files; refusing to overwrite it")
+    check_input_files(args.files)
+    out = None
+    if args.output:
+        out = check_file_output(args.output, inputs=args.files, suffixes=(".parquet", ".csv"))
     rows: list[dict[str, Any]] = []
     measurements = []
     failures: list[dict[str, str]] = []
@@ -216,8 +209,12 @@ def cmd_formats(args: argparse.Namespace) -> int:
 def cmd_fit(args: argparse.Namespace) -> int:
     from . import adapters
     from .fit import fit_many
+    from .outputs import check_file_output, check_input_files
 
     _check_executor(args)
+    check_input_files(args.files)
+    if args.output:
+        check_file_output(args.output, inputs=args.files, suffixes=(".csv",))
     data = adapters.read_many(args.files)
     fix = _parse_assignments(args.fix, "--fix")
     by = [c.strip() for c in args.by.split(",") if c.strip()]
@@ -234,17 +231,44 @@ def cmd_fit(args: argparse.Namespace) -> int:
         return_results=True,
     )
     if args.output:
-        from .dataset import atomic_output
+        from .outputs import atomic_output, csv_safe_frame
 
         with atomic_output(args.output) as tmp:
-            table.to_csv(tmp, index=False)
+            csv_safe_frame(table).to_csv(tmp, index=False)
+    failed = [r for r in table.to_dict("records") if not r["success"]]
     if args.json:
-        out = []
-        for key, res in results:
-            s = res.summary()
+        _emit_json(_fit_json(table, results, by))
+    else:
+        import pandas as pd
+
+        with pd.option_context("display.width", 200, "display.max_columns", 50):
+            print(table.to_string(index=False))
+    for r in failed:
+        group = ", ".join(f"{b}={r[b]}" for b in by)
+        print(f"labbrdf fit: group {group} FAILED: {r['message']}", file=sys.stderr)
+    return 3 if failed else 0
+
+
+def _same_key(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    def eq(x: Any, y: Any) -> bool:
+        return x == y or (x != x and y != y)  # NaN group keys are equal
+
+    return a.keys() == b.keys() and all(eq(a[k], b[k]) for k in a)
+
+
+def _fit_json(table: Any, results: list[tuple[dict[str, Any], Any]], by: list[str]) -> list:
+    """One object per row of the table, failed groups included (``success`` false and the
+    reason in ``message``); ``results`` holds the fitted groups in table order."""
+    out = []
+    j = 0
+    for row in table.to_dict("records"):
+        key = {b: row[b] for b in by}
+        if j < len(results) and _same_key(results[j][0], key):
+            s = results[j][1].summary()
+            j += 1
             out.append(
                 {
-                    "group": key,
+                    "group": results[j - 1][0],
                     "params": {
                         name: {
                             "value": p["value"],
@@ -257,15 +281,21 @@ def cmd_fit(args: argparse.Namespace) -> int:
                     "rmse": s["rmse"],
                     "nfev": s["nfev"],
                     "success": s["success"],
+                    "message": row.get("message", ""),
                 }
             )
-        _emit_json(out)
-    else:
-        import pandas as pd
-
-        with pd.option_context("display.width", 200, "display.max_columns", 50):
-            print(table.to_string(index=False))
-    return 0
+        else:
+            out.append(
+                {
+                    "group": key,
+                    "params": {},
+                    "rmse": None,
+                    "nfev": None,
+                    "success": False,
+                    "message": row.get("message", ""),
+                }
+            )
+    return out
 
 
 def cmd_hemispherical(args: argparse.Namespace) -> int:
@@ -303,9 +333,14 @@ def _complex(text: str, what: str) -> complex:
 def cmd_trace(args: argparse.Namespace) -> int:
 
     from . import tracer
+    from .outputs import check_file_output
     from .parallel import imap
 
     _check_executor(args)
+    if args.output:
+        check_file_output(args.output, suffixes=(".npz",))
+    if args.png:
+        check_file_output(args.png, suffixes=(".png",), option="--png")
     sub = _complex(args.substrate, "--substrate")
     kw: dict[str, Any] = {
         "wavelength_nm": args.wavelength,
@@ -344,9 +379,11 @@ def cmd_trace(args: argparse.Namespace) -> int:
     if args.output:
         result.save(args.output)
     if args.png:
+        from .outputs import atomic_output
         from .report.figures import save_trace_maps_png
 
-        save_trace_maps_png(result, args.png)
+        with atomic_output(args.png) as tmp:
+            save_trace_maps_png(result, tmp)
     summary = tracer.trace_summary(result)
     summary["seconds"] = seconds
     if args.json:
@@ -366,9 +403,11 @@ def cmd_trace(args: argparse.Namespace) -> int:
 
 @_executor_errors
 def cmd_validate(args: argparse.Namespace) -> int:
+    from .outputs import check_report_dir
     from .report import validate
 
     _check_executor(args)
+    check_report_dir(args.out, option="--out")
     return int(
         validate(
             out=args.out,
@@ -381,8 +420,11 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
+    from .outputs import check_input_files, check_report_dir
     from .report import user_report
 
+    check_input_files(args.files)
+    check_report_dir(args.output, inputs=args.files)
     return int(user_report(args.files, args.model, args.output))
 
 
@@ -475,6 +517,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ValueError, NotImplementedError, ImportError) as exc:
         # AdapterError, DatasetError, ModelError, FitError are ValueErrors with a message
         print(f"labbrdf {args.command}: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # an output or input the OS refused: no traceback
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"labbrdf {args.command}: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f"labbrdf {args.command}: out of memory (is an input a huge file?)", file=sys.stderr)
         return 2
     except KeyboardInterrupt:  # pragma: no cover
         return 130
