@@ -61,19 +61,36 @@ def _add_scheduler(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--scheduler",
         default="processes",
-        help="serial, processes (default), local (dask LocalCluster) or tcp://host:port",
+        help="serial, processes (default), local (dask LocalCluster on 127.0.0.1), "
+        "tls://host:port (a dask scheduler with TLS) or tcp://host:port (unauthenticated: "
+        "a trusted network only)",
     )
     p.add_argument("--workers", type=int, default=None, help="worker processes (default: cores)")
+    p.add_argument("--tls-ca", default=None, metavar="PEM", help="CA certificate (tls://)")
+    p.add_argument("--tls-cert", default=None, metavar="PEM", help="this client's certificate")
+    p.add_argument("--tls-key", default=None, metavar="PEM", help="this client's private key")
+    p.add_argument(
+        "--dashboard", action="store_true", help="start the local cluster's dashboard (127.0.0.1)"
+    )
 
 
 def _check_executor(args: argparse.Namespace) -> None:
     """Reject a bad ``--scheduler`` / ``--workers`` before any work is done."""
-    from .parallel import check_scheduler
+    from .parallel import check_scheduler, configure
 
     try:
         check_scheduler(args.scheduler)
     except ValueError as exc:
         raise UsageError(f"--scheduler: {exc}") from None
+    try:
+        configure(
+            dashboard=True if args.dashboard else None,
+            tls_ca=args.tls_ca,
+            tls_cert=args.tls_cert,
+            tls_key=args.tls_key,
+        )
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be >= 1, got {args.workers}")
 
