@@ -422,9 +422,10 @@ def cmd_trace(args: argparse.Namespace) -> int:
 def cmd_validate(args: argparse.Namespace) -> int:
     from .outputs import check_report_dir
     from .report import validate
+    from .report.validate import default_fixtures_dir
 
     _check_executor(args)
-    check_report_dir(args.out, option="--out")
+    check_report_dir(args.out, inputs=[default_fixtures_dir()], option="--out")
     return int(
         validate(
             out=args.out,

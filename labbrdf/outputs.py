@@ -39,6 +39,7 @@ import shutil
 import socket
 import stat
 import tempfile
+import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -244,6 +245,9 @@ def clean_leftovers(target: str | os.PathLike[str]) -> list[Path]:
         r"^\." + re.escape(target.name) + r"\.labbrdf-(tmp|new|old)-([0-9a-f]{6})-(\d+)-"
         r"[A-Za-z0-9_]+(\.tmp)?$"
     )
+    # report folders of labbrdf versions before these names (no host or pid): removed only
+    # when they hold exactly a report of ours and are older than an hour
+    legacy = re.compile(r"^\." + re.escape(target.name) + r"\.(new|old)-[a-z0-9_]{8}$")
     host = _host_tag()
     removed: list[Path] = []
     try:
@@ -251,6 +255,18 @@ def clean_leftovers(target: str | os.PathLike[str]) -> list[Path]:
     except OSError:
         return removed
     for e in entries:
+        lm = legacy.match(e.name)
+        if lm and _is_legacy_leftover(Path(e.path)):
+            p = Path(e.path)
+            try:
+                if lm.group(1) == "old" and not os.path.lexists(target):
+                    os.replace(p, target)
+                else:
+                    shutil.rmtree(p)
+                    removed.append(p)
+            except OSError:
+                pass
+            continue
         m = pat.match(e.name)
         if not m or m.group(2) != host or _pid_alive(int(m.group(3))):
             continue
@@ -272,6 +288,16 @@ def clean_leftovers(target: str | os.PathLike[str]) -> list[Path]:
         except OSError:
             continue
     return removed
+
+
+def _is_legacy_leftover(p: Path) -> bool:
+    try:
+        if p.is_symlink() or not p.is_dir() or time.time() - p.stat().st_mtime < 3600:
+            return False
+    except OSError:
+        return False
+    ours = _marker_files(p)
+    return ours is not None and not _foreign(p, ours)
 
 
 @contextlib.contextmanager

@@ -322,3 +322,28 @@ def test_dataset_csv_keeps_sample_names_exactly(tmp_path):
     write(m, tmp_path / "d.csv")
     back = read(tmp_path / "d.csv")
     pd.testing.assert_frame_equal(back.data, m.data)
+
+
+def test_leftover_report_folders_of_earlier_labbrdf_versions_are_removed(tmp_path):
+    """Before the host/pid names, a killed report run left .rep.old-XXXXXXXX folders."""
+    keys = ["title", "meta", "sections", "tables", "checks", "summary"]
+
+    def legacy(name: str, age_s: float, extra: str | None = None) -> Path:
+        d = tmp_path / name
+        d.mkdir()
+        _report(d)
+        (d / "results.json").write_text(json.dumps({k: {} for k in keys}))
+        if extra:
+            (d / extra).write_text("mine")
+        t = os.path.getmtime(d) - age_s
+        os.utime(d, (t, t))
+        return d
+
+    legacy(".rep.old-abcd1234", 7200)
+    kept = [
+        legacy(".rep.new-efgh5678", 60).name,  # recent: a run of an older version may be busy
+        legacy(".rep.old-ijkl9012", 7200, "thesis.tex").name,  # holds a user's file
+        legacy(".rep.old-mine", 7200).name,  # not the old name pattern
+    ]
+    replace_dir(tmp_path / "rep", _report)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*kept, "rep"])
