@@ -143,6 +143,19 @@ def _same(a: Path, b: Path) -> bool:
         return a.resolve() == b.resolve()
 
 
+def _check_writable(path: Path, option: str, shown: str | None = None) -> None:
+    """The nearest existing folder above ``path`` must be writable (checked before any
+    work, so that a long run does not end in a permission error)."""
+    d = Path(os.path.abspath(path)).parent
+    while not d.exists() and d != d.parent:
+        d = d.parent
+    if d.is_dir() and not os.access(d, os.W_OK | os.X_OK):
+        raise OutputError(
+            f"{option} {shown or path}: the folder {d} is not writable; expected a folder you can "
+            "write to"
+        )
+
+
 def _ends_with_sep(p: str | os.PathLike[str]) -> bool:
     s = os.fspath(p)
     return s.endswith(os.sep) or (os.altsep is not None and s.endswith(os.altsep))
@@ -228,6 +241,7 @@ def check_file_output(
     parent = p.parent if str(p.parent) else Path(".")
     if parent.exists() and not parent.is_dir():
         raise OutputError(f"{option} {p}: {parent} is not a folder")
+    _check_writable(p, option)
     return p
 
 
@@ -459,6 +473,7 @@ def check_report_dir(
                 )
     if out.parent.exists() and not out.parent.is_dir():
         raise OutputError(f"{option} {shown}: {out.parent} is not a folder")
+    _check_writable(out, option, shown)
     return out
 
 

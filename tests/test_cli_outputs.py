@@ -209,39 +209,55 @@ def test_unwritable_output_folder_is_a_message_and_exit_2(tmp_path, capsys, monk
 
 
 @pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("setpriv"), reason="needs root")
-def test_read_only_folder_for_another_user(tmp_path):
+def test_read_only_folder_for_another_user():
+    """As user nobody (root runs the tests here, and root may write anywhere): a folder
+    nobody may write into is refused before any work, with a message and exit 2."""
     import subprocess
     import sys
+    import tempfile
 
-    ro = tmp_path / "ro"
-    ro.mkdir(mode=0o755)
-    data = small_dataset(tmp_path / "d.csv")
-    os.chmod(tmp_path, 0o755)
-    os.chmod(data, 0o644)
-    code = "import sys; from labbrdf.cli import main; sys.exit(main(sys.argv[1:]))"
-    nobody = ["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", sys.executable]
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
-    probe = [*nobody, "-c", "import labbrdf.cli"]
-    if subprocess.run(probe, capture_output=True, env=env, cwd="/", timeout=120).returncode:
-        pytest.skip("the interpreter or labbrdf is not usable by user nobody")
-    r = subprocess.run(
-        [
-            *nobody,
-            "-c",
-            code,
-            "ingest",
-            str(data),
-            "-o",
-            str(ro / "x.csv"),
-        ],
-        capture_output=True,
-        text=True,
-        env=env,
-        cwd="/",
-        timeout=120,
-    )
-    assert r.returncode == 2, r.stderr
-    assert "Traceback" not in r.stderr and "x.csv" in r.stderr
+    base = Path(tempfile.mkdtemp(prefix="labbrdf-ro-", dir="/tmp"))
+    try:
+        base.chmod(0o755)  # readable by nobody (pytest's tmp_path is not)
+        ro = base / "ro"
+        ro.mkdir()
+        ro.chmod(0o755)  # owned by root: read-only for nobody
+        data = small_dataset(base / "d.csv")
+        data.chmod(0o644)
+        code = "import sys; from labbrdf.cli import main; sys.exit(main(sys.argv[1:]))"
+        nobody = ["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", sys.executable]
+        env = {
+            **os.environ,
+            "PYTHONPATH": str(Path(__file__).resolve().parents[1]),
+            "MPLCONFIGDIR": str(base / "mpl"),
+            "HOME": str(base),
+        }
+        (base / "mpl").mkdir(mode=0o777)
+        (base / "mpl").chmod(0o777)
+        probe = [*nobody, "-c", f"import labbrdf.cli; open({str(data)!r}).read()"]
+        if subprocess.run(probe, capture_output=True, env=env, cwd="/", timeout=120).returncode:
+            pytest.skip("the interpreter or labbrdf is not usable by user nobody")
+
+        def run(*argv: str) -> subprocess.CompletedProcess:
+            return subprocess.run(
+                [*nobody, "-c", code, *argv],
+                capture_output=True,
+                text=True,
+                env=env,
+                cwd="/",
+                timeout=120,
+            )
+
+        r = run("ingest", str(data), "-o", str(ro / "x.csv"))
+        assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+        assert "x.csv" in r.stderr and "not writable" in r.stderr, r.stderr
+        # a report is refused before its fits run, not after
+        r = run("report", str(data), "-o", str(ro / "rep"))
+        assert r.returncode == 2, r.stderr
+        assert "not writable" in r.stderr and "section" not in r.stderr, r.stderr
+        assert list(ro.iterdir()) == []
+    finally:
+        shutil.rmtree(base, ignore_errors=True)
 
 
 # --------------------------------------------------------------------------- writers' content
