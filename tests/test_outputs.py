@@ -347,3 +347,18 @@ def test_leftover_report_folders_of_earlier_labbrdf_versions_are_removed(tmp_pat
     ]
     replace_dir(tmp_path / "rep", _report)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*kept, "rep"])
+
+
+def test_library_reports_refuse_a_foreign_folder_before_any_work(tmp_path, capsys):
+    from labbrdf import report
+
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "thesis.tex").write_text("x")
+    scan = Path(__file__).resolve().parents[1] / "fixtures" / "specular" / "osr_specular.csv"
+    with pytest.raises(OutputError, match="not empty"):
+        report.user_report([scan], "smooth3", out, progress=True)
+    with pytest.raises(OutputError, match="not empty"):
+        report.validate(out=out, progress=True, quick=True)
+    assert "section" not in capsys.readouterr().err  # nothing ran
+    assert [p.name for p in out.iterdir()] == ["thesis.tex"]

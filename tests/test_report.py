@@ -320,8 +320,10 @@ def _leftovers(parent: Path, name: str) -> list[str]:
 def test_failed_run_leaves_previous_report_intact(tmp_path, monkeypatch):
     out = tmp_path / "validation"
     assert report.validate(out=out, progress=False, sections_to_run=[]) == 0
-    (out / "marker.txt").write_text("old report")
+    # a user's file in the report would now be refused up front; the old report's own
+    # files are the fingerprint
     before = (out / "index.html").read_bytes()
+    results_before = (out / "results.json").read_bytes()
 
     def broken_render(*a, **k):
         raise RuntimeError("disk full while rendering")
@@ -329,7 +331,7 @@ def test_failed_run_leaves_previous_report_intact(tmp_path, monkeypatch):
     monkeypatch.setattr(html, "render", broken_render)
     with pytest.raises(RuntimeError, match="disk full"):
         report.validate(out=out, progress=False, sections_to_run=[])
-    assert (out / "marker.txt").read_text() == "old report"
+    assert (out / "results.json").read_bytes() == results_before
     assert (out / "index.html").read_bytes() == before
     assert _leftovers(tmp_path, "validation") == []
 
