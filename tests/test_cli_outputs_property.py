@@ -41,6 +41,8 @@ OUTPUTS = [
     "existing_file",
     "cwd",
     "trailing_slash",
+    "link_to_input",
+    "link_to_folder",
 ]
 SUFFIX = {"ingest": ".parquet", "fit": ".csv", "trace-o": ".npz", "trace-png": ".png"}
 
@@ -91,6 +93,8 @@ def _tree(root: Path) -> dict[str, Path]:
     replace_dir(root / "prev", lambda d: (d / "index.html").write_text("<html/>"))
     for suffix in (".parquet", ".csv", ".npz", ".png", ""):
         (root / f"existing{suffix or '_file'}").write_text("user file\n")
+        (root / f"link{suffix or '_file'}").symlink_to(data / "a.csv")
+    (root / "link_dir").symlink_to(data, target_is_directory=True)
     return {"data": data, "other": other}
 
 
@@ -99,7 +103,10 @@ def _snapshot(root: Path) -> dict[str, tuple[bytes, int]]:
     for dirpath, _, names in os.walk(root):
         for n in names:
             p = Path(dirpath) / n
-            out[p.relative_to(root).as_posix()] = (p.read_bytes(), p.stat().st_mtime_ns)
+            if p.is_symlink():
+                out[p.relative_to(root).as_posix()] = (os.readlink(p).encode(), 0)
+            else:
+                out[p.relative_to(root).as_posix()] = (p.read_bytes(), p.stat().st_mtime_ns)
     return out
 
 
@@ -115,6 +122,8 @@ def _output(kind: str, writer: str, root: Path, d: dict[str, Path]) -> str:
         "existing_file": str(root / f"existing{suffix or '_file'}"),
         "cwd": ".",
         "trailing_slash": str(root / f"slash{suffix}") + "/",
+        "link_to_input": str(root / f"link{suffix or '_file'}"),
+        "link_to_folder": str(root / "link_dir"),
     }[kind]
 
 
@@ -144,7 +153,7 @@ def fast_reports(monkeypatch):
 
 @pytest.mark.slow
 @settings(
-    max_examples=30,
+    max_examples=int(os.environ.get("LABBRDF_PROPERTY_EXAMPLES", "30")),
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture],
     derandomize=True,
@@ -182,7 +191,9 @@ def test_no_writer_touches_inputs_or_anything_outside_its_output(
         outside_before = {k: v for k, v in before.items() if not _under(k, target, root)}
         outside_after = {k: v for k, v in after.items() if not _under(k, target, root)}
         assert outside_after == outside_before, (writer, kind, code, err.getvalue())
-        refused = {"input", "inputs_folder", "nonempty_dir", "cwd"}
+        refused = {"input", "inputs_folder", "nonempty_dir", "cwd", "link_to_folder"}
+        if writer not in ("trace-o", "trace-png"):
+            refused.add("link_to_input")  # trace has no inputs: the link is just replaced
         if writer in SUFFIX:
             refused.add("trailing_slash")  # a folder name for a file output
         else:
