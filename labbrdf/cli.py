@@ -1,8 +1,12 @@
 """The ``labbrdf`` command: a thin argparse layer over the library.
 
-Subcommands: ``ingest``, ``formats``, ``fit``, ``hemispherical``, ``trace``, ``validate``,
-``report``. Every subcommand returns an exit code: 0 success, 1 a validation check failed,
-2 bad input (unreadable file, unknown name, ...), with the error on stderr.
+Subcommands: ``ingest``, ``formats``, ``fit``, ``nk``, ``surface``, ``export``,
+``hemispherical``, ``trace``, ``validate``, ``report``. Every subcommand returns an exit
+code: 0 success, 1 a check of a report (``validate``, ``report``) failed, 2 a usage, input
+or output error (unreadable file, unknown name, an output path that is refused or cannot be
+written, ...), 3 ``fit``: some groups could not be fitted or did not converge (listed with
+``success`` false and the reason), 141 the reader of our output went away; the error is on
+stderr. Every output path goes through :mod:`labbrdf.outputs`.
 """
 
 from __future__ import annotations
@@ -137,19 +141,36 @@ def _add_scheduler(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--scheduler",
         default="processes",
-        help="serial, processes (default), local (dask LocalCluster) or tcp://host:port",
+        help="serial, processes (default), local (dask LocalCluster on 127.0.0.1), "
+        "tls://host:port (a dask scheduler with TLS) or tcp://host:port (unauthenticated: "
+        "a trusted network only)",
     )
     p.add_argument("--workers", type=int, default=None, help="worker processes (default: cores)")
+    p.add_argument("--tls-ca", default=None, metavar="PEM", help="CA certificate (tls://)")
+    p.add_argument("--tls-cert", default=None, metavar="PEM", help="this client's certificate")
+    p.add_argument("--tls-key", default=None, metavar="PEM", help="this client's private key")
+    p.add_argument(
+        "--dashboard", action="store_true", help="start the local cluster's dashboard (127.0.0.1)"
+    )
 
 
 def _check_executor(args: argparse.Namespace) -> None:
     """Reject a bad ``--scheduler`` / ``--workers`` before any work is done."""
-    from .parallel import check_scheduler
+    from .parallel import check_scheduler, configure
 
     try:
         check_scheduler(args.scheduler)
     except ValueError as exc:
         raise UsageError(f"--scheduler: {exc}") from None
+    try:
+        configure(
+            dashboard=True if args.dashboard else None,
+            tls_ca=args.tls_ca,
+            tls_cert=args.tls_cert,
+            tls_key=args.tls_key,
+        )
+    except ValueError as exc:
+        raise UsageError(str(exc)) from None
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be >= 1, got {args.workers}")
 
@@ -173,24 +194,15 @@ def _executor_errors(cmd: Any) -> Any:
 # ------------------------------------------------------------------------------- ingest
 
 
-def _samefile(a: Path, b: Path) -> bool:
-    try:
-        return a.exists() and b.exists() and os.path.samefile(a, b)
-    except OSError:
-        return False
-
-
 def cmd_ingest(args: argparse.Namespace) -> int:
     from . import adapters
     from .dataset import concat, write
+    from .outputs import check_file_output, check_input_files
 
-    out = Path(args.output) if args.output else None
-    if out is not None:
-        if out.suffix.lower() not in {".parquet", ".csv"}:
-            raise UsageError(f"-o {out}: use a .parquet or .csv file name")
-        for f in args.files:
-            if _samefile(out, Path(f)) or out.resolve() == Path(f).resolve():
-                raise UsageError(f"-o {out} is one of the input files; refusing to overwrite it")
+    check_input_files(args.files)
+    out = None
+    if args.output:
+        out = check_file_output(args.output, inputs=args.files, suffixes=(".parquet", ".csv"))
     from .selection import SelectionError
 
     rows: list[dict[str, Any]] = []
@@ -308,8 +320,12 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
     from . import adapters, models
     from .fit import fit_many
+    from .outputs import check_file_output, check_input_files
 
     _check_executor(args)
+    check_input_files(args.files)
+    if args.output:
+        check_file_output(args.output, inputs=args.files, suffixes=(".csv",))
     data = _selected(args, adapters.read_many(args.files))
     fix = _parse_assignments(args.fix, "--fix")
     options, start = _split_params(args.model, args.param)
@@ -361,17 +377,44 @@ def cmd_fit(args: argparse.Namespace) -> int:
             raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
         table, results = fit_many(data, model, **kw)
     if args.output:
-        from .dataset import atomic_output
+        from .outputs import atomic_output, csv_safe_frame
 
         with atomic_output(args.output) as tmp:
-            table.to_csv(tmp, index=False)
+            csv_safe_frame(table).to_csv(tmp, index=False)
+    failed = [r for r in table.to_dict("records") if not r["success"]]
     if args.json:
-        out = []
-        for key, res in results:
-            s = res.summary()
+        _emit_json(_fit_json(table, results, by))
+    else:
+        import pandas as pd
+
+        with pd.option_context("display.width", 200, "display.max_columns", 50):
+            print(table.to_string(index=False))
+    for r in failed:
+        group = ", ".join(f"{b}={r[b]}" for b in by)
+        print(f"labbrdf fit: group {group} FAILED: {r['message']}", file=sys.stderr)
+    return 3 if failed else 0
+
+
+def _same_key(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    def eq(x: Any, y: Any) -> bool:
+        return x == y or (x != x and y != y)  # NaN group keys are equal
+
+    return a.keys() == b.keys() and all(eq(a[k], b[k]) for k in a)
+
+
+def _fit_json(table: Any, results: list[tuple[dict[str, Any], Any]], by: list[str]) -> list:
+    """One object per row of the table, failed groups included (``success`` false and the
+    reason in ``message``); ``results`` holds the fitted groups in table order."""
+    out = []
+    j = 0
+    for row in table.to_dict("records"):
+        key = {b: row[b] for b in by}
+        if j < len(results) and _same_key(results[j][0], key):
+            s = results[j][1].summary()
+            j += 1
             out.append(
                 {
-                    "group": key,
+                    "group": results[j - 1][0],
                     "params": {
                         name: {
                             "value": p["value"],
@@ -388,16 +431,21 @@ def cmd_fit(args: argparse.Namespace) -> int:
                     "flags": {k: v["flags"] for k, v in s["params"].items() if v["flags"]},
                     "nfev": s["nfev"],
                     "success": s["success"],
-                    "message": s["message"],
+                    "message": row.get("message", ""),
                 }
             )
-        _emit_json(out)
-    else:
-        import pandas as pd
-
-        with pd.option_context("display.width", 200, "display.max_columns", 50):
-            print(table.to_string(index=False))
-    return 0
+        else:
+            out.append(
+                {
+                    "group": key,
+                    "params": {},
+                    "rmse": None,
+                    "nfev": None,
+                    "success": False,
+                    "message": row.get("message", ""),
+                }
+            )
+    return out
 
 
 def _metas(m: Any) -> list[dict[str, Any]]:
@@ -446,16 +494,18 @@ def _nk_at(table: Any, wavelength_nm: float, path: str) -> tuple[float, float]:
 def cmd_nk(args: argparse.Namespace) -> int:
     from . import adapters
     from .nk import combined_table, nk_json, nk_table
+    from .outputs import atomic_output, check_file_output, check_input_files, csv_safe_frame
 
+    check_input_files(args.files)
+    if args.output:
+        check_file_output(args.output, inputs=args.files, suffixes=(".csv",))
     data = _selected(args, adapters.read_many(args.files))
     on_ill = "warn" if args.allow_ill_conditioned else "raise"
     table = nk_table(data, on_ill_conditioned=on_ill, theta_sigma_deg=args.theta_sigma)
     if args.output:
-        from .dataset import atomic_output
-
         out = combined_table(table) if args.combined else table
         with atomic_output(args.output) as tmp:
-            out.to_csv(tmp, index=False)
+            csv_safe_frame(out).to_csv(tmp, index=False)
     if args.json:
         _emit_json(nk_json(table))
         return 0
@@ -480,6 +530,7 @@ def cmd_export(args: argparse.Namespace) -> int:
 
     from . import models
     from .adapters.zemax_bsdf import model_to_bsdf
+    from .outputs import check_file_output
 
     if args.format != "zemax-bsdf":
         raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
@@ -497,7 +548,9 @@ def cmd_export(args: argparse.Namespace) -> int:
     unknown = [k for k in values if k not in model.params]
     if unknown:
         raise UsageError(f"--param {unknown}: {args.model} parameters are {list(model.params)}")
-    out = Path(args.output)
+    out = check_file_output(
+        args.output, inputs=[args.nk_from] if args.nk_from else [], suffixes=(".bsdf",)
+    )
     if out.exists() and not args.overwrite:
         raise UsageError(f"-o {out}: exists; pass --overwrite to replace it")
     model_to_bsdf(
@@ -538,8 +591,12 @@ def _height_map(path: str, channel: str | None) -> Any:
 
 
 def cmd_surface(args: argparse.Namespace) -> int:
+    from .outputs import check_file_output, check_input_files
     from .topography import level, roughness_statistics
 
+    check_input_files([args.file])
+    if args.png:
+        check_file_output(args.png, inputs=[args.file], suffixes=(".png",), option="--png")
     hm = _height_map(args.file, args.channel)
     st = roughness_statistics(hm.heights, hm.pixel_size, degree=args.degree, blocks=args.blocks)
     if args.png:
@@ -619,9 +676,14 @@ def _complex(text: str, what: str) -> complex:
 def cmd_trace(args: argparse.Namespace) -> int:
 
     from . import tracer
+    from .outputs import check_file_output
     from .parallel import imap
 
     _check_executor(args)
+    if args.output:
+        check_file_output(args.output, suffixes=(".npz",))
+    if args.png:
+        check_file_output(args.png, suffixes=(".png",), option="--png")
     if (args.substrate is None) == (args.nk_from is None):
         raise UsageError("give the substrate index with --substrate N+Kj or --nk-from FILE")
     if args.nk_from is not None:
@@ -677,9 +739,11 @@ def cmd_trace(args: argparse.Namespace) -> int:
     if args.output:
         result.save(args.output)
     if args.png:
+        from .outputs import atomic_output
         from .report.figures import save_trace_maps_png
 
-        save_trace_maps_png(result, args.png)
+        with atomic_output(args.png) as tmp:
+            save_trace_maps_png(result, tmp)
     summary = tracer.trace_summary(result)
     summary["seconds"] = seconds
     if args.json:
@@ -699,9 +763,12 @@ def cmd_trace(args: argparse.Namespace) -> int:
 
 @_executor_errors
 def cmd_validate(args: argparse.Namespace) -> int:
+    from .outputs import check_report_dir
     from .report import validate
+    from .report.validate import default_fixtures_dir
 
     _check_executor(args)
+    check_report_dir(args.out, inputs=[default_fixtures_dir()], option="--out")
     return int(
         validate(
             out=args.out,
@@ -714,8 +781,11 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
+    from .outputs import check_input_files, check_report_dir
     from .report import user_report
 
+    check_input_files(args.files)
+    check_report_dir(args.output, inputs=args.files)
     return int(user_report(args.files, args.model, args.output))
 
 
@@ -886,6 +956,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
         return 141
+    except OSError as exc:  # an output or input the OS refused: no traceback
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"labbrdf {args.command}: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f"labbrdf {args.command}: out of memory (is an input a huge file?)", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:  # pragma: no cover
         return 130
 

@@ -37,15 +37,15 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
-from collections.abc import Iterable, Iterator, Mapping
-from contextlib import contextmanager
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
+
+from . import outputs as _outputs
 
 __all__ = [
     "COLUMNS",
@@ -513,23 +513,9 @@ def concat(measurements: Iterable[Measurement]) -> Measurement:
 # --------------------------------------------------------------------------- I/O
 
 
-@contextmanager
-def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
-    """Yield a temporary file name beside ``path``; rename it onto ``path`` on success.
-
-    On any exception the temporary file is removed and ``path`` is left as it was, so a
-    failed write never leaves a half-written or clobbered file.
-    """
-    target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    os.close(fd)
-    try:
-        yield tmp
-        os.replace(tmp, target)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+#: write to a temporary name beside the target, rename on success (see labbrdf.outputs:
+#: umask permissions, OS errors as OutputError, leftovers of killed runs cleaned up)
+atomic_output = _outputs.atomic_output
 
 
 def write_parquet(m: Measurement, path: str | os.PathLike[str]) -> Path:
@@ -567,6 +553,12 @@ def write_csv(m: Measurement, path: str | os.PathLike[str]) -> Path:
 
     The first line is ``# labbrdf-meta: <json>``; the rest is the table with floats written
     in their shortest round-tripping form, so :func:`read_csv` gives back the same numbers.
+
+    Text is written verbatim, without the ``'`` prefix that the CSV tables meant for
+    people get against spreadsheet formula injection (:func:`labbrdf.outputs.csv_safe_cell`):
+    this file is a data file that labbrdf and pandas read back exactly, and a prefix would
+    change sample names such as ``-1 deg tilt`` on every round trip. Do not open it in a
+    spreadsheet from an untrusted source; the fit and report tables are safe to open.
     """
     with atomic_output(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
         fh.write(_CSV_META_PREFIX + json.dumps(m.meta, allow_nan=False) + "\n")

@@ -17,6 +17,17 @@ Schedulers
     A running ``dask scheduler``; the workers are whatever ``dask worker tcp://host:port``
     processes are attached to it (they need labbrdf installed).
 
+Security
+--------
+Whoever can connect to a dask scheduler can run any code on every worker. ``local`` binds
+the scheduler, the workers, their nannies and every HTTP service to ``127.0.0.1`` and starts
+no dashboard unless asked (:func:`configure` ``dashboard=True``, ``labbrdf --dashboard`` or
+``LABBRDF_DASK_DASHBOARD=1``; it then listens on ``127.0.0.1:8787`` or a free port).
+A ``tcp://`` address is neither authenticated nor encrypted: a remote one prints a warning.
+``tls://`` uses dask's mutual TLS: the CA, certificate and key come from
+:func:`configure` (``labbrdf --tls-ca/--tls-cert/--tls-key``) or from the dask config
+``distributed.comm.tls.*``; with certificates configured, ``local`` runs on TLS too.
+
 Results always come back in the order of the items, so a computation whose tasks carry
 their own seeds gives the same numbers whatever the scheduler and the worker count.
 A worker that dies makes dask run the task again on another worker (up to ``retries``
@@ -43,6 +54,7 @@ from __future__ import annotations
 
 import asyncio
 import atexit
+import functools
 import os
 import sys
 import threading
@@ -65,6 +77,7 @@ __all__ = [
     "ParallelError",
     "Progress",
     "check_scheduler",
+    "configure",
     "imap",
     "run",
     "shutdown",
@@ -120,6 +133,105 @@ def check_scheduler(scheduler: str) -> str:
     )
 
 
+#: options of the dask schedulers, set by :func:`configure`
+_OPTIONS: dict[str, Any] = {"dashboard": None, "tls": None}
+
+_LOOPBACK = ("127.0.0.1", "localhost", "[::1]", "::1")
+
+
+def configure(
+    *,
+    dashboard: bool | None = None,
+    tls_ca: str | os.PathLike[str] | None = None,
+    tls_cert: str | os.PathLike[str] | None = None,
+    tls_key: str | os.PathLike[str] | None = None,
+) -> None:
+    """Set the dask options of this process (the CLI calls it from its flags).
+
+    Parameters
+    ----------
+    dashboard : bool, optional
+        Start the ``local`` cluster's dashboard on 127.0.0.1 (default: off, or on when the
+        environment has ``LABBRDF_DASK_DASHBOARD=1``).
+    tls_ca, tls_cert, tls_key : path-like, optional
+        PEM files for mutual TLS: the CA that signed every cluster certificate, and this
+        process's certificate and key (the key may be inside the certificate file). Used
+        for ``tls://`` addresses and, when given, for the ``local`` cluster as well.
+
+    Raises
+    ------
+    ValueError
+        A certificate option without ``tls_ca`` and ``tls_cert``, or a file that does not
+        exist.
+    """
+    if dashboard is not None:
+        _OPTIONS["dashboard"] = bool(dashboard)
+    if tls_ca is None and tls_cert is None and tls_key is None:
+        return
+    if tls_ca is None or tls_cert is None:
+        raise ValueError("TLS needs at least --tls-ca and --tls-cert (and --tls-key)")
+    files = {"--tls-ca": tls_ca, "--tls-cert": tls_cert, "--tls-key": tls_key}
+    for opt, f in files.items():
+        if f is not None and not os.path.isfile(f):
+            raise ValueError(f"{opt} {f}: no such file; expected a PEM file")
+    _OPTIONS["tls"] = {k: (os.fspath(v) if v is not None else None) for k, v in files.items()}
+
+
+def _dashboard_wanted() -> bool:
+    if _OPTIONS["dashboard"] is not None:
+        return bool(_OPTIONS["dashboard"])
+    return os.environ.get("LABBRDF_DASK_DASHBOARD", "").strip().lower() in ("1", "true", "yes")
+
+
+def _security() -> Any | None:
+    """A dask Security from :func:`configure`, else from the dask config
+    (``distributed.comm.tls.*``); None when neither names a CA and a certificate."""
+    from distributed.security import Security
+
+    files = _tls_files()
+    if files is None:
+        return None
+    ca, cert, key = files
+    return Security(
+        tls_ca_file=ca,
+        tls_client_cert=cert,
+        tls_client_key=key,
+        tls_scheduler_cert=cert,
+        tls_scheduler_key=key,
+        tls_worker_cert=cert,
+        tls_worker_key=key,
+        require_encryption=True,
+    )
+
+
+def _tls_files() -> tuple[str, str, str | None] | None:
+    """(CA, certificate, key) from :func:`configure`, else from the dask config."""
+    tls = _OPTIONS["tls"]
+    if tls is not None:
+        return tls["--tls-ca"], tls["--tls-cert"], tls["--tls-key"]
+    import dask
+
+    get = functools.partial(dask.config.get, default=None)
+    ca = get("distributed.comm.tls.ca-file")
+    cert = get("distributed.comm.tls.client.cert") or get("distributed.comm.tls.scheduler.cert")
+    key = get("distributed.comm.tls.client.key") or get("distributed.comm.tls.scheduler.key")
+    if ca and cert:
+        return ca, cert, key
+    return None
+
+
+def _host(address: str) -> str:
+    rest = address.split("://", 1)[1]
+    if rest.startswith("["):
+        return rest[: rest.find("]") + 1]
+    return rest.rsplit(":", 1)[0] if ":" in rest else rest
+
+
+def _warn(msg: str) -> None:
+    sys.stderr.write(f"labbrdf: WARNING: {msg}\n")
+    sys.stderr.flush()
+
+
 def _workers(workers: int | None) -> int:
     if workers is None:
         return max(1, os.cpu_count() or 1)
@@ -167,7 +279,7 @@ class Progress:
         self.stream.flush()
 
 
-#: the reusable LocalCluster: {"key": (workers, retries), "client": Client, "cluster": ...}
+#: the reusable LocalCluster: {"key": (workers, retries, tls files, dashboard), "client": ...}
 _LOCAL: dict[str, Any] = {}
 _LOCAL_LOCK = threading.Lock()
 _ATEXIT: list[bool] = []
@@ -195,14 +307,31 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
     """
     Client, LocalCluster = _import_dask()
     if scheduler != "local":
+        kw: dict[str, Any] = {}
+        if scheduler.startswith("tls://"):
+            sec = _security()
+            if sec is None:
+                raise ParallelError(
+                    f"{scheduler}: a tls:// scheduler needs certificates: --tls-ca, "
+                    "--tls-cert and --tls-key (or the dask config distributed.comm.tls.*)"
+                )
+            kw["security"] = sec
+        elif _host(scheduler) not in _LOOPBACK:
+            _warn(
+                f"{scheduler} is an unauthenticated, unencrypted connection: anyone who can "
+                "reach that port can run code on every worker and read the data. Use "
+                "tls:// with certificates, or a scheduler on a trusted network only."
+            )
         try:
-            return Client(scheduler, set_as_default=False), True
+            return Client(scheduler, set_as_default=False, **kw), True
         except OSError as exc:  # refused, timed out, unknown host
             raise ParallelError(
                 f"cannot reach the dask scheduler {scheduler} ({exc}); start one with "
                 "`dask scheduler` and attach workers with `dask worker <address>`"
             ) from exc
-    key = (_workers(workers), int(retries))
+    sec = _security()
+    dash = _dashboard_wanted()
+    key = (_workers(workers), int(retries), _tls_files(), dash)
     with _LOCAL_LOCK:
         client = _LOCAL.get("client")
         if client is not None and _LOCAL.get("key") == key and client.status == "running":
@@ -218,20 +347,29 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
     trim = env.pop("MALLOC_TRIM_THRESHOLD_", None)
     if trim is not None and os.environ.get("MALLOC_TRIM_THRESHOLD_") == str(trim):
         del os.environ["MALLOC_TRIM_THRESHOLD_"]
+    # everything on the loopback interface: the scheduler's HTTP server (which dask binds
+    # to all interfaces when given ":0"), the workers and their nannies; no dashboard
+    # unless asked; TLS when certificates are configured
+    extra: dict[str, Any] = {}
+    if sec is not None:
+        extra = {"security": sec, "protocol": "tls://"}
     with dask.config.set({"distributed.nanny.pre-spawn-environ": env}):
         cluster = LocalCluster(
             n_workers=key[0],
             threads_per_worker=1,
             processes=True,
-            dashboard_address=None,
-            # no dashboard; its HTTP server on a free port, no warning when 8787 is taken
+            host="127.0.0.1",
+            dashboard_address="127.0.0.1:8787" if dash else None,
             scheduler_kwargs={
                 "allowed_failures": key[1],
-                "dashboard": False,
-                "dashboard_address": ":0",
+                "dashboard": dash,
+                "dashboard_address": "127.0.0.1:8787" if dash else "127.0.0.1:0",
             },
+            **extra,
         )
-    client = Client(cluster, set_as_default=False)
+    client = Client(cluster, set_as_default=False, **({"security": sec} if sec else {}))
+    if dash:
+        _warn(f"dask dashboard (no authentication, this machine only): {client.dashboard_link}")
     with _LOCAL_LOCK:
         _LOCAL.update(key=key, client=client, cluster=cluster)
         if not _ATEXIT:

@@ -254,3 +254,27 @@ def test_ingest_selects_rows_and_refuses_an_empty_selection(fixtures_dir: Path, 
     capsys.readouterr()
     assert main(["ingest", scan, "--sample", "mirror"]) == 2
     assert "no row left" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("cmd", "out"),
+    [
+        (["nk", "{TA}", "-o"], "{TA}"),
+        (["nk", "{TA}", "-o"], "nk.txt"),
+        (["surface", "{DI}", "--png"], "map.jpg"),
+        (["export", "--model", "smooth3", "--theta-i", "30", "-o"], "out.csv"),
+        (["export", "--model", "smooth3", "--theta-i", "30", "-o"], "dir/"),
+    ],
+)
+def test_new_writers_refuse_inputs_and_wrong_suffixes(real_exports, tmp_path, capsys, cmd, out):
+    ta, di = str(real_exports / TA), str(real_exports / "topography" / "di-1.di")
+    target = out.format(TA=ta) if "{TA}" in out else str(tmp_path / out)
+    argv = [c.format(TA=ta, DI=di) for c in cmd] + [target]
+    before = {
+        p: p.stat().st_mtime_ns
+        for p in (real_exports / TA, real_exports / "topography" / "di-1.di")
+    }
+    assert main(argv) == 2
+    assert capsys.readouterr().err.strip()
+    assert {p: p.stat().st_mtime_ns for p in before} == before
+    assert sorted(tmp_path.iterdir()) == []

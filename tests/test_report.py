@@ -320,8 +320,10 @@ def _leftovers(parent: Path, name: str) -> list[str]:
 def test_failed_run_leaves_previous_report_intact(tmp_path, monkeypatch):
     out = tmp_path / "validation"
     assert report.validate(out=out, progress=False, sections_to_run=[]) == 0
-    (out / "marker.txt").write_text("old report")
+    # a user's file in the report would now be refused up front; the old report's own
+    # files are the fingerprint
     before = (out / "index.html").read_bytes()
+    results_before = (out / "results.json").read_bytes()
 
     def broken_render(*a, **k):
         raise RuntimeError("disk full while rendering")
@@ -329,7 +331,7 @@ def test_failed_run_leaves_previous_report_intact(tmp_path, monkeypatch):
     monkeypatch.setattr(html, "render", broken_render)
     with pytest.raises(RuntimeError, match="disk full"):
         report.validate(out=out, progress=False, sections_to_run=[])
-    assert (out / "marker.txt").read_text() == "old report"
+    assert (out / "results.json").read_bytes() == results_before
     assert (out / "index.html").read_bytes() == before
     assert _leftovers(tmp_path, "validation") == []
 
@@ -350,11 +352,23 @@ def test_failure_while_writing_leaves_previous_report_intact(tmp_path):
 
 def test_successful_run_replaces_the_old_report(tmp_path):
     out = tmp_path / "validation"
-    out.mkdir()
-    (out / "stale.txt").write_text("stale")
     assert report.validate(out=out, progress=False, sections_to_run=[]) == 0
-    assert not (out / "stale.txt").exists()
-    assert (out / "index.html").is_file()
+    (out / "tables" / "checks.csv").unlink()  # the user removed one of our files: still ours
+    old = json.loads((out / "results.json").read_text())["meta"]["created_utc"]
+    assert report.validate(out=out, progress=False, sections_to_run=[]) == 0
+    assert (out / "index.html").is_file() and (out / ".labbrdf-report").is_file()
+    assert json.loads((out / "results.json").read_text())["meta"]["created_utc"] >= old
+    assert _leftovers(tmp_path, "validation") == []
+
+
+def test_a_folder_that_is_not_a_report_is_never_replaced(tmp_path):
+    out = tmp_path / "validation"
+    out.mkdir()
+    (out / "stale.txt").write_text("mine")
+    with pytest.raises(ValueError, match="not empty and not a labbrdf report"):
+        report.validate(out=out, progress=False, sections_to_run=[])
+    assert (out / "stale.txt").read_text() == "mine"
+    assert [p.name for p in out.iterdir()] == ["stale.txt"]
     assert _leftovers(tmp_path, "validation") == []
 
 

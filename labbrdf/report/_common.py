@@ -18,9 +18,7 @@ import io
 import json
 import math
 import os
-import shutil
 import sys
-import tempfile
 import time
 import traceback
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -332,9 +330,12 @@ class Builder:
 
 
 def _cell(v: Any) -> Any:
+    """A CSV cell; text a spreadsheet would run as a formula gets a leading ``'``."""
+    from ..outputs import csv_safe_cell
+
     if v is None:
         return ""
-    return json.dumps(v) if isinstance(v, (list, dict)) else v
+    return csv_safe_cell(json.dumps(v) if isinstance(v, (list, dict)) else v)
 
 
 def tables_csv(results: Mapping[str, Any]) -> dict[str, str]:
@@ -368,47 +369,33 @@ def tables_csv(results: Mapping[str, Any]) -> dict[str, str]:
     return out
 
 
-def atomic_dir(out: str | os.PathLike[str], write: Callable[[Path], None]) -> Path:
-    """Build a folder with ``write(tmp)`` and move it into place at ``out``.
+def atomic_dir(
+    out: str | os.PathLike[str],
+    write: Callable[[Path], None],
+    *,
+    inputs: Sequence[str | os.PathLike[str]] = (),
+) -> Path:
+    """Build a report folder with ``write(tmp)`` and move it into place at ``out``.
 
-    The folder is built in a temporary sibling of ``out``; then an existing ``out`` is
-    renamed aside, the new folder renamed in, and the old one deleted. If ``write``
-    raises, the temporary folder is removed and an existing ``out`` is left untouched.
+    See :func:`labbrdf.outputs.replace_dir`: ``out`` must be new, empty or an earlier
+    labbrdf report holding only our files, and may not hold an input; otherwise
+    :class:`~labbrdf.outputs.OutputError` and nothing is touched. If ``write`` raises, the
+    temporary folder is removed and an existing ``out`` is left untouched.
     """
-    out = Path(out).resolve()
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.new-", dir=out.parent))
-    mask = os.umask(0)
-    os.umask(mask)
-    os.chmod(tmp, 0o777 & ~mask)  # mkdtemp makes 0700; a report folder is normally shared
-    try:
-        write(tmp)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    old: Path | None = None
-    if out.exists():
-        old = Path(tempfile.mkdtemp(prefix=f".{out.name}.old-", dir=out.parent))
-        old.rmdir()
-        os.replace(out, old)
-    try:
-        os.replace(tmp, out)
-    except BaseException:
-        if old is not None:
-            os.replace(old, out)
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
-    return out
+    from ..outputs import replace_dir
+
+    return replace_dir(out, write, inputs=inputs)
 
 
 def write_report(
     out: str | os.PathLike[str],
     results: Mapping[str, Any],
     html_text: str,
+    *,
+    inputs: Sequence[str | os.PathLike[str]] = (),
 ) -> Path:
-    """Write ``index.html``, ``results.json`` and ``tables/*.csv`` atomically into ``out``."""
+    """Write ``index.html``, ``results.json`` and ``tables/*.csv`` atomically into ``out``
+    (refused when ``out`` holds anything but an earlier report, or one of ``inputs``)."""
     payload = json.dumps(jsonable(results), indent=1, allow_nan=False)
     csvs = tables_csv(results)
 
@@ -419,4 +406,4 @@ def write_report(
         for tid, text in csvs.items():
             (d / "tables" / f"{tid}.csv").write_text(text, encoding="utf-8")
 
-    return atomic_dir(out, _write)
+    return atomic_dir(out, _write, inputs=inputs)

@@ -518,7 +518,7 @@ def save_surface_png(uri: str, path: Any) -> Any:
     """Write a figure data URI of :func:`surface_figure` to a PNG file (atomically)."""
     from pathlib import Path
 
-    from labbrdf.dataset import atomic_output
+    from labbrdf.outputs import atomic_output
 
     data = base64.b64decode(uri.split(",", 1)[1])
     with atomic_output(path) as tmp:

@@ -66,7 +66,8 @@ def user_report(
     Raises
     ------
     ValueError
-        No paths, or an unknown model name or option (before anything is written).
+        No paths, an unknown model name or option, or an output folder that is refused
+        (:class:`labbrdf.outputs.OutputError`), all before any work.
     """
     from labbrdf import models
 
@@ -76,6 +77,9 @@ def user_report(
     paths = [Path(p) for p in ([paths] if isinstance(paths, (str, os.PathLike)) else paths)]
     if not paths:
         raise ValueError("paths: expected at least one data file")
+    from ..outputs import check_report_dir
+
+    check_report_dir(out, inputs=paths)  # refused before the fits, not after
     opts = dict(options or {})
     try:
         models.get(model, **opts)
@@ -117,6 +121,6 @@ def user_report(
         properties.colour_section(ctx)
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
-    write_report(out, b.results, page)
+    write_report(out, b.results, page, inputs=paths)
     b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
     return code

@@ -126,6 +126,9 @@ def validate(
     """
     scale_name = "quick" if quick else "full"
     fx = Path(fixtures_dir) if fixtures_dir is not None else default_fixtures_dir()
+    from ..outputs import check_report_dir
+
+    check_report_dir(out, inputs=[fx], option="out")  # refused before the run, not after
     if shared_dir is False:
         shared = None
     elif shared_dir is None:
@@ -253,6 +256,6 @@ def validate(
         b.results["meta"]["sections_not_run"] = skipped
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
-    write_report(out, b.results, page)
+    write_report(out, b.results, page, inputs=[fx])
     b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
     return code

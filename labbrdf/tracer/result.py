@@ -166,10 +166,22 @@ class TraceResult:
 
     # -- I/O -------------------------------------------------------------------------
     def save(self, path: str | Path) -> Path:
-        """Write an .npz with ``mueller``, bin centres/edges, config JSON and ledger."""
+        """Write an .npz with ``mueller``, bin centres/edges, config JSON and ledger.
+
+        A name without ``.npz`` gets it appended (as numpy does); the file is written
+        atomically (:func:`labbrdf.outputs.atomic_output`). Returns the path written.
+        """
+        from ..outputs import atomic_output
+
         path = Path(path)
+        final = path if path.suffix == ".npz" else path.with_name(path.name + ".npz")
+        with atomic_output(final) as tmp, open(tmp, "wb") as fh:
+            self._savez(fh)
+        return final
+
+    def _savez(self, fh: Any) -> None:
         np.savez_compressed(
-            path,
+            fh,
             mueller=self.mueller,
             mueller_stderr=self.mueller_stderr,
             theta_r_deg=self.theta_r_deg,
@@ -187,7 +199,6 @@ class TraceResult:
             seconds=np.array(self.seconds),
             events=np.array(self.events),
         )
-        return path if path.suffix == ".npz" else path.with_name(path.name + ".npz")
 
     @classmethod
     def load(cls, path: str | Path) -> TraceResult:

@@ -1,0 +1,580 @@
+"""Output-path safety: every file or folder labbrdf writes goes through this module.
+
+Nothing a user owns is lost by our outputs:
+
+* :func:`check_file_output` refuses a file output that is one of the inputs, an existing
+  folder or anything but a regular file, a name ending in a path separator (a folder),
+  or a name without the expected suffix.
+* :func:`check_report_dir` refuses a report folder that is (or contains, or lies inside)
+  an input, an existing file, the current working folder, or an existing folder that is
+  neither empty nor a previous labbrdf report; a previous report in which the user put
+  a file of their own is refused too, naming that file. A report folder is recognised by
+  its marker file :data:`REPORT_MARKER` (a small JSON that lists the files we wrote), or,
+  for reports written before the marker existed, by its exact layout (``index.html``,
+  ``results.json`` with the report keys, ``tables/*.csv`` and nothing else).
+* :func:`atomic_output` (files) and :func:`replace_dir` (report folders) build the output
+  under a temporary hidden name beside it and rename it into place; outputs get the
+  permissions of the umask (``0o666 & ~umask``; a replaced file keeps its mode).
+* Temporary names carry our pattern, a host tag and the process id
+  (``.NAME.labbrdf-tmp-HOST-PID-XXXX.tmp``, ``.NAME.labbrdf-new-HOST-PID-XXXX``,
+  ``.NAME.labbrdf-old-HOST-PID-XXXX``). A run killed with SIGKILL leaves them behind; the
+  next write of the same output removes those whose process is gone (on this host), and
+  for folders only when they hold our marker. Nothing else is ever removed.
+
+Every refusal raises :class:`OutputError` (a ValueError: the CLI prints it and exits 2)
+naming the path and what was expected.
+
+This module imports nothing from labbrdf at import time, so every layer may use it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import hashlib
+import json
+import os
+import re
+import shutil
+import socket
+import stat
+import tempfile
+import time
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+__all__ = [
+    "CSV_FORMULA_PREFIXES",
+    "REPORT_MARKER",
+    "OutputError",
+    "atomic_output",
+    "check_file_output",
+    "check_input_files",
+    "check_report_dir",
+    "clean_leftovers",
+    "csv_safe_cell",
+    "csv_safe_frame",
+    "replace_dir",
+]
+
+#: the marker file written into every report folder
+REPORT_MARKER = ".labbrdf-report"
+
+#: text cells starting with one of these are prefixed with ``'`` in CSVs meant for people
+#: (OWASP "CSV injection"): a spreadsheet would otherwise run them as a formula
+CSV_FORMULA_PREFIXES = ("=", "+", "-", "@", "\t", "\r")
+
+_LEGACY_REPORT_KEYS = {"title", "meta", "sections", "tables", "checks", "summary"}
+
+
+class OutputError(ValueError, OSError):
+    """An output path that labbrdf refuses to write (or cannot write); CLI exit code 2.
+
+    Also an OSError, so that code which caught the OS error of a failed write still does.
+    """
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def _umask() -> int:
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)  # not thread-safe, hence /proc first
+    os.umask(mask)
+    return mask
+
+
+def _host_tag() -> str:
+    return hashlib.sha1(socket.gethostname().encode()).hexdigest()[:6]
+
+
+def _tag() -> str:
+    """``HOST-PID`` of this process, part of every temporary name."""
+    return f"{_host_tag()}-{os.getpid()}"
+
+
+def _pid_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # EPERM: alive, another user's
+        return True
+    return True
+
+
+def _display(path: Path | str) -> str:
+    return str(path)
+
+
+def _wraps_oserror(path: Path | str, what: str, exc: OSError) -> OutputError:
+    reason = exc.strerror or str(exc)
+    if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        hint = "; expected a folder you can write to"
+    elif exc.errno == errno.ENOSPC:
+        hint = "; the disk is full"
+    else:
+        hint = ""
+    return OutputError(f"{what} {_display(path)}: {reason}{hint}")
+
+
+def _is_within(child: Path, parent: Path) -> bool:
+    """``child`` equals ``parent`` or lies inside it (both resolved)."""
+    return child == parent or parent in child.parents
+
+
+def _resolved(p: str | os.PathLike[str]) -> Path:
+    return Path(os.path.abspath(os.fspath(p))).resolve()
+
+
+def _same(a: Path, b: Path) -> bool:
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return a.resolve() == b.resolve()
+
+
+def _check_writable(path: Path, option: str, shown: str | None = None) -> None:
+    """The nearest existing folder above ``path`` must be writable (checked before any
+    work, so that a long run does not end in a permission error)."""
+    d = Path(os.path.abspath(path)).parent
+    while not d.exists() and d != d.parent:
+        d = d.parent
+    if d.is_dir() and not os.access(d, os.W_OK | os.X_OK):
+        raise OutputError(
+            f"{option} {shown or path}: the folder {d} is not writable; expected a folder you can "
+            "write to"
+        )
+
+
+def _ends_with_sep(p: str | os.PathLike[str]) -> bool:
+    s = os.fspath(p)
+    return s.endswith(os.sep) or (os.altsep is not None and s.endswith(os.altsep))
+
+
+# --------------------------------------------------------------------------- inputs
+
+
+def check_input_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
+    """Refuse inputs that are not regular files (a device such as ``/dev/zero`` would be
+    read forever, a folder is not a data file); a missing file is left to the reader."""
+    out = []
+    for p in paths:
+        path = Path(p)
+        try:
+            st = os.stat(path)
+        except OSError:
+            out.append(path)
+            continue
+        if stat.S_ISDIR(st.st_mode):
+            raise OutputError(f"{path}: is a folder; expected a data file")
+        if not stat.S_ISREG(st.st_mode):
+            raise OutputError(
+                f"{path}: not a regular file (a device or pipe); expected a data file"
+            )
+        out.append(path)
+    return out
+
+
+# --------------------------------------------------------------------------- files
+
+
+def check_file_output(
+    path: str | os.PathLike[str],
+    *,
+    inputs: Iterable[str | os.PathLike[str]] = (),
+    suffixes: Sequence[str] = (),
+    option: str = "-o",
+) -> Path:
+    """Validate a file output before any work is done; return it as a Path.
+
+    Parameters
+    ----------
+    path : path-like
+        The output file name.
+    inputs : iterable of path-like
+        The command's input files: the output may not be one of them.
+    suffixes : sequence of str
+        Accepted suffixes (lower case, with the dot); empty accepts any.
+    option : str
+        The option name, for the messages.
+
+    Raises
+    ------
+    OutputError
+        The name ends with a separator (a folder), has the wrong suffix, is an existing
+        folder or a non-regular file, or is one of the inputs.
+    """
+    if not os.fspath(path):
+        raise OutputError(f"{option}: empty file name")
+    want = " or ".join(suffixes) if suffixes else "a file"
+    if _ends_with_sep(path):
+        raise OutputError(
+            f"{option} {os.fspath(path)}: ends with '/', which names a folder; expected a "
+            f"file name ending in {want}"
+        )
+    p = Path(path)
+    if p.is_symlink() and not p.exists():
+        raise OutputError(f"{option} {p}: a dangling symbolic link; expected a file name")
+    if p.exists():
+        if p.is_dir():
+            raise OutputError(
+                f"{option} {p}: is an existing folder; expected a file name ending in {want}"
+            )
+        if not p.is_file():
+            raise OutputError(f"{option} {p}: not a regular file; expected a file name")
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise OutputError(f"{option} {p}: expected a file name ending in {want}")
+    for f in inputs:
+        fp = Path(f)
+        if (p.exists() and fp.exists() and _same(p, fp)) or _resolved(p) == _resolved(fp):
+            raise OutputError(f"{option} {p} is one of the input files; refusing to overwrite it")
+    parent = p.parent if str(p.parent) else Path(".")
+    if parent.exists() and not parent.is_dir():
+        raise OutputError(f"{option} {p}: {parent} is not a folder")
+    _check_writable(p, option)
+    return p
+
+
+def clean_leftovers(target: str | os.PathLike[str]) -> list[Path]:
+    """Remove what earlier runs of labbrdf, killed before they finished, left beside
+    ``target``: temporary files and folders with our name pattern whose process (on this
+    host) is gone; folders only when they hold our :data:`REPORT_MARKER`.
+
+    A previous report moved aside (``...labbrdf-old-...``) when ``target`` itself is
+    missing is moved back to ``target`` rather than removed. Returns what was removed.
+    """
+    target = Path(target)
+    parent = target.parent if str(target.parent) else Path(".")
+    pat = re.compile(
+        r"^\." + re.escape(target.name) + r"\.labbrdf-(tmp|new|old)-([0-9a-f]{6})-(\d+)-"
+        r"[A-Za-z0-9_]+(\.tmp)?$"
+    )
+    # report folders of labbrdf versions before these names (no host or pid): removed only
+    # when they hold exactly a report of ours and are older than an hour
+    legacy = re.compile(r"^\." + re.escape(target.name) + r"\.(new|old)-[a-z0-9_]{8}$")
+    host = _host_tag()
+    removed: list[Path] = []
+    try:
+        entries = sorted(os.scandir(parent), key=lambda e: e.name)
+    except OSError:
+        return removed
+    for e in entries:
+        lm = legacy.match(e.name)
+        if lm and _is_legacy_leftover(Path(e.path)):
+            p = Path(e.path)
+            try:
+                if lm.group(1) == "old" and not os.path.lexists(target):
+                    os.replace(p, target)
+                else:
+                    shutil.rmtree(p)
+                    removed.append(p)
+            except OSError:
+                pass
+            continue
+        m = pat.match(e.name)
+        if not m or m.group(2) != host or _pid_alive(int(m.group(3))):
+            continue
+        kind = m.group(1)
+        p = Path(e.path)
+        try:
+            if kind == "tmp":
+                if e.is_file(follow_symlinks=False) and m.group(4):
+                    p.unlink()
+                    removed.append(p)
+                continue
+            if e.is_symlink() or not e.is_dir() or not (p / REPORT_MARKER).is_file():
+                continue
+            if kind == "old" and not os.path.lexists(target):
+                os.replace(p, target)  # killed between the two renames: put it back
+                continue
+            shutil.rmtree(p)
+            removed.append(p)
+        except OSError:
+            continue
+    return removed
+
+
+def _is_legacy_leftover(p: Path) -> bool:
+    try:
+        if p.is_symlink() or not p.is_dir() or time.time() - p.stat().st_mtime < 3600:
+            return False
+    except OSError:
+        return False
+    ours = _marker_files(p)
+    return ours is not None and not _foreign(p, ours)
+
+
+@contextlib.contextmanager
+def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
+    """Yield a temporary file name beside ``path``; rename it onto ``path`` on success.
+
+    On any exception the temporary file is removed and ``path`` is left as it was. The
+    file gets ``0o666 & ~umask`` (a file it replaces: that file's mode). An OS error
+    (read-only folder, full disk, ...) becomes :class:`OutputError` naming the path.
+    """
+    target = Path(path)
+    parent = target.parent if str(target.parent) else Path(".")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise _wraps_oserror(parent, "cannot create the folder", exc) from None
+    clean_leftovers(target)
+    try:
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{target.name}.labbrdf-tmp-{_tag()}-", suffix=".tmp", dir=parent
+        )
+    except OSError as exc:
+        raise _wraps_oserror(target, "cannot write", exc) from None
+    os.close(fd)
+    try:
+        yield tmp
+        try:
+            mode = stat.S_IMODE(os.stat(target).st_mode) if target.is_file() else None
+        except OSError:
+            mode = None
+        try:
+            os.chmod(tmp, mode if mode is not None else 0o666 & ~_umask())
+            if target.is_dir():
+                raise OutputError(f"cannot write {target}: is an existing folder")
+            os.replace(tmp, target)
+        except OSError as exc:
+            raise _wraps_oserror(target, "cannot write", exc) from None
+    finally:
+        if os.path.lexists(tmp):
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+
+
+# --------------------------------------------------------------------------- folders
+
+
+def _marker_files(d: Path) -> set[str] | None:
+    """The files a report folder's marker lists (relative, '/'-separated), or None when
+    ``d`` is not a labbrdf report folder."""
+    marker = d / REPORT_MARKER
+    if marker.is_file() and not marker.is_symlink():
+        try:
+            info = json.loads(marker.read_text(encoding="utf-8"))
+            files = info["files"]
+            if info.get("labbrdf") == "report" and all(isinstance(f, str) for f in files):
+                return set(files)
+        except (OSError, ValueError, KeyError, TypeError):
+            return None
+        return None
+    # a report written before the marker existed: exactly our layout
+    try:
+        res = json.loads((d / "results.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not (isinstance(res, dict) and _LEGACY_REPORT_KEYS <= set(res)):
+        return None
+    files = {"index.html", "results.json"}
+    tables = d / "tables"
+    if tables.is_dir() and not tables.is_symlink():
+        files |= {f"tables/{c.name}" for c in tables.iterdir() if c.name.endswith(".csv")}
+    return files
+
+
+def _foreign(d: Path, ours: set[str]) -> list[str]:
+    """Entries of ``d`` (recursively) that are not among ``ours`` or their folders."""
+    dirs = {str(Path(f).parent).replace(os.sep, "/") for f in ours} - {"."}
+    for f in list(dirs):
+        dirs |= {str(p).replace(os.sep, "/") for p in Path(f).parents if str(p) != "."}
+    allowed = set(ours) | {REPORT_MARKER}
+    out: list[str] = []
+    for root, dnames, fnames in os.walk(d):
+        rel_root = Path(root).relative_to(d)
+        for name in sorted(dnames):
+            rel = (rel_root / name).as_posix()
+            if rel not in dirs or (Path(root) / name).is_symlink():
+                out.append(rel + "/")
+        dnames[:] = [n for n in dnames if (rel_root / n).as_posix() in dirs]
+        for name in sorted(fnames):
+            rel = (rel_root / name).as_posix()
+            full = Path(root) / name
+            if rel not in allowed or full.is_symlink() or not full.is_file():
+                out.append(rel)
+    return out
+
+
+def check_report_dir(
+    path: str | os.PathLike[str],
+    *,
+    inputs: Iterable[str | os.PathLike[str]] = (),
+    option: str = "-o",
+) -> Path:
+    """Validate a report folder before any work is done; return it resolved.
+
+    Raises
+    ------
+    OutputError
+        ``path`` is an existing file, equals or contains an input (or lies inside an
+        input folder), is the current working folder, or is an existing folder that is
+        neither empty nor a previous labbrdf report, or a previous report that holds a
+        file we did not write (named in the message).
+    """
+    if not os.fspath(path):
+        raise OutputError(f"{option}: empty folder name")
+    shown = os.fspath(path)
+    if os.path.lexists(path) and not os.path.isdir(path):
+        raise OutputError(
+            f"{option} {shown}: is an existing file; expected a folder for the report "
+            "(a new name, an empty folder or an earlier report)"
+        )
+    out = _resolved(path)
+    for f in inputs:
+        fp = _resolved(f)
+        if _is_within(fp, out):
+            raise OutputError(
+                f"{option} {shown}: contains the input {f}; expected a folder that holds "
+                "none of the input files"
+            )
+        if _is_within(out, fp):
+            raise OutputError(f"{option} {shown}: lies inside the input {f}")
+    try:
+        cwd = Path.cwd().resolve()
+    except OSError:
+        cwd = None
+    if cwd is not None and _is_within(cwd, out):
+        raise OutputError(
+            f"{option} {shown}: is the current folder (or contains it); expected a new "
+            "folder name for the report, e.g. -o report"
+        )
+    if out.is_dir():
+        try:
+            empty = not any(out.iterdir())
+        except OSError as exc:
+            raise _wraps_oserror(out, "cannot read the folder", exc) from None
+        if not empty:
+            ours = _marker_files(out)
+            if ours is None:
+                raise OutputError(
+                    f"{option} {shown}: is a folder that is not empty and not a labbrdf "
+                    "report; expected a new folder name, an empty folder or an earlier "
+                    "report (nothing in it was changed)"
+                )
+            foreign = _foreign(out, ours)
+            if foreign:
+                names = ", ".join(foreign[:5]) + (", ..." if len(foreign) > 5 else "")
+                raise OutputError(
+                    f"{option} {shown}: is an earlier labbrdf report that now also holds "
+                    f"files labbrdf did not write ({names}); move them out or choose "
+                    "another folder (nothing was changed)"
+                )
+    if out.parent.exists() and not out.parent.is_dir():
+        raise OutputError(f"{option} {shown}: {out.parent} is not a folder")
+    _check_writable(out, option, shown)
+    return out
+
+
+def _listing(d: Path) -> list[str]:
+    return sorted(
+        (Path(root) / n).relative_to(d).as_posix()
+        for root, _, names in os.walk(d)
+        for n in names
+        if not (root == str(d) and n == REPORT_MARKER)
+    )
+
+
+def _write_marker(d: Path, files: list[str], status: str) -> None:
+    try:
+        from labbrdf import __version__ as version
+    except ImportError:  # pragma: no cover
+        version = "?"
+    info = {"labbrdf": "report", "version": version, "status": status, "files": files}
+    (d / REPORT_MARKER).write_text(json.dumps(info, indent=1) + "\n", encoding="utf-8")
+
+
+def replace_dir(
+    out: str | os.PathLike[str],
+    write: Callable[[Path], Any],
+    *,
+    inputs: Iterable[str | os.PathLike[str]] = (),
+    option: str = "-o",
+) -> Path:
+    """Build a report folder with ``write(tmp)`` and move it into place at ``out``.
+
+    ``out`` is checked with :func:`check_report_dir` before and again after building.
+    The folder is built in a hidden temporary sibling (marked as ours from the start),
+    then an existing ``out`` (an earlier report) is renamed aside, the new folder renamed
+    in, and the old one deleted. If ``write`` raises, the temporary folder is removed and
+    ``out`` is left untouched.
+    """
+    inputs = list(inputs)
+    target = check_report_dir(out, inputs=inputs, option=option)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise _wraps_oserror(target.parent, "cannot create the folder", exc) from None
+    clean_leftovers(target)
+    try:
+        tmp = Path(
+            tempfile.mkdtemp(prefix=f".{target.name}.labbrdf-new-{_tag()}-", dir=target.parent)
+        )
+    except OSError as exc:
+        raise _wraps_oserror(target, "cannot write the report folder", exc) from None
+    try:
+        try:
+            _write_marker(tmp, [], "building")
+            os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700; a report is shared
+        except OSError as exc:
+            raise _wraps_oserror(target, "cannot write the report folder", exc) from None
+        write(tmp)  # its own errors propagate unchanged
+        _write_marker(tmp, _listing(tmp), "complete")
+        check_report_dir(out, inputs=inputs, option=option)  # changed while we worked?
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    old: Path | None = None
+    try:
+        if target.exists():
+            old = Path(
+                tempfile.mkdtemp(prefix=f".{target.name}.labbrdf-old-{_tag()}-", dir=target.parent)
+            )
+            old.rmdir()
+            os.replace(target, old)
+        try:
+            os.replace(tmp, target)
+        except BaseException:
+            if old is not None:
+                os.replace(old, target)
+                old = None
+            raise
+    except OSError as exc:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise _wraps_oserror(target, "cannot replace the report folder", exc) from None
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
+    return target
+
+
+# --------------------------------------------------------------------------- CSV cells
+
+
+def csv_safe_cell(value: Any) -> Any:
+    """A text cell that a spreadsheet would run as a formula (starts with ``= + - @``, TAB
+    or CR) gets a leading ``'``; anything else is returned unchanged (numbers too)."""
+    if isinstance(value, str) and value.startswith(CSV_FORMULA_PREFIXES):
+        return "'" + value
+    return value
+
+
+def csv_safe_frame(df: Any) -> Any:
+    """A copy of a DataFrame whose text cells went through :func:`csv_safe_cell`; for CSV
+    tables meant to be opened by people (not for the dataset CSV, read back exactly)."""
+    out = df.copy()
+    for col in out.columns:
+        if out[col].dtype == object or str(out[col].dtype) in ("string", "str"):
+            out[col] = out[col].map(csv_safe_cell)
+    out.columns = [csv_safe_cell(c) if isinstance(c, str) else c for c in out.columns]
+    return out
