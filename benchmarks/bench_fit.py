@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 from scipy import optimize
 
-from labbrdf.fit import FitData, Objective, fit, fit_many
+from labbrdf.fitting import FitData, Objective, fit, fit_many
 from labbrdf.models import MODELS, get
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -3,7 +3,7 @@
 The public API is imported lazily so that ``import labbrdf`` stays cheap:
 
 - :func:`read`, :func:`read_many` (instrument adapters), :class:`Measurement`
-- :func:`fit`, :func:`fit_many` (nlopt fitting core)
+- :func:`fit`, :func:`fit_many` (nlopt fitting core, from :mod:`labbrdf.fitting`)
 - :func:`hemispherical_reflectance` (directional-hemispherical reflectance of a model)
 - :func:`trace` (Monte Carlo polarization ray tracer)
 """
@@ -21,9 +21,9 @@ _LAZY = {
     "Measurement": ("labbrdf.dataset", "Measurement"),
     "DatasetError": ("labbrdf.dataset", "DatasetError"),
     "AdapterError": ("labbrdf.adapters", "AdapterError"),
-    "fit": ("labbrdf.fit", "fit"),
-    "fit_many": ("labbrdf.fit", "fit_many"),
-    "FitResult": ("labbrdf.fit", "FitResult"),
+    "fit": ("labbrdf.fitting", "fit"),
+    "fit_many": ("labbrdf.fitting", "fit_many"),
+    "FitResult": ("labbrdf.fitting", "FitResult"),
     "hemispherical_reflectance": ("labbrdf.integrate", "hemispherical_reflectance"),
     "trace": ("labbrdf.tracer", "trace"),
     "TraceConfig": ("labbrdf.tracer", "TraceConfig"),
@@ -41,7 +41,7 @@ def __getattr__(name: str) -> Any:
         "dataset",
         "optics",
         "models",
-        "fit",
+        "fitting",
         "integrate",
         "tracer",
         "surface",

@@ -215,7 +215,7 @@ def cmd_formats(args: argparse.Namespace) -> int:
 @_executor_errors
 def cmd_fit(args: argparse.Namespace) -> int:
     from . import adapters
-    from .fit import fit_many
+    from .fitting import fit_many
 
     _check_executor(args)
     data = adapters.read_many(args.files)

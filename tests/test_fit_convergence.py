@@ -16,8 +16,8 @@ import pandas as pd
 import pytest
 
 import labbrdf
-from labbrdf.fit import FitData, fit
-from labbrdf.fit.core import CHI2_CONVERGED, CHI2_TOL, LOCAL_ROUNDS
+from labbrdf.fitting import FitData, fit
+from labbrdf.fitting.core import CHI2_CONVERGED, CHI2_TOL, LOCAL_ROUNDS
 from labbrdf.report.validate import validate
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -27,11 +27,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import labbrdf.fit.batch
+import labbrdf.fitting.batch
 from labbrdf import parallel
 from labbrdf.cli import main
 from labbrdf.dataset import Measurement, make_frame, write
-from labbrdf.fit import fit_many
+from labbrdf.fitting import fit_many
 from labbrdf.models import get as get_model
 from labbrdf.parallel import ParallelError
 from labbrdf.tracer import Substrate, TraceConfig, trace
@@ -262,8 +262,8 @@ def test_worker_killed_mid_batch_fit_is_retried_and_table_equals_serial(
     dask_ok, frame, serial_table, tmp_path, monkeypatch
 ):
     marker = tmp_path / "deaths"
-    killer = KillOnce("labbrdf.fit.batch", "_fit_chunk", fit_chunk, 2, marker)
-    monkeypatch.setattr(labbrdf.fit.batch, "_fit_chunk", killer)
+    killer = KillOnce("labbrdf.fitting.batch", "_fit_chunk", fit_chunk, 2, marker)
+    monkeypatch.setattr(labbrdf.fitting.batch, "_fit_chunk", killer)
     table = fit_many(frame, "smooth3", scheduler="local", workers=2, chunks=6, progress=False)
     assert deaths(marker) == 1
     assert_same_table(serial_table, table)
@@ -286,8 +286,8 @@ def test_batch_fit_fails_loudly_when_worker_retries_are_used_up(
 ):
     marker = tmp_path / "deaths"
     # dies on every attempt: the first run and the default 2 retries
-    killer = KillOnce("labbrdf.fit.batch", "_fit_chunk", fit_chunk, 1, marker, times=99)
-    monkeypatch.setattr(labbrdf.fit.batch, "_fit_chunk", killer)
+    killer = KillOnce("labbrdf.fitting.batch", "_fit_chunk", fit_chunk, 1, marker, times=99)
+    monkeypatch.setattr(labbrdf.fitting.batch, "_fit_chunk", killer)
     table = None
     with pytest.raises(ParallelError, match="2 retries were used up.*no partial result"):
         table = fit_many(frame, "smooth3", scheduler="local", workers=2, chunks=4, progress=False)

@@ -17,10 +17,10 @@ from scipy import optimize, special
 from ..dataset import Measurement
 from ..models import Model, Parameters
 from ..models import get as get_model
-from .data import FitData, FitError, _as_fit_data, _clean
+from .data import FitData, FitError, as_fit_data, clean_fit_data
 from .objective import GUESSES, Objective
 from .result import FitResult
-from .uncertainty import AT_BOUND_FRAC, _jacobian, _uncertainties
+from .uncertainty import AT_BOUND_FRAC, jacobian, uncertainties
 
 __all__ = [
     "ALGORITHMS",
@@ -31,6 +31,7 @@ __all__ = [
     "SPECULAR_LINE_SHAPE",
     "fit",
     "parse_method",
+    "setup_params",
 ]
 
 #: every nlopt algorithm, by name (``GN_CRS2_LM`` ...), read from the nlopt module itself
@@ -137,7 +138,7 @@ def _copy_params(p: Parameters) -> Parameters:
     return Parameters({k: copy.copy(q) for k, q in p.items()})
 
 
-def _setup_params(
+def setup_params(
     model: Model, params: Parameters | Mapping[str, float] | None, fix: Mapping[str, float] | None
 ) -> Parameters:
     p = _copy_params(model.params)
@@ -420,8 +421,8 @@ def fit(
         raise FitError(f"ci must be 'wald' or 'profile', got {ci!r}")
     if ci == "profile" and energy_constraint not in (False, None):
         raise FitError("ci='profile' is not combined with energy_constraint; use ci='wald'")
-    fd, ndropped = _clean(_as_fit_data(data, quantity, unit), nan_policy)
-    p = _setup_params(model, params, fix)
+    fd, ndropped = clean_fit_data(as_fit_data(data, quantity, unit), nan_policy)
+    p = setup_params(model, params, fix)
     guessed = guess and _apply_guess(model, fd, p, set(params or ()))
     weights, use_sigma = _weights(fd, use_sigma)
     varying = p.varying()
@@ -480,11 +481,11 @@ def fit(
         vals, chisqr = obj.solve(obj.from_vector(x) if obj.n else dict(obj.base))
         best = obj.model_values(vals)
         finite = all(math.isfinite(v) for v in vals.values()) and math.isfinite(chisqr)
-        J = _jacobian(obj, vals, varying) if finite else np.full((n_pts, nvarys), np.nan)
+        J = jacobian(obj, vals, varying) if finite else np.full((n_pts, nvarys), np.nan)
     resid = obj.y - best
     nfree = n_pts - nvarys
     redchi = chisqr / nfree
-    covar, stderr, correl, reasons, cond = _uncertainties(
+    covar, stderr, correl, reasons, cond = uncertainties(
         J, varying, vals, 1.0 if use_sigma else redchi, nfree
     )
     out, flags = _fitted_params(p, vals, stderr, correl, reasons, nfree)

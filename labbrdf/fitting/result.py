@@ -114,7 +114,7 @@ class FitResult:
         Notes on the data or the fit (dropped points, intervals not found).
     ci_method : str
         ``wald`` (value +- t stderr, Student t with ``nfree`` degrees of freedom) or
-        ``profile`` (profile of chi-square); see :func:`labbrdf.fit.fit`.
+        ``profile`` (profile of chi-square); see :func:`labbrdf.fitting.fit`.
     cond : float or None
         Condition number of the scaled Jacobian at the optimum.
     nlopt_version : str or None

@@ -1,6 +1,6 @@
 """Fit input: the rows of a dataset table (or plain arrays) that a model is fitted to.
 
-Angles stay in degrees here, as at every labbrdf boundary; :class:`~labbrdf.fit.Objective`
+Angles stay in degrees here, as at every labbrdf boundary; :class:`~labbrdf.fitting.Objective`
 converts them to radians for the model.
 """
 
@@ -15,7 +15,15 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..dataset import Measurement
 
-__all__ = ["FITTABLE_QUANTITIES", "FitData", "FitError"]
+__all__ = [
+    "FITTABLE_QUANTITIES",
+    "FitData",
+    "FitError",
+    "as_fit_data",
+    "clean_fit_data",
+    "select_rows",
+    "several_groups_message",
+]
 
 
 class FitError(ValueError):
@@ -113,10 +121,10 @@ class FitData:
         several of them, or several units, is refused unless ``quantity`` / ``unit`` say
         which to use. Several samples or wavelengths are refused too (use :func:`fit_many`).
         """
-        d, qty, unt = _select_rows(df, quantity, unit)
+        d, qty, unt = select_rows(df, quantity, unit)
         for key in ("sample", "wavelength_nm"):
             if key in d.columns and d[key].nunique(dropna=False) > 1:
-                raise FitError(_several(key, d[key].nunique(dropna=False)))
+                raise FitError(several_groups_message(key, d[key].nunique(dropna=False)))
         return cls._from_arrays(d, np.arange(len(d)), qty, unt)
 
     @classmethod
@@ -140,14 +148,14 @@ class FitData:
         )
 
 
-def _several(key: str, count: int) -> str:
+def several_groups_message(key: str, count: int) -> str:
     return (
         f"data hold {count} different {key!r} values; fit one group at a time, e.g. "
         "fit_many(data, model, by=['sample', 'wavelength_nm'])"
     )
 
 
-def _select_rows(df: Any, quantity: str | None, unit: str | None) -> tuple[pd.DataFrame, str, str]:
+def select_rows(df: Any, quantity: str | None, unit: str | None) -> tuple[pd.DataFrame, str, str]:
     """The fittable rows of a schema table, checked for one quantity and one unit."""
     if isinstance(df, Measurement):
         df = df.data
@@ -187,13 +195,13 @@ def _select_rows(df: Any, quantity: str | None, unit: str | None) -> tuple[pd.Da
     return d, combos[0][0], combos[0][1]
 
 
-def _as_fit_data(data: Any, quantity: str | None, unit: str | None) -> FitData:
+def as_fit_data(data: Any, quantity: str | None, unit: str | None) -> FitData:
     if isinstance(data, FitData):
         return data
     return FitData.from_frame(data, quantity=quantity, unit=unit)
 
 
-def _clean(data: FitData, nan_policy: str) -> tuple[FitData, int]:
+def clean_fit_data(data: FitData, nan_policy: str) -> tuple[FitData, int]:
     """Apply the NaN policy; return the clean data and the number of dropped points."""
     if nan_policy not in ("raise", "omit"):
         raise FitError(f"nan_policy must be 'raise' or 'omit', got {nan_policy!r}")
