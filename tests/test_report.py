@@ -17,9 +17,10 @@ import numpy as np
 import pytest
 
 from labbrdf import report
-from labbrdf.report import _common, html
-from labbrdf.report._common import Builder, Unavailable, fmt, resolve
-from labbrdf.report.validate import SECTIONS
+from labbrdf.report import builder as _common  # the module was report/_common.py
+from labbrdf.report import html
+from labbrdf.report.builder import Builder, Unavailable, fmt, resolve
+from labbrdf.report.validate import SECTION_IDS as SECTIONS
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 

@@ -1,4 +1,4 @@
-"""The report's building blocks: checks, tables, figures, formatting and atomic output.
+"""The report's building blocks: the Builder, checks, tables, formatting and atomic output.
 
 A report is built into one JSON-safe ``results`` dict (written as ``results.json``) and a
 dict of embedded figures. Every table cell on the page is rendered from ``results`` with
@@ -35,9 +35,15 @@ __all__ = [
     "Builder",
     "Unavailable",
     "atomic_dir",
+    "esc_pointer",
     "fmt",
     "jsonable",
+    "num",
     "resolve",
+    "slug",
+    "tables_csv",
+    "wl_label",
+    "write_report",
 ]
 
 #: the three check outcomes
@@ -117,8 +123,28 @@ def resolve(results: Mapping[str, Any], pointer: str) -> Any:
     return node
 
 
-def _esc_pointer(s: str) -> str:
+def esc_pointer(s: str) -> str:
+    """``s`` escaped as one reference token of a JSON pointer (RFC 6901)."""
     return str(s).replace("~", "~0").replace("/", "~1")
+
+
+def num(x: Any) -> float | None:
+    """``x`` as a finite float, or None (not a number, NaN or infinite)."""
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
+
+
+def slug(s: str) -> str:
+    """``s`` as an id fragment: alphanumerics kept, the rest ``_``, at most 40 characters."""
+    return "".join(c if c.isalnum() else "_" for c in s)[:40] or "sample"
+
+
+def wl_label(x: float) -> str:
+    """A wavelength for text: ``"550 nm"``."""
+    return f"{x:g} nm"
 
 
 # --------------------------------------------------------------------------- builder
