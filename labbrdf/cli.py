@@ -10,13 +10,14 @@ from __future__ import annotations
 import argparse
 import functools
 import json
-import math
 import os
 import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
+
+from .jsonsafe import jsonable
 
 __all__ = ["main"]
 
@@ -25,21 +26,8 @@ class UsageError(Exception):
     """A command-line input error: printed, exit code 2."""
 
 
-def _json_safe(x: Any) -> Any:
-    """NaN/inf -> None (JSON null), recursively; numpy scalars -> Python numbers."""
-    if isinstance(x, dict):
-        return {k: _json_safe(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_json_safe(v) for v in x]
-    if hasattr(x, "item") and not isinstance(x, str | bytes):
-        x = x.item()
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    return x
-
-
 def _emit_json(obj: Any) -> None:
-    print(json.dumps(_json_safe(obj), indent=2, allow_nan=False))
+    print(json.dumps(jsonable(obj), indent=2, allow_nan=False))
 
 
 def _parse_assignments(items: Sequence[str] | None, what: str) -> dict[str, float]:

@@ -30,6 +30,8 @@ from typing import Any
 
 import numpy as np
 
+from ..jsonsafe import jsonable
+
 __all__ = [
     "STATUSES",
     "Builder",
@@ -55,28 +57,6 @@ class Unavailable(Exception):
 
 
 # --------------------------------------------------------------------------- values
-
-
-def jsonable(x: Any) -> Any:
-    """A JSON-safe copy: numpy scalars/arrays to Python, NaN and inf to None, keys to str."""
-    if isinstance(x, Mapping):
-        return {str(k): jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [jsonable(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return [jsonable(v) for v in x.tolist()]
-    if isinstance(x, (bool, np.bool_)):
-        return bool(x)
-    if isinstance(x, (int, np.integer)):
-        return int(x)
-    if isinstance(x, (float, np.floating)):
-        v = float(x)
-        return v if math.isfinite(v) else None
-    if x is None or isinstance(x, str):
-        return x
-    if isinstance(x, Path):
-        return str(x)
-    return str(x)
 
 
 def fmt(value: Any, spec: str = "") -> str:
