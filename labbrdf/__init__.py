@@ -6,6 +6,7 @@ The public API is imported lazily so that ``import labbrdf`` stays cheap:
 - :func:`fit`, :func:`fit_many` (nlopt fitting core, from :mod:`labbrdf.fitting`)
 - :func:`hemispherical_reflectance` (directional-hemispherical reflectance of a model)
 - :func:`trace` (Monte Carlo polarization ray tracer)
+- :class:`LabbrdfError`, the base of every labbrdf error
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ _LAZY = {
     "Measurement": ("labbrdf.dataset", "Measurement"),
     "DatasetError": ("labbrdf.dataset", "DatasetError"),
     "AdapterError": ("labbrdf.adapters", "AdapterError"),
+    "LabbrdfError": ("labbrdf.errors", "LabbrdfError"),
     "fit": ("labbrdf.fitting", "fit"),
     "fit_many": ("labbrdf.fitting", "fit_many"),
     "FitResult": ("labbrdf.fitting", "FitResult"),
@@ -42,6 +44,8 @@ def __getattr__(name: str) -> Any:
         "optics",
         "models",
         "fitting",
+        "errors",
+        "jsonsafe",
         "integrate",
         "tracer",
         "surface",

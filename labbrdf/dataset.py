@@ -43,6 +43,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .errors import LabbrdfError
+
 __all__ = [
     "COLUMNS",
     "OPTIONAL_COLUMNS",
@@ -107,7 +109,7 @@ _META_KEY = b"labbrdf.meta"
 _CSV_META_PREFIX = "# labbrdf-meta: "
 
 
-class DatasetError(ValueError):
+class DatasetError(LabbrdfError, ValueError):
     """A table does not follow the labbrdf schema; the message names column and rows."""
 
 

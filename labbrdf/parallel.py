@@ -36,7 +36,7 @@ scheduler's ``distributed.scheduler.allowed-failures`` (dask's default 3), not `
 ``local`` workers are started without dask's default ``MALLOC_TRIM_THRESHOLD_=65536``,
 which made NumPy-heavy tracer blocks 3x slower on dask workers than in a process pool.
 
-This module imports nothing from labbrdf, so every layer may use it.
+This module imports nothing from labbrdf but :mod:`labbrdf.errors`, so every layer may use it.
 """
 
 from __future__ import annotations
@@ -60,6 +60,8 @@ from concurrent.futures import (
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, TypeVar
 
+from .errors import LabbrdfError
+
 __all__ = [
     "SCHEDULERS",
     "ParallelError",
@@ -82,7 +84,7 @@ _DASK_HINT = (
 )
 
 
-class ParallelError(RuntimeError):
+class ParallelError(LabbrdfError, RuntimeError):
     """A worker died (retries used up) or the dask scheduler is unreachable; no partial
     result is returned."""
 

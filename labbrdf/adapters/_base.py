@@ -12,11 +12,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..dataset import Measurement
+from ..errors import LabbrdfError
 
 __all__ = ["AdapterError", "Format", "decode", "read_bytes", "split_lines"]
 
 
-class AdapterError(ValueError):
+class AdapterError(LabbrdfError, ValueError):
     """A file cannot be read as the format asked for.
 
     The message always names the file, and the line (1-based) where that makes sense,

@@ -131,7 +131,7 @@ def fit_many(
         )
     kw = dict(fit_kw, method=method, seed=seed)
     todo = [(i, g) for i, g in enumerate(groups) if isinstance(g, FitData)]
-    from .. import parallel  # imports nothing from labbrdf: usable from every layer
+    from .. import parallel  # imports only labbrdf.errors: usable from every layer
 
     if chunks is None:
         nw = workers or max(1, os.cpu_count() or 1)

@@ -14,6 +14,7 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from ..dataset import Measurement
+from ..errors import LabbrdfError
 
 __all__ = [
     "FITTABLE_QUANTITIES",
@@ -26,7 +27,7 @@ __all__ = [
 ]
 
 
-class FitError(ValueError):
+class FitError(LabbrdfError, ValueError):
     """Bad fit input (data, method, parameter names) or a fit that cannot be set up."""
 
 

@@ -15,10 +15,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import LabbrdfError
+
 __all__ = ["Model", "ModelError", "Parameter", "Parameters"]
 
 
-class ModelError(ValueError):
+class ModelError(LabbrdfError, ValueError):
     """Unknown model, option or parameter name, or an invalid parameter value."""
 
 
