@@ -58,10 +58,10 @@ from typing import Any
 
 import numpy as np
 
-from labbrdf.tracer.binning import Grid
-from labbrdf.tracer.config import Coating, Substrate, TraceConfig
-from labbrdf.tracer.result import TraceResult, trace_summary
-from labbrdf.tracer.walk import BlockTally, GroupTally, _unit, run_unit, trace_block, trace_group
+from .binning import Grid
+from .config import Coating, Substrate, TraceConfig
+from .result import TraceResult, trace_summary
+from .walk import BlockTally, GroupTally, _unit, run_unit, trace_block, trace_group
 
 __all__ = [
     "BlockTally",
