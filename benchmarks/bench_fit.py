@@ -16,7 +16,7 @@ and the chi-square reached by
 and the worst ratio chi2(default) / chi2(de) (aim: <= 1, never worse). Then it times
 ``fit_many`` on one synthetic sample with 761 wavelengths (240-1000 nm) on a process pool.
 
-Aims (issue 4): <= 10 ms per smooth3 fit, <= 100 ms per five_param fit, 761 wavelengths
+Aims: <= 10 ms per smooth3 fit, <= 100 ms per five_param fit, 761 wavelengths
 in < 5 s on 2 cores. Not a timed test: numbers depend on the machine and its load.
 """
 

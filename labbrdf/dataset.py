@@ -2,7 +2,7 @@
 
 A :class:`Measurement` is a long ("tidy") :class:`pandas.DataFrame`, one measured value per
 row, plus a JSON-safe ``meta`` dict. Every adapter returns one; every workflow (fit, report)
-reads one. The schema is that of DESIGN.md, "The common dataset":
+reads one. The schema (also in ``docs/conventions.md``, "The common dataset"):
 
 ==================  ========  ===============================================================
 column              dtype     meaning
@@ -207,7 +207,7 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
 
     Notes
     -----
-    Written for tables of millions of rows (issue 3, ``benchmarks/bench_ingest.py``):
+    Written for tables of millions of rows (``benchmarks/bench_ingest.py``):
     string columns are checked on their distinct values when categorical, range checks
     first try two reductions and build the row masks only when a value is out of range,
     and columns that already have their canonical dtype are not copied (pandas'

@@ -16,7 +16,7 @@ ROOT = Path(__file__).resolve().parents[1]
 FIXTURES = ROOT / "fixtures"
 SHARED = Path(os.environ.get("LABBRDF_SHARED", ROOT.parent / "shared"))
 
-#: relative tolerance against double-precision oracles (issue 2: 1e-10)
+#: relative tolerance against double-precision oracles (1e-10)
 RTOL_ORACLE = 1e-10
 
 

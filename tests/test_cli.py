@@ -202,7 +202,7 @@ def test_fit_fix_and_bad_names(capsys):
 
 
 def test_hemispherical_json_matches_notes_table(capsys):
-    # notes/models.md 1.2: OSR 550 nm published fit, rho = 57.0607 % at 45 deg, 58.9843 % at 46
+    # docs/models.md 1.2: OSR 550 nm published fit, rho = 57.0607 % at 45 deg, 58.9843 % at 46
     code = main(
         [
             "hemispherical",

@@ -425,7 +425,7 @@ def test_the_package_level_fit_is_callable_after_import() -> None:
 
 
 def smooth3_rho(vals: Mapping[str, float], theta_i_deg: NDArray) -> NDArray:
-    """Closed form of notes/models.md 1.2 (complex erf), independent of labbrdf.integrate."""
+    """Closed form of docs/models.md 1.2 (complex erf), independent of labbrdf.integrate."""
     k1, k2, k3 = vals["k1"], vals["k2"], vals["k3"]
     ti = np.radians(np.asarray(theta_i_deg, float))
     c = ti - k2
@@ -457,7 +457,7 @@ def test_closed_form_rho_matches_quadrature() -> None:
 
 @pytest.mark.parametrize("method", ["GN_CRS2_LM+LN_BOBYQA", "GN_ISRES+LN_COBYLA"])
 def test_energy_constraint_keeps_rho_at_most_one(method: str) -> None:
-    # k1 = 2.2 with the OSR shape gives rho(60 deg) = 2.2/1.083 > 1 (notes/models.md 1.4)
+    # k1 = 2.2 with the OSR shape gives rho(60 deg) = 2.2/1.083 > 1 (docs/models.md 1.4)
     k = (2.2, -0.0166, 0.4176)
     ti, tr, y = smooth3_truth(k)
     fd = FitData(ti, tr, y)

@@ -1,4 +1,4 @@
-"""Scale-out on dask.distributed (issue 7): same numbers on every scheduler, loud failures.
+"""Scale-out on dask.distributed: same numbers on every scheduler, loud failures.
 
 Real batch fits and real tracer runs go through a 2-worker ``LocalCluster`` (``local``), a
 cluster started here and reached by its ``tcp://`` address, and the CLI; each is compared

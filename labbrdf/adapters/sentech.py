@@ -1,6 +1,6 @@
 """SENTECH SpectraRay ASCII exports (``.txt``): Psi/Delta at several angles, or a Mueller matrix.
 
-Layout (notes/formats.md section 5, checked on ``Si_SiO2_theta_50_60_70.txt`` and
+Layout (docs/formats.md section 5, checked on ``Si_SiO2_theta_50_60_70.txt`` and
 ``Wafer_MM_70.txt``): one header line ``; WAVELENGTH a1 a2 ...`` giving the angle of
 incidence of every data column, then rows ``wavelength[nm] v1 v2 ...`` separated by spaces,
 each with a trailing space. The header does not say what the columns hold:

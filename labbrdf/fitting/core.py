@@ -64,7 +64,7 @@ CONSTRAINED = frozenset(
 
 
 #: models whose shape parameters cannot be identified from specular-line data alone
-#: (notes/models.md 1.1: on theta_r == theta_i smooth3 gives only k1 exp(-k2^2/k3^2))
+#: (docs/models.md 1.1: on theta_r == theta_i smooth3 gives only k1 exp(-k2^2/k3^2))
 SPECULAR_LINE_SHAPE = {"smooth3": ("k2", "k3")}
 
 
@@ -348,7 +348,7 @@ def fit(
         and one of them varies.
     energy_constraint : bool or callable
         Keep the directional-hemispherical reflectance rho(theta_i) <= 1 over the measured
-        incidence range (notes/models.md 1.4). True uses
+        incidence range (docs/models.md 1.4). True uses
         :func:`labbrdf.integrate.hemispherical_reflectance`; a callable
         ``rho(values, theta_i_deg) -> array`` replaces it. rho is checked on the measured
         incidence angles plus 7 equally spaced ones from the smallest to the largest. With
@@ -409,7 +409,7 @@ def fit(
 
     When every point of a smooth3 fit lies on the specular line (theta_r == theta_i) the fit
     is refused unless k2 and k3 are fixed: there only k1 exp(-k2^2/k3^2) is identifiable
-    (notes/models.md 1.1), and fixing k2 = 0 alone would leave k3 without any effect.
+    (docs/models.md 1.1), and fixing k2 = 0 alone would leave k3 without any effect.
     """
     t0 = time.perf_counter()
     if isinstance(model, str):
@@ -686,7 +686,7 @@ def _check_design(model: Model, fd: FitData, varying: list[str]) -> None:
     if shape and on_line.all():
         raise FitError(
             f"data: all {n_pts} points lie on the specular line theta_r == theta_i, where "
-            f"{model.name} identifies only k1 exp(-k2^2/k3^2) (notes/models.md 1.1); "
+            f"{model.name} identifies only k1 exp(-k2^2/k3^2) (docs/models.md 1.1); "
             f"add off-specular points or fix {list(SPECULAR_LINE_SHAPE[model.name])}, "
             "e.g. fix={'k2': 0.0, 'k3': 0.4}"
         )

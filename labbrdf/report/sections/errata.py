@@ -17,7 +17,7 @@ from ..context import Context, paper_values
 
 __all__ = ["errata_section"]
 
-#: Energy-limit angles of the paper's own fits [deg], notes/models.md 1.4 (printed to 0.1)
+#: Energy-limit angles of the paper's own fits [deg], docs/models.md 1.4 (printed to 0.1)
 ENERGY_LIMIT_DEG = {
     ("OSR", 360.0): 70.4,
     ("OSR", 500.0): 63.1,
@@ -28,9 +28,9 @@ ENERGY_LIMIT_DEG = {
     ("mirror", 550.0): 76.5,
     ("mirror", 860.0): 80.6,
 }
-#: entries the notes print one digit off: the root is 76.2498 deg, which rounds to 76.2
+#: entries printed one digit off in docs/models.md 1.4: the root is 76.2498 deg (76.2)
 NOTES_MISROUNDED = {("mirror", 500.0)}
-#: R(30, 50) and R(50, 30) [sr^-1] at 550 nm with the paper's fits, notes/models.md 1.3
+#: R(30, 50) and R(50, 30) [sr^-1] at 550 nm with the paper's fits, docs/models.md 1.3
 RECIPROCITY_550 = {"OSR": (0.1209, 0.1059), "mirror": (0.0173, 0.0971)}
 
 
@@ -48,13 +48,13 @@ def errata_section(ctx: Context) -> None:
             "where": "2013 eq. (8)",
             "printed": "energy conserved iff k1 <= 4/pi",
             "correct": "no k1 > 0 conserves energy at all angles; k1 <= 4/(pi max I/cos) on "
-            "[0, theta_max] (notes 1.4)",
+            "[0, theta_max] (docs/models.md 1.4)",
             "used": "energy checks: rho(theta_i) and the limit angle of every fit",
         },
         {
             "where": "2013 section 2",
             "printed": "the model is reciprocal",
-            "correct": "reciprocal iff k2 = 0 (notes 1.3)",
+            "correct": "reciprocal iff k2 = 0 (docs/models.md 1.3)",
             "used": "reciprocity defect of every fit",
         },
         {
@@ -66,7 +66,7 @@ def errata_section(ctx: Context) -> None:
         {
             "where": "2013 eq. (6)",
             "printed": "square missing inside the root",
-            "correct": "see notes/models.md 3.4",
+            "correct": "see docs/models.md 3.4",
             "used": "ellipsometric inversion (optics)",
         },
         {
@@ -111,7 +111,7 @@ def errata_section(ctx: Context) -> None:
             ("used", "where it matters here", ""),
         ],
         rows,
-        caption="From DESIGN.md 'Known errors in the source papers' and notes/models.md.",
+        caption="Derivations and references: docs/errata.md and docs/models.md.",
     )
     t = ctx.published.get("params")
     if t is None:
@@ -147,7 +147,7 @@ def errata_section(ctx: Context) -> None:
             ("wavelength_nm", "\u03bb [nm]", "g"),
             ("k1", "k1 published", ".4f"),
             ("limit_deg", "\u03c1 = 1 reached at \u03b8i [deg]", ".3f"),
-            ("notes_deg", "notes/models.md 1.4 [deg]", ".1f"),
+            ("notes_deg", "docs/models.md 1.4 [deg]", ".1f"),
             ("k1max_60", "k1 max for \u03c1 \u2264 1 up to 60\u00b0", ".4g"),
             ("k1max_89", "k1 max up to 89\u00b0", ".4g"),
         ],
@@ -169,14 +169,14 @@ def errata_section(ctx: Context) -> None:
         )
         b.check(
             "errata.energy_limit_angles",
-            "the angles where the paper's fits reach \u03c1 = 1 match notes/models.md 1.4",
+            "the angles where the paper's fits reach \u03c1 = 1 match docs/models.md 1.4",
             worst <= 0.05,
-            against="notes/models.md 1.4 (independent scipy-quad oracle script)",
+            against="docs/models.md 1.4 (independent scipy-quad oracle script)",
             value=worst,
             tolerance=0.05,
-            justification="largest difference [deg]; the notes print 0.1 deg (rounding bound "
-            "0.05). Excluded: mirror 500 nm, which the notes print as 76.3 but whose root is "
-            "76.2498 deg (checked by quadrature above), so the notes misround it.",
+            justification="largest difference [deg]; docs/models.md prints 0.1 deg (rounding "
+            "bound 0.05). Excluded: mirror 500 nm, printed there as 76.3 but whose root is "
+            "76.2498 deg (checked by quadrature above), so the printed value is misrounded.",
         )
     rrows, worst = [], 0.0
     for sample, (a_ref, b_ref) in RECIPROCITY_550.items():
@@ -204,8 +204,8 @@ def errata_section(ctx: Context) -> None:
             ("k2", "k2 [rad]", ".5g"),
             ("f_30_50", "f(30\u00b0, 50\u00b0) [sr\u207b\u00b9]", ".4f"),
             ("f_50_30", "f(50\u00b0, 30\u00b0) [sr\u207b\u00b9]", ".4f"),
-            ("notes_30_50", "notes 1.3 f(30, 50)", ".4f"),
-            ("notes_50_30", "notes 1.3 f(50, 30)", ".4f"),
+            ("notes_30_50", "docs/models.md 1.3 f(30, 50)", ".4f"),
+            ("notes_50_30", "docs/models.md 1.3 f(50, 30)", ".4f"),
         ],
         rrows,
         caption="Modelled: smooth3 with the published parameters, in-plane (phi_r = 180 deg). "
@@ -214,9 +214,9 @@ def errata_section(ctx: Context) -> None:
     if rrows:
         b.check(
             "errata.reciprocity_values",
-            "f(30, 50) and f(50, 30) of the paper's 550 nm fits match notes/models.md 1.3",
+            "f(30, 50) and f(50, 30) of the paper's 550 nm fits match docs/models.md 1.3",
             worst <= 5e-5,
-            against="notes/models.md 1.3",
+            against="docs/models.md 1.3",
             value=worst,
             tolerance=5e-5,
             justification="4 decimals printed: rounding bound 5e-5 sr^-1",

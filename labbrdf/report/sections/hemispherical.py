@@ -128,7 +128,7 @@ def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
         caption="Measured: hemispherical reflectance of the spectrophotometer fixtures (the "
         "three published Table 3 values and the labelled synthetic interpolations through "
         "them). Modelled: rho(theta_i) = 2 pi int f cos sin d theta_r of smooth3 (closed "
-        "form, notes/models.md 1.2) with the paper's Table 1 parameters and with ours, at "
+        "form, docs/models.md 1.2) with the paper's Table 1 parameters and with ours, at "
         "45 deg (the geometry the paper names) and at 46 deg (where its 'integration result' "
         "is actually reproduced; see the errata). \u03c3 from the fit covariance.",
     )
@@ -182,7 +182,7 @@ def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
             against="Zou 2013 Table 3 (integration column) and Table 1",
             value=d46,
             tolerance=0.11,
-            justification="largest |rho_46 - printed| in %-points; notes/models.md 1.2 "
+            justification="largest |rho_46 - printed| in %-points; docs/models.md 1.2 "
             "documents deviations +0.02/-0.10/-0.03 (not explained by quadrature or "
             "cut-off; rounding in the paper) plus 0.005 for the 2 printed decimals",
         )
@@ -195,7 +195,7 @@ def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
             value=d45,
             tolerance=0.11,
             justification="smallest |rho_45 - printed| in %-points must exceed the 46-deg "
-            "tolerance (notes/models.md 1.2: 45 deg is 1.4-2 points low)",
+            "tolerance (docs/models.md 1.2: 45 deg is 1.4-2 points low)",
         )
     else:
         b.skip(

@@ -81,7 +81,7 @@ def physics_section(ctx: Context, angles_deg: Sequence[float] | None = None) -> 
         f"{step:g} deg scan, refined by Brent's method to 1e-6 deg), and the reciprocity "
         "defect on a 5 deg x 15 deg grid up to 85 deg. These are properties of the fitted "
         "models (findings), not software checks: smooth3 is reciprocal only for k2 = 0 and "
-        "no k1 > 0 conserves energy at all angles (notes/models.md 1.3-1.4); the five-"
+        "no k1 > 0 conserves energy at all angles (docs/models.md 1.3-1.4); the five-"
         "parameter diffuse term k_d/cos \u03b8i is not reciprocal for k_d > 0.",
     )
     b.check(

@@ -188,7 +188,7 @@ def factor_maps_section(ctx: Context) -> None:
             against="exited + absorbed + terminated = incident",
             value=max(errs),
             tolerance=1e-12,
-            justification="per-ray bookkeeping in float64 (issue 5 acceptance criterion)",
+            justification="per-ray bookkeeping in float64",
         )
     else:
         b.skip("tracer.factor_ledger", "energy ledger closes", "no factor-study run")
@@ -362,7 +362,7 @@ def validation_section(ctx: Context) -> None:
         against="albedo = 1 (lossless microsurface, Heitz et al. 2016 random walk)",
         value=abs(A - 1.0),
         tolerance=1e-3,
-        justification="issue 5 criterion (0.1 %): weight is only lost to the bounce limit",
+        justification="0.1 % of the energy at most: weight is only lost to the bounce limit",
     )
 
     # 3. single-scattering rough Al: albedo and in-plane BRDF against the oracles
@@ -525,5 +525,5 @@ def validation_section(ctx: Context) -> None:
             against="exited + absorbed + terminated = incident",
             value=max(ledger),
             tolerance=1e-12,
-            justification="per-ray bookkeeping in float64 (issue 5 acceptance criterion)",
+            justification="per-ray bookkeeping in float64",
         )
