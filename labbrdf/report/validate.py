@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import platform
+from importlib import resources
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -119,12 +120,20 @@ SECTIONS: list[Section] = [
 #: section ids in page order
 SECTION_IDS = tuple(sid for sid, _, _ in SECTIONS)
 
+#: the source tree's root when labbrdf runs from a checkout (its parent may hold ../shared)
 _ROOT = Path(__file__).resolve().parents[2]
 
 
 def default_fixtures_dir() -> Path:
-    """The bundled ``fixtures/`` folder of the source tree (or ``$LABBRDF_FIXTURES``)."""
-    return Path(os.environ.get("LABBRDF_FIXTURES", _ROOT / "fixtures"))
+    """The fixtures shipped in the package, ``labbrdf/data/fixtures`` (or ``$LABBRDF_FIXTURES``).
+
+    Found through :mod:`importlib.resources`, so that an installed wheel finds them too.
+    """
+    env = os.environ.get("LABBRDF_FIXTURES")
+    if env:
+        return Path(env)
+    # a wheel installs as plain files, so the resource folder is a real directory
+    return Path(str(resources.files("labbrdf") / "data" / "fixtures"))
 
 
 def default_shared_dir() -> Path | None:
@@ -160,7 +169,7 @@ def validate(
         Executor for the fits and the tracer runs (see :mod:`labbrdf.parallel`); None runs
         in this process.
     fixtures_dir : path-like, optional
-        The fixture folder (default: the bundled ``fixtures/``).
+        The fixture folder (default: :func:`default_fixtures_dir`).
     shared_dir : path-like, False or None
         ``../shared`` with the oracles; None finds it next to the project; False: act as if
         it were absent (oracle checks SKIPPED with the reason).
