@@ -148,7 +148,9 @@ def test_every_real_export_reads_through_one_entry_point(real_exports):
         assert m.meta["format"] != "labbrdf-dataset-csv", p
 
 
-FIXTURES_SCAN = __import__("pathlib").Path(__file__).resolve().parents[1] / "fixtures/specular"
+FIXTURES_SCAN = (
+    __import__("pathlib").Path(__file__).resolve().parents[1] / "labbrdf/data/fixtures/specular"
+)
 
 
 def test_fit_json_has_one_object_per_group(capsys, tmp_path):
