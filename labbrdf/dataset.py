@@ -459,7 +459,7 @@ def make_frame(
         "phi_r_deg": phi_r_deg,
         **optional,
     }
-    out = {}
+    out: dict[str, Any] = {}
     for k, v in cols.items():
         if isinstance(v, str) or np.ndim(v) == 0:
             out[k] = [v] * n

@@ -64,6 +64,8 @@ References
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -89,8 +91,12 @@ FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
 
-def _arrays(*values: ArrayLike) -> tuple[NDArray, ...]:
-    """Return every value as an ndarray (0-d for scalars), for uniform output types."""
+def _arrays(*values: ArrayLike) -> Any:
+    """Return every value as an ndarray (0-d for scalars), for uniform output types.
+
+    Typed ``Any``: a tuple's length and dtypes cannot follow ``*values``; each caller
+    declares the precise tuple it returns.
+    """
     return tuple(np.asarray(v) for v in values)
 
 
@@ -108,7 +114,7 @@ def _finite(name: str, value: ArrayLike, dtype: type) -> NDArray:
     if dtype is np.float64 and np.iscomplexobj(value):
         raise ValueError(f"{name}: expected real values, got complex")
     try:
-        arr = np.asarray(value, dtype=dtype)
+        arr: NDArray[Any] = np.asarray(value, dtype=dtype)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name}: expected a number or an array of numbers ({exc})") from None
     if not np.all(np.isfinite(arr)):
@@ -183,7 +189,9 @@ def _physical_root(w: ComplexArray) -> ComplexArray:
     return np.where(r.real + r.imag < 0, -r, r)
 
 
-def _kz(n1: ComplexArray, n2: ComplexArray, cos_i: ArrayLike) -> tuple[ComplexArray, ...]:
+def _kz(
+    n1: ComplexArray, n2: ComplexArray, cos_i: NDArray[np.float64] | float
+) -> tuple[ComplexArray, ComplexArray]:
     """Normal wave-vector components ``n1 cos_i`` and ``n2 cos_t`` [1, in units of k0].
 
     ``(n2 cos_t)^2 = n2^2 - n1^2 sin^2 = (n2^2 - n1^2) + (n1 cos_i)^2``; the second form is

@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable
 from pathlib import Path
+from typing import Any
 
 from ..dataset import Measurement, concat
 from . import (
@@ -67,7 +68,7 @@ READERS: dict[str, Format] = _registry()
 _SNIFF_BYTES = 8192
 
 
-def formats() -> list[dict[str, object]]:
+def formats() -> list[dict[str, Any]]:
     """The supported formats: name, description, extensions, quantities."""
     return [
         {

@@ -300,8 +300,8 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
             parts = ln.split("\t")
             if len(parts) == 2 and NUMBER.fullmatch(parts[1].strip()):
                 fit[parts[0].strip()] = float(parts[1])
-            for m in re.finditer(r"(Model|Date|Ver|Temp):\s*([^,]*)", ln):
-                meta[m.group(1).lower()] = m.group(2).strip()
+            for mt in re.finditer(r"(Model|Date|Ver|Temp):\s*([^,]*)", ln):
+                meta[mt.group(1).lower()] = mt.group(2).strip()
         if fit:
             meta["software_fit"] = fit
 

@@ -171,7 +171,7 @@ def read_sentech(path: str | os.PathLike[str], kind: str | None = None) -> Measu
         nao = n // 2
         psi = v[:, 1::2]
         delta = v[:, 2::2]
-        badpsi = ((psi < 0) | (psi > 90)).any(axis=1)
+        badpsi = np.asarray(((psi < 0) | (psi > 90)).any(axis=1))
         check_rows(path, block, badpsi, "psi must be within [0, 90] deg")
         aoi = angles[0::2]
         # row-major: for each line, for each AOI: psi, delta

@@ -437,7 +437,9 @@ def fit(
             f"parameters (linear: {list(model.linear)})"
         )
     profile = bool(lin) if profile is None else profile
-    rho_fn, th_grid = None, None
+    # rho(theta) <= 1 on th_grid [deg] when the energy constraint is on (rho_fn set)
+    rho_fn: Callable[[dict[str, float], NDArray], NDArray] | None = None
+    th_grid: NDArray = np.empty(0)
     if energy_constraint is not False and energy_constraint is not None:
         ti = np.asarray(fd.theta_i_deg, float)
         th_grid = np.unique(np.concatenate([np.linspace(ti.min(), ti.max(), 7), ti]))

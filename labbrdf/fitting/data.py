@@ -132,18 +132,19 @@ class FitData:
     def _from_arrays(
         cls, d: pd.DataFrame | dict[str, NDArray], idx: NDArray, quantity: str, unit: str
     ) -> FitData:
-        def col(name: str) -> NDArray | None:
-            if name not in d:
-                return None
+        def col(name: str) -> NDArray:
             return np.asarray(d[name], dtype=float)[idx]
+
+        def optional(name: str) -> NDArray | None:
+            return col(name) if name in d else None
 
         return cls(
             col("theta_i_deg"),
             col("theta_r_deg"),
             col("value"),
-            col("sigma"),
+            optional("sigma"),
             col("phi_r_deg"),
-            col("wavelength_nm"),
+            optional("wavelength_nm"),
             quantity,
             unit,
         )

@@ -16,10 +16,10 @@ from __future__ import annotations
 
 import os
 import platform
-from importlib import resources
 from collections.abc import Callable, Mapping, Sequence
+from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from .. import __version__
 from ..parallel import check_scheduler
@@ -150,7 +150,7 @@ def validate(
     workers: int | None = None,
     *,
     fixtures_dir: str | os.PathLike[str] | None = None,
-    shared_dir: str | os.PathLike[str] | None | bool = None,
+    shared_dir: str | os.PathLike[str] | Literal[False] | None = None,
     sections_to_run: Sequence[str] | None = None,
     extra_checks: Sequence[Callable[[Builder], Any]] = (),
     fit_options: Mapping[str, Any] | None = None,

@@ -62,7 +62,7 @@ def ggx_d(cos_m: ArrayLike, alpha: float) -> NDArray[np.float64]:
     return np.where(c > 0, d, 0.0)
 
 
-def smith_lambda(wz: ArrayLike, alpha: float) -> NDArray[np.float64]:
+def smith_lambda(wz: ArrayLike, alpha: float | NDArray[np.float64]) -> NDArray[np.float64]:
     """Smith Lambda of GGX for a direction with cosine ``wz`` to the normal [1].
 
     For upward directions (wz > 0), ``Lambda = (-1 + sqrt(1 + alpha^2 tan^2 theta)) / 2``;
@@ -76,7 +76,7 @@ def smith_lambda(wz: ArrayLike, alpha: float) -> NDArray[np.float64]:
     return np.where(z >= 0, lam, -1.0 - lam)
 
 
-def smith_g1(wz: ArrayLike, alpha: float) -> NDArray[np.float64]:
+def smith_g1(wz: ArrayLike, alpha: float | NDArray[np.float64]) -> NDArray[np.float64]:
     """Smith masking ``G1 = 2 / (1 + sqrt(1 + alpha^2 tan^2 theta))`` for wz > 0, else 0."""
     z = np.asarray(wz, dtype=float)
     lam = smith_lambda(np.abs(z), alpha)
@@ -99,7 +99,10 @@ def sample_ggx_cos(
 
 
 def sample_vndf(
-    wi: NDArray[np.float64], alpha: float, u1: NDArray[np.float64], u2: NDArray[np.float64]
+    wi: NDArray[np.float64],
+    alpha: float | NDArray[np.float64],
+    u1: NDArray[np.float64],
+    u2: NDArray[np.float64],
 ) -> NDArray[np.float64]:
     """Sample GGX visible normals for the direction ``wi`` (pointing away from the surface).
 

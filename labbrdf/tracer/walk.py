@@ -115,6 +115,7 @@ class _Setup:
 
             theta = np.degrees(np.arccos(np.clip(cos_i, 0.0, 1.0)))
             coat = self.coat
+            assert coat is not None  # TraceConfig refuses coherent=True without a coating
             rs, rp = film_amplitudes(
                 1.0, complex(coat.n, coat.k), self.n_sub, coat.thickness_nm, self.lam, theta
             )

@@ -28,7 +28,7 @@ __all__ = ["hemispherical_section"]
 
 def _rho_sigma(rec: FitRecord, theta_deg: float) -> float | None:
     """1-sigma of rho(theta) from the fit covariance (finite-difference gradient)."""
-    names = [k for k in ("k1", "k2", "k3") if rec.params.get(k, {}).get("stderr")]
+    names = [k for k in ("k1", "k2", "k3") if k in rec.params and rec.params[k]["stderr"]]
     if not names:
         return None
     v = dict(rec.values)
@@ -66,6 +66,8 @@ def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
     if not recs:
         raise Unavailable(f"no smooth3 fits of sample {sample}")
     d = ctx.data
+    if d is None:
+        raise Unavailable("no data ingested")
     meas = d[
         (d["quantity"] == "hemispherical_reflectance")
         & (d["sample"].str.lower() == sample.lower())

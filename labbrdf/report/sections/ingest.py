@@ -67,11 +67,11 @@ def ingest_files(
 ) -> None:
     """Read every file; a table of what each holds; a check that all were read."""
     b = ctx.b
-    paths = [Path(p) for p in paths]
-    if not paths:
+    files = [Path(p) for p in paths]
+    if not files:
         raise Unavailable("no input files")
     rows, failures = [], []
-    for p in paths:
+    for p in files:
         name = str(p.relative_to(root)) if root is not None and p.is_relative_to(root) else p.name
         try:
             m = adapters.read(p)

@@ -19,6 +19,7 @@ are upper bounds of the true errors, so the checks can only be stricter in reali
 
 from __future__ import annotations
 
+import builtins
 import functools
 import math
 from collections.abc import Callable, Iterable
@@ -56,19 +57,17 @@ def _robust_max(res: TraceResult, s0: np.ndarray) -> float | None:
 # --------------------------------------------------------------------------- helpers
 
 
-def _map_kw(ctx: Context) -> dict[str, Callable[..., Iterable[Any]]]:
-    """The ``map`` keyword that puts a tracer call on the report's scheduler (none: serial)."""
+def _map(ctx: Context) -> Callable[..., Iterable[Any]]:
+    """The ordered ``map`` that runs tracer work units on the report's scheduler."""
     if ctx.scheduler in (None, "serial"):
-        return {}
-    return {
-        "map": functools.partial(
-            parallel.imap, scheduler=ctx.scheduler, workers=ctx.workers, progress=False
-        )
-    }
+        return builtins.map
+    return functools.partial(
+        parallel.imap, scheduler=ctx.scheduler, workers=ctx.workers, progress=False
+    )
 
 
 def _run(ctx: Context, config: TraceConfig) -> TraceResult:
-    return trace(config, **_map_kw(ctx))
+    return trace(config, map=_map(ctx))
 
 
 def maps(result: TraceResult) -> dict[str, np.ndarray]:
@@ -98,12 +97,12 @@ def factor_maps_section(ctx: Context) -> None:
     rays = int(ctx.scale["factor"])
     step = float(ctx.scale.get("grid_step_deg", 1))
     b.log(f"  factor studies at {rays} rays per run")
-    runs = st.factor_studies(rays=rays, seed=0, step=step, **_map_kw(ctx))
+    runs = st.factor_studies(rays=rays, seed=0, step=step, map=_map(ctx))
     ctx.factor_runs = runs
     studies: dict[str, list[tuple[str, TraceResult]]] = {}
     for study, label, res in runs:
         studies.setdefault(str(study), []).append((str(label), res))
-    rows = []
+    rows: list[dict[str, Any]] = []
     for study, items in studies.items():
         mp = [maps(r) for _, r in items]
         labels = [lab for lab, _ in items]
@@ -434,10 +433,10 @@ def validation_section(ctx: Context) -> None:
                         continue
                     ip = int(np.argmin(np.abs(mm["phi"] - phi)))
                     th = rr["theta_r_deg"].to_numpy(float)
-                    it = np.array([int(np.argmin(np.abs(mm["theta"] - t))) for t in th])
+                    its = np.array([int(np.argmin(np.abs(mm["theta"] - t))) for t in th])
                     g = len(th) // GROUP * GROUP
-                    w = cosw[it[:g], ip].reshape(-1, GROUP)
-                    f_grp = (mm["s0"][it[:g], ip].reshape(-1, GROUP) * w).sum(1) / w.sum(1)
+                    w = cosw[its[:g], ip].reshape(-1, GROUP)
+                    f_grp = (mm["s0"][its[:g], ip].reshape(-1, GROUP) * w).sum(1) / w.sum(1)
                     f_ref = (rr["f_M00"].to_numpy(float)[:g].reshape(-1, GROUP) * w).sum(1)
                     f_ref = f_ref / w.sum(1)
                     th_grp = th[:g].reshape(-1, GROUP).mean(1)
