@@ -65,8 +65,11 @@ def _check_executor(args: argparse.Namespace) -> None:
 
 
 def _executor_errors(cmd: Any) -> Any:
-    """A run abandoned by the executor (dead workers, unreachable scheduler): exit code 2
-    with the reason, not a traceback; nothing partial has been written."""
+    """Make a run abandoned by the executor exit with code 2 and the reason.
+
+    Dead workers or an unreachable scheduler give the reason on stderr, not a traceback;
+    nothing partial has been written.
+    """
 
     @functools.wraps(cmd)
     def wrapper(args: argparse.Namespace) -> int:

@@ -85,8 +85,10 @@ _DASK_HINT = (
 
 
 class ParallelError(LabbrdfError, RuntimeError):
-    """A worker died (retries used up) or the dask scheduler is unreachable; no partial
-    result is returned."""
+    """A worker died (retries used up) or the dask scheduler is unreachable.
+
+    No partial result is returned.
+    """
 
 
 def _import_dask() -> tuple[Any, Any]:
@@ -148,6 +150,7 @@ class Progress:
         self._last_decile = -1
 
     def update(self, n: int = 1) -> None:
+        """Count ``n`` more finished tasks and show the progress (when enabled)."""
         self.done += n
         if not self.enabled:
             return
@@ -385,8 +388,9 @@ def _imap_dask(
     bar: Progress,
     retries: int,
 ) -> Iterator[R]:
-    """Keep ``window`` unyielded tasks on the cluster; results arrive through dask's
-    ``as_completed`` (fetched in the background, batched) and are yielded in item order.
+    """Keep ``window`` unyielded tasks on the cluster; yield the results in item order.
+
+    Results arrive through dask's ``as_completed`` (fetched in the background, batched).
 
     The default window, 4 per worker thread of the cluster and at least 16, hides the
     scheduler round trip (a few ms); tasks are submitted in batches of half a window.

@@ -1,15 +1,15 @@
-"""FFT Gaussian random rough surfaces (Dong et al. 2022, section 2.1, eqs. 1-5, corrected).
+r"""FFT Gaussian random rough surfaces (Dong et al. 2022, section 2.1, eqs. 1-5, corrected).
 
 A surface ``z = f(x, y)`` on a periodic M x N grid has the Gaussian autocorrelation of
 eq. (1),
 
-.. math:: C(x, y) = \\sigma^2 \\exp(-x^2/c_x^2 - y^2/c_y^2),
+.. math:: C(x, y) = \sigma^2 \exp(-x^2/c_x^2 - y^2/c_y^2),
 
 whose power spectral density (2-D Fourier transform, convention
-``S(k) = (2 pi)^-2 \\int C(r) exp(-i k.r) d^2 r``) is
+``S(k) = (2 pi)^-2 \int C(r) exp(-i k.r) d^2 r``) is
 
-.. math:: S(k_x, k_y) = \\frac{\\sigma^2 c_x c_y}{4\\pi}
-          \\exp\\left(-\\frac{k_x^2 c_x^2 + k_y^2 c_y^2}{4}\\right).
+.. math:: S(k_x, k_y) = \frac{\sigma^2 c_x c_y}{4\pi}
+          \exp\left(-\frac{k_x^2 c_x^2 + k_y^2 c_y^2}{4}\right).
 
 References
 ----------

@@ -141,6 +141,11 @@ def _copy_params(p: Parameters) -> Parameters:
 def setup_params(
     model: Model, params: Parameters | Mapping[str, float] | None, fix: Mapping[str, float] | None
 ) -> Parameters:
+    """The model's parameters with ``params`` (values or Parameters) and ``fix`` applied.
+
+    Internal API of :mod:`labbrdf.fitting`; raises :class:`FitError` naming unknown or
+    inconsistent parameter names.
+    """
     p = _copy_params(model.params)
     if params is not None:
         for k, v in params.items():

@@ -151,6 +151,7 @@ class FitData:
 
 
 def several_groups_message(key: str, count: int) -> str:
+    """The error message for data that hold ``count`` groups of ``key`` (internal API)."""
     return (
         f"data hold {count} different {key!r} values; fit one group at a time, e.g. "
         "fit_many(data, model, by=['sample', 'wavelength_nm'])"
@@ -198,6 +199,7 @@ def select_rows(df: Any, quantity: str | None, unit: str | None) -> tuple[pd.Dat
 
 
 def as_fit_data(data: Any, quantity: str | None, unit: str | None) -> FitData:
+    """``data`` as :class:`FitData` (a FitData is returned as is; internal API)."""
     if isinstance(data, FitData):
         return data
     return FitData.from_frame(data, quantity=quantity, unit=unit)

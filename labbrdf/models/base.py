@@ -101,6 +101,7 @@ class Parameters(Mapping[str, Parameter]):
         units: str = "1",
         **kw: Any,
     ) -> Parameter:
+        """Add (or replace) the parameter ``name`` and return it (as lmfit's ``add``)."""
         p = Parameter(name, value, min, max, vary, units, **kw)
         self._p[name] = p
         return p
@@ -127,6 +128,7 @@ class Parameters(Mapping[str, Parameter]):
         return f"Parameters({inner})"
 
     def copy(self) -> Parameters:
+        """A deep copy (the parameters are independent of this set's)."""
         return Parameters(copy.deepcopy(self._p))
 
     def values(self) -> dict[str, float]:  # type: ignore[override]
@@ -134,6 +136,7 @@ class Parameters(Mapping[str, Parameter]):
         return {k: p.value for k, p in self._p.items()}
 
     def varying(self) -> list[str]:
+        """Names of the parameters that vary in a fit."""
         return [k for k, p in self._p.items() if p.vary]
 
 

@@ -1,5 +1,6 @@
-"""Monte Carlo polarization ray tracer for rough (coated) surfaces (Dong et al. 2022, done
-rigorously; see ``docs/models.md`` section 6).
+"""Monte Carlo polarization ray tracer for rough (coated) surfaces (Dong et al. 2022).
+
+Done rigorously; see ``docs/models.md`` section 6.
 
 >>> from labbrdf.tracer import TraceConfig, Substrate, trace
 >>> res = trace(TraceConfig(rays=2000, substrate=Substrate(alpha=0.2), scattering="single"))

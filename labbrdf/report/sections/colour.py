@@ -1,5 +1,7 @@
-"""Section ``colour``: the sample colour from spectrophotometer reflectance (CIE 1931 2 deg
-observer, D65, sRGB, with colour-science)."""
+"""Section ``colour``: the sample colour from spectrophotometer reflectance.
+
+CIE 1931 2 deg observer, illuminant D65, sRGB, computed with colour-science.
+"""
 
 from __future__ import annotations
 

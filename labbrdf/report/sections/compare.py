@@ -1,5 +1,7 @@
-"""Section ``compare``: the 3- and 5-parameter models fitted to the same scans (Fig. 4 of
-Zou 2013)."""
+"""Section ``compare``: the 3- and 5-parameter models fitted to the same scans.
+
+As Fig. 4 of Zou, Bai, Wu (2013), doi:10.3788/AOS201333.0612008.
+"""
 
 from __future__ import annotations
 

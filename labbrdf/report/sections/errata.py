@@ -1,5 +1,6 @@
-"""Section ``errata``: the errors of the source papers this report depends on [Zou2013]_,
-with the checks that confirm them (derivations in ``docs/errata.md``).
+"""Section ``errata``: the errors of the source papers this report depends on [Zou2013]_.
+
+With the checks that confirm them; derivations in ``docs/errata.md``.
 
 References
 ----------

@@ -1,9 +1,8 @@
-"""Section ``hemispherical``: the hemispherical integral of the fits against the
-spectrophotometer and the paper's Table 3 [Zou2013]_.
+"""Section ``hemispherical``: the fits' hemispherical integral against the spectrophotometer.
 
-Published numbers come from ``fixtures/published/zou2013_table{1,3}.csv`` (with their
-citation headers); that Table 3 is reproduced at 46 deg, not 45, is derived in
-``docs/errata.md``.
+Compared with the paper's Table 3 [Zou2013]_. Published numbers come from
+``fixtures/published/zou2013_table{1,3}.csv`` (with their citation headers); that Table 3
+is reproduced at 46 deg, not 45, is derived in ``docs/errata.md``.
 
 References
 ----------

@@ -1,6 +1,6 @@
-"""Sections ``tracer_maps`` and ``tracer_validation``: the 2022 factor-study maps, and the
-tracer against analytic limits and independent oracles.
+"""Sections ``tracer_maps`` and ``tracer_validation``: factor-study maps, tracer validation.
 
+The 2022 factor-study maps, and the tracer against analytic limits and independent oracles.
 Dong et al., "Polarized BRDF of coated rough surfaces" (2022): the factor studies of its
 section 4 and the model of its section 2.3, as :mod:`labbrdf.tracer` implements them.
 
