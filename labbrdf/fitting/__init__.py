@@ -24,9 +24,9 @@ Modules: :mod:`~labbrdf.fitting.data` (FitData, row selection),
 
 Internal API: names without an underscore that the modules share but this package does not
 re-export (``data.as_fit_data``, ``data.clean_fit_data``, ``data.select_rows``,
-``data.several_groups_message``, ``core.setup_params``, ``uncertainty.jacobian``,
-``uncertainty.uncertainties``); each module lists them in its own ``__all__``. They may
-change without notice.
+``data.several_groups_message``, ``FitData.from_arrays``, ``core.setup_params``,
+``uncertainty.jacobian``, ``uncertainty.uncertainties``); each module lists its functions
+among them in its own ``__all__``. They may change without notice.
 
 ``labbrdf.fit`` and ``labbrdf.fit_many`` are these functions, re-exported by ``labbrdf``.
 """

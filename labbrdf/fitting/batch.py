@@ -127,7 +127,7 @@ def fit_many(
         groups.append(
             several_groups_message(*several[0])
             if several
-            else FitData._from_arrays(arrays, idx, qty, unt)
+            else FitData.from_arrays(arrays, idx, qty, unt)
         )
     kw = dict(fit_kw, method=method, seed=seed)
     todo = [(i, g) for i, g in enumerate(groups) if isinstance(g, FitData)]

@@ -126,12 +126,18 @@ class FitData:
         for key in ("sample", "wavelength_nm"):
             if key in d.columns and d[key].nunique(dropna=False) > 1:
                 raise FitError(several_groups_message(key, d[key].nunique(dropna=False)))
-        return cls._from_arrays(d, np.arange(len(d)), qty, unt)
+        return cls.from_arrays(d, np.arange(len(d)), qty, unt)
 
     @classmethod
-    def _from_arrays(
+    def from_arrays(
         cls, d: pd.DataFrame | dict[str, NDArray], idx: NDArray, quantity: str, unit: str
     ) -> FitData:
+        """The rows ``idx`` of the columns of ``d`` (checked schema rows; internal API).
+
+        Used by :meth:`from_frame` and by :func:`~labbrdf.fitting.fit_many`, which selects
+        the rows of every group once and builds each group's FitData from them.
+        """
+
         def col(name: str) -> NDArray:
             return np.asarray(d[name], dtype=float)[idx]
 

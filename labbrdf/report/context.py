@@ -21,6 +21,7 @@ import pandas as pd
 
 from .. import models, parallel
 from ..fitting import fit
+from ..tracer import TraceResult
 from .builder import Builder, Unavailable, num
 
 __all__ = [
@@ -103,7 +104,7 @@ class Context:
     shared: Path | None = None
     #: results kept for later sections (and tests): the compare fits, the factor-study runs
     compare_fits: dict[str, list[FitRecord]] = field(default_factory=dict)
-    factor_runs: list[Any] = field(default_factory=list)
+    factor_runs: list[tuple[str, str, TraceResult]] = field(default_factory=list)
 
     @property
     def data(self) -> pd.DataFrame | None:
