@@ -16,7 +16,7 @@ and the chi-square reached by
 and the worst ratio chi2(default) / chi2(de) (aim: <= 1, never worse). Then it times
 ``fit_many`` on one synthetic sample with 761 wavelengths (240-1000 nm) on a process pool.
 
-Aims (issue 4): <= 10 ms per smooth3 fit, <= 100 ms per five_param fit, 761 wavelengths
+Aims: <= 10 ms per smooth3 fit, <= 100 ms per five_param fit, 761 wavelengths
 in < 5 s on 2 cores. Not a timed test: numbers depend on the machine and its load.
 """
 
@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 from scipy import optimize
 
-from labbrdf.fit import FitData, Objective, fit, fit_many
+from labbrdf.fitting import FitData, Objective, fit, fit_many
 from labbrdf.models import MODELS, get
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -66,7 +66,10 @@ def synthetic(k: tuple[float, float, float], rng: np.random.Generator) -> FitDat
 
 def fixture_groups() -> list[tuple[str, FitData]]:
     groups = []
-    files = [ROOT / "fixtures" / "specular" / f"{s}_specular.csv" for s in ("osr", "mirror")]
+    files = [
+        ROOT / "labbrdf" / "data" / "fixtures" / "specular" / f"{s}_specular.csv"
+        for s in ("osr", "mirror")
+    ]
     if all(f.is_file() for f in files):
         for f in files:
             df = pd.read_csv(f, comment="#")

@@ -16,7 +16,7 @@ this process, the median of ``--repeat`` runs of
   columns categorical);
 
 and prints lines/s, MB/s and the ratio labbrdf/pandas. The runs are interleaved (one of each
-per round), so a change of machine load hits all of them alike. Aim (issue 3): labbrdf at
+per round), so a change of machine load hits all of them alike. Aim: labbrdf at
 least half pandas' speed (ratio >= 0.5). Not a timed test: numbers depend on the machine and
 its load (and on the state of the allocator: pandas alone varies by up to 2x between runs).
 """

@@ -35,7 +35,7 @@ import numpy as np
 import pandas as pd
 
 from labbrdf import parallel
-from labbrdf.fit import fit_many
+from labbrdf.fitting import fit_many
 from labbrdf.models import get as get_model
 from labbrdf.tracer import Substrate, TraceConfig, trace
 

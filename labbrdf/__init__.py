@@ -3,9 +3,10 @@
 The public API is imported lazily so that ``import labbrdf`` stays cheap:
 
 - :func:`read`, :func:`read_many` (instrument adapters), :class:`Measurement`
-- :func:`fit`, :func:`fit_many` (nlopt fitting core)
+- :func:`fit`, :func:`fit_many` (nlopt fitting core, from :mod:`labbrdf.fitting`)
 - :func:`hemispherical_reflectance` (directional-hemispherical reflectance of a model)
 - :func:`trace` (Monte Carlo polarization ray tracer)
+- :class:`LabbrdfError`, the base of every labbrdf error
 """
 
 from __future__ import annotations
@@ -21,9 +22,10 @@ _LAZY = {
     "Measurement": ("labbrdf.dataset", "Measurement"),
     "DatasetError": ("labbrdf.dataset", "DatasetError"),
     "AdapterError": ("labbrdf.adapters", "AdapterError"),
-    "fit": ("labbrdf.fit", "fit"),
-    "fit_many": ("labbrdf.fit", "fit_many"),
-    "FitResult": ("labbrdf.fit", "FitResult"),
+    "LabbrdfError": ("labbrdf.errors", "LabbrdfError"),
+    "fit": ("labbrdf.fitting", "fit"),
+    "fit_many": ("labbrdf.fitting", "fit_many"),
+    "FitResult": ("labbrdf.fitting", "FitResult"),
     "hemispherical_reflectance": ("labbrdf.integrate", "hemispherical_reflectance"),
     "trace": ("labbrdf.tracer", "trace"),
     "TraceConfig": ("labbrdf.tracer", "TraceConfig"),
@@ -41,7 +43,9 @@ def __getattr__(name: str) -> Any:
         "dataset",
         "optics",
         "models",
-        "fit",
+        "fitting",
+        "errors",
+        "jsonsafe",
         "integrate",
         "tracer",
         "surface",

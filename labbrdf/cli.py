@@ -20,7 +20,9 @@ import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
+
+from .jsonsafe import jsonable
 
 __all__ = ["main"]
 
@@ -29,21 +31,8 @@ class UsageError(Exception):
     """A command-line input error: printed, exit code 2."""
 
 
-def _json_safe(x: Any) -> Any:
-    """NaN/inf -> None (JSON null), recursively; numpy scalars -> Python numbers."""
-    if isinstance(x, dict):
-        return {k: _json_safe(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_json_safe(v) for v in x]
-    if hasattr(x, "item") and not isinstance(x, str | bytes):
-        x = x.item()
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    return x
-
-
 def _emit_json(obj: Any) -> None:
-    print(json.dumps(_json_safe(obj), indent=2, allow_nan=False))
+    print(json.dumps(jsonable(obj), indent=2, allow_nan=False))
 
 
 def _parse_assignments(items: Sequence[str] | None, what: str) -> dict[str, float]:
@@ -176,8 +165,11 @@ def _check_executor(args: argparse.Namespace) -> None:
 
 
 def _executor_errors(cmd: Any) -> Any:
-    """A run abandoned by the executor (dead workers, unreachable scheduler): exit code 2
-    with the reason, not a traceback; nothing partial has been written."""
+    """Make a run abandoned by the executor exit with code 2 and the reason.
+
+    Dead workers or an unreachable scheduler give the reason on stderr, not a traceback;
+    nothing partial has been written.
+    """
 
     @functools.wraps(cmd)
     def wrapper(args: argparse.Namespace) -> int:
@@ -319,7 +311,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     import pandas as pd
 
     from . import adapters, models
-    from .fit import fit_many
+    from .fitting import fit_many
     from .outputs import check_file_output, check_input_files
 
     _check_executor(args)
@@ -353,7 +345,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
     if args.nk_from:
         if "n" not in _model_options(args.model):
             raise UsageError(f"--nk-from: model {args.model!r} takes no index n, k")
-        tables, results = [], []
+        tables: list[Any] = []
+        results: list[Any] = []
         nk = _nk_combined(args.nk_from)
         unstated = [
             str(m.get("source", "?")) for m in _metas(data) if m.get("wavelength_stated") is False
@@ -403,8 +396,11 @@ def _same_key(a: dict[str, Any], b: dict[str, Any]) -> bool:
 
 
 def _fit_json(table: Any, results: list[tuple[dict[str, Any], Any]], by: list[str]) -> list:
-    """One object per row of the table, failed groups included (``success`` false and the
-    reason in ``message``); ``results`` holds the fitted groups in table order."""
+    """One JSON object per row of the fit table, failed groups included.
+
+    A failed group has ``success`` false and the reason in ``message``; ``results`` holds
+    the fitted groups in table order.
+    """
     out = []
     j = 0
     for row in table.to_dict("records"):
@@ -500,7 +496,7 @@ def cmd_nk(args: argparse.Namespace) -> int:
     if args.output:
         check_file_output(args.output, inputs=args.files, suffixes=(".csv",))
     data = _selected(args, adapters.read_many(args.files))
-    on_ill = "warn" if args.allow_ill_conditioned else "raise"
+    on_ill: Literal["warn", "raise"] = "warn" if args.allow_ill_conditioned else "raise"
     table = nk_table(data, on_ill_conditioned=on_ill, theta_sigma_deg=args.theta_sigma)
     if args.output:
         out = combined_table(table) if args.combined else table

@@ -2,7 +2,7 @@
 
 A :class:`Measurement` is a long ("tidy") :class:`pandas.DataFrame`, one measured value per
 row, plus a JSON-safe ``meta`` dict. Every adapter returns one; every workflow (fit, report)
-reads one. The schema is that of DESIGN.md, "The common dataset":
+reads one. The schema (also in ``docs/conventions.md``, "The common dataset"):
 
 ==================  ========  ===============================================================
 column              dtype     meaning
@@ -46,6 +46,7 @@ import numpy as np
 import pandas as pd
 
 from . import outputs as _outputs
+from .errors import LabbrdfError
 
 __all__ = [
     "COLUMNS",
@@ -113,7 +114,7 @@ _META_KEY = b"labbrdf.meta"
 _CSV_META_PREFIX = "# labbrdf-meta: "
 
 
-class DatasetError(ValueError):
+class DatasetError(LabbrdfError, ValueError):
     """A table does not follow the labbrdf schema; the message names column and rows."""
 
 
@@ -211,7 +212,7 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
 
     Notes
     -----
-    Written for tables of millions of rows (issue 3, ``benchmarks/bench_ingest.py``):
+    Written for tables of millions of rows (``benchmarks/bench_ingest.py``):
     string columns are checked on their distinct values when categorical, range checks
     first try two reductions and build the row masks only when a value is out of range,
     and columns that already have their canonical dtype are not copied (pandas'
@@ -469,7 +470,7 @@ def make_frame(
         "phi_r_deg": phi_r_deg,
         **optional,
     }
-    out = {}
+    out: dict[str, Any] = {}
     for k, v in cols.items():
         if isinstance(v, str) or np.ndim(v) == 0:
             out[k] = [v] * n

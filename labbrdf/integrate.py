@@ -45,7 +45,7 @@ def smooth3_lobe_integral(theta_i: ArrayLike, k2: float, k3: float) -> NDArray[n
     """``I(theta_i) = int_0^{pi/2} exp(-(theta_i - k2 - t)^2 / k3^2) sin t dt`` in closed form.
 
     ``I = Im{k3 e^{ic} e^{-k3^2/4} (sqrt(pi)/2) [erf(u1 - i k3/2) - erf(u0 - i k3/2)]}`` with
-    ``c = theta_i - k2``, ``u0 = -c/k3``, ``u1 = (pi/2 - c)/k3`` (notes/models.md 1.2).
+    ``c = theta_i - k2``, ``u0 = -c/k3``, ``u1 = (pi/2 - c)/k3`` (docs/models.md 1.2).
 
     Parameters
     ----------
@@ -95,7 +95,7 @@ def smooth3_hemispherical(
     Notes
     -----
     The paper's eq. (8) bounds this by ``2 pi k1 / 8`` and concludes that ``k1 <= 4/pi``
-    conserves energy; that holds at normal incidence only (notes/models.md 1.4).
+    conserves energy; that holds at normal incidence only (docs/models.md 1.4).
     """
     ti = np.radians(_check_theta_i(theta_i_deg))
     return math.pi * k1 * smooth3_lobe_integral(ti, k2, k3) / (4.0 * np.cos(ti))
@@ -105,7 +105,7 @@ def k1_max_energy(k2: float, k3: float, theta_max_deg: float) -> float:
     """Largest k1 for which smooth3 keeps ``rho(theta) <= 1`` for all ``theta <= theta_max``.
 
     ``k1_max = 4 / (pi max_{0 <= theta <= theta_max} I(theta) / cos(theta))``
-    (notes/models.md 1.4; replaces the paper's ``k1 <= 4/pi``, eq. (8) of [1]_).
+    (docs/models.md 1.4; replaces the paper's ``k1 <= 4/pi``, eq. (8) of [1]_).
 
     Parameters
     ----------

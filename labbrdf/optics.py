@@ -4,8 +4,8 @@ Pure NumPy (physics layer): no pandas I/O, matplotlib or nlopt. Every public fun
 vectorised with NumPy broadcasting; angles are in degrees at the public API (radians inside).
 Outputs are ndarrays (0-d for scalar inputs).
 
-Conventions (the ONE labbrdf convention, "LB" of ``../shared/oracles/README.md`` section 2)
-------------------------------------------------------------------------------------------
+Conventions (the ONE labbrdf convention, "LB"; also in ``docs/conventions.md``)
+-----------------------------------------------------------------------------
 * Time dependence ``exp(-i omega t)``; complex index ``N = n + ik`` with ``k >= 0`` for an
   absorbing medium. A plane wave travels as ``exp(+i k0 (kx x + kz z))``, so the physical
   root of ``kz = N cos(theta)`` has ``Im(kz) >= 0`` (it decays away from the interface) and,
@@ -34,7 +34,7 @@ Conventions (the ONE labbrdf convention, "LB" of ``../shared/oracles/README.md``
 * Ellipsometry: ``rho = tan(psi) exp(i Delta)`` in the Nebraska convention (Muller 1969;
   Azzam and Bashara), with ``Delta = 180 deg`` at normal incidence and ``0 < Delta < 180``
   for a bare absorber; ``Delta`` is returned in ``[0, 360)``. With the LB amplitudes above
-  this is ``tan(psi) = |rp/rs|``, ``Delta = arg(rs rp*)`` (notes/models.md section 3.2: the
+  this is ``tan(psi) = |rp/rs|``, ``Delta = arg(rs rp*)`` (docs/models.md section 3.2: the
   Nebraska rho is the complex conjugate of the LB ``rp/rs``, and (psi, Delta) are the same
   numbers in both conventions).
 
@@ -56,13 +56,16 @@ References
    Acta Optica Sinica 33(6) 0612008 (2013), doi:10.3788/AOS201333.0612008, eqs. (4)-(6).
 .. [4] K. Berger, A. Weidlich, A. Wilkie, M. Wimmer, "Modeling and verifying the polarizing
    reflectance of real-world metallic surfaces", IEEE CG&A 32(2) 24-33 (2012).
-.. [5] Dong et al., Monte Carlo pBRDF of coated surfaces (2022),
-   ``../shared/papers/dong2022_coated_surface_pbrdf.txt``, eqs. (8), (11), (12), (13), (17).
+.. [5] Z. Dong, P. Bai, W. Xu, Y. Liu, X. Sun, "Modeling and characteristic analysis methods
+   for reflection polarization on coated surfaces", Acta Optica Sinica 42(22) 2224001
+   (2022), doi:10.3788/AOS202242.2224001, eqs. (8), (11), (12), (13), (17); its errors
+   are listed in ``docs/errata.md``.
 """
 
 from __future__ import annotations
 
 import warnings
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -89,8 +92,12 @@ FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
 
-def _arrays(*values: ArrayLike) -> tuple[NDArray, ...]:
-    """Return every value as an ndarray (0-d for scalars), for uniform output types."""
+def _arrays(*values: ArrayLike) -> Any:
+    """Return every value as an ndarray (0-d for scalars), for uniform output types.
+
+    Typed ``Any``: a tuple's length and dtypes cannot follow ``*values``; each caller
+    declares the precise tuple it returns.
+    """
     return tuple(np.asarray(v) for v in values)
 
 
@@ -108,7 +115,7 @@ def _finite(name: str, value: ArrayLike, dtype: type) -> NDArray:
     if dtype is np.float64 and np.iscomplexobj(value):
         raise ValueError(f"{name}: expected real values, got complex")
     try:
-        arr = np.asarray(value, dtype=dtype)
+        arr: NDArray[Any] = np.asarray(value, dtype=dtype)
     except (TypeError, ValueError) as exc:
         raise ValueError(f"{name}: expected a number or an array of numbers ({exc})") from None
     if not np.all(np.isfinite(arr)):
@@ -183,7 +190,9 @@ def _physical_root(w: ComplexArray) -> ComplexArray:
     return np.where(r.real + r.imag < 0, -r, r)
 
 
-def _kz(n1: ComplexArray, n2: ComplexArray, cos_i: ArrayLike) -> tuple[ComplexArray, ...]:
+def _kz(
+    n1: ComplexArray, n2: ComplexArray, cos_i: NDArray[np.float64] | float
+) -> tuple[ComplexArray, ComplexArray]:
     """Normal wave-vector components ``n1 cos_i`` and ``n2 cos_t`` [1, in units of k0].
 
     ``(n2 cos_t)^2 = n2^2 - n1^2 sin^2 = (n2^2 - n1^2) + (n1 cos_i)^2``; the second form is
@@ -621,7 +630,7 @@ def psi_delta(
     ``rho = tan(psi) exp(i Delta) = rp/rs`` (Zou 2013 eq. (4)) holds literally in the
     Nebraska convention (``exp(+i omega t)``, ``N = n - ik``). labbrdf's amplitudes are LB
     (``exp(-i omega t)``, ``N = n + ik``), whose ``rp/rs`` is the complex conjugate, so
-    ``Delta = arg(rs rp*)`` here (notes/models.md section 3.2); the numbers agree with
+    ``Delta = arg(rs rp*)`` here (docs/models.md section 3.2); the numbers agree with
     pyElli's (psi, Delta).
     """
     nc = _index("n", n)
@@ -705,7 +714,7 @@ def nk_from_psi_delta(
         The (pseudo-)index ``N = n + ik`` [1]:
         ``N^2 = n0^2 sin^2(theta) [1 + tan^2(theta) ((1 - rho)/(1 + rho))^2]`` with the LB
         ``rho = tan(psi) exp(-i Delta)`` (Azzam and Bashara [2]_ section 4.3;
-        notes/models.md section 3.1). Any overlayer or roughness makes it a pseudo-index.
+        docs/models.md section 3.1). Any overlayer or roughness makes it a pseudo-index.
 
     Raises
     ------
@@ -718,9 +727,9 @@ def nk_from_psi_delta(
     -----
     The root of ``N^2`` is taken with ``Re(N) + Im(N) >= 0`` (branch cut on the negative
     imaginary axis of ``N^2``). For physical data (``Im(N^2) >= 0``) it is the principal
-    root with ``n, k >= 0``, as in notes/models.md 3.1. When noise pushes ``Im(N^2)``
+    root with ``n, k >= 0``, as in docs/models.md 3.1. When noise pushes ``Im(N^2)``
     slightly negative, a dielectric-like point (``Re N^2 > 0``) comes back with a small
-    ``k < 0`` (reported, not clipped: notes 3.2), and a metal-like point (``Re N^2 < 0``,
+    ``k < 0`` (reported, not clipped: docs/models.md 3.2), and a metal-like point (``Re N^2 < 0``,
     ``n`` near 0) with a small ``n < 0`` instead of a sign-flipped ``k``.
     """
     psi = np.radians(_finite("psi_deg", psi_deg, np.float64))
@@ -782,7 +791,7 @@ def berger_reflectances(
 
     Notes
     -----
-    Corrected form of notes/models.md section 3.4 (Berger et al. 2012 [4]_ as quoted in
+    Corrected form of docs/models.md section 3.4 (Berger et al. 2012 [4]_ as quoted in
     Zou 2013 [3]_ eqs. (5)-(6)). Two misprints of eqs. (5)-(6) are fixed: the square
     belongs on ``q`` inside the root (``sqrt(q^2 + 4 n^2 k^2)``, eq. (6)), and the
     numerator of eq. (5) needs ``(a - sin g tan g)``, not ``(a - sin g)`` (the two agree only
@@ -980,7 +989,8 @@ def film_mueller_incoherent(
 
     Notes
     -----
-    Matches the ``own_inc_series`` rows of ``../shared/oracles/coated_smooth.csv``; this is
+    Matches the ``own_inc_series`` rows of the oracle table ``coated_smooth.csv``
+    (``tests/test_optics_oracles.py``); this is
     the smooth limit of the coated-surface tracer (Dong 2022 [5]_ models the rough case).
     """
     rs_tot, rp_tot, coh = _film_incoherent(

@@ -144,8 +144,10 @@ def _same(a: Path, b: Path) -> bool:
 
 
 def _check_writable(path: Path, option: str, shown: str | None = None) -> None:
-    """The nearest existing folder above ``path`` must be writable (checked before any
-    work, so that a long run does not end in a permission error)."""
+    """Refuse an output whose nearest existing parent folder is not writable.
+
+    Checked before any work, so that a long run does not end in a permission error.
+    """
     d = Path(os.path.abspath(path)).parent
     while not d.exists() and d != d.parent:
         d = d.parent
@@ -165,8 +167,11 @@ def _ends_with_sep(p: str | os.PathLike[str]) -> bool:
 
 
 def check_input_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
-    """Refuse inputs that are not regular files (a device such as ``/dev/zero`` would be
-    read forever, a folder is not a data file); a missing file is left to the reader."""
+    """Refuse inputs that are not regular files.
+
+    A device such as ``/dev/zero`` would be read forever, and a folder is not a data file;
+    a missing file is left to the reader.
+    """
     out = []
     for p in paths:
         path = Path(p)
@@ -246,9 +251,10 @@ def check_file_output(
 
 
 def clean_leftovers(target: str | os.PathLike[str]) -> list[Path]:
-    """Remove what earlier runs of labbrdf, killed before they finished, left beside
-    ``target``: temporary files and folders with our name pattern whose process (on this
-    host) is gone; folders only when they hold our :data:`REPORT_MARKER`.
+    """Remove what killed earlier runs of labbrdf left beside ``target``.
+
+    That is temporary files and folders with our name pattern whose process (on this host)
+    is gone; folders only when they hold our :data:`REPORT_MARKER`.
 
     A previous report moved aside (``...labbrdf-old-...``) when ``target`` itself is
     missing is moved back to ``target`` rather than removed. Returns what was removed.
@@ -359,8 +365,10 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
 
 
 def _marker_files(d: Path) -> set[str] | None:
-    """The files a report folder's marker lists (relative, '/'-separated), or None when
-    ``d`` is not a labbrdf report folder."""
+    """List the files a report folder's marker names, or None for a non-report folder.
+
+    Paths are relative and '/'-separated.
+    """
     marker = d / REPORT_MARKER
     if marker.is_file() and not marker.is_symlink():
         try:
@@ -562,16 +570,22 @@ def replace_dir(
 
 
 def csv_safe_cell(value: Any) -> Any:
-    """A text cell that a spreadsheet would run as a formula (starts with ``= + - @``, TAB
-    or CR) gets a leading ``'``; anything else is returned unchanged (numbers too)."""
+    """Neutralise a text cell that a spreadsheet would run as a formula.
+
+    A cell starting with ``= + - @``, TAB or CR gets a leading ``'``; anything else is
+    returned unchanged (numbers too).
+    """
     if isinstance(value, str) and value.startswith(CSV_FORMULA_PREFIXES):
         return "'" + value
     return value
 
 
 def csv_safe_frame(df: Any) -> Any:
-    """A copy of a DataFrame whose text cells went through :func:`csv_safe_cell`; for CSV
-    tables meant to be opened by people (not for the dataset CSV, read back exactly)."""
+    """Copy a DataFrame with every text cell passed through :func:`csv_safe_cell`.
+
+    For CSV tables meant to be opened by people, not for the dataset CSV (read back
+    exactly).
+    """
     out = df.copy()
     for col in out.columns:
         if out[col].dtype == object or str(out[col].dtype) in ("string", "str"):

@@ -47,7 +47,7 @@ scheduler's ``distributed.scheduler.allowed-failures`` (dask's default 3), not `
 ``local`` workers are started without dask's default ``MALLOC_TRIM_THRESHOLD_=65536``,
 which made NumPy-heavy tracer blocks 3x slower on dask workers than in a process pool.
 
-This module imports nothing from labbrdf, so every layer may use it.
+This module imports nothing from labbrdf but :mod:`labbrdf.errors`, so every layer may use it.
 """
 
 from __future__ import annotations
@@ -72,6 +72,8 @@ from concurrent.futures import (
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, TypeVar
 
+from .errors import LabbrdfError
+
 __all__ = [
     "SCHEDULERS",
     "ParallelError",
@@ -95,9 +97,11 @@ _DASK_HINT = (
 )
 
 
-class ParallelError(RuntimeError):
-    """A worker died (retries used up) or the dask scheduler is unreachable; no partial
-    result is returned."""
+class ParallelError(LabbrdfError, RuntimeError):
+    """A worker died (retries used up) or the dask scheduler is unreachable.
+
+    No partial result is returned.
+    """
 
 
 def _import_dask() -> tuple[Any, Any]:
@@ -184,8 +188,11 @@ def _dashboard_wanted() -> bool:
 
 
 def _security() -> Any | None:
-    """A dask Security from :func:`configure`, else from the dask config
-    (``distributed.comm.tls.*``); None when neither names a CA and a certificate."""
+    """Build the dask Security from :func:`configure`, else from the dask config.
+
+    The config keys are ``distributed.comm.tls.*``; None when neither names a CA and a
+    certificate.
+    """
     from distributed.security import Security
 
     files = _tls_files()
@@ -258,6 +265,7 @@ class Progress:
         self._last_decile = -1
 
     def update(self, n: int = 1) -> None:
+        """Count ``n`` more finished tasks and show the progress (when enabled)."""
         self.done += n
         if not self.enabled:
             return
@@ -521,8 +529,9 @@ def _imap_dask(
     bar: Progress,
     retries: int,
 ) -> Iterator[R]:
-    """Keep ``window`` unyielded tasks on the cluster; results arrive through dask's
-    ``as_completed`` (fetched in the background, batched) and are yielded in item order.
+    """Keep ``window`` unyielded tasks on the cluster; yield the results in item order.
+
+    Results arrive through dask's ``as_completed`` (fetched in the background, batched).
 
     The default window, 4 per worker thread of the cluster and at least 16, hides the
     scheduler round trip (a few ms); tasks are submitted in batches of half a window.

@@ -1,5 +1,7 @@
-"""Row selection on a dataset: the ``--wavelength``, ``--theta-i``, ``--quantity`` and
-``--sample`` options of the command line, as one function.
+"""Row selection on a dataset, as the command line's selection options do it.
+
+The ``--wavelength``, ``--theta-i``, ``--quantity`` and ``--sample`` options, as one
+function.
 
 Ranges are closed intervals ``MIN:MAX`` (either end may be left open, ``400:`` or ``:700``);
 a single number selects that value to 1e-6. Selection never changes a value; a selection
@@ -132,12 +134,12 @@ def select(
             raise SelectionError(f"{opt} {r}: no row left; the data hold {col} {held}")
         keep &= m
     for col, names, opt in (("quantity", quantity, "--quantity"), ("sample", sample, "--sample")):
-        wanted = _names(names)
+        wanted: list[str] = _names(names)
         if not wanted:
             continue
         m = df[col].astype(str).isin(wanted).to_numpy()
         if not (keep & m).any():
-            held = sorted(set(df[col].astype(str)))
-            raise SelectionError(f"{opt} {','.join(wanted)}: no row left; the data hold {held}")
+            present = sorted(set(df[col].astype(str)))
+            raise SelectionError(f"{opt} {','.join(wanted)}: no row left; the data hold {present}")
         keep &= m
     return df[keep].reset_index(drop=True)

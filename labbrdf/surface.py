@@ -1,15 +1,15 @@
-"""FFT Gaussian random rough surfaces (Dong et al. 2022, section 2.1, eqs. 1-5, corrected).
+r"""FFT Gaussian random rough surfaces (Dong et al. 2022, section 2.1, eqs. 1-5, corrected).
 
 A surface ``z = f(x, y)`` on a periodic M x N grid has the Gaussian autocorrelation of
 eq. (1),
 
-.. math:: C(x, y) = \\sigma^2 \\exp(-x^2/c_x^2 - y^2/c_y^2),
+.. math:: C(x, y) = \sigma^2 \exp(-x^2/c_x^2 - y^2/c_y^2),
 
 whose power spectral density (2-D Fourier transform, convention
-``S(k) = (2 pi)^-2 \\int C(r) exp(-i k.r) d^2 r``) is
+``S(k) = (2 pi)^-2 \int C(r) exp(-i k.r) d^2 r``) is
 
-.. math:: S(k_x, k_y) = \\frac{\\sigma^2 c_x c_y}{4\\pi}
-          \\exp\\left(-\\frac{k_x^2 c_x^2 + k_y^2 c_y^2}{4}\\right).
+.. math:: S(k_x, k_y) = \frac{\sigma^2 c_x c_y}{4\pi}
+          \exp\left(-\frac{k_x^2 c_x^2 + k_y^2 c_y^2}{4}\right).
 
 References
 ----------
@@ -40,6 +40,7 @@ Departures from the paper:
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import NDArray
@@ -68,9 +69,9 @@ class Surface:
         The requested RMS height and correlation lengths (c_x, c_y).
     """
 
-    x: NDArray[np.float64]
-    y: NDArray[np.float64]
-    z: NDArray[np.float64]
+    x: NDArray[np.floating[Any]]
+    y: NDArray[np.floating[Any]]
+    z: NDArray[np.floating[Any]]
     sigma: float
     corr_length: tuple[float, float]
 
@@ -88,7 +89,11 @@ def _pair(value: float | tuple[float, float], name: str) -> tuple[float, float]:
 
 
 def gaussian_psd(
-    kx: NDArray[np.float64], ky: NDArray[np.float64], sigma: float, cx: float, cy: float
+    kx: NDArray[np.floating[Any]],
+    ky: NDArray[np.floating[Any]],
+    sigma: float,
+    cx: float,
+    cy: float,
 ) -> NDArray[np.float64]:
     """Power spectral density of the Gaussian correlation, corrected eq. (2) of Dong 2022.
 
@@ -143,7 +148,9 @@ def gaussian_surface(
     ValueError
         For non-positive sizes, lengths or sigma.
     """
-    m, n = (shape, shape) if np.isscalar(shape) else tuple(shape)  # type: ignore[misc]
+    m: Any
+    n: Any
+    m, n = (shape, shape) if np.isscalar(shape) else tuple(cast("tuple[int, int]", shape))
     if int(m) != m or int(n) != n or m < 8 or n < 8:
         raise ValueError(f"shape must be integers >= 8, got {shape!r}")
     m, n = int(m), int(n)
@@ -170,7 +177,7 @@ def height_rms(surface: Surface) -> float:
     return float(np.sqrt(np.mean((z - z.mean()) ** 2)))
 
 
-def _autocorrelation(z: NDArray[np.float64]) -> NDArray[np.float64]:
+def _autocorrelation(z: NDArray[np.floating[Any]]) -> NDArray[np.float64]:
     """Circular autocorrelation normalised to 1 at zero lag."""
     f = np.fft.fft2(z - z.mean())
     acf = np.fft.ifft2(f * np.conj(f)).real

@@ -338,6 +338,7 @@ class SlopeFits:
     ks_threshold: float = KS_WARN
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-safe dict (NaN -> None, tuples -> lists)."""
         return _json_safe(asdict(self))
 
 
@@ -708,7 +709,7 @@ def roughness_statistics(
         if not k.startswith("_") and isinstance(v, float) and math.isfinite(v)
     ]
     if len(tiles) > 1:
-        reps = {k: [] for k in scal}
+        reps: dict[str, list[float]] = {k: [] for k in scal}
         for t in tiles:
             rep = _core(z, valid & ~t, px, degree)
             for k in scal:

@@ -13,10 +13,10 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-FIXTURES = ROOT / "fixtures"
+FIXTURES = ROOT / "labbrdf" / "data" / "fixtures"
 SHARED = Path(os.environ.get("LABBRDF_SHARED", ROOT.parent / "shared"))
 
-#: relative tolerance against double-precision oracles (issue 2: 1e-10)
+#: relative tolerance against double-precision oracles (1e-10)
 RTOL_ORACLE = 1e-10
 
 

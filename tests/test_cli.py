@@ -156,7 +156,9 @@ def test_every_real_export_reads_through_one_entry_point(real_exports):
         assert m.meta["format"] != "labbrdf-dataset-csv", p
 
 
-FIXTURES_SCAN = __import__("pathlib").Path(__file__).resolve().parents[1] / "fixtures/specular"
+FIXTURES_SCAN = (
+    __import__("pathlib").Path(__file__).resolve().parents[1] / "labbrdf/data/fixtures/specular"
+)
 
 
 def test_fit_json_has_one_object_per_group(capsys, tmp_path):
@@ -210,7 +212,7 @@ def test_fit_fix_and_bad_names(capsys):
 
 
 def test_hemispherical_json_matches_notes_table(capsys):
-    # notes/models.md 1.2: OSR 550 nm published fit, rho = 57.0607 % at 45 deg, 58.9843 % at 46
+    # docs/models.md 1.2: OSR 550 nm published fit, rho = 57.0607 % at 45 deg, 58.9843 % at 46
     code = main(
         [
             "hemispherical",

@@ -19,7 +19,14 @@ import pytest
 from labbrdf.cli import main
 from labbrdf.dataset import Measurement, make_frame, write
 
-SCAN = Path(__file__).resolve().parents[1] / "fixtures" / "specular" / "osr_specular.csv"
+SCAN = (
+    Path(__file__).resolve().parents[1]
+    / "labbrdf"
+    / "data"
+    / "fixtures"
+    / "specular"
+    / "osr_specular.csv"
+)
 TRACE = [
     "trace",
     "--substrate",

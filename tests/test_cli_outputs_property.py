@@ -28,7 +28,7 @@ import labbrdf.report
 from labbrdf.cli import main
 from labbrdf.dataset import Measurement, make_frame, write
 from labbrdf.outputs import replace_dir
-from labbrdf.report._common import write_report
+from labbrdf.report.builder import write_report
 
 WRITERS = ["ingest", "fit", "trace-o", "trace-png", "report", "validate"]
 OUTPUTS = [

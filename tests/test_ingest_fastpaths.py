@@ -1,4 +1,4 @@
-"""The fast paths of the ingest pipeline (issue 3) give the same result as the exact ones.
+"""The fast paths of the ingest pipeline give the same result as the exact ones.
 
 ``validate``, the block parser and the Woollam reader take shortcuts on large, clean files
 (range checks by min/max, categorical string columns, ASCII files parsed in place, a

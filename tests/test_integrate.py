@@ -23,7 +23,7 @@ from labbrdf.integrate import (
     smooth3_lobe_integral,
 )
 
-# notes/models.md 1.2 (oracles/smooth3_oracle.py): rho in percent, 4 decimals printed,
+# docs/models.md 1.2 (oracles/smooth3_oracle.py): rho in percent, 4 decimals printed,
 # at theta_i = 30, 45, 46, 60 deg, from the published Table 1 (OSR) and Table 2 (mirror) fits
 RHO_PERCENT = {
     ("OSR", 360): (24.4994, 41.5215, 42.9312, 68.5021),
@@ -37,14 +37,14 @@ RHO_PERCENT = {
 }
 RHO_ANGLES = (30.0, 45.0, 46.0, 60.0)
 
-# notes/models.md 1.4: k1max with the 550 nm shapes (printed as strings: digits set tolerance)
+# docs/models.md 1.4: k1max with the 550 nm shapes (printed as strings: digits set tolerance)
 K1MAX = {
     "OSR": ("14.04", "1.721", "1.083", "0.757", "0.454", "0.266", "0.063"),
     "mirror": ("48.21", "2.356", "1.314", "0.815", "0.414", "0.219", "0.047"),
 }
 K1MAX_ANGLES = (0.0, 46.0, 60.0, 70.0, 80.0, 85.0, 89.0)
 
-# notes/models.md 1.4: angle where the published fits reach rho = 1 (0.1 deg printed)
+# docs/models.md 1.4: angle where the published fits reach rho = 1 (0.1 deg printed)
 RHO1_ANGLE = {"OSR": (70.4, 63.1, 61.9, 61.5), "mirror": (77.9, 76.3, 76.5, 80.6)}
 
 
@@ -116,7 +116,7 @@ def test_table3_integration_column_is_reproduced_at_46_deg(zou2013_params, zou20
         rho45 = 100 * float(hemispherical_reflectance(SMOOTH3, zou2013_params[("OSR", nm)], 45))
         dev46.append(round(rho46, 2) - printed[nm])
         dev45.append(printed[nm] - rho45)
-    # notes 1.2: at 46 deg the printed values are off by +0.02 / -0.10 / -0.03 points
+    # docs/models.md 1.2: at 46 deg the printed values are off by +0.02 / -0.10 / -0.03 points
     np.testing.assert_allclose(dev46, [0.02, -0.10, -0.03], atol=1e-9)
     assert max(abs(d) for d in dev46) < 0.11
     # at 45 deg (the geometry the paper names) the model is 1.39 to 1.95 points lower
@@ -135,7 +135,7 @@ def test_table3_best_single_angle_is_46_02_deg(zou2013_params, zou2013_table3):
         return math.sqrt(np.mean(np.square(d)))
 
     best = minimize_scalar(rms, bounds=(44, 48), method="bounded", options={"xatol": 1e-6})
-    assert best.x == pytest.approx(46.02, abs=0.005)  # notes 1.2: 46.02 deg, RMS 0.047
+    assert best.x == pytest.approx(46.02, abs=0.005)  # docs/models.md 1.2: 46.02 deg, RMS 0.047
     assert best.fun == pytest.approx(0.047, abs=0.0005)
     per_nm = [
         brentq(
@@ -296,7 +296,7 @@ def test_smith_microfacet_conserves_energy():
     assert energy_limit_angle(m, {"alpha": 0.4}, step_deg=20.0, theta_max_deg=80.0) == 80.0
 
 
-# notes/models.md 2.3 (oracles/data/five_param_albedo.csv), total rho, 3 decimals printed
+# docs/models.md 2.3 (oracles/data/five_param_albedo.csv), total rho, 3 decimals printed
 FIVE_PARAM_ALBEDO = {
     ("glossy", "ts"): (0.580, 0.621, 0.837, 1.255, 1.514),
     ("glossy", "none"): (0.626, 0.671, 0.912, 1.651, 2.673),

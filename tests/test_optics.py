@@ -380,7 +380,7 @@ def test_inversion_of_slightly_negative_im_eps_for_a_metal_keeps_k_positive():
 def test_inversion_of_a_noisy_dielectric_reports_negative_k_rather_than_clipping():
     psi, delta = optics.psi_delta(1.5, 45.0)
     n = optics.nk_from_psi_delta(psi, delta + 0.01, 45.0)
-    assert n.imag < 0  # notes/models.md 3.2: do not clip silently
+    assert n.imag < 0  # docs/models.md 3.2: do not clip silently
     assert n.real == pytest.approx(1.5, abs=1e-3)
 
 
@@ -479,7 +479,7 @@ def test_berger_form_equals_fresnel_reflectances(n2):
 
 
 def test_berger_garbled_numerator_differs_from_the_corrected_form_away_from_45_deg():
-    # notes/models.md 3.4: (a - sin g) instead of (a - sin g tan g) errs by 43 % for Cu at
+    # docs/models.md 3.4: (a - sin g) instead of (a - sin g tan g) errs by 43 % for Cu at
     # 75 deg and coincides at 45 deg; our function must not be the garbled one.
     n, k = N_CU.real, N_CU.imag
     for g, differs in ((45.0, False), (75.0, True)):

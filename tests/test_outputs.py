@@ -28,7 +28,7 @@ from labbrdf.outputs import (
     csv_safe_cell,
     replace_dir,
 )
-from labbrdf.report import _common
+from labbrdf.report import builder
 
 
 def _report(d: Path) -> None:
@@ -112,7 +112,7 @@ def test_write_report_refuses_an_output_folder_holding_an_input(tmp_path):
     scan.write_text("data")
     res = {"tables": {}, "checks": []}
     with pytest.raises(OutputError, match="contains the input"):
-        _common.write_report(tmp_path, res, "<html/>", inputs=[scan])
+        builder.write_report(tmp_path, res, "<html/>", inputs=[scan])
     assert scan.read_text() == "data"
 
 
@@ -298,7 +298,7 @@ def test_report_tables_csv_neutralises_formulas():
         },
         "checks": [],
     }
-    rows = list(csv.reader(io.StringIO(_common.tables_csv(res)["fits"])))
+    rows = list(csv.reader(io.StringIO(builder.tables_csv(res)["fits"])))
     assert rows[1] == ['\'=HYPERLINK("http://evil","x")', "-1.5"]
 
 
@@ -355,7 +355,14 @@ def test_library_reports_refuse_a_foreign_folder_before_any_work(tmp_path, capsy
     out = tmp_path / "mine"
     out.mkdir()
     (out / "thesis.tex").write_text("x")
-    scan = Path(__file__).resolve().parents[1] / "fixtures" / "specular" / "osr_specular.csv"
+    scan = (
+        Path(__file__).resolve().parents[1]
+        / "labbrdf"
+        / "data"
+        / "fixtures"
+        / "specular"
+        / "osr_specular.csv"
+    )
     with pytest.raises(OutputError, match="not empty"):
         report.user_report([scan], "smooth3", out, progress=True)
     with pytest.raises(OutputError, match="not empty"):

@@ -1,15 +1,46 @@
-"""The executor layer: same results on every scheduler, truthful progress, loud failures."""
+"""The executor layer (labbrdf.parallel): same results on every scheduler, truthful
+progress, loud failures; and scale-out of its users (batch fits, tracer, CLI, validate).
+
+The second part (scale-out on dask.distributed): real batch fits and real tracer runs go
+through a 2-worker ``LocalCluster`` (``local``), a cluster started here and reached by its
+``tcp://`` address, and the CLI; each is compared bit for bit with the serial run. Worker
+deaths are injected by :class:`KillOnce`, a picklable wrapper that makes the worker process
+running one chosen task exit, a given number of times (counted in a marker file under
+``tmp_path``, so the count survives the dead process). dask's retries must then give the
+serial numbers, and exhausted retries a :class:`ParallelError` with nothing returned.
+"""
 
 from __future__ import annotations
 
+import builtins
+import functools
+import importlib
 import io
+import json
 import math
 import os
+import re
+import shutil
+import subprocess
+import sys
+import textwrap
+import time
+from concurrent.futures import Future
+from pathlib import Path
+from typing import Any
 
+import numpy as np
+import pandas as pd
 import pytest
 
+import labbrdf.fitting.batch
 from labbrdf import parallel
+from labbrdf.cli import main
+from labbrdf.dataset import Measurement, make_frame, write
+from labbrdf.fitting import fit_many
+from labbrdf.models import get as get_model
 from labbrdf.parallel import ParallelError, Progress
+from labbrdf.tracer import Substrate, TraceConfig, trace
 
 
 def crash_once(arg):
@@ -105,3 +136,778 @@ def test_dask_worker_that_always_dies_fails_loudly(dask_available):
     with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
         with pytest.raises(ParallelError, match="no partial result"):
             parallel.run(always_crash, [1, 2], scheduler="local", workers=1, retries=0)
+
+
+# ======================================================================================
+# scale-out: batch fits, tracer, CLI and validate on dask.distributed
+# ======================================================================================
+
+#: the tracer run of these tests: 8 blocks of 1500 rays (Al, alpha 0.2, 45 deg), coarse grid,
+#: each block its own fold group so that work units can be spread over workers
+TRACE = TraceConfig(
+    rays=12_000,
+    block_rays=1500,
+    fold_blocks=1,
+    substrate=Substrate(alpha=0.2),
+    theta_step_deg=6.0,
+    phi_step_deg=6.0,
+    scattering="single",
+    seed=7,
+)
+#: columns that hold wall times, the only ones allowed to differ between schedulers
+TIMING = ["elapsed_s"]
+
+
+# ----------------------------------------------------------------------------------------
+# fault injection (module level: dask pickles it by reference into the workers)
+# ----------------------------------------------------------------------------------------
+
+
+def trace_block(item: tuple[TraceConfig, tuple[int, ...]]) -> int:
+    """Key of a tracer work unit ``(config, fold groups)``: its first group (= block here)."""
+    return item[1][0]
+
+
+def fit_chunk(item: tuple[Any, list[tuple[int, Any]], dict, bool]) -> int:
+    """Key of a fit_many chunk ``(model, [(group index, FitData), ...], kw, keep)``."""
+    return item[1][0][0]
+
+
+class KillOnce:
+    """Run ``module.name(item)``; on the task whose ``key(item) == victim`` first kill the
+    worker process (``os._exit``), ``times`` times in all (counted in ``marker``).
+
+    The wrapped function is carried by name and looked up in the worker, so the parent may
+    monkeypatch the original with this wrapper (as for ``fit_many``'s chunk function).
+    """
+
+    def __init__(self, module: str, name: str, key: Any, victim: int, marker: Path, times=1):
+        self.module, self.name, self.key, self.victim = module, name, key, victim
+        self.marker, self.times = str(marker), times
+
+    def __call__(self, item: Any) -> Any:
+        if self.key(item) == self.victim:
+            deaths = Path(self.marker).read_text().count("x") if os.path.exists(self.marker) else 0
+            if deaths < self.times:
+                with open(self.marker, "a") as fh:
+                    fh.write("x")
+                os._exit(3)
+        return getattr(importlib.import_module(self.module), self.name)(item)
+
+
+def deaths(marker: Path) -> int:
+    return marker.read_text().count("x") if marker.exists() else 0
+
+
+# ----------------------------------------------------------------------------------------
+# data and helpers
+# ----------------------------------------------------------------------------------------
+
+
+def batch_frame(n_wl: int = 6) -> pd.DataFrame:
+    """Synthetic smooth3 scans of two samples in the fixtures' geometry and noise model."""
+    rng = np.random.default_rng(20260707)
+    ti = np.repeat([30.0, 45.0, 60.0], 21)
+    tr = ti + np.tile(np.round(np.arange(-2.0, 2.0001, 0.2), 10), 3)
+    model = get_model("smooth3")
+    frames = []
+    for sample, k1 in (("OSR", 0.9), ("mirror", 0.5)):
+        for wl in np.linspace(400.0, 900.0, n_wl):
+            k = {"k1": k1, "k2": -0.015, "k3": 0.416}
+            y = model.evaluate(np.radians(ti), np.radians(tr), params=k)
+            sigma = np.hypot(0.005 * y, 1e-4)
+            frames.append(
+                make_frame(
+                    sample=sample,
+                    instrument="synthetic",
+                    source="test_scaleout",
+                    quantity="brdf",
+                    value=y + sigma * rng.standard_normal(y.size),
+                    sigma=sigma,
+                    unit="sr-1",
+                    wavelength_nm=wl,
+                    theta_i_deg=ti,
+                    theta_r_deg=tr,
+                    phi_r_deg=180.0,
+                )
+            )
+    return Measurement(pd.concat(frames, ignore_index=True)).data
+
+
+def assert_same_table(a: pd.DataFrame, b: pd.DataFrame) -> None:
+    pd.testing.assert_frame_equal(a.drop(columns=TIMING), b.drop(columns=TIMING), check_exact=True)
+
+
+def assert_same_trace(a: Any, b: Any) -> None:
+    for name in ("sums", "sumsq", "counts", "hemi", "block_hemi", "block_rays"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+    assert a.ledger == b.ledger
+    assert a.events == b.events
+
+
+def dask_map(**kw: Any) -> Any:
+    return functools.partial(parallel.imap, **kw)
+
+
+@pytest.fixture(scope="module")
+def dask_ok() -> None:
+    pytest.importorskip("dask.distributed")
+
+
+@pytest.fixture(scope="module")
+def frame() -> pd.DataFrame:
+    return batch_frame()
+
+
+@pytest.fixture(scope="module")
+def serial_table(frame: pd.DataFrame) -> pd.DataFrame:
+    return fit_many(frame, "smooth3", scheduler="serial", progress=False)
+
+
+@pytest.fixture(scope="module")
+def serial_trace() -> Any:
+    return trace(TRACE, map=builtins.map)
+
+
+@pytest.fixture(scope="module")
+def tcp_cluster(dask_ok: None) -> Any:
+    """A 2-worker cluster started here; the tests reach it only through its address."""
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(
+        n_workers=2,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        scheduler_kwargs={"dashboard": False, "dashboard_address": ":0"},
+    ) as cluster:
+        yield cluster.scheduler_address
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _close_local_cluster() -> Any:
+    yield
+    parallel.shutdown()
+
+
+def _progress_counts(err: str, desc: str) -> list[tuple[int, int]]:
+    return [
+        (int(a), int(b)) for a, b in re.findall(rf"^{re.escape(desc)}: (\d+)/(\d+)", err, re.M)
+    ]
+
+
+# ----------------------------------------------------------------------------------------
+# same numbers on every scheduler
+# ----------------------------------------------------------------------------------------
+
+
+@pytest.mark.slow
+def test_batch_fit_on_two_worker_local_cluster_equals_serial_bit_for_bit(
+    dask_ok, frame, serial_table
+):
+    table = fit_many(frame, "smooth3", scheduler="local", workers=2, chunks=5, progress=False)
+    assert serial_table["success"].all() and len(serial_table) == 12
+    assert_same_table(serial_table, table)
+    info = parallel._LOCAL["client"].scheduler_info()
+    assert len(info["workers"]) == 2  # --workers really gave two worker processes
+
+
+@pytest.mark.slow
+def test_trace_on_two_worker_local_cluster_equals_serial_bit_for_bit(dask_ok, serial_trace):
+    assert TRACE.n_blocks == 8
+    res = trace(TRACE, map=dask_map(scheduler="local", workers=2), blocks_per_unit=3)
+    assert_same_trace(serial_trace, res)
+
+
+def test_trace_on_one_and_two_pool_workers_equals_serial_bit_for_bit(serial_trace):
+    for workers, per_unit in ((1, 1), (2, 3)):
+        res = trace(
+            TRACE, map=dask_map(scheduler="processes", workers=workers), blocks_per_unit=per_unit
+        )
+        assert_same_trace(serial_trace, res)
+
+
+@pytest.mark.slow
+def test_tcp_scheduler_address_gives_serial_numbers(
+    tcp_cluster, frame, serial_table, serial_trace
+):
+    assert tcp_cluster.startswith("tcp://")
+    table = fit_many(frame, "smooth3", scheduler=tcp_cluster, chunks=4, progress=False)
+    assert_same_table(serial_table, table)
+    assert_same_trace(serial_trace, trace(TRACE, map=dask_map(scheduler=tcp_cluster)))
+
+
+# ----------------------------------------------------------------------------------------
+# a worker that dies mid-run: dask retries, or a loud failure with nothing returned
+# ----------------------------------------------------------------------------------------
+
+
+@pytest.mark.slow
+def test_worker_killed_mid_trace_is_retried_and_result_equals_serial(
+    dask_ok, serial_trace, tmp_path, capsys
+):
+    marker = tmp_path / "deaths"
+    killer = KillOnce("labbrdf.tracer.walk", "_unit", trace_block, 5, marker)
+
+    def faulty_map(func: Any, items: Any) -> Any:
+        assert func.__name__ == "_unit"
+        return parallel.imap(
+            killer, items, scheduler="local", workers=2, progress=True, desc="trace"
+        )
+
+    res = trace(TRACE, map=faulty_map)
+    assert deaths(marker) == 1  # a worker really died, mid-run (block 5 of 8)
+    assert_same_trace(serial_trace, res)
+    counts = _progress_counts(capsys.readouterr().err, "trace")
+    done = [c for c, _ in counts]
+    assert done == sorted(done) and counts[-1] == (8, 8)  # truthful: never past 8/8
+
+
+@pytest.mark.slow
+def test_worker_killed_mid_batch_fit_is_retried_and_table_equals_serial(
+    dask_ok, frame, serial_table, tmp_path, monkeypatch
+):
+    marker = tmp_path / "deaths"
+    killer = KillOnce("labbrdf.fitting.batch", "_fit_chunk", fit_chunk, 2, marker)
+    monkeypatch.setattr(labbrdf.fitting.batch, "_fit_chunk", killer)
+    table = fit_many(frame, "smooth3", scheduler="local", workers=2, chunks=6, progress=False)
+    assert deaths(marker) == 1
+    assert_same_table(serial_table, table)
+
+
+@pytest.mark.slow
+def test_trace_fails_loudly_when_worker_retries_are_used_up(dask_ok, tmp_path):
+    marker = tmp_path / "deaths"
+    killer = KillOnce("labbrdf.tracer.walk", "_unit", trace_block, 3, marker)
+    faulty = functools.partial(parallel.imap, scheduler="local", workers=2, retries=0, window=2)
+    result = None
+    with pytest.raises(ParallelError, match="0 retries were used up.*no partial result"):
+        result = trace(TRACE, map=lambda f, items: faulty(killer, items))
+    assert result is None and deaths(marker) == 1
+
+
+@pytest.mark.slow
+def test_batch_fit_fails_loudly_when_worker_retries_are_used_up(
+    dask_ok, frame, tmp_path, monkeypatch
+):
+    marker = tmp_path / "deaths"
+    # dies on every attempt: the first run and the default 2 retries
+    killer = KillOnce("labbrdf.fitting.batch", "_fit_chunk", fit_chunk, 1, marker, times=99)
+    monkeypatch.setattr(labbrdf.fitting.batch, "_fit_chunk", killer)
+    table = None
+    with pytest.raises(ParallelError, match="2 retries were used up.*no partial result"):
+        table = fit_many(frame, "smooth3", scheduler="local", workers=2, chunks=4, progress=False)
+    assert table is None and deaths(marker) == 3
+
+
+@pytest.mark.slow
+def test_task_that_raises_on_dask_is_not_retried_and_propagates(tcp_cluster, tmp_path):
+    marker = tmp_path / "calls"
+    with pytest.raises(ValueError, match="bad item 2"):
+        parallel.run(functools.partial(raise_on_two, str(marker)), range(4), scheduler=tcp_cluster)
+    assert marker.read_text() == "x"  # ran once: an exception is an answer, not a crash
+
+
+def raise_on_two(marker: str, x: int) -> int:
+    if x == 2:
+        with open(marker, "a") as fh:
+            fh.write("x")
+        raise ValueError(f"bad item {x}")
+    return x
+
+
+def sleepy_fail(x: int) -> int:
+    if x == 1:
+        raise ValueError("item 1 is bad")
+    time.sleep(0.5)
+    return x
+
+
+def scheduler_tasks(dask_scheduler: Any) -> int:
+    return len(dask_scheduler.tasks)
+
+
+@pytest.mark.slow
+def test_failed_dask_run_leaves_no_tasks_running_on_the_reused_cluster(dask_ok):
+    with pytest.raises(ValueError, match="item 1 is bad") as excinfo:
+        parallel.run(sleepy_fail, range(40), scheduler="local", workers=2)
+    # excinfo keeps the generator's frame (and its futures) alive, as a caller's error
+    # handler would: only an explicit cancel stops the ~14 submitted tasks (3 s of work)
+    client = parallel._LOCAL["client"]
+    deadline = time.monotonic() + 1.0
+    while client.run_on_scheduler(scheduler_tasks) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert client.run_on_scheduler(scheduler_tasks) == 0
+    assert excinfo.value is not None
+
+
+def env_var(name: str) -> str | None:
+    return os.environ.get(name)
+
+
+@pytest.mark.slow
+def test_local_cluster_workers_start_without_dask_malloc_trim_setting(dask_ok):
+    # MALLOC_TRIM_THRESHOLD_ makes glibc mmap each large array afresh: tracer blocks ran
+    # 3x slower on dask workers than in a process pool
+    out = parallel.run(env_var, ["MALLOC_TRIM_THRESHOLD_", "OMP_NUM_THREADS"], scheduler="local")
+    assert out[0] is None
+    assert out[1] == "1"  # dask's other worker settings are kept
+
+
+class LateFuture(Future):
+    """Finished, but ``done()`` says False the first time: it finished 'during' the loop."""
+
+    def __init__(self, value: int) -> None:
+        super().__init__()
+        self.set_result(value)
+        self._asked = False
+
+    def done(self) -> bool:
+        asked, self._asked = self._asked, True
+        return asked
+
+
+def test_progress_counts_a_task_that_finishes_while_results_are_collected():
+    bar = parallel.Progress(5, enabled=False)
+    out = list(parallel._ordered(LateFuture, 5, 2, bar, lambda f: f.result()))
+    assert out == [0, 1, 2, 3, 4]
+    assert bar.done == 5  # every task counted exactly once
+
+
+# ----------------------------------------------------------------------------------------
+# dask is an optional extra
+# ----------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("scheduler", ["local", "tcp://127.0.0.1:8786"])
+def test_dask_scheduler_without_dask_says_how_to_install_it(monkeypatch, scheduler):
+    parallel.shutdown()
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)  # import raises ImportError
+    with pytest.raises(ImportError, match=r"pip install labbrdf\[dask\]"):
+        parallel.run(abs, [1, -2], scheduler=scheduler, workers=2)
+
+
+def test_cli_trace_without_dask_exits_2_with_the_install_hint(monkeypatch, capsys):
+    parallel.shutdown()
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)
+    argv = ["trace", "--substrate", "1.55+7.71j", "--alpha", "0.2", "--theta-i", "45"]
+    code = main([*argv, "--wavelength", "650", "--rays", "1000", "--scheduler", "local"])
+    assert code == 2
+    assert "pip install labbrdf[dask]" in capsys.readouterr().err
+
+
+def test_validate_checks_the_scheduler_before_running_any_section(monkeypatch, tmp_path):
+    from labbrdf.report import validate
+
+    with pytest.raises(ValueError, match="unknown scheduler 'gpu'"):
+        validate(out=tmp_path / "a", quick=True, scheduler="gpu", sections_to_run=[])
+    monkeypatch.setitem(sys.modules, "dask.distributed", None)
+    with pytest.raises(ImportError, match=r"pip install labbrdf\[dask\]"):
+        validate(out=tmp_path / "b", quick=True, scheduler="local", sections_to_run=[])
+    assert not (tmp_path / "a").exists() and not (tmp_path / "b").exists()
+    out = str(tmp_path / "c")
+    assert main(["validate", "--out", out, "--quick", "--scheduler", "local"]) == 2
+    assert not (tmp_path / "c").exists()
+
+
+@pytest.mark.slow
+def test_unreachable_tcp_scheduler_is_a_clear_error(dask_ok, frame, tmp_path, capsys):
+    import dask
+
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        with pytest.raises(ParallelError, match="cannot reach the dask scheduler tcp://127"):
+            parallel.run(abs, [1], scheduler="tcp://127.0.0.1:9")
+        data = _write_dataset(frame, tmp_path)
+        argv = ["fit", data, "--model", "smooth3", "-o", str(tmp_path / "t.csv")]
+        assert main([*argv, "--scheduler", "tcp://127.0.0.1:9"]) == 2
+    assert "labbrdf fit: cannot reach the dask scheduler" in capsys.readouterr().err
+    assert not (tmp_path / "t.csv").exists()  # nothing written
+
+
+def test_negative_retries_are_rejected(dask_ok):
+    with pytest.raises(ValueError, match="retries must be >= 0, got -1"):
+        parallel.run(abs, [1], scheduler="tcp://127.0.0.1:9", retries=-1)  # before connecting
+
+
+# ----------------------------------------------------------------------------------------
+# the CLI honours --scheduler and --workers end to end
+# ----------------------------------------------------------------------------------------
+
+
+class Spy:
+    """Records the scheduler options of every parallel.imap call, then runs it."""
+
+    def __init__(self) -> None:
+        self.calls: list[dict[str, Any]] = []
+        self.pools: list[int] = []
+        self._imap = parallel.imap
+
+    def imap(self, func: Any, items: Any, **kw: Any) -> Any:
+        self.calls.append(dict(kw, func=getattr(func, "__name__", repr(func))))
+        return self._imap(func, items, **kw)
+
+
+@pytest.fixture
+def spy(monkeypatch) -> Spy:
+    s = Spy()
+    monkeypatch.setattr(parallel, "imap", s.imap)
+    real_pool = parallel.ProcessPoolExecutor
+
+    def pool(max_workers: int) -> Any:
+        s.pools.append(max_workers)
+        return real_pool(max_workers=max_workers)
+
+    monkeypatch.setattr(parallel, "ProcessPoolExecutor", pool)
+    return s
+
+
+TRACE_ARGV = [
+    "trace",
+    "--substrate",
+    "1.55+7.71j",
+    "--alpha",
+    "0.2",
+    "--theta-i",
+    "45",
+    "--wavelength",
+    "650",
+    "--rays",
+    "70000",  # 3 blocks of 32768
+    "--seed",
+    "3",
+    "--single-scattering",
+    "--json",
+]
+
+
+def _trace_json(capsys, *extra: str) -> dict[str, Any]:
+    assert main([*TRACE_ARGV, *extra]) == 0
+    out = json.loads(capsys.readouterr().out)
+    out.pop("seconds")
+    return out
+
+
+def test_cli_trace_honours_scheduler_and_workers(spy, capsys):
+    serial = _trace_json(capsys, "--scheduler", "serial")
+    assert spy.calls == []  # serial: no executor at all
+    pool = _trace_json(capsys, "--scheduler", "processes", "--workers", "3")
+    assert [(c["scheduler"], c["workers"]) for c in spy.calls] == [("processes", 3)]
+    assert spy.pools == [3]  # a pool of 3 worker processes really ran the blocks
+    assert pool == serial
+
+
+@pytest.mark.slow
+def test_cli_trace_over_tcp_equals_serial(tcp_cluster, capsys):
+    serial = _trace_json(capsys, "--scheduler", "serial")
+    assert _trace_json(capsys, "--scheduler", tcp_cluster) == serial
+
+
+def _write_dataset(frame: pd.DataFrame, tmp_path: Path) -> str:
+    path = tmp_path / "scans.csv"
+    write(Measurement(frame), path)
+    return str(path)
+
+
+def test_cli_fit_honours_scheduler_and_workers(spy, frame, tmp_path, capsys):
+    data = _write_dataset(frame, tmp_path)
+    argv = ["fit", data, "--model", "smooth3", "--json", "-o"]
+    assert main([*argv, str(tmp_path / "serial.csv"), "--scheduler", "serial"]) == 0
+    assert spy.pools == []
+    assert main([*argv, str(tmp_path / "pool.csv"), "--scheduler", "processes",
+                 "--workers", "2"]) == 0  # fmt: skip
+    assert [(c["scheduler"], c["workers"]) for c in spy.calls] == [
+        ("serial", None),
+        ("processes", 2),
+    ]
+    assert spy.pools == [2]  # a pool of 2 worker processes really ran the fits
+    capsys.readouterr()
+    serial = pd.read_csv(tmp_path / "serial.csv")
+    assert len(serial) == 12 and serial["success"].all()
+    assert_same_table(serial, pd.read_csv(tmp_path / "pool.csv"))
+
+
+@pytest.mark.slow
+def test_cli_fit_over_tcp_equals_serial_bit_for_bit(tcp_cluster, frame, tmp_path, capsys):
+    data = _write_dataset(frame, tmp_path)
+    argv = ["fit", data, "--model", "smooth3", "--json"]
+    assert main([*argv, "-o", str(tmp_path / "serial.csv"), "--scheduler", "serial"]) == 0
+    serial = capsys.readouterr().out
+    assert main([*argv, "-o", str(tmp_path / "tcp.csv"), "--scheduler", tcp_cluster]) == 0
+    assert capsys.readouterr().out == serial
+    assert_same_table(pd.read_csv(tmp_path / "serial.csv"), pd.read_csv(tmp_path / "tcp.csv"))
+
+
+def test_cli_validate_passes_scheduler_and_workers_to_the_report(monkeypatch, tmp_path):
+    import labbrdf.report
+
+    seen: dict[str, Any] = {}
+
+    def fake_validate(**kw: Any) -> int:
+        seen.update(kw)
+        return 0
+
+    monkeypatch.setattr(labbrdf.report, "validate", fake_validate)
+    out = str(tmp_path / "rep")
+    argv = ["validate", "--out", out, "--quick", "--scheduler", "processes", "--workers", "2"]
+    assert main(argv) == 0
+    assert seen == {"out": out, "quick": True, "progress": True, "scheduler": "processes",
+                    "workers": 2}  # fmt: skip
+
+
+@pytest.mark.slow
+def test_validate_runs_its_fits_and_traces_on_the_requested_scheduler(spy, fixtures_dir, tmp_path):
+    from labbrdf.report import validate
+
+    if not (fixtures_dir / "specular").is_dir():
+        pytest.skip("fixtures/specular absent")
+    code = validate(
+        out=tmp_path / "rep",
+        quick=True,
+        progress=False,
+        scheduler="processes",
+        workers=2,
+        fixtures_dir=fixtures_dir,
+        shared_dir=False,
+        sections_to_run=["fits", "tracer_maps"],
+    )
+    assert code in (0, 1)
+    funcs = {c["func"] for c in spy.calls}
+    assert "_unit" in funcs and funcs & {"fit_task", "_fit_chunk"}  # tracer runs and fits
+    assert spy.calls and {(c["scheduler"], c["workers"]) for c in spy.calls} == {("processes", 2)}
+    assert set(spy.pools) == {2}
+
+
+@pytest.mark.parametrize("bad", [["--scheduler", "gpu"], ["--workers", "0"]])
+def test_cli_rejects_bad_scheduler_or_workers(bad, capsys):
+    assert main([*TRACE_ARGV[:-1], "--rays", "100", *bad]) == 2
+    err = capsys.readouterr().err
+    assert re.search(r"unknown scheduler 'gpu'|workers must be >= 1, got 0", err)
+
+
+# ----------------------------------------------------------- the cluster, not open to the network
+#
+# The dask cluster is not open to the network.
+#
+# * ``local`` binds every listening socket (scheduler, its HTTP server, workers, nannies) to
+#   127.0.0.1 and starts no dashboard unless asked: checked with psutil in a child process,
+#   so that sockets of other tests cannot mix in.
+# * ``tls://``: a cluster with mutual TLS (certificates made here with the ``openssl``
+#   command) gives the serial numbers for a batch fit and a trace, reached through
+#   :func:`labbrdf.parallel.configure` (the CLI's ``--tls-*``) and through the dask config;
+#   a client without a certificate is refused.
+# * a ``tcp://`` address of another host prints a warning that it is unauthenticated.
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture
+def reset_parallel_options() -> Any:
+    options = getattr(parallel, "_OPTIONS", {})
+    saved = dict(options)
+    yield
+    parallel.shutdown()
+    options.clear()
+    options.update(saved)
+
+
+LISTEN = textwrap.dedent(
+    """
+    import json, sys
+    import psutil
+    from labbrdf import parallel
+
+    def main():
+        assert parallel.run(abs, [-1, 2], scheduler="local", workers=2) == [1, 2]
+        client = parallel._LOCAL["client"]
+        me = psutil.Process()
+        listen = []
+        for p in [me, *me.children(recursive=True)]:
+            for c in p.net_connections(kind="inet"):
+                if c.status == psutil.CONN_LISTEN:
+                    listen.append([p.pid, c.laddr.ip, c.laddr.port])
+        info = client.scheduler_info()
+        addresses = [info["address"]]
+        for w, v in info["workers"].items():
+            addresses += [w, v.get("nanny")]
+        print(json.dumps({"listen": listen, "addresses": addresses,
+                          "services": info.get("services", {}),
+                          "pids": len(me.children(recursive=True))}))
+        parallel.shutdown()
+
+    if __name__ == "__main__":
+        main()
+    """
+)
+
+
+def _run_listen(env_extra: dict[str, str]) -> dict[str, Any]:
+    pytest.importorskip("psutil")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), **env_extra}
+    r = subprocess.run(
+        [sys.executable, "-c", LISTEN], capture_output=True, text=True, env=env, timeout=180
+    )
+    assert r.returncode == 0, r.stderr[-2000:]
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
+def test_local_cluster_listens_on_loopback_only_and_has_no_dashboard():
+    info = _run_listen({"LABBRDF_DASK_DASHBOARD": ""})
+    assert info["pids"] >= 2  # the worker processes were inspected too
+    assert info["listen"], info
+    for pid, ip, port in info["listen"]:
+        assert ip == "127.0.0.1", f"pid {pid} listens on {ip}:{port}"
+    for a in info["addresses"]:
+        assert a.startswith("tcp://127.0.0.1:"), a
+    # dask always runs the scheduler's HTTP server (/health, /metrics; listed as
+    # "dashboard"): checked above to be on 127.0.0.1 like every other socket
+
+
+@pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
+def test_dashboard_only_when_asked_and_on_loopback():
+    pytest.importorskip("bokeh")
+    info = _run_listen({"LABBRDF_DASK_DASHBOARD": "1"})
+    port = info["services"]["dashboard"]
+    assert any(ip == "127.0.0.1" and p == port for _, ip, p in info["listen"])
+    for _, ip, _ in info["listen"]:
+        assert ip == "127.0.0.1"
+
+
+# --------------------------------------------------------------------------- TLS
+
+
+@pytest.fixture(scope="module")
+def certs(tmp_path_factory) -> dict[str, str]:
+    """A CA and one certificate it signed (for 127.0.0.1/localhost), made with openssl."""
+    if shutil.which("openssl") is None:
+        pytest.skip("the openssl command is not installed")
+    d = tmp_path_factory.mktemp("tls")
+
+    def ossl(*args: str) -> None:
+        subprocess.run(["openssl", *args], cwd=d, check=True, capture_output=True, timeout=60)
+
+    days = ["-days", "2"]
+    ossl("req", "-x509", "-newkey", "rsa:2048", "-nodes", *days, "-subj", "/CN=labbrdf CA",
+         "-keyout", "ca.key", "-out", "ca.pem")  # fmt: skip
+    ossl("req", "-newkey", "rsa:2048", "-nodes", "-subj", "/CN=localhost",
+         "-keyout", "node.key", "-out", "node.csr")  # fmt: skip
+    (d / "ext.cnf").write_text(
+        "subjectAltName=IP:127.0.0.1,DNS:localhost\nextendedKeyUsage=serverAuth,clientAuth\n"
+    )
+    ossl("x509", "-req", "-in", "node.csr", "-CA", "ca.pem", "-CAkey", "ca.key",
+         "-CAcreateserial", *days, "-extfile", "ext.cnf", "-out", "node.pem")  # fmt: skip
+    return {
+        k: str(d / f) for k, f in (("ca", "ca.pem"), ("cert", "node.pem"), ("key", "node.key"))
+    }
+
+
+@pytest.fixture(scope="module")
+def serial() -> tuple[Any, Any, Any]:
+    frame = batch_frame(n_wl=2)
+    return (
+        frame,
+        fit_many(frame, "smooth3", scheduler="serial", progress=False),
+        trace(TRACE, map=builtins.map),
+    )
+
+
+def _tls_cluster(certs: dict[str, str]) -> Any:
+    from distributed import LocalCluster
+    from distributed.security import Security
+
+    sec = Security(
+        tls_ca_file=certs["ca"],
+        tls_scheduler_cert=certs["cert"],
+        tls_scheduler_key=certs["key"],
+        tls_worker_cert=certs["cert"],
+        tls_worker_key=certs["key"],
+        tls_client_cert=certs["cert"],
+        tls_client_key=certs["key"],
+        require_encryption=True,
+    )
+    return LocalCluster(
+        n_workers=2,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        protocol="tls://",
+        security=sec,
+        dashboard_address=None,
+        scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
+    )
+
+
+@pytest.mark.slow
+@pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
+def test_tls_scheduler_gives_serial_numbers_and_refuses_a_client_without_certificate(
+    certs, serial
+):
+    import functools
+
+    frame, table0, trace0 = serial
+    with _tls_cluster(certs) as cluster:
+        addr = cluster.scheduler_address
+        assert addr.startswith("tls://127.0.0.1:")
+        # without certificates: a clear error before anything runs
+        with pytest.raises(parallel.ParallelError, match="needs certificates"):
+            parallel.run(abs, [1], scheduler=addr)
+        # a client with no certificate cannot talk to the cluster
+        from distributed import Client
+
+        with pytest.raises(Exception):  # noqa: B017 - TLS handshake or timeout error
+            Client(addr.replace("tls://", "tcp://"), timeout="3s", set_as_default=False)
+        parallel.configure(tls_ca=certs["ca"], tls_cert=certs["cert"], tls_key=certs["key"])
+        table = fit_many(frame, "smooth3", scheduler=addr, chunks=3, progress=False)
+        assert_same_table(table0, table)
+        res = trace(TRACE, map=functools.partial(parallel.imap, scheduler=addr))
+        assert_same_trace(trace0, res)
+
+
+@pytest.mark.slow
+@pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
+def test_tls_from_the_dask_config_and_a_local_cluster_on_tls(certs, serial):
+    import dask
+
+    frame, table0, _ = serial
+    cfg = {
+        "distributed.comm.tls.ca-file": certs["ca"],
+        "distributed.comm.tls.client.cert": certs["cert"],
+        "distributed.comm.tls.client.key": certs["key"],
+    }
+    with dask.config.set(cfg):
+        table = fit_many(frame, "smooth3", scheduler="local", workers=2, chunks=3, progress=False)
+        info = parallel._LOCAL["client"].scheduler_info()
+        assert info["address"].startswith("tls://127.0.0.1:")
+        assert all(w.startswith("tls://127.0.0.1:") for w in info["workers"])
+    assert_same_table(table0, table)
+
+
+@pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
+def test_cli_tls_options_need_existing_files(tmp_path, capsys):
+    scan = ROOT / "labbrdf" / "data" / "fixtures" / "specular" / "osr_specular.csv"
+    argv = ["fit", str(scan), "--model", "smooth3", "--scheduler", "tls://127.0.0.1:1"]
+    assert main([*argv, "--tls-ca", str(tmp_path / "nope.pem"), "--tls-cert", "x"]) == 2
+    assert "nope.pem" in capsys.readouterr().err
+    assert main([*argv, "--tls-key", str(tmp_path / "k.pem")]) == 2
+    assert "--tls-ca" in capsys.readouterr().err
+    assert main(argv) == 2  # tls:// without certificates
+    assert "needs certificates" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------- tcp
+
+
+@pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
+def test_tcp_to_another_host_warns_that_it_is_unauthenticated(monkeypatch, capsys):
+    class Refused:
+        def __init__(self, *a: Any, **k: Any) -> None:
+            raise OSError("connection refused")
+
+    monkeypatch.setattr(parallel, "_import_dask", lambda: (Refused, None))
+    with pytest.raises(parallel.ParallelError, match="cannot reach"):
+        parallel.run(abs, [1], scheduler="tcp://192.0.2.7:8786")
+    err = capsys.readouterr().err
+    assert "WARNING" in err and "unauthenticated" in err and "tls://" in err
+    with pytest.raises(parallel.ParallelError):
+        parallel.run(abs, [1], scheduler="tcp://127.0.0.1:8786")
+    assert "unauthenticated" not in capsys.readouterr().err  # this machine: no warning

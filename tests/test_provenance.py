@@ -7,7 +7,7 @@ import platform
 from importlib import metadata
 
 import labbrdf
-from labbrdf.fit import FitData, fit
+from labbrdf.fitting import FitData, fit
 from labbrdf.provenance import PACKAGES, version_of, versions
 from labbrdf.report.validate import validate
 

@@ -12,45 +12,65 @@ candidates. Readers never try each other under ``except``: a parse error is repo
 
 from __future__ import annotations
 
-import importlib
 import os
 from collections.abc import Iterable
 from pathlib import Path
+from typing import Any
 
 from ..dataset import Measurement, concat
+from . import (
+    accurion,
+    cary,
+    filmsense,
+    jasco,
+    jcamp,
+    labbrdf_csv,
+    native,
+    perkinelmer,
+    sentech,
+    spc,
+    woollam,
+    zemax_bsdf,
+)
 from ._base import AdapterError, Format, check_regular_file
 
 __all__ = ["AdapterError", "Format", "READERS", "formats", "read", "read_many", "sniff"]
 
-# One module per vendor; each defines FORMATS: tuple[Format, ...].
-_MODULES = (
-    "woollam",
-    "accurion",
-    "filmsense",
-    "sentech",
-    "jasco",
-    "perkinelmer",
-    "cary",
-    "jcamp",
-    "spc",
-    "labbrdf_csv",
-    "native",
-    "zemax_bsdf",
+# One module per vendor; each defines FORMATS: tuple[Format, ...]. The order here is the
+# order of formats() and of the candidates named in errors.
+_VENDOR_MODULES = (
+    woollam,
+    accurion,
+    filmsense,
+    sentech,
+    jasco,
+    perkinelmer,
+    cary,
+    jcamp,
+    spc,
+    labbrdf_csv,
+    native,
+    zemax_bsdf,
 )
 
+
+def _registry() -> dict[str, Format]:
+    out: dict[str, Format] = {}
+    for module in _VENDOR_MODULES:
+        for f in module.FORMATS:
+            if f.name in out:
+                raise RuntimeError(f"duplicate adapter name {f.name!r}")
+            out[f.name] = f
+    return out
+
+
 #: name -> Format
-READERS: dict[str, Format] = {}
-for _mod in _MODULES:
-    _m = importlib.import_module(f"{__name__}.{_mod}")
-    for _f in _m.FORMATS:
-        if _f.name in READERS:
-            raise RuntimeError(f"duplicate adapter name {_f.name!r}")
-        READERS[_f.name] = _f
+READERS: dict[str, Format] = _registry()
 
 _SNIFF_BYTES = 8192
 
 
-def formats() -> list[dict[str, object]]:
+def formats() -> list[dict[str, Any]]:
     """The supported formats: name, description, extensions, quantities."""
     return [
         {

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..dataset import Measurement
+from ..errors import LabbrdfError
 
 __all__ = [
     "DECIMAL",
@@ -44,7 +45,7 @@ NONFINITE = re.compile(r"[+-]?(?:inf(?:inity)?|nan)", re.IGNORECASE)
 MAX_POINTS = 2_000_000
 
 
-class AdapterError(ValueError):
+class AdapterError(LabbrdfError, ValueError):
     """A file cannot be read as the format asked for.
 
     The message always names the file, and the line (1-based) where that makes sense,

@@ -1,6 +1,6 @@
 """Agilent/Varian Cary WinUV "Scan" CSV export (``.csv``), one or many samples side by side.
 
-Layout (notes/formats.md section 9; ``CuPCtS_H2O_vis.csv`` with one sample and
+Layout (docs/formats.md section 9; ``CuPCtS_H2O_vis.csv`` with one sample and
 ``filters.csv`` with eleven, Cary 50, Scan 3.00):
 
 * row 1: the sample names, each followed by an empty cell (``600LP,,600LP1,,...``);

@@ -1,6 +1,6 @@
 """Film Sense FS-series multi-wavelength ellipsometer text exports (``.txt``).
 
-Layout (notes/formats.md section 4, checked on ``Filmsense_staticTest.txt`` and
+Layout (docs/formats.md section 4, checked on ``Filmsense_staticTest.txt`` and
 ``Filmsense_kineticTest.txt``), TAB separated:
 
 1. ``Film_Sense_Data`` (one measurement) or ``Film_Sense_Dyn_Data`` (a time series);
@@ -66,11 +66,11 @@ def filmsense_psi_delta(
         psi = arccos(N) / 2 [deg], in [0, 90].
     delta : numpy.ndarray
         Delta = arg((C + iS) / (1 + N)) = atan2(S, C) [deg] (1 + N > 0 is real), wrapped
-        into [0, 360): the Nebraska convention of DESIGN.md, see Notes.
+        into [0, 360): the Nebraska convention (``docs/conventions.md``), see Notes.
 
     Notes
     -----
-    The formula is the one notes/formats.md section 4 gives (refellips' reading of Film
+    The formula is the one docs/formats.md section 4 gives (refellips' reading of Film
     Sense files). Its sign was checked against physics on ``Filmsense_staticTest.txt`` (a Si
     wafer, the software's own fit is a 1.60 nm film): at 946.73 nm, where crystalline Si is
     nearly transparent (n = 3.58), N, C, S give psi = 8.35 deg and Delta = 176.36 deg, and a
@@ -319,8 +319,8 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
             parts = ln.split("\t")
             if len(parts) == 2 and NUMBER.fullmatch(parts[1].strip()):
                 fit[parts[0].strip()] = float(parts[1])
-            for m in re.finditer(r"(Model|Date|Ver|Temp):\s*([^,]*)", ln):
-                meta[m.group(1).lower()] = m.group(2).strip()
+            for mt in re.finditer(r"(Model|Date|Ver|Temp):\s*([^,]*)", ln):
+                meta[mt.group(1).lower()] = mt.group(2).strip()
         if fit:
             meta["software_fit"] = fit
 

@@ -12,7 +12,7 @@ Text export (``jasco-spectramanager-text``)
     match the data rows and every X must lie on ``FIRSTX + i * DELTAX``.
 
 Binary ``.jws``/``.jrs`` (``jasco-jws``), Spectra Manager 2 ("``L~S ``" magic)
-    Little-endian fixed offsets (notes/formats.md section 7, confirmed on three V-730 files):
+    Little-endian fixed offsets (docs/formats.md section 7, confirmed on three V-730 files):
     NPOINTS int32 at 0x84; FIRSTX, LASTX, DELTAX float64 at 0x88/0x90/0x98; x-unit code
     (byte) at 0xA0 (3 = nm); y-mode code (byte) at 0xA4 (0 = %T, 2 = %R, 3 = Abs, 8-10 =
     single-beam intensity); data-block length int64 at 0xC8; model, serial, title, comment,
@@ -123,8 +123,10 @@ def _reflectance_quantity(quantity: str, accessory: str) -> str:
 
 
 def _sniff_text(head: bytes) -> bool:
-    """``TITLE`` first (after a UTF-8 BOM, if any), ``NPOINTS`` and ``XYDATA`` lines; line
-    ends CRLF, LF or CR alike."""
+    """Sniff a JASCO text export by its ``TITLE``, ``NPOINTS`` and ``XYDATA`` lines.
+
+    ``TITLE`` comes first (after a UTF-8 BOM, if any); line ends CRLF, LF or CR alike.
+    """
     head = head.removeprefix(b"\xef\xbb\xbf")
     return (
         head.startswith(b"TITLE")

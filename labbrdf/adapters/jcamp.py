@@ -3,7 +3,7 @@
 Reference: R.S. McDonald, P.A. Wilks, "JCAMP-DX: a standard form for exchange of infrared
 spectra in computer readable form", Appl. Spectrosc. 42 (1988) 151,
 doi:10.1366/0003702884428734 (ASDF compression, section "XYDATA"); the UV-Vis use of the
-same records is as in the two real files of notes/formats.md section 10.
+same records is as in the two real files of docs/formats.md section 10.
 
 What is read
     Labelled data records ``##LABEL= value``; labels are normalised (upper case, blanks,

@@ -1,6 +1,6 @@
 """labbrdf's own documented CSV layouts: specular scans and hemispherical-reflectance spectra.
 
-No public real file of a goniometric specular scan was found (notes/formats.md, "Formats we
+No public real file of a goniometric specular scan was found (docs/formats.md, "Formats we
 looked for"), so labbrdf defines two small CSV layouts that any lab script or spreadsheet
 can write. Both are UTF-8 text (a UTF-8 BOM is allowed), any line ending, ``.`` as the
 decimal separator, ``,`` as the cell separator.

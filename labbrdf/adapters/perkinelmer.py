@@ -1,6 +1,6 @@
 """PerkinElmer UV WinLab ASCII export (``.asc``, "PE UV ... PEDS 4.00", e.g. ``*.Probe.Raw.asc``).
 
-Layout (notes/formats.md section 8, seen in three Lambda 1050 files of UV WinLab 6.3.2):
+Layout (docs/formats.md section 8, seen in three Lambda 1050 files of UV WinLab 6.3.2):
 line 1 is the magic ``PE UV SUBTECH SPECTRUM ASCII PEDS <version>`` (blank-padded), then one
 value per line without labels: original file name (3; it is the sample name, used without
 its ``.Probe.Raw.asc`` endings, else the file stem), creation date ``yy/mm/dd`` and time

@@ -1,6 +1,6 @@
 """SENTECH SpectraRay ASCII exports (``.txt``): Psi/Delta at several angles, or a Mueller matrix.
 
-Layout (notes/formats.md section 5, checked on ``Si_SiO2_theta_50_60_70.txt`` and
+Layout (docs/formats.md section 5, checked on ``Si_SiO2_theta_50_60_70.txt`` and
 ``Wafer_MM_70.txt``): one header line ``; WAVELENGTH a1 a2 ...`` giving the angle of
 incidence of every data column, then rows ``wavelength[nm] v1 v2 ...`` separated by spaces,
 each with a trailing space. The header does not say what the columns hold:
@@ -173,7 +173,7 @@ def read_sentech(path: str | os.PathLike[str], kind: str | None = None) -> Measu
         nao = n // 2
         psi = v[:, 1::2]
         delta = v[:, 2::2]
-        badpsi = ((psi < 0) | (psi > 90)).any(axis=1)
+        badpsi = np.asarray(((psi < 0) | (psi > 90)).any(axis=1))
         check_rows(path, block, badpsi, "psi must be within [0, 90] deg")
         aoi = angles[0::2]
         # row-major: for each line, for each AOI: psi, delta

@@ -1,6 +1,6 @@
 """Thermo Galactic SPC binary spectra (``.spc``), new little-endian format (version byte 0x4B).
 
-Layout (Galactic Industries, "SPC file format", 1996; notes/formats.md section 11): a
+Layout (Galactic Industries, "SPC file format", 1996; docs/formats.md section 11): a
 512-byte main header (all little-endian): ``ftflgs`` byte 0, ``fversn`` byte 1 (0x4B),
 ``fexp`` signed byte 3 (Y exponent; -128 = float32 Y), ``fnpts`` int32 at 4, ``ffirst``/
 ``flast`` float64 at 8/16, ``fnsub`` int32 at 24, ``fxtype``/``fytype`` bytes 28/29,

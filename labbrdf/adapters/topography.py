@@ -80,6 +80,7 @@ class HeightMap:
 
     @property
     def is_profile(self) -> bool:
+        """True for a line profile (1-D heights)."""
         return self.heights.ndim == 1
 
     @property
@@ -141,11 +142,8 @@ def read_height_map(
     chans = list(reader.channels)
     names = tuple(str(c.name) for c in chans)
     if channel is None:
-        index = (
-            int(getattr(reader, "default_channel", None).index)
-            if hasattr(reader, "default_channel")
-            else 0
-        )
+        default = getattr(reader, "default_channel", None)
+        index = int(default.index) if default is not None else 0
     elif isinstance(channel, str):
         if channel not in names:
             raise AdapterError(p, f"no channel {channel!r}; channels are {list(names)}")

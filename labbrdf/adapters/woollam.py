@@ -1,6 +1,6 @@
 """J.A. Woollam ASCII data files: WVASE32 and CompleteEASE exports (``.dat``).
 
-Layout (notes/formats.md sections 1-2, checked on every real file in
+Layout (docs/formats.md sections 1-2, checked on every real file in
 ``shared/real-exports/woollam-*``): a header of up to five lines found by content, not by
 position --
 
@@ -304,12 +304,13 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
 
     Notes
     -----
-    Conventions (checked on the real files, notes/formats.md 1-2):
+    Conventions (checked on the real files, docs/formats.md 1-2):
 
-    * Delta is Woollam's, i.e. the Nebraska convention of DESIGN.md (Delta = 180 deg at
-      normal incidence, 0 < Delta < 180 deg for an absorbing substrate: the Ta metal file
-      ``w2_10102006.dat`` has 68 < Delta < 159 deg). Files write it in 0..360 or -180..180;
-      it is only wrapped, and the range as written is kept in ``meta["delta_range_in_file"]``.
+    * Delta is Woollam's, i.e. the Nebraska convention of ``docs/conventions.md`` (Delta =
+      180 deg at normal incidence, 0 < Delta < 180 deg for an absorbing substrate: the Ta
+      metal file ``w2_10102006.dat`` has 68 < Delta < 159 deg). Files write it in 0..360 or
+      -180..180; it is only wrapped, and the range as written is kept in
+      ``meta["delta_range_in_file"]``.
     * eV is converted by lambda = 1240 eV nm / E (not E * hc, the pyElli 0.23.1 bug), with
       the 1240 WVASE itself uses (see :data:`WVASE_HC_EV_NM`), giving 245.73-1697.77 nm for
       ``wafer_2_01242007.dat`` like the nm files of the same instrument; Angstrom by /10.

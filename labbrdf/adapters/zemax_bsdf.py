@@ -476,6 +476,7 @@ def _parse_data(path: str | os.PathLike[str], cur: _Lines, t: BsdfTable) -> None
                     f"found {found}",
                     item[0] if item else cur.last_line(),
                 )
+            assert item is not None  # parts is empty without an item
             t.tis[r, c, a] = _num(path, parts[1], item[0], "TIS")
             br, bl = _block_rows(path, cur, naz, nrad, where)
             rows += br
@@ -627,7 +628,7 @@ def read_zemax_bsdf(
     if wavelength_nm is None:
         wavelength_nm = _own_wavelength(t.comments)
     stated = wavelength_nm is not None
-    wl = float(wavelength_nm) if stated else DEFAULT_WAVELENGTH_NM
+    wl = float(wavelength_nm) if wavelength_nm is not None else DEFAULT_WAVELENGTH_NM
     if not (math.isfinite(wl) and wl > 0):
         raise AdapterError(path, f"wavelength_nm={wavelength_nm!r}: expected a finite number > 0")
     frame, dropped = _table_frame(t, path, wl)
@@ -818,8 +819,11 @@ def _table_from_measurement(m: Measurement) -> BsdfTable:
 
 
 def _cos_weights(t: BsdfTable) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """``(w, cos_r)``: solid-angle weights [sr] and projected cosines (0 below the horizon),
-    each ``(aoi, azimuth, radial)``."""
+    """Solid-angle weights and projected cosines of the grid points.
+
+    Returns ``(w, cos_r)``: weights [sr] and cosines (0 below the horizon), each shaped
+    ``(aoi, azimuth, radial)``.
+    """
     w = _azimuth_weights(t.azimuth_deg, t.symmetry)[:, None] * _radial_weights(t.radial_deg)
     ti = t.theta_i_deg[:, None, None]
     d = scatter_to_direction(ti, t.radial_deg[None, None, :], t.azimuth_deg[None, :, None])
@@ -997,8 +1001,8 @@ def write_bsdf(
         f"SpectralContent  {spectral}",
         f"ScatterType  {scatter_type}",
     ]
-    for key, a in zip(_HEADER_LISTS, (rot, ti, az, rad), strict=True):
-        head += [f"{key}  {a.size}", "\t".join(f"{x:.15g}" for x in a)]
+    for key, arr in zip(_HEADER_LISTS, (rot, ti, az, rad), strict=True):
+        head += [f"{key}  {arr.size}", "\t".join(f"{x:.15g}" for x in arr)]
     head.append("")
     parts = ["\n".join(head)]
     for c, name in enumerate(SPECTRAL[spectral]):

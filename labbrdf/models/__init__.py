@@ -10,11 +10,18 @@ from __future__ import annotations
 from typing import Any
 
 from .base import Model, ModelError, Parameter, Parameters
+from .five_param import FiveParam
+from .microfacet import Microfacet
+from .smooth3 import Smooth3
 
 __all__ = ["MODELS", "Model", "ModelError", "Parameter", "Parameters", "get", "names"]
 
-#: name -> Model subclass (filled below)
-MODELS: dict[str, type[Model]] = {}
+#: name -> Model subclass
+MODELS: dict[str, type[Model]] = {
+    "smooth3": Smooth3,
+    "five_param": FiveParam,
+    "microfacet": Microfacet,
+}
 
 
 def get(name: str, **options: Any) -> Model:
@@ -27,17 +34,5 @@ def get(name: str, **options: Any) -> Model:
 
 
 def names() -> list[str]:
+    """The registry names, sorted."""
     return sorted(MODELS)
-
-
-from .smooth3 import Smooth3  # noqa: E402
-
-MODELS["smooth3"] = Smooth3
-
-from .five_param import FiveParam  # noqa: E402
-
-MODELS["five_param"] = FiveParam
-
-from .microfacet import Microfacet  # noqa: E402
-
-MODELS["microfacet"] = Microfacet

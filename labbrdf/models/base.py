@@ -15,10 +15,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..errors import LabbrdfError
+
 __all__ = ["Model", "ModelError", "Parameter", "Parameters"]
 
 
-class ModelError(ValueError):
+class ModelError(LabbrdfError, ValueError):
     """Unknown model, option or parameter name, or an invalid parameter value."""
 
 
@@ -99,6 +101,7 @@ class Parameters(Mapping[str, Parameter]):
         units: str = "1",
         **kw: Any,
     ) -> Parameter:
+        """Add (or replace) the parameter ``name`` and return it (as lmfit's ``add``)."""
         p = Parameter(name, value, min, max, vary, units, **kw)
         self._p[name] = p
         return p
@@ -125,6 +128,7 @@ class Parameters(Mapping[str, Parameter]):
         return f"Parameters({inner})"
 
     def copy(self) -> Parameters:
+        """A deep copy (the parameters are independent of this set's)."""
         return Parameters(copy.deepcopy(self._p))
 
     def values(self) -> dict[str, float]:  # type: ignore[override]
@@ -132,6 +136,7 @@ class Parameters(Mapping[str, Parameter]):
         return {k: p.value for k, p in self._p.items()}
 
     def varying(self) -> list[str]:
+        """Names of the parameters that vary in a fit."""
         return [k for k, p in self._p.items() if p.vary]
 
 

@@ -85,12 +85,12 @@ class FiveParam(Model):
 
     Parameters: ``kb`` [sr^-1] in [1e-6, 1e3] (log), ``kr`` [1] in [1e-3, 3] (log),
     ``a`` [1] in [0.05, 10], ``b`` [1] in [-20, 20], ``kd`` [sr^-1] in [0, 1/pi]
-    (notes/models.md 2.4). ``kb`` and ``kd`` enter linearly.
+    (docs/models.md 2.4). ``kb`` and ``kd`` enter linearly.
 
     Notes
     -----
     The shadowing function G is **unverified against the 2002 paper**: its text could not be
-    read (notes/models.md 2.2); the V-groove default is the Torrance-Sparrow heritage choice.
+    read (docs/models.md 2.2); the V-groove default is the Torrance-Sparrow heritage choice.
     Fitted ``kb, kr, a, b`` are not comparable across G choices, so the choice is kept in
     ``options``. The specular term is reciprocal for every built-in G; the printed diffuse
     term ``k_d / cos ti`` is not, so the model is reciprocal only for ``kd == 0`` or the
@@ -133,7 +133,7 @@ class FiveParam(Model):
         super().__init__(shadowing=shadowing, diffuse=diffuse)
 
     def default_params(self) -> Parameters:
-        """Defaults and bounds of notes/models.md 2.4 (engineering judgement)."""
+        """Defaults and bounds of docs/models.md 2.4 (engineering judgement)."""
         p = Parameters()
         p.add("kb", 1.0, 1e-6, 1e3, units="sr-1", log=True, description="specular amplitude")
         p.add("kr", 0.1, 1e-3, 3.0, units="1", log=True, description="facet slope parameter")

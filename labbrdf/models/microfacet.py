@@ -61,7 +61,7 @@ def ggx_distribution(cos_m: ArrayLike, alpha: float) -> NDArray[np.float64]:
 
     Notes
     -----
-    The 2022 paper's eq. (14) misses alpha^2 in the numerator (DESIGN.md errata).
+    The 2022 paper's eq. (14) misses alpha^2 in the numerator (``docs/errata.md``).
     """
     c2 = np.asarray(cos_m, dtype=float) ** 2
     d = alpha**2 / (math.pi * (1.0 + (alpha**2 - 1.0) * c2) ** 2)
@@ -151,7 +151,7 @@ class Microfacet(Model):
         "EGSR 2007 (GGX D, Smith G1); Fresnel amplitudes of the substrate"
     )
     doi = "10.2312/EGWR/EGSR07/195-206"
-    linear = ("scale",)
+    linear: tuple[str, ...] = ("scale",)
 
     def __init__(
         self,

@@ -58,16 +58,16 @@ class Smooth3(Model):
     ``R = k1 / (8 cos theta_i cos theta_r) exp(-(theta_i - theta_r - k2)^2 / k3^2)`` [sr^-1],
     with one parameter triple per wavelength.
 
-    Parameters (notes/models.md 1.5): ``k1`` [1] in [0, 5] (linear, may be profiled out),
+    Parameters (docs/models.md 1.5): ``k1`` [1] in [0, 5] (linear, may be profiled out),
     ``k2`` [rad] in [-0.5, 0.5], ``k3`` [rad] in [1e-3, pi/2] searched on a log scale.
 
     Notes
     -----
     The paper's model is in-plane; here it is used as a BRDF without azimuth dependence
     (``phi_r`` is ignored), which is how its hemispherical integral (paper Table 3) was made.
-    The model is reciprocal iff ``k2 == 0`` (notes/models.md 1.3), contrary to the paper's
+    The model is reciprocal iff ``k2 == 0`` (docs/models.md 1.3), contrary to the paper's
     claim. Energy is conserved only over a finite incidence range, not for ``k1 <= 4/pi`` as
-    the paper's eq. (8) states (notes/models.md 1.4; see :mod:`labbrdf.integrate`).
+    the paper's eq. (8) states (docs/models.md 1.4; see :mod:`labbrdf.integrate`).
     On the specular line only ``k1 exp(-k2^2/k3^2)`` is identifiable.
     """
 
@@ -85,7 +85,7 @@ class Smooth3(Model):
         super().__init__()
 
     def default_params(self) -> Parameters:
-        """Defaults near the paper's OSR 550 nm fit; bounds of notes/models.md 1.5."""
+        """Defaults near the paper's OSR 550 nm fit; bounds of docs/models.md 1.5."""
         p = Parameters()
         p.add("k1", 1.0, 0.0, 5.0, units="1", description="amplitude")
         p.add("k2", 0.0, -0.5, 0.5, units="rad", description="lobe shift (peak at ti - k2)")
@@ -132,7 +132,7 @@ class Smooth3(Model):
         return float(theta_i - p["k2"])
 
     def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:
-        """True iff ``k2 == 0`` (notes/models.md 1.3)."""
+        """True iff ``k2 == 0`` (docs/models.md 1.3)."""
         return self.values(params)["k2"] == 0.0
 
 

@@ -353,7 +353,7 @@ def polar_maps_figure(
         ):
             ax = axes[i, j]
             z = np.ma.masked_invalid(np.asarray(data, float))
-            kw = {} if lim is None else {"vmin": lim[0], "vmax": lim[1]}
+            kw: dict[str, float | None] = {} if lim is None else {"vmin": lim[0], "vmax": lim[1]}
             if i == 0 and s0_max is not None and s0_max[j] is not None:
                 kw = {"vmin": 0.0, "vmax": s0_max[j]}
             mesh = ax.pcolormesh(P, T, z, cmap=cmap, shading="flat", **kw)
@@ -480,7 +480,7 @@ def surface_figure(
     ax = axes[2]
     sx, sy = slopes(z, px, valid)
     areal = sy is not None
-    q = np.hypot(sx, sy) if areal else sx
+    q = np.hypot(sx, sy) if sy is not None else sx
     fits = stats.slope_fits
     if q.size:
         hi = float(np.quantile(np.abs(q), 0.995)) or 1.0

@@ -3,7 +3,7 @@
 Everything that comes from files (sample names, header lines, comments) is plain text in
 ``results`` and is escaped by Jinja2's autoescaping; the only raw values on the page are the
 base64 PNG data URIs of the figures and the ``#rrggbb`` colour swatches, both made by the
-report itself. Table cells are rendered with :func:`labbrdf.report._common.fmt` and carry
+report itself. Table cells are rendered with :func:`labbrdf.report.builder.fmt` and carry
 ``data-key`` (a JSON pointer into ``results.json``) and ``data-fmt`` attributes.
 """
 
@@ -14,7 +14,7 @@ from typing import Any
 
 import jinja2
 
-from ._common import _esc_pointer, fmt
+from .builder import esc_pointer, fmt
 
 __all__ = ["render"]
 
@@ -28,7 +28,7 @@ def _env() -> jinja2.Environment:
         lstrip_blocks=True,
     )
     env.filters["fmt"] = fmt
-    env.filters["ptr"] = _esc_pointer
+    env.filters["ptr"] = esc_pointer
     return env
 
 

@@ -13,9 +13,18 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from .. import __version__, models
 from ..provenance import versions
-from . import figure_sections, html, properties, sections
-from ._common import Builder, write_report
+from . import html
+from .builder import Builder, write_report
+from .context import METHOD, Context
+from .sections import Section, run
+from .sections.colour import colour_section
+from .sections.fits import fits_section
+from .sections.ingest import ingest_files
+from .sections.physics import physics_section
+from .sections.scans import scans_section
+from .sections.spectra import spectra_section
 
 __all__ = ["user_report"]
 
@@ -26,7 +35,7 @@ def user_report(
     out: str | os.PathLike[str],
     *,
     options: Mapping[str, Any] | None = None,
-    method: str = sections.METHOD,
+    method: str = METHOD,
     seed: int = 0,
     progress: bool = True,
     scheduler: str | None = None,
@@ -47,7 +56,7 @@ def user_report(
     options : mapping, optional
         Model options, e.g. ``{"shadowing": "mb"}`` for five_param.
     method, seed :
-        Optimiser (nlopt names joined by ``+``) and seed, as for :func:`labbrdf.fit`.
+        Optimiser (nlopt names joined by ``+``) and seed, as for :func:`labbrdf.fitting.fit`.
     progress : bool
         Progress lines on stderr.
     scheduler, workers :
@@ -69,8 +78,6 @@ def user_report(
         No paths, an unknown model name or option, or an output folder that is refused
         (:class:`labbrdf.outputs.OutputError`), all before any work.
     """
-    from labbrdf import models
-
     unknown = set(kw) - {"quick"}
     if unknown:
         raise TypeError(f"user_report() got unexpected keyword argument(s) {sorted(unknown)}")
@@ -85,13 +92,11 @@ def user_report(
         models.get(model, **opts)
     except Exception as exc:
         raise ValueError(f"model: {exc}") from None
-    import labbrdf
-
     b = Builder(
         title or f"labbrdf report: {model} fits",
         progress=progress,
         meta={
-            "labbrdf_version": labbrdf.__version__,
+            "labbrdf_version": __version__,
             "mode": "user",
             "model": model,
             "options": opts,
@@ -101,24 +106,33 @@ def user_report(
             "environment": versions(),
         },
     )
-    ctx = sections.Context(
+    ctx = Context(
         b, scheduler=scheduler, workers=workers, progress=progress, method=method, seed=seed
     )
-    with b.section("ingest", "Ingested files"):
-        b.text(
+
+    def ingest(ctx: Context) -> None:
+        ctx.b.text(
             f"{len(paths)} file(s) given; each was read with labbrdf.read into the common dataset."
         )
-        sections.ingest(ctx, paths)
-    with b.section("fits", f"Fitted {model} parameters per sample and wavelength"):
-        sections.fits_section(ctx, [(model, opts)])
-    with b.section("scans", "Measured points and model curves"):
-        figure_sections.scans_section(ctx, [model])
-    with b.section("spectra", "Parameter spectra against wavelength"):
-        figure_sections.spectra_section(ctx, model)
-    with b.section("physics", "Energy conservation and reciprocity of every fit"):
-        properties.physics_section(ctx)
-    with b.section("colour", "Sample colour from spectrophotometer reflectance"):
-        properties.colour_section(ctx)
+        ingest_files(ctx, paths)
+
+    sections: list[Section] = [
+        ("ingest", "Ingested files", ingest),
+        (
+            "fits",
+            f"Fitted {model} parameters per sample and wavelength",
+            lambda ctx: fits_section(ctx, [(model, opts)]),
+        ),
+        ("scans", "Measured points and model curves", lambda ctx: scans_section(ctx, [model])),
+        (
+            "spectra",
+            "Parameter spectra against wavelength",
+            lambda ctx: spectra_section(ctx, model),
+        ),
+        ("physics", "Energy conservation and reciprocity of every fit", physics_section),
+        ("colour", "Sample colour from spectrophotometer reflectance", colour_section),
+    ]
+    run(ctx, sections)
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
     write_report(out, b.results, page, inputs=paths)

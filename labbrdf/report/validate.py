@@ -17,14 +17,37 @@ from __future__ import annotations
 import os
 import platform
 from collections.abc import Callable, Mapping, Sequence
+from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
+from .. import __version__
+from ..parallel import check_scheduler
 from ..provenance import versions
-from . import figure_sections, html, paper, properties, sections, tracer_sections
-from ._common import Builder, Unavailable, write_report
+from . import html
+from .builder import Builder, write_report
+from .context import Context
+from .sections import Section, run
+from .sections.colour import colour_section
+from .sections.compare import compare_section
+from .sections.errata import errata_section
+from .sections.fits import fits_section
+from .sections.hemispherical import hemispherical_section
+from .sections.ingest import fixture_files, fixtures_section
+from .sections.physics import physics_section
+from .sections.scans import scans_section
+from .sections.spectra import spectra_section
+from .sections.tracer import factor_maps_section, validation_section
 
-__all__ = ["SCALES", "SECTIONS", "default_fixtures_dir", "default_shared_dir", "validate"]
+__all__ = [
+    "SCALES",
+    "SECTIONS",
+    "SECTION_IDS",
+    "default_fixtures_dir",
+    "default_shared_dir",
+    "fixture_files",
+    "validate",
+]
 
 #: rays per tracer run and the grid of the factor-study maps. ``factor``: each of the 15
 #: factor-study runs (the 2022 paper used 2e5 rays; 5e5 here so that the broad alpha = 0.6
@@ -36,47 +59,87 @@ SCALES: dict[str, dict[str, int]] = {
     "full": {"factor": 500_000, "validation": 1_000_000, "grid_step_deg": 1},
 }
 
-#: section ids in page order
-SECTIONS = (
-    "ingest",
-    "fits",
-    "scans",
-    "spectra",
-    "hemispherical",
-    "physics",
-    "compare",
-    "colour",
-    "tracer_maps",
-    "tracer_validation",
-    "errata",
-)
 
+def _fits(ctx: Context) -> None:
+    fits_section(
+        ctx,
+        [("smooth3", {}), ("five_param", {})],
+        published_check=True,
+        chi2_models=["smooth3"],
+    )
+
+
+def _scans(ctx: Context) -> None:
+    scans_section(ctx, ["smooth3", "five_param"])
+
+
+def _spectra(ctx: Context) -> None:
+    spectra_section(ctx, "smooth3")
+    spectra_section(ctx, "five_param")
+
+
+def _hemispherical(ctx: Context) -> None:
+    hemispherical_section(ctx, "OSR")
+
+
+def _physics(ctx: Context) -> None:
+    physics_section(ctx, angles_deg=(0.0, 30.0, 45.0, 60.0))
+
+
+def _compare(ctx: Context) -> None:
+    compare_section(ctx, 45.0, sample="OSR")
+
+
+#: the validation report's sections in page order: (id, title, function of the Context)
+SECTIONS: list[Section] = [
+    ("ingest", "Ingested files", fixtures_section),
+    ("fits", "Fitted parameters per sample and wavelength (Tables 1-2 style)", _fits),
+    ("scans", "Measured points and model curves (Figs. 2-3 style)", _scans),
+    ("spectra", "Parameter spectra against wavelength", _spectra),
+    (
+        "hemispherical",
+        "Hemispherical integral against the spectrophotometer (Table 3)",
+        _hemispherical,
+    ),
+    ("physics", "Energy conservation and reciprocity of every fitted model", _physics),
+    ("compare", "3- vs 5-parameter model (Fig. 4 style)", _compare),
+    ("colour", "Sample colour from the spectrophotometer reflectance", colour_section),
+    (
+        "tracer_maps",
+        "Tracer S0 and DOP hemisphere maps: the 2022 factor studies",
+        factor_maps_section,
+    ),
+    (
+        "tracer_validation",
+        "Tracer validation: analytic limits and oracles",
+        validation_section,
+    ),
+    ("errata", "Paper errata this report depends on", errata_section),
+]
+
+#: section ids in page order
+SECTION_IDS = tuple(sid for sid, _, _ in SECTIONS)
+
+#: the source tree's root when labbrdf runs from a checkout (its parent may hold ../shared)
 _ROOT = Path(__file__).resolve().parents[2]
 
 
 def default_fixtures_dir() -> Path:
-    """The bundled ``fixtures/`` folder of the source tree (or ``$LABBRDF_FIXTURES``)."""
-    return Path(os.environ.get("LABBRDF_FIXTURES", _ROOT / "fixtures"))
+    """The fixtures shipped in the package, ``labbrdf/data/fixtures`` (or ``$LABBRDF_FIXTURES``).
+
+    Found through :mod:`importlib.resources`, so that an installed wheel finds them too.
+    """
+    env = os.environ.get("LABBRDF_FIXTURES")
+    if env:
+        return Path(env)
+    # a wheel installs as plain files, so the resource folder is a real directory
+    return Path(str(resources.files("labbrdf") / "data" / "fixtures"))
 
 
 def default_shared_dir() -> Path | None:
     """``../shared`` next to the project (or ``$LABBRDF_SHARED``), None when absent."""
     p = Path(os.environ.get("LABBRDF_SHARED", _ROOT.parent / "shared"))
     return p if p.is_dir() else None
-
-
-def fixture_files(folder: Path) -> list[Path]:
-    """Every data file under ``folder`` except ``published/``, docs and the generator."""
-    skip_dirs = {"published", "__pycache__"}
-    out = []
-    for p in sorted(folder.rglob("*")):
-        rel = p.relative_to(folder)
-        if not p.is_file() or any(part in skip_dirs or part.startswith(".") for part in rel.parts):
-            continue
-        if p.suffix.lower() in (".md", ".py", ".txt", ".pyc") or p.name.startswith("."):
-            continue
-        out.append(p)
-    return out
 
 
 def validate(
@@ -87,7 +150,7 @@ def validate(
     workers: int | None = None,
     *,
     fixtures_dir: str | os.PathLike[str] | None = None,
-    shared_dir: str | os.PathLike[str] | None | bool = None,
+    shared_dir: str | os.PathLike[str] | Literal[False] | None = None,
     sections_to_run: Sequence[str] | None = None,
     extra_checks: Sequence[Callable[[Builder], Any]] = (),
     fit_options: Mapping[str, Any] | None = None,
@@ -106,17 +169,17 @@ def validate(
         Executor for the fits and the tracer runs (see :mod:`labbrdf.parallel`); None runs
         in this process.
     fixtures_dir : path-like, optional
-        The fixture folder (default: the bundled ``fixtures/``).
+        The fixture folder (default: :func:`default_fixtures_dir`).
     shared_dir : path-like, False or None
         ``../shared`` with the oracles; None finds it next to the project; False: act as if
         it were absent (oracle checks SKIPPED with the reason).
     sections_to_run : sequence of str, optional
-        A subset of :data:`SECTIONS` (tests); the others are listed as not run.
+        A subset of :data:`SECTION_IDS` (tests); the others are listed as not run.
     extra_checks : sequence of callables
         ``f(builder)`` each adding checks to a final "extra checks" section (tests inject a
         failing check here).
     fit_options : mapping, optional
-        Further :func:`labbrdf.fit` keywords for every fit (tests starve ``maxeval`` to
+        Further :func:`labbrdf.fitting.fit` keywords for every fit (tests starve ``maxeval`` to
         show that the fits' success check can fail).
 
     Returns
@@ -136,20 +199,16 @@ def validate(
     else:
         shared = Path(shared_dir) if Path(shared_dir).is_dir() else None
     if scheduler is not None:
-        from labbrdf.parallel import check_scheduler
-
         check_scheduler(scheduler)  # a bad name or missing dask fails here, not per section
-    todo = list(SECTIONS if sections_to_run is None else sections_to_run)
-    unknown = [s for s in todo if s not in SECTIONS]
+    todo = list(SECTION_IDS if sections_to_run is None else sections_to_run)
+    unknown = [s for s in todo if s not in SECTION_IDS]
     if unknown:
-        raise ValueError(f"unknown section(s) {unknown}; sections are {list(SECTIONS)}")
-    import labbrdf
-
+        raise ValueError(f"unknown section(s) {unknown}; sections are {list(SECTION_IDS)}")
     b = Builder(
         "labbrdf validation report",
         progress=progress,
         meta={
-            "labbrdf_version": labbrdf.__version__,
+            "labbrdf_version": __version__,
             "mode": scale_name,
             "scale": SCALES[scale_name],
             "fixtures_dir": str(fx),
@@ -161,97 +220,24 @@ def validate(
             "sections_run": todo,
         },
     )
-    ctx = sections.Context(
+    ctx = Context(
         b,
         quick=quick,
         scheduler=scheduler,
         workers=workers,
         progress=progress,
         fit_options=dict(fit_options or {}),
+        scale=SCALES[scale_name],
+        fixtures=fx,
+        shared=shared,
     )
-    ctx.extra.update({"scale": SCALES[scale_name], "shared": shared, "fixtures": fx})
-
-    def want(sid: str) -> bool:
-        return sid in todo
-
-    with b.section("ingest", "Ingested files"):
-        b.text(
-            f"Fixture folder: {fx}. Every file below was read with labbrdf.read (format "
-            "from the extension and the header) into the common dataset. The fixtures are "
-            "SYNTHETIC files in real export formats, see fixtures/README.md."
-        )
-        pub = paper.load_published(ctx, fx / "published")
-        b.text("Published tables read: " + (", ".join(pub) if pub else "none found") + ".")
-        if not fx.is_dir():
-            raise Unavailable(f"fixture folder {fx} not found")
-        files = fixture_files(fx)
-        sections.ingest(ctx, files, root=fx)
-    steps: list[tuple[str, str, Callable[[], None]]] = [
-        (
-            "fits",
-            "Fitted parameters per sample and wavelength (Tables 1-2 style)",
-            lambda: sections.fits_section(
-                ctx,
-                [("smooth3", {}), ("five_param", {})],
-                published_check=True,
-                chi2_models=["smooth3"],
-            ),
-        ),
-        (
-            "scans",
-            "Measured points and model curves (Figs. 2-3 style)",
-            lambda: figure_sections.scans_section(ctx, ["smooth3", "five_param"]),
-        ),
-        (
-            "spectra",
-            "Parameter spectra against wavelength",
-            lambda: [
-                figure_sections.spectra_section(ctx, "smooth3"),
-                figure_sections.spectra_section(ctx, "five_param"),
-            ],
-        ),
-        (
-            "hemispherical",
-            "Hemispherical integral against the spectrophotometer (Table 3)",
-            lambda: paper.hemispherical_section(ctx, "OSR"),
-        ),
-        (
-            "physics",
-            "Energy conservation and reciprocity of every fitted model",
-            lambda: properties.physics_section(ctx, angles_deg=(0.0, 30.0, 45.0, 60.0)),
-        ),
-        (
-            "compare",
-            "3- vs 5-parameter model (Fig. 4 style)",
-            lambda: figure_sections.compare_section(ctx, 45.0, sample="OSR"),
-        ),
-        (
-            "colour",
-            "Sample colour from the spectrophotometer reflectance",
-            lambda: properties.colour_section(ctx),
-        ),
-        (
-            "tracer_maps",
-            "Tracer S0 and DOP hemisphere maps: the 2022 factor studies",
-            lambda: tracer_sections.factor_maps_section(ctx),
-        ),
-        (
-            "tracer_validation",
-            "Tracer validation: analytic limits and oracles",
-            lambda: tracer_sections.validation_section(ctx),
-        ),
-        ("errata", "Paper errata this report depends on", lambda: paper.errata_section(ctx)),
-    ]
-    for sid, title, fn in steps:
-        if not want(sid):
-            continue
-        with b.section(sid, title):
-            fn()
+    # ingest always runs: every other section reads what it ingested
+    run(ctx, SECTIONS, only={"ingest", *todo})
     if extra_checks:
         with b.section("extra", "Extra checks"):
             for f in extra_checks:
                 f(b)
-    skipped = [s for s in SECTIONS if s not in todo]
+    skipped = [s for s in SECTION_IDS if s not in todo]
     if skipped:
         b.results["meta"]["sections_not_run"] = skipped
     code = b.finish()

@@ -1,5 +1,6 @@
-"""Monte Carlo polarization ray tracer for rough (coated) surfaces (Dong et al. 2022, done
-rigorously; see DESIGN.md "Tracer").
+"""Monte Carlo polarization ray tracer for rough (coated) surfaces (Dong et al. 2022).
+
+Done rigorously; see ``docs/models.md`` section 6.
 
 >>> from labbrdf.tracer import TraceConfig, Substrate, trace
 >>> res = trace(TraceConfig(rays=2000, substrate=Substrate(alpha=0.2), scattering="single"))
@@ -36,7 +37,7 @@ bit-for-bit the same whatever the number of blocks per work unit and whatever ``
 (n_bins x 33)-float tally per group: with one tally per 32768-ray block, sending it back
 (8.6 MB) cost as much as computing it and two processes were no faster than one.
 
-Coating thickness (issue 5, item 4): in this incoherent ray optics the thickness enters only
+Coating thickness: in this incoherent ray optics the thickness enters only
 through Beer-Lambert absorption, so for the paper's lossless varnish the result does not
 depend on it and the paper's lambda/4 maximum (its Fig. 13) cannot appear. The option
 ``coherent=True`` models coating + substrate as one rough interface whose facets carry a
@@ -58,10 +59,10 @@ from typing import Any
 
 import numpy as np
 
-from labbrdf.tracer.binning import Grid
-from labbrdf.tracer.config import Coating, Substrate, TraceConfig
-from labbrdf.tracer.result import TraceResult, trace_summary
-from labbrdf.tracer.walk import BlockTally, GroupTally, _unit, run_unit, trace_block, trace_group
+from .binning import Grid
+from .config import Coating, Substrate, TraceConfig
+from .result import TraceResult, trace_summary
+from .walk import BlockTally, GroupTally, _unit, run_unit, trace_block, trace_group
 
 __all__ = [
     "BlockTally",

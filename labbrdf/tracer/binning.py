@@ -65,12 +65,12 @@ class Grid:
     @property
     def theta_centres_deg(self) -> NDArray[np.float64]:
         """Nominal polar centres [deg]: 0, h, ..., 90."""
-        return np.arange(self.n_theta) * self.theta_step_deg
+        return np.arange(self.n_theta, dtype=np.float64) * self.theta_step_deg
 
     @property
     def phi_centres_deg(self) -> NDArray[np.float64]:
         """Azimuth centres [deg]: 0, g, ..., 360 - g."""
-        return np.arange(self.n_phi) * self.phi_step_deg
+        return np.arange(self.n_phi, dtype=np.float64) * self.phi_step_deg
 
     @property
     def theta_edges_deg(self) -> NDArray[np.float64]:
@@ -82,7 +82,7 @@ class Grid:
     @property
     def phi_edges_deg(self) -> NDArray[np.float64]:
         """Azimuth edges [deg], length n_phi + 1: -g/2, g/2, ..., 360 - g/2."""
-        return (np.arange(self.n_phi + 1) - 0.5) * self.phi_step_deg
+        return (np.arange(self.n_phi + 1, dtype=np.float64) - 0.5) * self.phi_step_deg
 
     @property
     def solid_angle_sr(self) -> NDArray[np.float64]:

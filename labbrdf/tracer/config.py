@@ -94,6 +94,8 @@ class Substrate:
             raise ValueError("from_surface needs an areal height map (2-D), got a profile")
         px = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (2,)))
         sx, sy = slopes(z, px)
+        if sy is None:
+            raise ValueError("a slope table needs an areal height map (2-D), got a profile")
         table = TabulatedNDF.from_slopes(sx, sy, bins=bins)
         alpha = min(fit_slope_distribution(sx, sy).ggx.alpha, 10.0)
         return cls(alpha=alpha, ndf=table, **kw)

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from labbrdf.optics import fresnel_cos
+from ..optics import fresnel_cos
 
 __all__ = [
     "apply_fresnel",

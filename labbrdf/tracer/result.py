@@ -10,8 +10,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from labbrdf.tracer.binning import Grid
-from labbrdf.tracer.config import TraceConfig
+from .binning import Grid
+from .config import TraceConfig
 
 __all__ = ["TraceResult", "trace_summary"]
 

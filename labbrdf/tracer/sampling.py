@@ -65,7 +65,7 @@ def ggx_d(cos_m: ArrayLike, alpha: float) -> NDArray[np.float64]:
     return np.where(c > 0, d, 0.0)
 
 
-def smith_lambda(wz: ArrayLike, alpha: float) -> NDArray[np.float64]:
+def smith_lambda(wz: ArrayLike, alpha: float | NDArray[np.float64]) -> NDArray[np.float64]:
     """Smith Lambda of GGX for a direction with cosine ``wz`` to the normal [1].
 
     For upward directions (wz > 0), ``Lambda = (-1 + sqrt(1 + alpha^2 tan^2 theta)) / 2``;
@@ -79,7 +79,7 @@ def smith_lambda(wz: ArrayLike, alpha: float) -> NDArray[np.float64]:
     return np.where(z >= 0, lam, -1.0 - lam)
 
 
-def smith_g1(wz: ArrayLike, alpha: float) -> NDArray[np.float64]:
+def smith_g1(wz: ArrayLike, alpha: float | NDArray[np.float64]) -> NDArray[np.float64]:
     """Smith masking ``G1 = 2 / (1 + sqrt(1 + alpha^2 tan^2 theta))`` for wz > 0, else 0."""
     z = np.asarray(wz, dtype=float)
     lam = smith_lambda(np.abs(z), alpha)
@@ -102,7 +102,10 @@ def sample_ggx_cos(
 
 
 def sample_vndf(
-    wi: NDArray[np.float64], alpha: float, u1: NDArray[np.float64], u2: NDArray[np.float64]
+    wi: NDArray[np.float64],
+    alpha: float | NDArray[np.float64],
+    u1: NDArray[np.float64],
+    u2: NDArray[np.float64],
 ) -> NDArray[np.float64]:
     """Sample GGX visible normals for the direction ``wi`` (pointing away from the surface).
 
@@ -410,7 +413,8 @@ class TabulatedNDF:
         if z.ndim != 2:
             raise ValueError("a slope table needs an areal height map (2-D), got a profile")
         px = tuple(np.broadcast_to(np.asarray(pixel_size, dtype=float), (2,)))
-        sx, sy = slopes(z, px)  # type: ignore[arg-type]
+        sx, sy = slopes(z, px)
+        assert sy is not None  # an areal map has slopes along y
         return cls.from_slopes(sx, sy, **kw)
 
     # -- serialisation ----------------------------------------------------------------
@@ -429,6 +433,7 @@ class TabulatedNDF:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> TabulatedNDF:
+        """The table written by :meth:`to_dict`."""
         d = dict(data)
         d.pop("kind", None)
         return cls(d.pop("x_edges"), d.pop("y_edges"), d.pop("mass"), **d)
@@ -564,8 +569,11 @@ class TabulatedNDF:
     def _cells(
         self, cdf: NDArray, u: NDArray, v: NDArray, start: NDArray | int = 0
     ) -> tuple[NDArray, NDArray, NDArray]:
-        """Cell by inverse CDF of ``u`` over the sorted cells ``start..``, uniform position
-        in it from (u's remainder, v). Returns x, y and the (unsorted) cell index."""
+        """Pick a cell by inverse CDF of ``u`` over the sorted cells ``start..``.
+
+        The position in the cell is uniform, from (u's remainder, v). Returns x, y and the
+        (unsorted) cell index.
+        """
         total = cdf[-1]
         start = np.asarray(start)
         base = np.where(start > 0, cdf[np.maximum(start - 1, 0)], 0.0)

@@ -26,8 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from labbrdf.tracer.config import Coating, Substrate, TraceConfig
-from labbrdf.tracer.result import TraceResult
+from .config import Coating, Substrate, TraceConfig
+from .result import TraceResult
 
 __all__ = ["MATERIALS", "evaluate_claims", "factor_studies", "study_configs"]
 
@@ -113,7 +113,7 @@ def factor_studies(
     -------
     list of (study, label, TraceResult)
     """
-    from labbrdf.tracer import trace
+    from . import trace
 
     return [
         (study, label, trace(cfg, map=map))

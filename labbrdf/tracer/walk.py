@@ -53,10 +53,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from labbrdf.tracer.binning import Grid, bin_exits
-from labbrdf.tracer.config import TraceConfig
-from labbrdf.tracer.interfaces import apply_fresnel, fresnel_abcs, rotate_frame, s_axis
-from labbrdf.tracer.sampling import sample_height, sample_vndf, smith_g1, smith_lambda
+from .binning import Grid, bin_exits
+from .config import TraceConfig
+from .interfaces import apply_fresnel, fresnel_abcs, rotate_frame, s_axis
+from .sampling import sample_height, sample_vndf, smith_g1, smith_lambda
 
 __all__ = ["BlockTally", "GroupTally", "run_unit", "trace_block", "trace_group"]
 
@@ -140,10 +140,11 @@ class _Setup:
         self, cos_i: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray]:
         if self.coherent:
-            from labbrdf.optics import film_amplitudes
+            from ..optics import film_amplitudes
 
             theta = np.degrees(np.arccos(np.clip(cos_i, 0.0, 1.0)))
             coat = self.coat
+            assert coat is not None  # TraceConfig refuses coherent=True without a coating
             rs, rp = film_amplitudes(
                 1.0, complex(coat.n, coat.k), self.n_sub, coat.thickness_nm, self.lam, theta
             )

@@ -1,4 +1,4 @@
-"""The report's building blocks: checks, tables, figures, formatting and atomic output.
+"""The report's building blocks: the Builder, checks, tables, formatting and atomic output.
 
 A report is built into one JSON-safe ``results`` dict (written as ``results.json``) and a
 dict of embedded figures. Every table cell on the page is rendered from ``results`` with
@@ -28,14 +28,22 @@ from typing import Any
 
 import numpy as np
 
+from ..jsonsafe import jsonable
+
 __all__ = [
     "STATUSES",
     "Builder",
     "Unavailable",
     "atomic_dir",
+    "esc_pointer",
     "fmt",
     "jsonable",
+    "num",
     "resolve",
+    "slug",
+    "tables_csv",
+    "wl_label",
+    "write_report",
 ]
 
 #: the three check outcomes
@@ -47,28 +55,6 @@ class Unavailable(Exception):
 
 
 # --------------------------------------------------------------------------- values
-
-
-def jsonable(x: Any) -> Any:
-    """A JSON-safe copy: numpy scalars/arrays to Python, NaN and inf to None, keys to str."""
-    if isinstance(x, Mapping):
-        return {str(k): jsonable(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [jsonable(v) for v in x]
-    if isinstance(x, np.ndarray):
-        return [jsonable(v) for v in x.tolist()]
-    if isinstance(x, (bool, np.bool_)):
-        return bool(x)
-    if isinstance(x, (int, np.integer)):
-        return int(x)
-    if isinstance(x, (float, np.floating)):
-        v = float(x)
-        return v if math.isfinite(v) else None
-    if x is None or isinstance(x, str):
-        return x
-    if isinstance(x, Path):
-        return str(x)
-    return str(x)
 
 
 def fmt(value: Any, spec: str = "") -> str:
@@ -115,8 +101,28 @@ def resolve(results: Mapping[str, Any], pointer: str) -> Any:
     return node
 
 
-def _esc_pointer(s: str) -> str:
+def esc_pointer(s: str) -> str:
+    """``s`` escaped as one reference token of a JSON pointer (RFC 6901)."""
     return str(s).replace("~", "~0").replace("/", "~1")
+
+
+def num(x: Any) -> float | None:
+    """``x`` as a finite float, or None (not a number, NaN or infinite)."""
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return None
+    return v if math.isfinite(v) else None
+
+
+def slug(s: str) -> str:
+    """``s`` as an id fragment: alphanumerics kept, the rest ``_``, at most 40 characters."""
+    return "".join(c if c.isalnum() else "_" for c in s)[:40] or "sample"
+
+
+def wl_label(x: float) -> str:
+    """A wavelength for text: ``"550 nm"``."""
+    return f"{x:g} nm"
 
 
 # --------------------------------------------------------------------------- builder
@@ -394,8 +400,10 @@ def write_report(
     *,
     inputs: Sequence[str | os.PathLike[str]] = (),
 ) -> Path:
-    """Write ``index.html``, ``results.json`` and ``tables/*.csv`` atomically into ``out``
-    (refused when ``out`` holds anything but an earlier report, or one of ``inputs``)."""
+    """Write ``index.html``, ``results.json`` and ``tables/*.csv`` atomically into ``out``.
+
+    Refused when ``out`` holds anything but an earlier report, or one of ``inputs``.
+    """
     payload = json.dumps(jsonable(results), indent=1, allow_nan=False)
     csvs = tables_csv(results)
 

@@ -12,8 +12,8 @@ import pandas as pd
 from ..dataset import Measurement
 from ..models import Model
 from ..models import get as get_model
-from .core import _setup_params, fit, parse_method
-from .data import FitData, FitError, _select_rows, _several
+from .core import fit, parse_method, setup_params
+from .data import FitData, FitError, select_rows, several_groups_message
 from .result import FitResult
 
 __all__ = ["fit_many"]
@@ -104,8 +104,8 @@ def fit_many(
     missing = [c for c in by if c not in data.columns]
     if missing:
         raise FitError(f"by: unknown column(s) {missing}; columns are {list(data.columns)}")
-    _setup_params(model, fit_kw.get("params"), fit_kw.get("fix"))  # fail early on names
-    d, qty, unt = _select_rows(data, fit_kw.pop("quantity", None), fit_kw.pop("unit", None))
+    setup_params(model, fit_kw.get("params"), fit_kw.get("fix"))  # fail early on names
+    d, qty, unt = select_rows(data, fit_kw.pop("quantity", None), fit_kw.pop("unit", None))
     arrays = {
         c: d[c].to_numpy()
         for c in ("theta_i_deg", "theta_r_deg", "value", "sigma", "phi_r_deg", "wavelength_nm")
@@ -125,11 +125,13 @@ def fit_many(
         several = [(k, np.unique(c[idx]).size) for k, c in codes.items()]
         several = [(k, m) for k, m in several if m > 1]
         groups.append(
-            _several(*several[0]) if several else FitData._from_arrays(arrays, idx, qty, unt)
+            several_groups_message(*several[0])
+            if several
+            else FitData.from_arrays(arrays, idx, qty, unt)
         )
     kw = dict(fit_kw, method=method, seed=seed)
     todo = [(i, g) for i, g in enumerate(groups) if isinstance(g, FitData)]
-    from .. import parallel  # imports nothing from labbrdf: usable from every layer
+    from .. import parallel  # imports only labbrdf.errors: usable from every layer
 
     if chunks is None:
         nw = workers or max(1, os.cpu_count() or 1)

@@ -1,6 +1,6 @@
 """Fit input: the rows of a dataset table (or plain arrays) that a model is fitted to.
 
-Angles stay in degrees here, as at every labbrdf boundary; :class:`~labbrdf.fit.Objective`
+Angles stay in degrees here, as at every labbrdf boundary; :class:`~labbrdf.fitting.Objective`
 converts them to radians for the model.
 """
 
@@ -14,11 +14,20 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from ..dataset import Measurement
+from ..errors import LabbrdfError
 
-__all__ = ["FITTABLE_QUANTITIES", "FitData", "FitError"]
+__all__ = [
+    "FITTABLE_QUANTITIES",
+    "FitData",
+    "FitError",
+    "as_fit_data",
+    "clean_fit_data",
+    "select_rows",
+    "several_groups_message",
+]
 
 
-class FitError(ValueError):
+class FitError(LabbrdfError, ValueError):
     """Bad fit input (data, method, parameter names) or a fit that cannot be set up."""
 
 
@@ -113,41 +122,49 @@ class FitData:
         several of them, or several units, is refused unless ``quantity`` / ``unit`` say
         which to use. Several samples or wavelengths are refused too (use :func:`fit_many`).
         """
-        d, qty, unt = _select_rows(df, quantity, unit)
+        d, qty, unt = select_rows(df, quantity, unit)
         for key in ("sample", "wavelength_nm"):
             if key in d.columns and d[key].nunique(dropna=False) > 1:
-                raise FitError(_several(key, d[key].nunique(dropna=False)))
-        return cls._from_arrays(d, np.arange(len(d)), qty, unt)
+                raise FitError(several_groups_message(key, d[key].nunique(dropna=False)))
+        return cls.from_arrays(d, np.arange(len(d)), qty, unt)
 
     @classmethod
-    def _from_arrays(
+    def from_arrays(
         cls, d: pd.DataFrame | dict[str, NDArray], idx: NDArray, quantity: str, unit: str
     ) -> FitData:
-        def col(name: str) -> NDArray | None:
-            if name not in d:
-                return None
+        """The rows ``idx`` of the columns of ``d`` (checked schema rows; internal API).
+
+        Used by :meth:`from_frame` and by :func:`~labbrdf.fitting.fit_many`, which selects
+        the rows of every group once and builds each group's FitData from them.
+        """
+
+        def col(name: str) -> NDArray:
             return np.asarray(d[name], dtype=float)[idx]
+
+        def optional(name: str) -> NDArray | None:
+            return col(name) if name in d else None
 
         return cls(
             col("theta_i_deg"),
             col("theta_r_deg"),
             col("value"),
-            col("sigma"),
+            optional("sigma"),
             col("phi_r_deg"),
-            col("wavelength_nm"),
+            optional("wavelength_nm"),
             quantity,
             unit,
         )
 
 
-def _several(key: str, count: int) -> str:
+def several_groups_message(key: str, count: int) -> str:
+    """The error message for data that hold ``count`` groups of ``key`` (internal API)."""
     return (
         f"data hold {count} different {key!r} values; fit one group at a time, e.g. "
         "fit_many(data, model, by=['sample', 'wavelength_nm'])"
     )
 
 
-def _select_rows(df: Any, quantity: str | None, unit: str | None) -> tuple[pd.DataFrame, str, str]:
+def select_rows(df: Any, quantity: str | None, unit: str | None) -> tuple[pd.DataFrame, str, str]:
     """The fittable rows of a schema table, checked for one quantity and one unit."""
     if isinstance(df, Measurement):
         df = df.data
@@ -187,13 +204,14 @@ def _select_rows(df: Any, quantity: str | None, unit: str | None) -> tuple[pd.Da
     return d, combos[0][0], combos[0][1]
 
 
-def _as_fit_data(data: Any, quantity: str | None, unit: str | None) -> FitData:
+def as_fit_data(data: Any, quantity: str | None, unit: str | None) -> FitData:
+    """``data`` as :class:`FitData` (a FitData is returned as is; internal API)."""
     if isinstance(data, FitData):
         return data
     return FitData.from_frame(data, quantity=quantity, unit=unit)
 
 
-def _clean(data: FitData, nan_policy: str) -> tuple[FitData, int]:
+def clean_fit_data(data: FitData, nan_policy: str) -> tuple[FitData, int]:
     """Apply the NaN policy; return the clean data and the number of dropped points."""
     if nan_policy not in ("raise", "omit"):
         raise FitError(f"nan_policy must be 'raise' or 'omit', got {nan_policy!r}")

@@ -196,7 +196,7 @@ class Objective:
     def from_vector(self, x: ArrayLike) -> dict[str, float]:
         """Every parameter's natural value at search vector ``x`` (profiled ones unsolved)."""
         vals = dict(self.base)
-        for (k, scaled, lo, span, log), xi in zip(self._spec, x, strict=True):
+        for (k, scaled, lo, span, log), xi in zip(self._spec, np.asarray(x), strict=True):
             t = lo + float(xi) * span if scaled else float(xi)
             v = math.exp(t) if log else t
             if scaled and not 0.0 < xi < 1.0:  # exp(log(max)) can miss max by an ulp

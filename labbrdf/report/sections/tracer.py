@@ -1,4 +1,8 @@
-"""Tracer sections: the 2022 factor-study maps and the tracer validations.
+"""Sections ``tracer_maps`` and ``tracer_validation``: factor-study maps, tracer validation.
+
+The 2022 factor-study maps, and the tracer against analytic limits and independent oracles.
+Dong et al., "Polarized BRDF of coated rough surfaces" (2022): the factor studies of its
+section 4 and the model of its section 2.3, as :mod:`labbrdf.tracer` implements them.
 
 Statistical tolerances
 ----------------------
@@ -15,17 +19,21 @@ are upper bounds of the true errors, so the checks can only be stricter in reali
 
 from __future__ import annotations
 
-import inspect
+import builtins
+import functools
 import math
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from . import figures
-from ._common import Unavailable
-from .sections import Context
+from ... import optics, parallel
+from ...tracer import Substrate, TraceConfig, TraceResult, trace
+from ...tracer import studies as st
+from .. import figures
+from ..context import Context
 
 __all__ = ["factor_maps_section", "maps", "validation_section"]
 
@@ -41,99 +49,43 @@ MIN_COUNT = 20
 SHOW_COUNT = 10
 
 
-def _counts(res: Any, m: dict[str, np.ndarray]) -> np.ndarray:
-    cnt = getattr(res, "counts", None)
-    return np.full(m["s0"].shape, MIN_COUNT) if cnt is None else np.asarray(cnt)
-
-
-def _robust_max(res: Any, s0: np.ndarray) -> float | None:
-    ok = _counts(res, {"s0": s0}) >= MIN_COUNT
+def _robust_max(res: TraceResult, s0: np.ndarray) -> float | None:
+    ok = res.counts >= MIN_COUNT
     return float(s0[ok].max()) if ok.any() else None
 
 
 # --------------------------------------------------------------------------- helpers
 
 
-def _tracer() -> Any:
-    try:
-        from labbrdf import tracer
-    except ImportError as exc:
-        raise Unavailable(f"labbrdf.tracer cannot be imported ({exc})") from None
-    for name in ("trace", "TraceConfig"):
-        if not hasattr(tracer, name):
-            raise Unavailable(f"labbrdf.tracer has no {name} yet")
-    return tracer
-
-
-def _map(ctx: Context, sig: Any) -> dict[str, Any]:
-    """Keyword arguments that put a tracer call on the requested scheduler."""
+def _map(ctx: Context) -> Callable[..., Iterable[Any]]:
+    """The ordered ``map`` that runs tracer work units on the report's scheduler."""
     if ctx.scheduler in (None, "serial"):
-        return {}
-    if "scheduler" in sig:
-        return {"scheduler": ctx.scheduler, "workers": ctx.workers}
-    if "map" in sig:
-        import functools
-
-        from labbrdf import parallel
-
-        return {
-            "map": functools.partial(
-                parallel.imap, scheduler=ctx.scheduler, workers=ctx.workers, progress=False
-            )
-        }
-    return {}
+        return builtins.map
+    return functools.partial(
+        parallel.imap, scheduler=ctx.scheduler, workers=ctx.workers, progress=False
+    )
 
 
-def _run(ctx: Context, config: Any) -> Any:
-    tr = _tracer()
-    return tr.trace(config, **_map(ctx, inspect.signature(tr.trace).parameters))
+def _run(ctx: Context, config: TraceConfig) -> TraceResult:
+    return trace(config, map=_map(ctx))
 
 
-def _get(obj: Any, *names: str) -> Any:
-    for n in names:
-        if hasattr(obj, n):
-            v = getattr(obj, n)
-            return v() if callable(v) else v
-    raise Unavailable(f"TraceResult has none of {names}")
-
-
-def maps(result: Any) -> dict[str, np.ndarray]:
-    """S0 [sr^-1] and DOP [1] maps for unpolarized input, and the bin edges [deg]."""
-    m = np.asarray(_get(result, "mueller"), float)
-    s = m[..., :, 0]  # M @ [1, 0, 0, 0]
-    s0 = s[..., 0]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        dop = np.where(s0 > 0, np.sqrt(np.sum(s[..., 1:] ** 2, axis=-1)) / s0, np.nan)
+def maps(result: TraceResult) -> dict[str, np.ndarray]:
+    """S0 [sr^-1] and DOP [1] maps for unpolarized input, bin edges and centres [deg]."""
     return {
-        "s0": s0,
-        "dop": dop,
-        "theta_edges": np.asarray(_get(result, "theta_r_edges_deg", "theta_edges_deg"), float),
-        "phi_edges": np.asarray(_get(result, "phi_r_edges_deg", "phi_edges_deg"), float),
-        "theta": np.asarray(_get(result, "theta_r_deg", "theta_centres_deg"), float),
-        "phi": np.asarray(_get(result, "phi_r_deg", "phi_centres_deg"), float),
+        "s0": result.s0(),
+        "dop": result.dop(),
+        "theta_edges": result.theta_r_edges_deg,
+        "phi_edges": result.phi_r_edges_deg,
+        "theta": result.theta_r_deg,
+        "phi": result.phi_r_deg,
     }
 
 
-def _summary(result: Any) -> dict[str, Any]:
-    tr = _tracer()
-    if hasattr(tr, "trace_summary"):
-        return dict(tr.trace_summary(result))
-    return {"albedo": float(_get(result, "albedo")), "energy": dict(_get(result, "ledger"))}
-
-
-def _ledger_error(summ: dict[str, Any]) -> float | None:
-    e = summ.get("energy") or {}
-    try:
-        return abs(float(e["exited"]) + float(e["absorbed"]) + float(e["terminated"]) - 1.0)
-    except (KeyError, TypeError, ValueError):
-        return None
-
-
-def _cos_solid_angle(theta_edges: np.ndarray, phi_edges: np.ndarray) -> np.ndarray:
-    t = np.radians(np.clip(theta_edges, 0, 90))
-    band = 0.5 * (np.sin(t[1:]) ** 2 - np.sin(t[:-1]) ** 2)
-    dphi = np.radians(np.diff(phi_edges))
-    return band[:, None] * dphi[None, :]
+def _ledger_error(result: TraceResult) -> float:
+    """|exited + absorbed + terminated - 1| of a run's energy ledger."""
+    e = result.ledger
+    return abs(float(e["exited"]) + float(e["absorbed"]) + float(e["terminated"]) - 1.0)
 
 
 # --------------------------------------------------------------------------- maps
@@ -141,36 +93,21 @@ def _cos_solid_angle(theta_edges: np.ndarray, phi_edges: np.ndarray) -> np.ndarr
 
 def factor_maps_section(ctx: Context) -> None:
     """S0 and DOP hemisphere maps of the four factor studies; the paper's claims."""
-    tr = _tracer()
-    st = tr if hasattr(tr, "factor_studies") else None
-    if st is None:
-        try:
-            from labbrdf.tracer import studies as st
-        except ImportError:
-            raise Unavailable("labbrdf.tracer.factor_studies not available yet") from None
     b = ctx.b
-    scale = ctx.extra["scale"]
-    rays = int(scale["factor"])
-    kw: dict[str, Any] = {"rays": rays, "seed": 0}
-    sig = inspect.signature(st.factor_studies).parameters
-    step = scale.get("grid_step_deg", 1)
-    if "step" in sig:
-        kw["step"] = float(step)
-    kw.update(_map(ctx, sig))
+    rays = int(ctx.scale["factor"])
+    step = float(ctx.scale.get("grid_step_deg", 1))
     b.log(f"  factor studies at {rays} rays per run")
-    runs = list(st.factor_studies(**kw))
-    ctx.extra["factor_runs"] = runs
-    studies: dict[str, list[tuple[str, Any]]] = {}
+    runs = st.factor_studies(rays=rays, seed=0, step=step, map=_map(ctx))
+    ctx.factor_runs = runs
+    studies: dict[str, list[tuple[str, TraceResult]]] = {}
     for study, label, res in runs:
         studies.setdefault(str(study), []).append((str(label), res))
-    rows = []
+    rows: list[dict[str, Any]] = []
     for study, items in studies.items():
         mp = [maps(r) for _, r in items]
         labels = [lab for lab, _ in items]
         for (lab, r), mm in zip(items, mp, strict=True):
-            summ = _summary(r)
-            cnt = getattr(r, "counts", None)
-            ok = np.ones(mm["s0"].shape, bool) if cnt is None else np.asarray(cnt) >= MIN_COUNT
+            ok = r.counts >= MIN_COUNT
             if not ok.any():
                 ok[:] = True
             s0 = np.where(ok, mm["s0"], -np.inf)
@@ -182,16 +119,16 @@ def factor_maps_section(ctx: Context) -> None:
                     "study": study,
                     "case": lab,
                     "rays": rays,
-                    "albedo": summ.get("albedo"),
-                    "absorbed": (summ.get("energy") or {}).get("absorbed"),
-                    "terminated": (summ.get("energy") or {}).get("terminated"),
+                    "albedo": r.albedo(),
+                    "absorbed": r.ledger["absorbed"],
+                    "terminated": r.ledger["terminated"],
                     "s0_peak": float(s0[k]),
                     "s0_peak_theta": float(mm["theta"][k[0]]),
                     "s0_peak_phi": float(mm["phi"][k[1]]),
                     "dop_peak": float(dop[kd]),
                     "dop_peak_theta": float(mm["theta"][kd[0]]),
                     "dop_peak_phi": float(mm["phi"][kd[1]]),
-                    "ledger_err": _ledger_error(summ),
+                    "ledger_err": _ledger_error(r),
                 }
             )
         b.figure(
@@ -208,7 +145,7 @@ def factor_maps_section(ctx: Context) -> None:
                 labels,
                 [m["s0"] for m in mp],
                 [
-                    np.where(_counts(r, m) >= SHOW_COUNT, m["dop"], np.nan)
+                    np.where(r.counts >= SHOW_COUNT, m["dop"], np.nan)
                     for (_, r), m in zip(items, mp, strict=True)
                 ],
                 mp[0]["theta_edges"],
@@ -241,7 +178,7 @@ def factor_maps_section(ctx: Context) -> None:
         "films with coherent Airy amplitudes per facet). Peaks are searched among bins with "
         f"at least {MIN_COUNT} exiting rays.",
     )
-    errs = [r["ledger_err"] for r in rows if r["ledger_err"] is not None]
+    errs = [r["ledger_err"] for r in rows]
     if errs:
         b.check(
             "tracer.factor_ledger",
@@ -250,38 +187,28 @@ def factor_maps_section(ctx: Context) -> None:
             against="exited + absorbed + terminated = incident",
             value=max(errs),
             tolerance=1e-12,
-            justification="per-ray bookkeeping in float64 (issue 5 acceptance criterion)",
+            justification="per-ray bookkeeping in float64",
         )
     else:
-        b.skip("tracer.factor_ledger", "energy ledger closes", "no ledger in the results")
-    _claims(ctx, st, runs)
+        b.skip("tracer.factor_ledger", "energy ledger closes", "no factor-study run")
+    _claims(ctx, runs)
 
 
-def _claims(ctx: Context, st: Any, runs: list[Any]) -> None:
-    fn = None
-    for name in ("evaluate_claims", "check_claims", "claims"):
-        if callable(getattr(st, name, None)):
-            fn = getattr(st, name)
-            break
-    if fn is None:
-        ctx.b.note("paper claims", "not available: labbrdf.tracer has no claims checker yet")
-        return
+def _claims(ctx: Context, runs: list[tuple[str, str, TraceResult]]) -> None:
     try:
-        claims = list(fn(runs))
-    except ValueError as exc:
+        claims = st.evaluate_claims(runs)
+    except ValueError as exc:  # a study whose maps have too few rays to judge
         ctx.b.note("paper claims", f"not available: {exc}")
         return
     rows = []
     for c in claims:
-        ev = c.get("evidence", "")
-        if isinstance(ev, dict):
-            ev = "; ".join(f"{k}: {_short(v)}" for k, v in ev.items())
+        ev = "; ".join(f"{k}: {_short(v)}" for k, v in c["evidence"].items())
         rows.append(
             {
-                "study": str(c.get("study", "")),
-                "claim": str(c.get("claim", "")),
-                "holds": c.get("holds"),
-                "evidence": str(ev),
+                "study": str(c["study"]),
+                "claim": str(c["claim"]),
+                "holds": c["holds"],
+                "evidence": ev,
             }
         )
     ctx.b.table(
@@ -323,39 +250,32 @@ def _oracle(shared: Path | None, name: str) -> pd.DataFrame | None:
 
 def validation_section(ctx: Context) -> None:
     """Tracer against analytic limits (smooth Fresnel, white furnace, ledger) and oracles."""
-    tr = _tracer()
     b = ctx.b
-    n = int(ctx.extra["scale"]["validation"])
-    shared = ctx.extra.get("shared")
-    cfg = tr.TraceConfig
-    Sub = getattr(tr, "Substrate", None)
-    if Sub is None:
-        from labbrdf.tracer.config import Substrate as Sub  # noqa: N813
+    n = int(ctx.scale["validation"])
+    shared = ctx.shared
     no_shared = "../shared/oracles not available (the report builds without it)"
     rows: list[dict[str, Any]] = []
     ledger: list[float] = []
 
-    def note_run(name: str, res: Any) -> dict[str, Any]:
-        s = _summary(res)
-        e = _ledger_error(s)
-        if e is not None:
-            ledger.append(e)
-        return s
+    def albedo(res: TraceResult) -> float:
+        """The run's albedo; its energy-ledger error is kept for the final check."""
+        ledger.append(_ledger_error(res))
+        return res.albedo()
 
     # 1. smooth limit against Fresnel
     fres = _oracle(shared, "smooth_fresnel.csv")
     res = _run(
         ctx,
-        cfg(
+        TraceConfig(
             wavelength_nm=650.0,
             theta_i_deg=45.0,
-            substrate=Sub(1.55, 7.71, 0.0),
+            substrate=Substrate(1.55, 7.71, 0.0),
             rays=min(n, 20_000),
             seed=1,
             scattering="single",
         ),
     )
-    s = note_run("smooth", res)
+    A = albedo(res)
     mm = maps(res)
     if fres is not None:
         ref = fres[
@@ -368,17 +288,14 @@ def validation_section(ctx: Context) -> None:
         M_ref = ref[[f"M{i}{j}" for i in range(4) for j in range(4)]].to_numpy(float)[0]
         src = f"smooth_fresnel.csv ({ref['source'].iloc[0]})"
     else:
-        from labbrdf import optics
-
         rs, rp = optics.fresnel(1.0, complex(1.55, 7.71), 45.0)[:2]
         M_ref = np.asarray(optics.mueller_reflection(rs, rp), float).reshape(16)
         src = "labbrdf.optics (oracle table absent)"
-    m = np.asarray(_get(res, "mueller"), float)
+    m = res.mueller
     it = int(np.argmin(np.abs(mm["theta"] - 45.0)))
     ip = int(np.argmin(np.abs(mm["phi"] - 180.0)))
-    cosw = _cos_solid_angle(mm["theta_edges"], mm["phi_edges"])
+    cosw = res.grid.cos_solid_angle_sr
     M_bin = (m[it, ip] * cosw[it, ip]).reshape(16)
-    A = float(s.get("albedo"))
     r00 = M_ref[0]
     dev_norm = float(np.max(np.abs(M_bin / M_bin[0] - M_ref / r00))) if M_bin[0] > 0 else math.inf
     rows.append(
@@ -416,17 +333,16 @@ def validation_section(ctx: Context) -> None:
     # 2. white furnace
     res = _run(
         ctx,
-        cfg(
+        TraceConfig(
             wavelength_nm=650.0,
             theta_i_deg=45.0,
-            substrate=Sub(alpha=1.0, mirror=True),
+            substrate=Substrate(alpha=1.0, mirror=True),
             rays=min(n, 50_000),
             seed=2,
             scattering="multiple",
         ),
     )
-    s = note_run("furnace", res)
-    A = float(s["albedo"])
+    A = albedo(res)
     rows.append(
         {
             "case": "ideal mirror microsurface, alpha = 1, 45 deg, multiple scattering",
@@ -445,7 +361,7 @@ def validation_section(ctx: Context) -> None:
         against="albedo = 1 (lossless microsurface, Heitz et al. 2016 random walk)",
         value=abs(A - 1.0),
         tolerance=1e-3,
-        justification="issue 5 criterion (0.1 %): weight is only lost to the bounce limit",
+        justification="0.1 % of the energy at most: weight is only lost to the bounce limit",
     )
 
     # 3. single-scattering rough Al: albedo and in-plane BRDF against the oracles
@@ -470,17 +386,16 @@ def validation_section(ctx: Context) -> None:
         for k, ti in enumerate((30.0, 60.0)):
             res = _run(
                 ctx,
-                cfg(
+                TraceConfig(
                     wavelength_nm=650.0,
                     theta_i_deg=ti,
-                    substrate=Sub(1.55, 7.71, 0.2),
+                    substrate=Substrate(1.55, 7.71, 0.2),
                     rays=n,
                     seed=10 + k,
                     scattering="single",
                 ),
             )
-            s = note_run(f"rough {ti}", res)
-            A = float(s["albedo"])
+            A = albedo(res)
             if alb is not None:
                 ref = alb[
                     (alb["material"] == "Al")
@@ -504,7 +419,7 @@ def validation_section(ctx: Context) -> None:
                     )
             if inpl is not None:
                 mm = maps(res)
-                cosw = _cos_solid_angle(mm["theta_edges"], mm["phi_edges"])
+                cosw = res.grid.cos_solid_angle_sr
                 ref = inpl[
                     (inpl["material"] == "Al")
                     & np.isclose(inpl["alpha"], 0.2)
@@ -518,10 +433,10 @@ def validation_section(ctx: Context) -> None:
                         continue
                     ip = int(np.argmin(np.abs(mm["phi"] - phi)))
                     th = rr["theta_r_deg"].to_numpy(float)
-                    it = np.array([int(np.argmin(np.abs(mm["theta"] - t))) for t in th])
+                    its = np.array([int(np.argmin(np.abs(mm["theta"] - t))) for t in th])
                     g = len(th) // GROUP * GROUP
-                    w = cosw[it[:g], ip].reshape(-1, GROUP)
-                    f_grp = (mm["s0"][it[:g], ip].reshape(-1, GROUP) * w).sum(1) / w.sum(1)
+                    w = cosw[its[:g], ip].reshape(-1, GROUP)
+                    f_grp = (mm["s0"][its[:g], ip].reshape(-1, GROUP) * w).sum(1) / w.sum(1)
                     f_ref = (rr["f_M00"].to_numpy(float)[:g].reshape(-1, GROUP) * w).sum(1)
                     f_ref = f_ref / w.sum(1)
                     th_grp = th[:g].reshape(-1, GROUP).mean(1)
@@ -609,5 +524,5 @@ def validation_section(ctx: Context) -> None:
             against="exited + absorbed + terminated = incident",
             value=max(ledger),
             tolerance=1e-12,
-            justification="per-ray bookkeeping in float64 (issue 5 acceptance criterion)",
+            justification="per-ray bookkeeping in float64",
         )

@@ -1,4 +1,4 @@
-"""Tests of labbrdf.fit: the 2013 paper reproduced, uncertainties, flags, bad input, batches.
+"""Tests of labbrdf.fitting: the 2013 paper reproduced, uncertainties, flags, bad input, batches.
 
 Synthetic data are made here from the published Tables 1-2 of Zou, Bai, Wu (2013),
 doi:10.3788/AOS201333.0612008 (theta_i 30/45/60 deg, theta_r = theta_i +- 2 deg in 0.2 deg
@@ -19,9 +19,9 @@ from numpy.typing import NDArray
 from scipy import integrate, optimize, special, stats
 
 from labbrdf.dataset import Measurement, make_frame
-from labbrdf.fit import FitData, FitError, fit, fit_many, parse_method
-from labbrdf.fit.objective import _bounded_lsq, _guess_smooth3
-from labbrdf.fit.result import _fmt_ci, _fmt_unc
+from labbrdf.fitting import FitData, FitError, fit, fit_many, parse_method
+from labbrdf.fitting.objective import _bounded_lsq, _guess_smooth3
+from labbrdf.fitting.result import _fmt_ci, _fmt_unc
 from labbrdf.models import Model, ModelError, Parameters, get
 
 #: Zou 2013 Table 1 (OSR) and Table 2 (mirror): wavelength [nm] -> (k1, k2 [rad], k3 [rad])
@@ -415,7 +415,7 @@ def test_any_nlopt_algorithm_name_is_accepted(method: str) -> None:
 
 
 def test_the_package_level_fit_is_callable_after_import() -> None:
-    import labbrdf.fit  # noqa: F401  (rebinds labbrdf.fit to the module)
+    import labbrdf.fitting  # noqa: F401  (the subpackage no longer shadows labbrdf.fit)
 
     fd, _ = line_data()
     assert labbrdf.fit(Line(), fd).success
@@ -425,7 +425,7 @@ def test_the_package_level_fit_is_callable_after_import() -> None:
 
 
 def smooth3_rho(vals: Mapping[str, float], theta_i_deg: NDArray) -> NDArray:
-    """Closed form of notes/models.md 1.2 (complex erf), independent of labbrdf.integrate."""
+    """Closed form of docs/models.md 1.2 (complex erf), independent of labbrdf.integrate."""
     k1, k2, k3 = vals["k1"], vals["k2"], vals["k3"]
     ti = np.radians(np.asarray(theta_i_deg, float))
     c = ti - k2
@@ -457,7 +457,7 @@ def test_closed_form_rho_matches_quadrature() -> None:
 
 @pytest.mark.parametrize("method", ["GN_CRS2_LM+LN_BOBYQA", "GN_ISRES+LN_COBYLA"])
 def test_energy_constraint_keeps_rho_at_most_one(method: str) -> None:
-    # k1 = 2.2 with the OSR shape gives rho(60 deg) = 2.2/1.083 > 1 (notes/models.md 1.4)
+    # k1 = 2.2 with the OSR shape gives rho(60 deg) = 2.2/1.083 > 1 (docs/models.md 1.4)
     k = (2.2, -0.0166, 0.4176)
     ti, tr, y = smooth3_truth(k)
     fd = FitData(ti, tr, y)

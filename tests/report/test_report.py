@@ -1,4 +1,4 @@
-"""The HTML validation report (issue 6): structure, numbers, exit codes, atomicity, escaping.
+"""The HTML validation report: structure, numbers, exit codes, atomicity, escaping.
 
 One quick validation report is built per test session (module fixture); the other tests
 build small reports (a subset of the sections, or a user report of a generated file).
@@ -17,9 +17,10 @@ import numpy as np
 import pytest
 
 from labbrdf import report
-from labbrdf.report import _common, html
-from labbrdf.report._common import Builder, Unavailable, fmt, resolve
-from labbrdf.report.validate import SECTIONS
+from labbrdf.report import builder as _common  # the module was report/_common.py
+from labbrdf.report import html
+from labbrdf.report.builder import Builder, Unavailable, fmt, resolve
+from labbrdf.report.validate import SECTION_IDS as SECTIONS
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -212,7 +213,7 @@ def test_table3_is_reproduced_at_46_not_45_degrees(quick_report):
     _, _, results = quick_report
     rows = results["tables"]["hemispherical"]["rows"]
     by_wl = {r["wavelength_nm"]: r for r in rows}
-    # notes/models.md 1.2: 42.93 / 56.54 / 58.98 % at 46 deg, printed to 2 decimals
+    # docs/models.md 1.2: 42.93 / 56.54 / 58.98 % at 46 deg, printed to 2 decimals
     for wl, want in ((360.0, 0.4293), (500.0, 0.5654), (550.0, 0.5898)):
         assert by_wl[wl]["paper_46"] == pytest.approx(want, abs=5e-5)
         assert by_wl[wl]["t3_integration"] - by_wl[wl]["paper_45"] > 0.013

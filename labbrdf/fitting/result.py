@@ -7,28 +7,12 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
 from numpy.typing import NDArray
 
+from ..jsonsafe import jsonable
 from ..models import Parameters
 
 __all__ = ["FitResult"]
-
-
-def _jsonable(v: Any) -> Any:
-    if isinstance(v, dict):
-        return {str(k): _jsonable(x) for k, x in v.items()}
-    if isinstance(v, list | tuple):
-        return [_jsonable(x) for x in v]
-    if isinstance(v, np.ndarray):
-        return [_jsonable(x) for x in v.tolist()]
-    if isinstance(v, bool | np.bool_):
-        return bool(v)
-    if isinstance(v, int | np.integer):
-        return int(v)
-    if isinstance(v, float | np.floating):
-        return float(v) if math.isfinite(v) else None
-    return v
 
 
 def _decimals(stderr: float) -> int:
@@ -118,7 +102,7 @@ class FitResult:
         Notes on the data or the fit (dropped points, intervals not found).
     ci_method : str
         ``wald`` (value +- t stderr, Student t with ``nfree`` degrees of freedom) or
-        ``profile`` (profile of chi-square); see :func:`labbrdf.fit.fit`.
+        ``profile`` (profile of chi-square); see :func:`labbrdf.fitting.fit`.
     cond : float or None
         Condition number of the scaled Jacobian at the optimum.
     nlopt_version : str or None
@@ -241,7 +225,7 @@ class FitResult:
             "ci_method": self.ci_method,
             "nlopt_version": self.nlopt_version,
         }
-        return _jsonable(out)
+        return jsonable(out)
 
     def _param_lines(self) -> list[tuple[str, str, str, str]]:
         rows = []

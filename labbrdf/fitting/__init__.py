@@ -5,27 +5,33 @@
 >>> print(res.fit_report())                            # doctest: +SKIP
 >>> table = labbrdf.fit_many(dataset, "smooth3")       # doctest: +SKIP
 
-The parts follow refnx's split (STYLE.md item 7): a :class:`~labbrdf.models.base.Model` is
+The parts follow refnx's split: a :class:`~labbrdf.models.base.Model` is
 a pure forward function; :class:`Objective` turns the varying parameters into a flat vector
 and gives weighted residuals and chi-square (profiling out linear amplitudes by bounded
 linear least squares); :func:`fit` drives nlopt, one stage per algorithm name, global then
-local; :class:`FitResult` reports itself with lmfit's attribute names (STYLE.md item 8).
+local; :class:`FitResult` reports itself with lmfit's attribute names (``params``,
+``chisqr``, ``redchi``, ``nfev``, ``fit_report()``).
 
 Conventions: angles in degrees in every table and :class:`FitData`, radians into the model;
 ``phi_r = 180 deg`` is the specular half-plane. Workflow layer (b): imports numpy, scipy,
 pandas and nlopt; the physics layer never imports this module.
 
-Modules: :mod:`~labbrdf.fit.data` (FitData, row selection), :mod:`~labbrdf.fit.objective`
-(Objective, profiling, starting points), :mod:`~labbrdf.fit.core` (nlopt stages, :func:`fit`),
-:mod:`~labbrdf.fit.uncertainty` (covariance and flags), :mod:`~labbrdf.fit.result`
-(FitResult), :mod:`~labbrdf.fit.batch` (:func:`fit_many`).
+Modules: :mod:`~labbrdf.fitting.data` (FitData, row selection),
+:mod:`~labbrdf.fitting.objective` (Objective, profiling, starting points),
+:mod:`~labbrdf.fitting.core` (nlopt stages, :func:`fit`),
+:mod:`~labbrdf.fitting.uncertainty` (covariance and flags), :mod:`~labbrdf.fitting.result`
+(FitResult), :mod:`~labbrdf.fitting.batch` (:func:`fit_many`).
+
+Internal API: names without an underscore that the modules share but this package does not
+re-export (``data.as_fit_data``, ``data.clean_fit_data``, ``data.select_rows``,
+``data.several_groups_message``, ``FitData.from_arrays``, ``core.setup_params``,
+``uncertainty.jacobian``, ``uncertainty.uncertainties``); each module lists its functions
+among them in its own ``__all__``. They may change without notice.
+
+``labbrdf.fit`` and ``labbrdf.fit_many`` are these functions, re-exported by ``labbrdf``.
 """
 
 from __future__ import annotations
-
-import sys
-import types
-from typing import Any
 
 from .batch import fit_many
 from .core import ALGORITHMS, CONSTRAINED, SPECULAR_LINE_SHAPE, fit, parse_method
@@ -53,17 +59,3 @@ __all__ = [
     "fit_many",
     "parse_method",
 ]
-
-
-class _CallableModule(types.ModuleType):
-    """``labbrdf.fit(...)`` keeps working after ``import labbrdf.fit`` rebinds the name.
-
-    Importing the submodule sets the attribute ``labbrdf.fit`` to this module, hiding the
-    lazily exported function of the same name; calling the module calls :func:`fit`.
-    """
-
-    def __call__(self, *args: Any, **kwargs: Any) -> FitResult:
-        return fit(*args, **kwargs)
-
-
-sys.modules[__name__].__class__ = _CallableModule

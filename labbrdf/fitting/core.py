@@ -17,10 +17,10 @@ from scipy import optimize, special
 from ..dataset import Measurement
 from ..models import Model, Parameters
 from ..models import get as get_model
-from .data import FitData, FitError, _as_fit_data, _clean
+from .data import FitData, FitError, as_fit_data, clean_fit_data
 from .objective import GUESSES, Objective
 from .result import FitResult
-from .uncertainty import AT_BOUND_FRAC, _jacobian, _uncertainties
+from .uncertainty import AT_BOUND_FRAC, jacobian, uncertainties
 
 __all__ = [
     "ALGORITHMS",
@@ -32,6 +32,7 @@ __all__ = [
     "SPECULAR_LINE_SHAPE",
     "fit",
     "parse_method",
+    "setup_params",
 ]
 
 #: every nlopt algorithm, by name (``GN_CRS2_LM`` ...), read from the nlopt module itself
@@ -64,7 +65,7 @@ CONSTRAINED = frozenset(
 
 
 #: models whose shape parameters cannot be identified from specular-line data alone
-#: (notes/models.md 1.1: on theta_r == theta_i smooth3 gives only k1 exp(-k2^2/k3^2))
+#: (docs/models.md 1.1: on theta_r == theta_i smooth3 gives only k1 exp(-k2^2/k3^2))
 SPECULAR_LINE_SHAPE = {"smooth3": ("k2", "k3")}
 
 
@@ -150,9 +151,14 @@ def _copy_params(p: Parameters) -> Parameters:
     return Parameters({k: copy.copy(q) for k, q in p.items()})
 
 
-def _setup_params(
+def setup_params(
     model: Model, params: Parameters | Mapping[str, float] | None, fix: Mapping[str, float] | None
 ) -> Parameters:
+    """The model's parameters with ``params`` (values or Parameters) and ``fix`` applied.
+
+    Internal API of :mod:`labbrdf.fitting`; raises :class:`FitError` naming unknown or
+    inconsistent parameter names.
+    """
     p = _copy_params(model.params)
     if params is not None:
         for k, v in params.items():
@@ -363,7 +369,7 @@ def fit(
         and one of them varies.
     energy_constraint : bool or callable
         Keep the directional-hemispherical reflectance rho(theta_i) <= 1 over the measured
-        incidence range (notes/models.md 1.4). True uses
+        incidence range (docs/models.md 1.4). True uses
         :func:`labbrdf.integrate.hemispherical_reflectance`; a callable
         ``rho(values, theta_i_deg) -> array`` replaces it. rho is checked on the measured
         incidence angles plus 7 equally spaced ones from the smallest to the largest. With
@@ -440,7 +446,7 @@ def fit(
 
     When every point of a smooth3 fit lies on the specular line (theta_r == theta_i) the fit
     is refused unless k2 and k3 are fixed: there only k1 exp(-k2^2/k3^2) is identifiable
-    (notes/models.md 1.1), and fixing k2 = 0 alone would leave k3 without any effect.
+    (docs/models.md 1.1), and fixing k2 = 0 alone would leave k3 without any effect.
     """
     t0 = time.perf_counter()
     if isinstance(model, str):
@@ -452,7 +458,7 @@ def fit(
         raise FitError(f"ci must be 'wald' or 'profile', got {ci!r}")
     if ci == "profile" and energy_constraint not in (False, None):
         raise FitError("ci='profile' is not combined with energy_constraint; use ci='wald'")
-    fd, ndropped = _clean(_as_fit_data(data, quantity, unit), nan_policy)
+    fd, ndropped = clean_fit_data(as_fit_data(data, quantity, unit), nan_policy)
     nmasked = 0
     if mask_zeros:
         zero = np.asarray(fd.value) == 0.0
@@ -461,7 +467,7 @@ def fit(
             raise FitError(f"data: all {nmasked} points are 0 (masked); nothing to fit")
         if nmasked:
             fd = fd.take(~zero)
-    p = _setup_params(model, params, fix)
+    p = setup_params(model, params, fix)
     guessed = guess and _apply_guess(model, fd, p, set(params or ()))
     weights, use_sigma, weighting = _weighting(fd, use_sigma, weighting, relative_floor)
     varying = p.varying()
@@ -476,7 +482,9 @@ def fit(
             f"parameters (linear: {list(model.linear)})"
         )
     profile = bool(lin) if profile is None else profile
-    rho_fn, th_grid = None, None
+    # rho(theta) <= 1 on th_grid [deg] when the energy constraint is on (rho_fn set)
+    rho_fn: Callable[[dict[str, float], NDArray], NDArray] | None = None
+    th_grid: NDArray = np.empty(0)
     if energy_constraint is not False and energy_constraint is not None:
         ti = np.asarray(fd.theta_i_deg, float)
         th_grid = np.unique(np.concatenate([np.linspace(ti.min(), ti.max(), 7), ti]))
@@ -520,11 +528,11 @@ def fit(
         vals, chisqr = obj.solve(obj.from_vector(x) if obj.n else dict(obj.base))
         best = obj.model_values(vals)
         finite = all(math.isfinite(v) for v in vals.values()) and math.isfinite(chisqr)
-        J = _jacobian(obj, vals, varying) if finite else np.full((n_pts, nvarys), np.nan)
+        J = jacobian(obj, vals, varying) if finite else np.full((n_pts, nvarys), np.nan)
     resid = obj.y - best
     nfree = n_pts - nvarys
     redchi = chisqr / nfree
-    covar, stderr, correl, reasons, cond = _uncertainties(
+    covar, stderr, correl, reasons, cond = uncertainties(
         J, varying, vals, 1.0 if use_sigma else redchi, nfree
     )
     out, flags = _fitted_params(p, vals, stderr, correl, reasons, nfree)
@@ -750,7 +758,7 @@ def _check_design(model: Model, fd: FitData, varying: list[str]) -> None:
     if shape and on_line.all():
         raise FitError(
             f"data: all {n_pts} points lie on the specular line theta_r == theta_i, where "
-            f"{model.name} identifies only k1 exp(-k2^2/k3^2) (notes/models.md 1.1); "
+            f"{model.name} identifies only k1 exp(-k2^2/k3^2) (docs/models.md 1.1); "
             f"add off-specular points or fix {list(SPECULAR_LINE_SHAPE[model.name])}, "
             "e.g. fix={'k2': 0.0, 'k3': 0.4}"
         )

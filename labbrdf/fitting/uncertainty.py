@@ -9,7 +9,15 @@ from numpy.typing import NDArray
 
 from .objective import Objective
 
-__all__ = ["AT_BOUND_FRAC", "COND_MAX", "CORREL_MAX", "REL_STDERR_MAX", "REL_STDERR_POOR"]
+__all__ = [
+    "AT_BOUND_FRAC",
+    "COND_MAX",
+    "CORREL_MAX",
+    "REL_STDERR_MAX",
+    "REL_STDERR_POOR",
+    "jacobian",
+    "uncertainties",
+]
 
 #: |correlation| above which both parameters are flagged "not identifiable"
 CORREL_MAX = 0.99
@@ -24,7 +32,7 @@ COND_MAX = 1e10
 AT_BOUND_FRAC = 1e-6
 
 
-def _jacobian(obj: Objective, vals: dict[str, float], names: list[str]) -> NDArray:
+def jacobian(obj: Objective, vals: dict[str, float], names: list[str]) -> NDArray:
     """Weighted residual Jacobian d(sw * (y - f))/dp in the parameters' natural scale.
 
     Central differences, step ``6e-6 * max(|p|, 1e-3 * span)`` (6e-6 ~ eps^(1/3), the
@@ -53,7 +61,7 @@ def _jacobian(obj: Objective, vals: dict[str, float], names: list[str]) -> NDArr
     return J
 
 
-def _uncertainties(
+def uncertainties(
     J: NDArray, names: list[str], values: dict[str, float], scale: float, nfree: int
 ) -> tuple[
     NDArray | None,

@@ -16,12 +16,12 @@ import pandas as pd
 import pytest
 
 import labbrdf
-from labbrdf.fit import FitData, fit
-from labbrdf.fit.core import CHI2_CONVERGED, CHI2_TOL, LOCAL_ROUNDS
+from labbrdf.fitting import FitData, fit
+from labbrdf.fitting.core import CHI2_CONVERGED, CHI2_TOL, LOCAL_ROUNDS
 from labbrdf.report.validate import validate
 
-ROOT = Path(__file__).resolve().parents[1]
-SCANS = ROOT / "fixtures" / "specular"
+ROOT = Path(__file__).resolve().parents[2]
+SCANS = ROOT / "labbrdf" / "data" / "fixtures" / "specular"
 
 #: every fittable model of the specular fixtures, with each five_param shadowing choice
 MODELS = [("smooth3", {}), ("five_param", {}), ("five_param", {"shadowing": "none"}),

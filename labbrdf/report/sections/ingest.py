@@ -1,0 +1,145 @@
+"""Section ``ingest``: every input file read into the common dataset, with what it holds."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from ... import adapters
+from ..builder import Unavailable
+from ..context import Context, load_published
+
+__all__ = ["fixture_files", "fixtures_section", "ingest_files"]
+
+
+def fixture_files(folder: Path) -> list[Path]:
+    """Every data file under ``folder`` except ``published/``, docs and the generator."""
+    skip_dirs = {"published", "__pycache__"}
+    out = []
+    for p in sorted(folder.rglob("*")):
+        rel = p.relative_to(folder)
+        if not p.is_file() or any(part in skip_dirs or part.startswith(".") for part in rel.parts):
+            continue
+        if p.suffix.lower() in (".md", ".py", ".txt", ".pyc") or p.name.startswith("."):
+            continue
+        out.append(p)
+    return out
+
+
+def fixtures_section(ctx: Context) -> None:
+    """The validation report's ingest: the published tables, then every fixture file."""
+    fx = ctx.fixtures
+    if fx is None:
+        raise Unavailable("no fixture folder given")
+    b = ctx.b
+    b.text(
+        f"Fixture folder: {fx}. Every file below was read with labbrdf.read (format "
+        "from the extension and the header) into the common dataset. The fixtures are "
+        "SYNTHETIC files in real export formats, see fixtures/README.md."
+    )
+    pub = load_published(ctx, fx / "published")
+    b.text("Published tables read: " + (", ".join(pub) if pub else "none found") + ".")
+    if not fx.is_dir():
+        raise Unavailable(f"fixture folder {fx} not found")
+    ingest_files(ctx, fixture_files(fx), root=fx)
+
+
+def _meta_header(meta: Mapping[str, Any], limit: int = 3) -> str:
+    for key in ("header_lines", "header", "comments", "comment", "notes"):
+        v = meta.get(key)
+        if isinstance(v, str) and v.strip():
+            return v.strip()[:300]
+        if isinstance(v, list) and v:
+            return " | ".join(str(x) for x in v[:limit])[:300]
+        if isinstance(v, Mapping) and v:
+            return " | ".join(f"{k}: {x}" for k, x in list(v.items())[:limit])[:300]
+    return ""
+
+
+def ingest_files(
+    ctx: Context,
+    paths: Sequence[str | os.PathLike[str]],
+    root: Path | None = None,
+    *,
+    check_id: str = "ingest.read",
+) -> None:
+    """Read every file; a table of what each holds; a check that all were read."""
+    b = ctx.b
+    files = [Path(p) for p in paths]
+    if not files:
+        raise Unavailable("no input files")
+    rows, failures = [], []
+    for p in files:
+        name = str(p.relative_to(root)) if root is not None and p.is_relative_to(root) else p.name
+        try:
+            m = adapters.read(p)
+        except Exception as exc:  # noqa: BLE001 - each failure is reported
+            failures.append(f"{name}: {exc}")
+            rows.append({"file": name, "status": "error", "error": str(exc)})
+            continue
+        fmt_name = m.meta.get("format") or m.meta.get("adapter") or ""
+        if not fmt_name:
+            try:
+                cands = adapters.sniff(p)
+                fmt_name = cands[0] if len(cands) == 1 else ""
+            except Exception:  # noqa: BLE001 - format name is informative only
+                fmt_name = ""
+        s = m.summary()
+        d = m.data
+        ctx.frames.append(d)
+        rec = {
+            "file": name,
+            "status": "read",
+            "format": fmt_name,
+            "sample": ", ".join(s["sample"]),
+            "instrument": ", ".join(sorted(set(d["instrument"]))),
+            "quantities": ", ".join(s["quantities"]),
+            "rows": s["rows"],
+            "wl_min": s["wavelength_nm"][0],
+            "wl_max": s["wavelength_nm"][1],
+            "theta_i": ", ".join(f"{t:g}" for t in s["theta_i_deg"]),
+            "sigma": "yes" if d["sigma"].notna().any() else "no",
+            "header": _meta_header(m.meta),
+            "error": "",
+        }
+        ctx.files.append({**rec, "path": str(p), "meta": m.meta})
+        rows.append(rec)
+    b.table(
+        "ingested_files",
+        "Ingested files",
+        [
+            ("file", "file", ""),
+            ("status", "status", ""),
+            ("format", "format", ""),
+            ("sample", "sample(s)", ""),
+            ("instrument", "instrument", ""),
+            ("quantities", "quantities", ""),
+            ("rows", "rows", "d"),
+            ("wl_min", "\u03bb min [nm]", ".6g"),
+            ("wl_max", "\u03bb max [nm]", ".6g"),
+            ("theta_i", "\u03b8i [deg]", ""),
+            ("sigma", "\u03c3 given", ""),
+            ("header", "header / comments (from the file)", ""),
+            ("error", "error", ""),
+        ],
+        rows,
+        caption="One row per input file: what the reader found in it. Text in the last "
+        "columns is copied from the file and shown verbatim.",
+    )
+    b.check(
+        check_id,
+        "every input file reads into the common dataset",
+        not failures,
+        against="labbrdf.read (adapters) and the dataset schema",
+        value=len(paths) - len(failures),
+        tolerance=len(paths),
+        justification="value = files read, tolerance = files given; all must read",
+        reason="; ".join(failures)[:2000],
+    )
+    if not ctx.frames:
+        raise Unavailable("no file could be read")
+
+
+# --------------------------------------------------------------------------- fits
