@@ -345,5 +345,6 @@ FORMATS: tuple[Format, ...] = (
         sniff=sniff_accurion,
         read=read_accurion,
         quantities=("psi", "delta"),
+        keywords=(b"#Lambda\t", b"#ROIidx\t", b"\tAOI\t", b"WVASEformat"),
     ),
 )

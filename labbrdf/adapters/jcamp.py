@@ -413,5 +413,6 @@ FORMATS = (
         _sniff,
         read_jcamp,
         ("absorbance", "transmittance", "reflectance", "hemispherical_reflectance"),
+        keywords=(b"##TITLE", b"##JCAMP", b"##XYDATA", b"##XYPOINTS"),
     ),
 )

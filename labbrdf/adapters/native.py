@@ -56,5 +56,6 @@ FORMATS = (
         (".csv",),
         _sniff_csv,
         read_dataset_csv,
+        keywords=(b"labbrdf-meta",),
     ),
 )

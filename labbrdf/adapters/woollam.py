@@ -664,6 +664,7 @@ FORMATS: tuple[Format, ...] = (
         "generalized ellipsometry, depolarization, reflectance, Mueller matrix",
         extensions=(".dat",),
         sniff=sniff_wvase,
+        keywords=(b"VASEmethod[", b"RTmethod[", b"WVASE"),
         read=read_woollam,
         quantities=(
             "psi",
@@ -679,6 +680,7 @@ FORMATS: tuple[Format, ...] = (
         description="J.A. Woollam CompleteEASE ASCII export (3.x static/dynamic, 6.x tagged)",
         extensions=(".dat",),
         sniff=sniff_completeease,
+        keywords=(b"VASEmethod[", b"CompleteEASE"),
         read=read_woollam,
         quantities=("psi", "delta", "depolarization", "specular_intensity"),
     ),
