@@ -60,6 +60,7 @@ __all__ = [
     "read",
     "read_csv",
     "read_parquet",
+    "sidecar_path",
     "validate",
     "write",
     "write_csv",
@@ -562,18 +563,31 @@ def read_parquet(path: str | os.PathLike[str]) -> Measurement:
         raise DatasetError(f"{path}: {exc}") from None
 
 
-def write_csv(m: Measurement, path: str | os.PathLike[str]) -> Path:
-    """Write a measurement to CSV, atomically.
+def sidecar_path(path: str | os.PathLike[str]) -> Path:
+    """The metadata file that :func:`write_csv` writes beside ``path``: ``<stem>.meta.json``."""
+    p = Path(path)
+    return p.with_name(p.stem + ".meta.json")
 
-    The first line is ``# labbrdf-meta: <json>``; the rest is the table with floats written
-    in their shortest round-tripping form, so :func:`read_csv` gives back the same numbers.
+
+def write_csv(m: Measurement, path: str | os.PathLike[str]) -> Path:
+    """Write a measurement to CSV plus its metadata to ``<stem>.meta.json``, atomically.
+
+    The CSV is the plain table (first line the column names, so a spreadsheet shows it as
+    is), floats written in their shortest round-tripping form so :func:`read_csv` gives
+    back the same numbers. The meta goes to the sidecar JSON (:func:`sidecar_path`). Both
+    are written to temporary files and renamed into place only when both are complete.
     """
-    with atomic_output(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
-        fh.write(_CSV_META_PREFIX + json.dumps(m.meta, allow_nan=False) + "\n")
-        # pandas formats floats through numpy's printing, which an imported package may
-        # have switched to its 12-digit legacy mode (colour-science sets legacy="1.13")
-        with np.printoptions(legacy=False):
-            m.data.to_csv(fh, index=False, lineterminator="\n")
+    side = sidecar_path(path)
+    with atomic_output(path) as tmp, atomic_output(side) as tmp_side:
+        with open(tmp_side, "w", encoding="utf-8", newline="\n") as fh:
+            json.dump(m.meta, fh, allow_nan=False, indent=1)
+            fh.write("\n")
+        with open(tmp, "w", encoding="utf-8", newline="") as fh:
+            # pandas formats floats through numpy's printing, which an imported package
+            # may have switched to its 12-digit legacy mode (colour-science sets
+            # legacy="1.13")
+            with np.printoptions(legacy=False):
+                m.data.to_csv(fh, index=False, lineterminator="\n")
     return Path(path)
 
 
@@ -586,7 +600,12 @@ _EXACT_FLOATS: dict[str, Any] = (
 
 
 def read_csv(path: str | os.PathLike[str]) -> Measurement:
-    """Read a CSV file written by :func:`write_csv` (a plain schema CSV works too)."""
+    """Read a CSV file written by :func:`write_csv` (a plain schema CSV works too).
+
+    The meta comes from the sidecar ``<stem>.meta.json`` when it exists; files written by
+    earlier versions carry it in a first line ``# labbrdf-meta: {...}`` instead, which is
+    read too (and wins, being part of the file).
+    """
     path = Path(path)
     with open(path, encoding="utf-8", newline="") as fh:
         first = fh.readline()
@@ -598,6 +617,12 @@ def read_csv(path: str | os.PathLike[str]) -> Measurement:
                 raise DatasetError(f"{path}, line 1: bad labbrdf-meta JSON ({exc})") from None
         else:
             fh.seek(0)
+            side = sidecar_path(path)
+            if side.is_file():
+                try:
+                    meta = json.loads(side.read_text(encoding="utf-8"))
+                except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+                    raise DatasetError(f"{side}: not valid JSON ({exc})") from None
         dtypes = {c: str for c in ("sample", "instrument", "source", "unit", "channel")}
         try:
             df = pd.read_csv(
