@@ -514,12 +514,20 @@ def concat(measurements: Iterable[Measurement]) -> Measurement:
 # --------------------------------------------------------------------------- I/O
 
 
+def _umask() -> int:
+    """The process umask (read by setting it and setting it back: there is no getter)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 @contextmanager
 def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
     """Yield a temporary file name beside ``path``; rename it onto ``path`` on success.
 
     On any exception the temporary file is removed and ``path`` is left as it was, so a
-    failed write never leaves a half-written or clobbered file.
+    failed write never leaves a half-written or clobbered file. The file gets the mode any
+    other new file gets, 0o666 minus the umask (:func:`tempfile.mkstemp` creates it 0o600).
     """
     target = Path(path)
     target.parent.mkdir(parents=True, exist_ok=True)
@@ -527,6 +535,7 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
     os.close(fd)
     try:
         yield tmp
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, target)
     finally:
         if os.path.exists(tmp):
