@@ -26,7 +26,9 @@ Optional columns (:data:`OPTIONAL_COLUMNS`) carry what some instruments add: ``t
 channel: ``p``, ``s``, ``pp``, ``ps``, ``sp``; tristimulus channel ``X``, ``Y``, ``Z``;
 ``""`` for none, and a missing value, as when files with and without the column are
 concatenated, becomes ``""``), ``x_mm``/``y_mm`` (stage position of the spot [mm]),
-``sample_rotation_deg`` (rotation of an anisotropic sample about its normal [deg]).
+``sample_rotation_deg`` (rotation of an anisotropic sample about its normal [deg]),
+``zone`` (nulling-ellipsometer zone of the row, e.g. Accurion zones 1-4: a whole number
+>= 0 stored as float so that rows without one, as after concatenation, are NaN).
 Canonical units: angles in degrees, Delta in [0, 360) (Nebraska convention), reflectance,
 transmittance and depolarization as fractions. Quantity ``btdf`` [sr-1]: theta_r is
 measured from the back normal and phi_r is the azimuth of the transmitted direction.
@@ -89,6 +91,7 @@ OPTIONAL_COLUMNS: dict[str, str] = {
     "x_mm": "float64",
     "y_mm": "float64",
     "sample_rotation_deg": "float64",
+    "zone": "float64",
 }
 
 _MUELLER = tuple(f"mueller_{i}{j}" for i in range(1, 5) for j in range(1, 5))
@@ -320,6 +323,11 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
             bad = np.isinf(a) | (a < 0) | (a > 90)
             if bad.any():
                 raise DatasetError(f"column {name!r}: expected [0, 90] deg or NaN in {_rows(bad)}")
+    if "zone" in out.columns:
+        z = out["zone"].to_numpy()
+        bad = ~np.isnan(z) & ~(np.isfinite(z) & (z >= 0) & (z == np.round(z)))
+        if bad.any():
+            raise DatasetError(f"column 'zone': expected an integer >= 0 or NaN in {_rows(bad)}")
     a = out["phi_r_deg"].to_numpy()
     if not _in_range(a, 0.0, 360.0, hi_open=True):
         bad = np.isinf(a) | (a < 0) | (a >= 360)
@@ -447,8 +455,8 @@ def make_frame(
 ) -> pd.DataFrame:
     """Build a schema table from arrays and scalars (broadcast to one length).
 
-    Optional columns (``time_s``, ``channel``, ``x_mm``, ``y_mm``, ``sample_rotation_deg``)
-    go in ``optional``.
+    Optional columns (``time_s``, ``channel``, ``x_mm``, ``y_mm``, ``sample_rotation_deg``,
+    ``zone``) go in ``optional``.
     The result is not validated; wrap it in :class:`Measurement` to do so.
     """
     unknown = set(optional) - set(OPTIONAL_COLUMNS)
