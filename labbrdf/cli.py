@@ -195,6 +195,10 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     out = None
     if args.output:
         out = check_file_output(args.output, inputs=args.files, suffixes=(".parquet", ".csv"))
+        if out.suffix.lower() == ".csv":  # its metadata goes to a sidecar beside it
+            from .dataset import sidecar_path
+
+            check_file_output(sidecar_path(out), inputs=args.files, suffixes=(".json",))
     from .selection import SelectionError
 
     rows: list[dict[str, Any]] = []

@@ -26,7 +26,9 @@ Optional columns (:data:`OPTIONAL_COLUMNS`) carry what some instruments add: ``t
 channel: ``p``, ``s``, ``pp``, ``ps``, ``sp``; tristimulus channel ``X``, ``Y``, ``Z``;
 ``""`` for none, and a missing value, as when files with and without the column are
 concatenated, becomes ``""``), ``x_mm``/``y_mm`` (stage position of the spot [mm]),
-``sample_rotation_deg`` (rotation of an anisotropic sample about its normal [deg]).
+``sample_rotation_deg`` (rotation of an anisotropic sample about its normal [deg]),
+``zone`` (nulling-ellipsometer zone of the row, e.g. Accurion zones 1-4: a whole number
+>= 0 stored as float so that rows without one, as after concatenation, are NaN).
 Canonical units: angles in degrees, Delta in [0, 360) (Nebraska convention), reflectance,
 transmittance and depolarization as fractions. Quantity ``btdf`` [sr-1]: theta_r is
 measured from the back normal and phi_r is the azimuth of the transmitted direction.
@@ -61,6 +63,7 @@ __all__ = [
     "read",
     "read_csv",
     "read_parquet",
+    "sidecar_path",
     "validate",
     "write",
     "write_csv",
@@ -89,6 +92,7 @@ OPTIONAL_COLUMNS: dict[str, str] = {
     "x_mm": "float64",
     "y_mm": "float64",
     "sample_rotation_deg": "float64",
+    "zone": "float64",
 }
 
 _MUELLER = tuple(f"mueller_{i}{j}" for i in range(1, 5) for j in range(1, 5))
@@ -320,6 +324,11 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
             bad = np.isinf(a) | (a < 0) | (a > 90)
             if bad.any():
                 raise DatasetError(f"column {name!r}: expected [0, 90] deg or NaN in {_rows(bad)}")
+    if "zone" in out.columns:
+        z = out["zone"].to_numpy()
+        bad = ~np.isnan(z) & ~(np.isfinite(z) & (z >= 0) & (z == np.round(z)))
+        if bad.any():
+            raise DatasetError(f"column 'zone': expected an integer >= 0 or NaN in {_rows(bad)}")
     a = out["phi_r_deg"].to_numpy()
     if not _in_range(a, 0.0, 360.0, hi_open=True):
         bad = np.isinf(a) | (a < 0) | (a >= 360)
@@ -447,8 +456,8 @@ def make_frame(
 ) -> pd.DataFrame:
     """Build a schema table from arrays and scalars (broadcast to one length).
 
-    Optional columns (``time_s``, ``channel``, ``x_mm``, ``y_mm``, ``sample_rotation_deg``)
-    go in ``optional``.
+    Optional columns (``time_s``, ``channel``, ``x_mm``, ``y_mm``, ``sample_rotation_deg``,
+    ``zone``) go in ``optional``.
     The result is not validated; wrap it in :class:`Measurement` to do so.
     """
     unknown = set(optional) - set(OPTIONAL_COLUMNS)
@@ -549,11 +558,19 @@ def read_parquet(path: str | os.PathLike[str]) -> Measurement:
         raise DatasetError(f"{path}: {exc}") from None
 
 
-def write_csv(m: Measurement, path: str | os.PathLike[str]) -> Path:
-    """Write a measurement to CSV, atomically.
+def sidecar_path(path: str | os.PathLike[str]) -> Path:
+    """The metadata file that :func:`write_csv` writes beside ``path``: ``<stem>.meta.json``."""
+    p = Path(path)
+    return p.with_name(p.stem + ".meta.json")
 
-    The first line is ``# labbrdf-meta: <json>``; the rest is the table with floats written
-    in their shortest round-tripping form, so :func:`read_csv` gives back the same numbers.
+
+def write_csv(m: Measurement, path: str | os.PathLike[str]) -> Path:
+    """Write a measurement to CSV plus its metadata to ``<stem>.meta.json``, atomically.
+
+    The CSV is the plain table (first line the column names, so a spreadsheet shows it as
+    is), floats written in their shortest round-tripping form so :func:`read_csv` gives
+    back the same numbers. The meta goes to the sidecar JSON (:func:`sidecar_path`). Both
+    are written to temporary files and renamed into place only when both are complete.
 
     Text is written verbatim, without the ``'`` prefix that the CSV tables meant for
     people get against spreadsheet formula injection (:func:`labbrdf.outputs.csv_safe_cell`):
@@ -561,12 +578,17 @@ def write_csv(m: Measurement, path: str | os.PathLike[str]) -> Path:
     change sample names such as ``-1 deg tilt`` on every round trip. Do not open it in a
     spreadsheet from an untrusted source; the fit and report tables are safe to open.
     """
-    with atomic_output(path) as tmp, open(tmp, "w", encoding="utf-8", newline="") as fh:
-        fh.write(_CSV_META_PREFIX + json.dumps(m.meta, allow_nan=False) + "\n")
-        # pandas formats floats through numpy's printing, which an imported package may
-        # have switched to its 12-digit legacy mode (colour-science sets legacy="1.13")
-        with np.printoptions(legacy=False):
-            m.data.to_csv(fh, index=False, lineterminator="\n")
+    side = sidecar_path(path)
+    with atomic_output(path) as tmp, atomic_output(side) as tmp_side:
+        with open(tmp_side, "w", encoding="utf-8", newline="\n") as fh:
+            json.dump(m.meta, fh, allow_nan=False, indent=1)
+            fh.write("\n")
+        with open(tmp, "w", encoding="utf-8", newline="") as fh:
+            # pandas formats floats through numpy's printing, which an imported package
+            # may have switched to its 12-digit legacy mode (colour-science sets
+            # legacy="1.13")
+            with np.printoptions(legacy=False):
+                m.data.to_csv(fh, index=False, lineterminator="\n")
     return Path(path)
 
 
@@ -579,7 +601,12 @@ _EXACT_FLOATS: dict[str, Any] = (
 
 
 def read_csv(path: str | os.PathLike[str]) -> Measurement:
-    """Read a CSV file written by :func:`write_csv` (a plain schema CSV works too)."""
+    """Read a CSV file written by :func:`write_csv` (a plain schema CSV works too).
+
+    The meta comes from the sidecar ``<stem>.meta.json`` when it exists; files written by
+    earlier versions carry it in a first line ``# labbrdf-meta: {...}`` instead, which is
+    read too (and wins, being part of the file).
+    """
     path = Path(path)
     with open(path, encoding="utf-8", newline="") as fh:
         first = fh.readline()
@@ -591,6 +618,12 @@ def read_csv(path: str | os.PathLike[str]) -> Measurement:
                 raise DatasetError(f"{path}, line 1: bad labbrdf-meta JSON ({exc})") from None
         else:
             fh.seek(0)
+            side = sidecar_path(path)
+            if side.is_file():
+                try:
+                    meta = json.loads(side.read_text(encoding="utf-8"))
+                except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+                    raise DatasetError(f"{side}: not valid JSON ({exc})") from None
         dtypes = {c: str for c in ("sample", "instrument", "source", "unit", "channel")}
         try:
             df = pd.read_csv(

@@ -177,6 +177,7 @@ def test_trace_output_names_are_checked_before_tracing(tmp_path, capsys, argv, w
 
 def test_ingest_and_fit_refuse_a_folder_or_a_trailing_slash(tmp_path, capsys):
     data = small_dataset(tmp_path / "d.csv")
+    before = sorted(p.name for p in tmp_path.iterdir())  # the dataset and its sidecar
     expect_refused(capsys, ["ingest", str(data), "-o", str(tmp_path)], "existing folder")
     expect_refused(
         capsys, ["ingest", str(data), "-o", str(tmp_path / "x.parquet") + "/"], "ends with '/'"
@@ -184,7 +185,7 @@ def test_ingest_and_fit_refuse_a_folder_or_a_trailing_slash(tmp_path, capsys):
     fit = ["fit", str(data), "--model", "smooth3", "--scheduler", "serial"]
     expect_refused(capsys, [*fit, "-o", str(tmp_path)], "existing folder")
     expect_refused(capsys, [*fit, "-o", str(tmp_path / "p.txt")], ".csv")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.csv"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == before == ["d.csv", "d.meta.json"]
 
 
 def _deny_writes(monkeypatch):

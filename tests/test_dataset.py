@@ -143,7 +143,8 @@ def test_round_trip_is_exact(tmp_path, suffix):
     back = read(path)
     pd.testing.assert_frame_equal(back.data, m.data, check_exact=True)
     assert back.meta == m.meta
-    assert sorted(p.name for p in tmp_path.iterdir()) == [f"out{suffix}"]  # no temp left
+    sidecar = ["out.meta.json"] if suffix == ".csv" else []
+    assert sorted(p.name for p in tmp_path.iterdir()) == [f"out{suffix}", *sidecar]  # no temp
 
 
 @settings(max_examples=50, deadline=None)
@@ -196,7 +197,7 @@ def test_write_failure_leaves_previous_file(tmp_path, monkeypatch):
     with pytest.raises(OSError, match="disk full"):
         write(_psi_delta(n=7), p)
     assert p.read_bytes() == before
-    assert [x.name for x in tmp_path.iterdir()] == ["out.csv"]
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["out.csv", "out.meta.json"]
 
 
 def test_summary_is_json_safe():

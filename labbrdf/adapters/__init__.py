@@ -4,10 +4,14 @@
 >>> m = labbrdf.read("w2_10102006.dat")           # doctest: +SKIP
 >>> labbrdf.adapters.formats()                    # doctest: +SKIP
 
-Dispatch (:func:`read`): an explicit ``format`` wins; else the file's extension, when it
-belongs to one format only; else header sniffing among the formats of that extension (or
-all formats), when exactly one claims the file. Otherwise :class:`AdapterError` names the
-candidates. Readers never try each other under ``except``: a parse error is reported as is.
+Dispatch (:func:`read`): an explicit ``format`` wins; else the header sniffers decide,
+the formats of the file's extension first: when exactly one of them claims the file it is
+read with that one; when none does, the content decides across all formats (a JASCO text
+export saved as ``.csv`` is still read as JASCO). When no sniffer claims the file, an
+extension that belongs to one format only sends it to that reader, whose error says what is
+wrong where; otherwise :class:`AdapterError` names the closest candidates: the formats of the
+extension and those whose typical keywords occur in the first bytes. Readers never try each
+other under ``except``: a parse error is reported as is.
 """
 
 from __future__ import annotations
@@ -88,15 +92,41 @@ def _by_extension(path: Path) -> list[str]:
     return [n for n, f in READERS.items() if any(name.endswith(e) for e in f.extensions)]
 
 
-def sniff(path: str | os.PathLike[str]) -> list[str]:
-    """Names of the formats whose sniffer claims the file."""
+def _head(path: str | os.PathLike[str]) -> bytes:
     check_regular_file(path)
     try:
         with open(path, "rb") as fh:
-            head = fh.read(_SNIFF_BYTES)
+            return fh.read(_SNIFF_BYTES)
     except OSError as exc:
         raise AdapterError(path, f"cannot be read ({exc.strerror or exc})") from None
+
+
+def sniff(path: str | os.PathLike[str]) -> list[str]:
+    """Names of the formats whose sniffer claims the file."""
+    head = _head(path)
     return [n for n, f in READERS.items() if f.sniff(head)]
+
+
+def _no_match_message(path: Path, by_ext: list[str], head: bytes) -> str:
+    """Name the closest candidates: the extension's formats and keyword matches."""
+    near = [
+        n for n, f in READERS.items() if n not in by_ext and any(k in head for k in f.keywords)
+    ]
+    parts = []
+    if by_ext:
+        parts.append(f"formats of the extension {path.suffix.lower()!r}: {by_ext}")
+    if near:
+        parts.append(f"formats whose keywords occur in the header: {near}")
+    if not parts:
+        return (
+            "no adapter recognises this file: neither its extension nor its first lines "
+            "belong to a supported format; labbrdf.adapters.formats() lists them"
+        )
+    return (
+        "no adapter recognises this file (no header sniffer claims it); closest candidates: "
+        + "; ".join(parts)
+        + "; pass format= to read it with one of them and see what does not match"
+    )
 
 
 def _read_with(name: str, path: Path) -> Measurement:
@@ -133,19 +163,17 @@ def read(path: str | os.PathLike[str], format: str | None = None) -> Measurement
     if format is not None:
         return _read_with(format, p)
     by_ext = _by_extension(p)
-    if len(by_ext) == 1:
-        return _read_with(by_ext[0], p)
-    claimed = sniff(p)
-    pool = [n for n in claimed if n in by_ext] if by_ext else claimed
+    head = _head(p)
+    claimed = [n for n, f in READERS.items() if f.sniff(head)]
+    # the extension's formats first; when none of them claims the file, the content decides
+    pool = [n for n in claimed if n in by_ext] or claimed
     if len(pool) == 1:
         return _read_with(pool[0], p)
-    if not pool:
-        hint = f" (extension matches {by_ext})" if by_ext else ""
-        raise AdapterError(
-            path,
-            f"no adapter recognises this file{hint}; pass format= one of {sorted(READERS)}",
-        )
-    raise AdapterError(path, f"several adapters claim this file: {pool}; pass format=")
+    if pool:
+        raise AdapterError(path, f"several adapters claim this file: {pool}; pass format=")
+    if len(by_ext) == 1:  # its reader says what is wrong, and where
+        return _read_with(by_ext[0], p)
+    raise AdapterError(path, _no_match_message(p, by_ext, head))
 
 
 def read_many(paths: Iterable[str | os.PathLike[str]], format: str | None = None) -> Measurement:

@@ -94,6 +94,13 @@ class Format:
         format. Must be cheap and must never raise.
     read : callable
         ``read(path) -> Measurement``; raises :class:`AdapterError` on anything it cannot read.
+    quantities : tuple of str
+        The dataset quantities the reader can produce.
+    keywords : tuple of bytes
+        Byte strings typical of the format's first lines (a magic word, a header keyword).
+        A file that no sniffer claims but that contains one of them names this format among
+        the closest candidates in the error of :func:`labbrdf.read`. Never used to choose a
+        reader.
     """
 
     name: str
@@ -102,6 +109,7 @@ class Format:
     sniff: Callable[[bytes], bool]
     read: Callable[[str | os.PathLike[str]], Measurement]
     quantities: tuple[str, ...] = field(default=())
+    keywords: tuple[bytes, ...] = field(default=())
 
 
 def parse_number(

@@ -189,7 +189,9 @@ def read_accurion(path: str | os.PathLike[str]) -> Measurement:
 
     Notes
     -----
-    Zones: the rows of zones 1-4 are the data (each a complete nulling measurement). The
+    Zones: the rows of zones 1-4 are the data (each a complete nulling measurement) and
+    keep their number in the ``zone`` column, so the four rows of one spot and angle stay
+    distinguishable. The
     zone-0 rows (average of the zones) are dropped as redundant and the zone-5 rows (the
     max - min spread of the zones, see the module docstring) are not measurements either;
     both are counted in ``meta["dropped_rows"]`` and the spreads are kept in
@@ -293,7 +295,7 @@ def read_accurion(path: str | os.PathLike[str]) -> Measurement:
         return np.repeat(a[r], 2)
 
     optional: dict[str, Any] = {}
-    for c in ("Time", "X_pos", "Y_pos"):
+    for c in ("Time", "X_pos", "Y_pos", "Zone"):
         if c in col:
             optional[COLUMN_MAP[c]] = two(col[c])
     values = np.empty(2 * m)
@@ -345,5 +347,6 @@ FORMATS: tuple[Format, ...] = (
         sniff=sniff_accurion,
         read=read_accurion,
         quantities=("psi", "delta"),
+        keywords=(b"#Lambda\t", b"#ROIidx\t", b"\tAOI\t", b"WVASEformat"),
     ),
 )

@@ -323,5 +323,6 @@ FORMATS = (
         _sniff,
         read_cary_csv,
         ("absorbance", "transmittance", "reflectance", "hemispherical_reflectance"),
+        keywords=(b"Wavelength (nm),",),
     ),
 )

@@ -365,5 +365,6 @@ FORMATS: tuple[Format, ...] = (
         sniff=sniff_filmsense,
         read=read_filmsense,
         quantities=("psi", "delta", "depolarization"),
+        keywords=(b"Film_Sense",),
     ),
 )

@@ -443,6 +443,7 @@ FORMATS = (
         _sniff_text,
         read_jasco_text,
         ("absorbance", "transmittance", "reflectance", "hemispherical_reflectance"),
+        keywords=(b"JASCO", b"\nXYDATA"),
     ),
     Format(
         "jasco-jws",

@@ -10,10 +10,12 @@ What is read
     ``-``, ``_`` and ``/`` removed, so ``##BLOCK_ID``, ``##BLOCK-ID =`` and ``##DATA TYPE``
     match), ``$$`` comments are stripped. A block runs from ``##TITLE=`` to ``##END=``;
     a ``##DATA TYPE= LINK`` block holds child blocks (``##BLOCKS=`` must equal their number).
-    Every spectrum block needs ``##XYDATA= (X++(Y..Y))``, ``FIRSTX``, ``LASTX``, ``NPOINTS``;
-    ``XFACTOR``/``YFACTOR`` default to 1. Ordinates may be AFFN, PAC (sign-separated), SQZ,
-    DIF and DUP forms and ``?`` (missing, dropped and counted). X = FIRSTX + i * (LASTX -
-    FIRSTX) / (NPOINTS - 1).
+    Every spectrum block needs ``##XYDATA= (X++(Y..Y))`` with ``FIRSTX``, ``LASTX``,
+    ``NPOINTS``, or ``##XYPOINTS= (XY..XY)`` with ``NPOINTS``; ``XFACTOR``/``YFACTOR``
+    default to 1. XYDATA ordinates may be AFFN, PAC (sign-separated), SQZ, DIF and DUP forms
+    and ``?`` (missing, dropped and counted); X = FIRSTX + i * (LASTX - FIRSTX) /
+    (NPOINTS - 1). XYPOINTS holds AFFN X, Y pairs (comma, semicolon or blank separated,
+    several per line, ``?`` for a missing Y); X = the written X times XFACTOR.
 
 Checks (each raises AdapterError with the line)
     * the X at the start of every data line (times XFACTOR) must be within half a step of
@@ -22,6 +24,11 @@ Checks (each raises AdapterError with the line)
       equal the last ordinate (and is not a new point);
     * the number of ordinates must equal NPOINTS; ``DELTAX`` must agree with
       (LASTX - FIRSTX) / (NPOINTS - 1) to 1 %;
+    * XYPOINTS: NPOINTS is checked against the point cap before reading, a line whose pairs
+      go past NPOINTS is refused, the number of pairs must equal NPOINTS, every line holds
+      whole pairs, X is strictly monotonic, and FIRSTX/LASTX (when given) match the
+      first/last X;
+    * a table of another kind (``PEAK TABLE``, ``NTUPLES``) is refused at its line;
     * unclosed blocks, a ``##TITLE`` inside a spectrum block, a repeated label in one block,
       text after the last ``##END=``.
 
@@ -86,6 +93,13 @@ _TOKEN = re.compile(
 )
 
 
+#: The data tables read: equidistant ``(X++(Y..Y))`` and explicit ``(XY..XY)`` pairs.
+_TABLES = ("XYDATA", "XYPOINTS")
+#: Tables that exist in JCAMP-DX but are not spectra this reader takes.
+_OTHER_TABLES = ("PEAKTABLE", "NTUPLES", "PEAKASSIGNMENTS", "XYPOINTS")
+_PAIR_TOKEN = re.compile(r"[^\s,;]+")
+
+
 def _norm(label: str) -> str:
     return re.sub(r"[\s\-_/]", "", label).upper()
 
@@ -97,6 +111,7 @@ class _Block:
     labels: dict[str, str] = field(default_factory=dict)
     data: list[tuple[int, str]] = field(default_factory=list)
     data_line: int = 0
+    lines: dict[str, int] = field(default_factory=dict)
     children: list[_Block] = field(default_factory=list)
 
 
@@ -115,7 +130,7 @@ def _parse_blocks(path: str | os.PathLike[str], lines: list[str]) -> _Block:
                 continue
             if root is not None and not stack:
                 raise AdapterError(path, f"text after the last ##END=: {s[:30]!r}", n)
-            if current == "XYDATA" and stack:
+            if current in _TABLES and stack:
                 stack[-1].data.append((n, s))
             elif current and current != "END" and stack:
                 stack[-1].records[current] += "\n" + s  # continuation of a value
@@ -154,9 +169,17 @@ def _parse_blocks(path: str | os.PathLike[str], lines: list[str]) -> _Block:
         block = stack[-1]
         if key in block.records and not key.startswith("$"):
             raise AdapterError(path, f"label ##{label.strip()}= repeated in one block", n)
+        if key in _TABLES and block.data_line:
+            raise AdapterError(
+                path,
+                f"a second data table (##{label.strip()}=) in the block opened at line "
+                f"{block.line}",
+                n,
+            )
         block.records[key] = value
         block.labels[key] = label.strip()
-        if key == "XYDATA":
+        block.lines[key] = n
+        if key in _TABLES:
             block.data_line = n
     if root is None:
         raise AdapterError(path, "no ##TITLE= record: not a JCAMP-DX file")
@@ -273,22 +296,69 @@ def _decode_table(
     return ys
 
 
+def _decode_points(
+    path: str | os.PathLike[str], block: _Block, npoints: int
+) -> tuple[list[float], list[float]]:
+    """An ``(XY..XY)`` table: AFFN X, Y pairs separated by commas, semicolons or blanks.
+
+    Pairs may run over several per line but never across lines; ``?`` is a missing Y.
+    More pairs than NPOINTS are refused at the line where they begin, before they are kept.
+    """
+    xs: list[float] = []
+    ys: list[float] = []
+    for n, text in block.data:
+        fields = _PAIR_TOKEN.findall(text)
+        if len(fields) % 2:
+            raise AdapterError(
+                path, f"an odd number of values ({len(fields)}): expected X, Y pairs", n
+            )
+        if len(xs) + len(fields) // 2 > npoints:
+            raise AdapterError(
+                path, f"the table runs past its {npoints} points: more than NPOINTS = {npoints}", n
+            )
+        for k in range(0, len(fields), 2):
+            x = number(fields[k], path, n, "X")
+            y = float("nan") if fields[k + 1] == "?" else number(fields[k + 1], path, n, "Y")
+            if len(xs) >= 2 and (x - xs[-1]) * (xs[1] - xs[0]) <= 0 or (xs and x == xs[-1]):
+                raise AdapterError(
+                    path, f"X {x:g} after {xs[-1]:g}: the abscissae are not strictly monotonic", n
+                )
+            xs.append(x)
+            ys.append(y)
+    return xs, ys
+
+
 def _spectrum(
     path: str | os.PathLike[str], block: _Block, index: int
 ) -> tuple[pd.DataFrame, int, dict[str, Any]]:
     rec = block.records
     where = block.line
-    if "XYDATA" not in rec:
+    if "XYDATA" in rec:
+        table = "XYDATA"
+        if re.sub(r"\s", "", rec["XYDATA"]).upper() != "(X++(Y..Y))":
+            raise AdapterError(
+                path,
+                f"##XYDATA= {rec['XYDATA']!r}: only (X++(Y..Y)) is supported",
+                block.data_line,
+            )
+    elif "XYPOINTS" in rec:
+        table = "XYPOINTS"
+        if re.sub(r"\s", "", rec["XYPOINTS"]).upper() != "(XY..XY)":
+            raise AdapterError(
+                path,
+                f"##XYPOINTS= {rec['XYPOINTS']!r}: only (XY..XY) is supported",
+                block.data_line,
+            )
+    else:
+        other = next((k for k in _OTHER_TABLES if k in rec), None)
         raise AdapterError(
             path,
-            "block has no ##XYDATA= table (PEAK TABLE, XYPOINTS and NTUPLES are not supported)",
-            where,
+            "block has no ##XYDATA= table (nor ##XYPOINTS=)"
+            + (f"; ##{block.labels[other]}= is not supported" if other else ""),
+            block.lines[other] if other else where,
         )
-    if re.sub(r"\s", "", rec["XYDATA"]).upper() != "(X++(Y..Y))":
-        raise AdapterError(
-            path, f"##XYDATA= {rec['XYDATA']!r}: only (X++(Y..Y)) is supported", block.data_line
-        )
-    for key in ("FIRSTX", "LASTX", "NPOINTS"):
+    needed = ("FIRSTX", "LASTX", "NPOINTS") if table == "XYDATA" else ("NPOINTS",)
+    for key in needed:
         if key not in rec:
             raise AdapterError(path, f"block has no ##{key}= record", where)
     xunits = rec.get("XUNITS", "").strip().upper()
@@ -301,14 +371,49 @@ def _spectrum(
         raise AdapterError(
             path, f"YUNITS {rec.get('YUNITS', '')!r}: expected one of {sorted(_YUNITS)}", where
         )
+    xfactor = number(rec.get("XFACTOR", "1"), path, where, "XFACTOR")
+    yfactor = number(rec.get("YFACTOR", "1"), path, where, "YFACTOR")
+    if table == "XYDATA":
+        x, ys = _xydata(path, block, xfactor)
+    else:
+        x, ys = _xypoints(path, block, xfactor)
+    quantity, scale = _YUNITS[yunits]
+    if quantity == "reflectance" and any(
+        re.search(r"sphere", v, re.IGNORECASE) for v in rec.values()
+    ):
+        quantity = "hemispherical_reflectance"
+    with np.errstate(over="ignore", invalid="ignore"):
+        x_nm = x * _XUNITS[xunits]
+    title = rec.get("TITLE", "").strip() or f"{Path(path).stem} block {index + 1}"
+    frame, dropped = spectrum_frame(
+        path=path,
+        sample=title,
+        instrument=INSTRUMENT,
+        quantity=quantity,
+        scale=scale * yfactor,
+        x_nm=x_nm,
+        y=np.asarray(ys, dtype=float),
+    )
+    header = {block.labels[k]: v for k, v in rec.items() if k not in _TABLES}
+    info = {"title": title, "line": block.line, "table": table, "header": header}
+    return frame, dropped, info
+
+
+def _xydata(
+    path: str | os.PathLike[str], block: _Block, xfactor: float
+) -> tuple[np.ndarray, list[float]]:
+    """Abscissae and ordinates of an ``(X++(Y..Y))`` table, with its checks.
+
+    Abscissae are actual values (FIRSTX and LASTX are not scaled by XFACTOR); ordinates are
+    not yet multiplied by YFACTOR.
+    """
+    rec, where = block.records, block.line
     first = number(rec["FIRSTX"], path, where, "FIRSTX")
     last = number(rec["LASTX"], path, where, "LASTX")
     npoints = number(rec["NPOINTS"], path, where, "NPOINTS")
     if npoints < 2 or npoints != int(npoints):
         raise AdapterError(path, f"NPOINTS {rec['NPOINTS']!r}: expected an integer >= 2", where)
     npoints = check_count(path, "NPOINTS", int(npoints), line=where)
-    xfactor = number(rec.get("XFACTOR", "1"), path, where, "XFACTOR")
-    yfactor = number(rec.get("YFACTOR", "1"), path, where, "YFACTOR")
     step = (last - first) / (npoints - 1)
     if step == 0 or xfactor == 0:
         raise AdapterError(path, "FIRSTX equals LASTX or XFACTOR is 0", where)
@@ -329,25 +434,50 @@ def _spectrum(
             f"NPOINTS is {npoints} but the table decodes to {len(ys)} ordinates",
             block.data[-1][0] if block.data else block.data_line,
         )
-    quantity, scale = _YUNITS[yunits]
-    if quantity == "reflectance" and any(
-        re.search(r"sphere", v, re.IGNORECASE) for v in rec.values()
-    ):
-        quantity = "hemispherical_reflectance"
     with np.errstate(over="ignore", invalid="ignore"):
-        x = (first + step * np.arange(npoints)) * _XUNITS[xunits]
-    title = rec.get("TITLE", "").strip() or f"{Path(path).stem} block {index + 1}"
-    frame, dropped = spectrum_frame(
-        path=path,
-        sample=title,
-        instrument=INSTRUMENT,
-        quantity=quantity,
-        scale=scale * yfactor,
-        x_nm=x,
-        y=np.asarray(ys, dtype=float),
-    )
-    header = {block.labels[k]: v for k, v in rec.items() if k != "XYDATA"}
-    return frame, dropped, {"title": title, "line": block.line, "header": header}
+        x = first + step * np.arange(npoints)
+    return x, ys
+
+
+def _xypoints(
+    path: str | os.PathLike[str], block: _Block, xfactor: float
+) -> tuple[np.ndarray, list[float]]:
+    """Abscissae (actual values: X times XFACTOR) and ordinates of an ``(XY..XY)`` table.
+
+    NPOINTS is checked against the cap before any pair is kept and must equal the number
+    of pairs; FIRSTX and LASTX, when given, must match the first and last X (to 1e-6 of
+    the X range, relative).
+    """
+    rec = block.records
+    nline = block.lines["NPOINTS"]
+    declared = number(rec["NPOINTS"], path, nline, "NPOINTS")
+    if declared < 1 or declared != int(declared):
+        raise AdapterError(path, f"NPOINTS {rec['NPOINTS']!r}: expected an integer >= 1", nline)
+    npoints = check_count(path, "NPOINTS", int(declared), line=nline)
+    if xfactor == 0:
+        raise AdapterError(path, "XFACTOR is 0", block.lines["XFACTOR"])
+    xs, ys = _decode_points(path, block, npoints)
+    last_line = block.data[-1][0] if block.data else block.data_line
+    if len(xs) != npoints:
+        raise AdapterError(
+            path, f"NPOINTS is {npoints} but the table has {len(xs)} points", last_line
+        )
+    x = np.asarray(xs, dtype=float) * xfactor
+    span = abs(float(x[-1] - x[0])) or abs(float(x[0])) or 1.0
+    for key, k, line in (
+        ("FIRSTX", 0, block.data[0][0] if block.data else block.data_line),
+        ("LASTX", -1, last_line),
+    ):
+        if key in rec:
+            want = number(rec[key], path, block.lines[key], key)
+            if abs(want - x[k]) > 1e-6 * span:
+                what = "first" if k == 0 else "last"
+                raise AdapterError(
+                    path,
+                    f"{key} {want:g} disagrees with the {what} X {x[k]:g} of the table",
+                    line,
+                )
+    return x, ys
 
 
 def read_jcamp(path: str | os.PathLike[str]) -> Measurement:
@@ -408,10 +538,11 @@ def read_jcamp(path: str | os.PathLike[str]) -> Measurement:
 FORMATS = (
     Format(
         "jcamp-dx",
-        "JCAMP-DX UV-Vis-NIR spectra (LINK blocks; AFFN, PAC, SQZ, DIF, DUP)",
+        "JCAMP-DX UV-Vis-NIR spectra (LINK blocks; XYDATA AFFN, PAC, SQZ, DIF, DUP; XYPOINTS)",
         (".jdx", ".dx", ".jcamp"),
         _sniff,
         read_jcamp,
         ("absorbance", "transmittance", "reflectance", "hemispherical_reflectance"),
+        keywords=(b"##TITLE", b"##JCAMP", b"##XYDATA", b"##XYPOINTS"),
     ),
 )

@@ -397,6 +397,7 @@ FORMATS = (
         _sniff_specular,
         read_specular_scan,
         ("brdf", "specular_intensity"),
+        keywords=(b"# labbrdf ",),
     ),
     Format(
         "labbrdf-hemispherical-reflectance",
@@ -405,5 +406,6 @@ FORMATS = (
         _sniff_hemi,
         read_hemispherical,
         ("hemispherical_reflectance",),
+        keywords=(b"# labbrdf ",),
     ),
 )

@@ -219,5 +219,6 @@ FORMATS = (
         _sniff,
         read_perkinelmer_asc,
         ("transmittance", "reflectance", "hemispherical_reflectance", "absorbance"),
+        keywords=(b"PE UV", b"PEDS"),
     ),
 )

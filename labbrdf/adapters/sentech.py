@@ -219,5 +219,6 @@ FORMATS: tuple[Format, ...] = (
         sniff=sniff_sentech,
         read=read_sentech,
         quantities=("psi", "delta", *(str(q) for q in _MM)),
+        keywords=(b"; WAVELENGTH", b"SpectraRay"),
     ),
 )

@@ -13,11 +13,16 @@ exponent is -128, else int32 (int16 with flag TSPREC 0x01) scaled by 2**(exp - 3
 monotonic (ascending or descending) and within 1 nm to 1 mm, else the header is corrupt.
 
 Supported: one or several subfiles sharing one X axis (TMULTI without TXYXYS), X in nm
-(``fxtype`` 3) or micrometres (2), Y absorbance (``fytype`` 2). The file size must equal
-the header plus the data blocks (plus the log block at ``flogoff`` when present), else the
-file is truncated or misread and AdapterError gives the byte offset. Each subfile becomes
-one spectrum, named by the comment (``fcmnt``), else the file stem, with ``#k`` appended
-when there are several.
+(``fxtype`` 3) or micrometres (2), Y absorbance (``fytype`` 2), transmission (128) or
+reflectance (129), the codes of Galactic's ``spc.h``. The format does not say whether a
+transmission or reflectance is a fraction or percent: a Y axis label (``fcatxt``, flag
+TALABS 0x20) containing ``%`` means percent, else values above 1.5 (no fraction reaches
+that) mean percent, else the values are taken as fractions. Percent is divided by 100, and
+``meta["y_scale_in_file"]``/``meta["y_scale_basis"]`` say what the file held and why.
+The file size must equal the header plus the data blocks (plus the log block at
+``flogoff`` when present), else the file is truncated or misread and AdapterError gives the
+byte offset. Each subfile becomes one spectrum, named by the comment (``fcmnt``), else the
+file stem, with ``#k`` appended when there are several.
 
 Notes
 -----
@@ -26,8 +31,6 @@ builds with current pip, and ``spc-io`` 0.2.1 reads HOLMIUM.SPC correctly (901 p
 first Y 1.1663, used as an optional cross-check in the tests) but pulls in pydantic 2,
 prints to stdout on errors and raises bare ValueErrors without offsets. The subset of the
 format UV-Vis instruments write fits in this module.
-Y types 128 (transmission) and 129 (reflectance) are refused: the format does not say
-whether they are fractions or percent and no real file was available to decide.
 """
 
 from __future__ import annotations
@@ -52,7 +55,42 @@ _HEADER = 512
 _SUBHEADER = 32
 _TSPREC, _TMULTI, _TXYXYS, _TXVALS = 0x01, 0x04, 0x40, 0x80
 _XUNITS = {3: ("nm", 1.0), 2: ("micrometers", 1000.0)}
-_YTYPES = {2: ("absorbance", 1.0)}
+#: Supported ``fytype`` codes and their quantity. The SPC format names the codes (Galactic's
+#: spc.h: 2 Absorbance, 128 Transmission, 129 Reflectance) but not whether 128/129 hold
+#: fractions or percent: see :func:`_percent_or_fraction`.
+_YTYPES = {2: "absorbance", 128: "transmittance", 129: "reflectance"}
+#: Names of the other ``fytype`` codes, for the error message (spc.h ``Y...`` constants).
+_YTYPE_NAMES = {
+    0: "arbitrary intensity",
+    1: "interferogram",
+    3: "Kubelka-Munk",
+    4: "counts",
+    5: "volts",
+    6: "degrees",
+    7: "milliamps",
+    8: "millimeters",
+    9: "millivolts",
+    10: "log(1/R)",
+    11: "percent",
+    12: "intensity",
+    13: "relative intensity",
+    14: "energy",
+    16: "decibel",
+    19: "temperature (F)",
+    20: "temperature (C)",
+    21: "temperature (K)",
+    22: "index of refraction",
+    23: "extinction coefficient",
+    24: "real",
+    25: "imaginary",
+    26: "complex",
+    130: "arbitrary or single beam with valley peaks",
+    131: "emission",
+}
+_TALABS = 0x20
+#: Above this a transmittance or reflectance cannot be a fraction (a fluorescent white
+#: reaches about 1.1), so the file holds percent.
+_FRACTION_MAX = 1.5
 #: the wavelengths an optical spectrum can have [nm] (EUV to far infrared)
 _WAVELENGTH_RANGE_NM = (1.0, 1.0e6)
 
@@ -82,6 +120,32 @@ def _fdate(value: int) -> str | None:
         ).isoformat()
     except ValueError:
         return None
+
+
+def _percent_or_fraction(y: np.ndarray, ylabel: str | None) -> tuple[float, str, str]:
+    """Scale to a fraction, what the file holds and why, for a transmission/reflectance Y.
+
+    A Y axis label (``fcatxt``, flag TALABS) with ``%`` means percent. Otherwise the values
+    decide: above :data:`_FRACTION_MAX` they can only be percent; else they are taken as the
+    fraction the dataset stores, and the basis says that the file does not say.
+    """
+    if ylabel and "%" in ylabel:
+        return 0.01, "percent", f"the Y axis label {ylabel!r} says percent"
+    finite = y[np.isfinite(y)]
+    top = float(finite.max()) if finite.size else float("nan")
+    if top > _FRACTION_MAX:
+        return (
+            0.01,
+            "percent",
+            f"values up to {top:.6g} cannot be a fraction (the SPC y type does not say "
+            "fraction or percent)",
+        )
+    return (
+        1.0,
+        "fraction",
+        f"values up to {top:.6g}, read as a fraction; the SPC y type does not say fraction "
+        "or percent" + (f", nor does the Y axis label {ylabel!r}" if ylabel else ""),
+    )
 
 
 def read_spc(path: str | os.PathLike[str]) -> Measurement:
@@ -146,8 +210,8 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
         raise fail(f"x type {xtype}: only nm (3) and micrometers (2) are supported", 28)
     if ytype not in _YTYPES:
         raise fail(
-            f"y type {ytype}: only absorbance (2) is supported (128/129 transmission and "
-            "reflectance do not say fraction or percent)",
+            f"y type {ytype} ({_YTYPE_NAMES.get(ytype, 'unknown code')}): only absorbance (2), "
+            "transmission (128) and reflectance (129) are supported",
             29,
         )
     xbytes = 4 * npts if flags & _TXVALS else 0
@@ -199,10 +263,14 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
             _HEADER + 4 * (k + 1) if flags & _TXVALS else 8,
         )
 
-    quantity, scale = _YTYPES[ytype]
+    quantity = _YTYPES[ytype]
+    ylabel = None
+    if flags & _TALABS:  # fcatxt at byte 218: X, Y, Z axis labels separated by NULs
+        labels = raw[218:248].split(b"\x00")
+        ylabel = labels[1].decode("latin-1").strip() if len(labels) > 1 else ""
     comment = _text(raw, 88, 130)
     base = comment or Path(path).stem
-    frames, subs, dropped = [], [], 0
+    ys: list[tuple[np.ndarray, int]] = []
     offset = _HEADER + xbytes
     for k in range(nsub):
         subexp = struct.unpack_from("<b", raw, offset + 1)[0]
@@ -218,6 +286,13 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
             y = np.frombuffer(raw, "<i4", npts, start).astype(float) * 2.0 ** (exp - 32)
         else:
             y = np.frombuffer(raw, "<i2", npts, start).astype(float) * 2.0 ** (exp - 16)
+        ys.append((y, int(exp)))
+        offset = start + width * npts
+    scale, in_file, basis = 1.0, None, None
+    if quantity != "absorbance":
+        scale, in_file, basis = _percent_or_fraction(np.concatenate([y for y, _ in ys]), ylabel)
+    frames, subs, dropped = [], [], 0
+    for k, (y, exp) in enumerate(ys):
         frame, d = spectrum_frame(
             path=path,
             sample=base if nsub == 1 else f"{base} #{k}",
@@ -229,8 +304,7 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
         )
         frames.append(frame)
         dropped += d
-        subs.append({"exponent": int(exp), "points": int(npts), "dropped": d})
-        offset = start + width * npts
+        subs.append({"exponent": exp, "points": int(npts), "dropped": d})
     meta: dict[str, Any] = {
         "format": "galactic-spc",
         "flags": int(flags),
@@ -241,6 +315,10 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
         "last_x": float(last),
         "x_unit": xname,
         "y_type": int(ytype),
+        "y_type_name": quantity,
+        "y_axis_label": ylabel,
+        "y_scale_in_file": in_file,
+        "y_scale_basis": basis,
         "date": _fdate(struct.unpack_from("<I", raw, 32)[0]),
         "resolution": _text(raw, 36, 9),
         "source_instrument": _text(raw, 45, 9),
@@ -260,6 +338,6 @@ FORMATS = (
         (".spc",),
         _sniff,
         read_spc,
-        ("absorbance",),
+        ("absorbance", "transmittance", "reflectance"),
     ),
 )

@@ -28,7 +28,28 @@ tag                             fields after the tag                            
 
 Reflectance: in an ``RTmethod`` file the ``uR``/``pR``/``sR`` rows are calibrated specular
 reflectances (fractions, as in ``ta2o5_02262007_rp.dat``) and become ``reflectance`` with
-theta_r = theta_i, phi_r = 180 deg. In an ellipsometric (``VASEmethod``) file an ``uR`` row
+theta_r = theta_i, phi_r = 180 deg. They are reflectances of one polarisation (the header's
+``PolRT`` is the fixed polariser: -0.08 deg for p, 89.92 deg for s), not the unpolarised
+reflectance a colour is computed from; ``meta["reflectance_kind"]`` says so, e.g.
+``"single-polarisation (p) ellipsometer reflectance"``.
+
+The angle field of such a row is not always the angle of incidence.
+``ots_sio2_1mm_02262007_rp.dat`` ("Rp several angles", ``PolRT=-0.08``) has six blocks of
+the same 676 wavelengths with the field at 0, 10, ..., 50 deg, and its Rp is the same in all
+of them (median spread 0.3 %, no trend; thin-film fringes at the same wavelengths), whereas
+Fresnel's Rp of any surface changes by tens of percent between 0 and 50 deg (Si at 1000 nm:
+0.32 to 0.17), and at 0 deg a reflection ellipsometer cannot record a specular beam at all.
+Its siblings ``ta2o5_02262007_rp.dat``/``_rs.dat`` (same instrument and day, same header
+layout) carry one block at 45 deg whose Rp and Rs differ as Fresnel says they do at 45 deg.
+So the field there is a setting that did not change the measurement: not the polariser
+(fixed by ``PolRT`` in the header; turning it would mix in Rs), not a tilt (the beam would
+leave the detector), but something an isotropic sample is blind to, most likely a rotation
+of the sample about its normal; the file does not say which. Such rows are read with
+theta_i = theta_r = phi_r = NaN (the geometry is unknown) and the column is kept in
+``meta["angle_column"]`` (values, rows per value in file order, the reason). The test: the
+field goes below 10 deg, or it spans at least 30 deg while the reflectance stays within 1 %.
+
+In an ellipsometric (``VASEmethod``) file an ``uR`` row
 is the reflected intensity the ellipsometer recorded on the side: CompleteEASE 3.65 writes
 values of 0.65-6.9 with a constant placeholder sigma of 1 that rise and fall with wavelength
 like a lamp spectrum, which is neither a reflectance fraction (> 1) nor a plausible percent
@@ -293,7 +314,9 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
         files, ``channel`` ``u``/``p``/``s``), ``specular_intensity`` (uR inside an
         ellipsometric file, arbitrary scale) and ``mueller_ij`` (normalised), with the
         file's sigmas, wavelength in nm, theta_i = the AOI as written (never rounded),
-        theta_r = theta_i and phi_r = 180 deg (specular). Dynamic CompleteEASE data carry
+        theta_r = theta_i and phi_r = 180 deg (specular), except RTmethod reflectances whose
+        angle field cannot be the angle of incidence (NaN, field in
+        ``meta["angle_column"]``; see the module notes). Dynamic CompleteEASE data carry
         ``time_s``. Delta is wrapped into [0, 360).
 
     Raises
@@ -547,6 +570,12 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
     def lab(key: str) -> pd.Categorical:
         return labels([pp[key] for pp in parts], counts)
 
+    theta = aoi
+    phi = np.full(n, 180.0)
+    if rt:
+        theta = aoi.copy()
+        _rt_geometry(wl, aoi, v[:, 2], tcodes, code, utags, theta, phi, meta)
+
     optional: dict[str, Any] = {}
     if any(pp["channel"] and pp["count"] for pp in parts):
         optional["channel"] = lab("channel")
@@ -566,9 +595,9 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
         sigma=num("sigma"),
         unit=lab("unit"),
         wavelength_nm=take(wl),
-        theta_i_deg=take(aoi),
-        theta_r_deg=take(aoi),  # a second array: the columns must not share memory
-        phi_r_deg=180.0,
+        theta_i_deg=take(theta),
+        theta_r_deg=take(theta),  # a second array: the columns must not share memory
+        phi_r_deg=take(phi),
         **optional,
     )
     if dynamic:
@@ -584,9 +613,99 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
     meta["delta_convention"] = "Nebraska (Woollam): Delta = 180 deg at normal incidence"
     meta["delta_range_in_file"] = delta_range(np.concatenate(delta_seen)) if delta_seen else None
     meta["delta_range"] = "[0, 360)"
-    meta["angles_deg"] = group_angles(aoi)
+    meta["angles_deg"] = group_angles(theta)
     meta["wavelength_nm"] = [float(np.min(wl)), float(np.max(wl))]
     return measurement(path, frame, meta)
+
+
+#: Below this angle of incidence a reflection ellipsometer cannot record a specular
+#: reflectance: source and detector arms would overlap (WVASE's own convention for angle 0
+#: is normal incidence in transmission).
+_MIN_REFLECTION_AOI_DEG = 10.0
+#: A reflectance that stays within this relative spread (median over wavelengths) while the
+#: angle column spans at least :data:`_FLAT_SPAN_DEG` cannot be a function of the angle of
+#: incidence: Fresnel's Rp changes by more over such a span (Si at 1000 nm: 0.32 at 0 deg,
+#: 0.17 at 50 deg; even aluminium changes by several percent between 0 and 50 deg).
+_FLAT_RTOL = 0.01
+_FLAT_SPAN_DEG = 30.0
+_REFL_KIND = {"p": "single-polarisation (p)", "s": "single-polarisation (s)", "u": "unpolarised"}
+
+
+def _angle_column_not_aoi(wl: np.ndarray, ang: np.ndarray, val: np.ndarray) -> str | None:
+    """Why the angle column of reflectance rows cannot be their angle of incidence, or None."""
+    reasons = []
+    if ang.min() < _MIN_REFLECTION_AOI_DEG:
+        reasons.append(
+            f"it reaches {ang.min():g} deg, where a reflection ellipsometer cannot measure a "
+            "specular reflectance"
+        )
+    u = np.unique(ang)
+    if u.size >= 2 and u[-1] - u[0] >= _FLAT_SPAN_DEG:
+        table = (
+            pd.DataFrame({"wl": wl, "a": ang, "v": val})
+            .pivot_table(index="wl", columns="a", values="v", aggfunc="mean")
+            .dropna()
+        )
+        if len(table):
+            spread = (table.max(axis=1) - table.min(axis=1)) / table.abs().mean(axis=1)
+            med = float(np.median(spread))
+            if med < _FLAT_RTOL:
+                reasons.append(
+                    f"the reflectance at one wavelength changes by {100 * med:.2g} % (median) "
+                    f"over {u[0]:g}-{u[-1]:g} deg, where Fresnel reflectance would change by "
+                    "far more"
+                )
+    return "; ".join(reasons) or None
+
+
+def _rt_geometry(
+    wl: np.ndarray,
+    aoi: np.ndarray,
+    value: np.ndarray,
+    tcodes: np.ndarray,
+    code: dict[str, int],
+    utags: list[str],
+    theta: np.ndarray,
+    phi: np.ndarray,
+    meta: dict[str, Any],
+) -> None:
+    """Geometry and kind of the reflectance rows of an ``RTmethod`` file (in place).
+
+    Where the angle column cannot be the angle of incidence (see :func:`read_woollam`),
+    ``theta`` and ``phi`` become NaN for those rows and the column goes to
+    ``meta["angle_column"]``. ``meta["reflectance_kind"]`` says which polarisation.
+    """
+    tags = [t for t in sorted(utags) if t in _REFL]
+    if not tags:
+        return
+    meta["reflectance_kind"] = (
+        "; ".join(_REFL_KIND[_REFL[t]] for t in tags) + " ellipsometer reflectance"
+    )
+    flagged = np.zeros(aoi.size, dtype=bool)
+    reasons = []
+    for t in tags:
+        rows = tcodes == code[t]
+        ok = rows & np.isfinite(value)
+        why = _angle_column_not_aoi(wl[ok], aoi[ok], value[ok]) if ok.any() else None
+        if why is not None:
+            flagged |= rows
+            reasons.append(f"{t}: {why}")
+    if not flagged.any():
+        return
+    theta[flagged] = np.nan
+    phi[flagged] = np.nan
+    a = aoi[flagged]
+    vals, counts = np.unique(a, return_counts=True)
+    meta["angle_column"] = {
+        "values_deg": [float(x) for x in vals],
+        "rows_per_value": [int(c) for c in counts],
+        "is_angle_of_incidence": False,
+        "reason": "; ".join(reasons),
+        "meaning": "a per-block setting (written in the AOI field) that did not change the "
+        "measured reflectance, e.g. a sample rotation about its normal; the file does not "
+        "say which, so the angle of incidence is unknown (NaN) and the rows are kept in "
+        "file order, one block per value",
+    }
 
 
 def _ascii_head(raw: bytes, nlines: int) -> str:
@@ -665,6 +784,7 @@ FORMATS: tuple[Format, ...] = (
         "generalized ellipsometry, depolarization, reflectance, Mueller matrix",
         extensions=(".dat",),
         sniff=sniff_wvase,
+        keywords=(b"VASEmethod[", b"RTmethod[", b"WVASE"),
         read=read_woollam,
         quantities=(
             "psi",
@@ -680,6 +800,7 @@ FORMATS: tuple[Format, ...] = (
         description="J.A. Woollam CompleteEASE ASCII export (3.x static/dynamic, 6.x tagged)",
         extensions=(".dat",),
         sniff=sniff_completeease,
+        keywords=(b"VASEmethod[", b"CompleteEASE"),
         read=read_woollam,
         quantities=("psi", "delta", "depolarization", "specular_intensity"),
     ),

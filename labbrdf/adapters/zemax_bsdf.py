@@ -1109,5 +1109,6 @@ FORMATS = (
         _sniff,
         read_zemax_bsdf,
         ("brdf", "btdf"),
+        keywords=(b"AngleOfIncidence", b"ScatterAzimuth", b"ScatterRadial"),
     ),
 )

@@ -56,3 +56,15 @@ def test_row_with_an_empty_field_is_refused(real_exports: Path, tmp_path: Path, 
     bad.write_bytes(raw[:start] + new + raw[start + len(line3) :])
     with pytest.raises(AdapterError, match=r"line 3: field \d+ \(\w+\) is empty"):
         labbrdf.read(bad)
+
+
+def test_zone_numbers_are_kept_so_rows_of_one_spot_and_angle_differ(real_exports: Path) -> None:
+    d = labbrdf.read(real_exports / "accurion-ep4-dat" / "15-1-1.dat").data
+    assert "zone" in d.columns
+    at50 = d[(d["theta_i_deg"] == 50.0) & (d["quantity"] == "psi")]
+    # lines 3-6: zone 4 Psi 31.474, zone 2 31.291, ... (zones 0 and 5 are not data rows)
+    assert sorted(at50["zone"]) == [1.0, 2.0, 3.0, 4.0]
+    assert at50.loc[at50["zone"] == 2, "value"].item() == pytest.approx(31.291, abs=5e-4)
+    assert at50.loc[at50["zone"] == 4, "value"].item() == pytest.approx(31.474, abs=5e-4)
+    key = ["quantity", "wavelength_nm", "theta_i_deg", "x_mm", "y_mm", "zone"]
+    assert not d.duplicated(key).any()

@@ -67,3 +67,82 @@ def test_fifo_is_refused_without_blocking(tmp_path: Path) -> None:
 def test_directory_with_format_names_it_a_directory(tmp_path: Path) -> None:
     with pytest.raises(AdapterError, match="is a directory"):
         labbrdf.read(tmp_path, format="jcamp-dx")
+
+
+# ----------------------------------------------------------------- content over extension
+
+
+def test_jasco_text_saved_as_csv_is_read_as_jasco(real_exports: Path, tmp_path: Path) -> None:
+    src = real_exports / "jasco-spectramanager-text" / "uvvis_abs.txt"
+    renamed = tmp_path / "uvvis_abs.csv"
+    renamed.write_bytes(src.read_bytes())
+    m = labbrdf.read(renamed)
+    assert m.meta["format"] == "jasco-spectramanager-text"
+    ref = labbrdf.read(renamed, format="jasco-spectramanager-text")
+    assert m.data["value"].tolist() == ref.data["value"].tolist()
+    assert len(m.data) == 61
+
+
+def test_wvase_saved_as_txt_is_read_as_wvase(real_exports: Path, tmp_path: Path) -> None:
+    src = real_exports / "woollam-wvase-ascii" / "w2_10102006.dat"
+    renamed = tmp_path / "w2_10102006.txt"
+    renamed.write_bytes(src.read_bytes())
+    m = labbrdf.read(renamed)
+    assert m.meta["format"] == "woollam-wvase"
+    assert len(m.data) == len(labbrdf.read(src).data)
+
+
+def test_jasco_text_saved_as_asc_is_read_as_jasco(real_exports: Path, tmp_path: Path) -> None:
+    # .asc belongs to one format only, whose sniffer does not claim the file
+    src = real_exports / "jasco-spectramanager-text" / "uvvis_abs.txt"
+    renamed = tmp_path / "uvvis_abs.asc"
+    renamed.write_bytes(src.read_bytes())
+    assert labbrdf.read(renamed).meta["format"] == "jasco-spectramanager-text"
+
+
+def test_damaged_file_of_a_one_format_extension_gets_that_readers_error(
+    real_exports: Path, tmp_path: Path
+) -> None:
+    src = real_exports / "perkinelmer-uvwinlab-asc" / "KTF-D.Probe.Raw.asc"
+    bad = tmp_path / "KTF-D.asc"
+    bad.write_bytes(b"PE UV  garbage\r\n" + src.read_bytes().split(b"\r\n", 1)[1])
+    with pytest.raises(AdapterError) as exc:
+        labbrdf.read(bad)
+    assert "no adapter" not in str(exc.value)
+
+
+def test_unrecognised_csv_names_the_csv_formats_not_all(tmp_path: Path) -> None:
+    p = tmp_path / "notes.csv"
+    p.write_text("hello,world\n1,2\n")
+    with pytest.raises(AdapterError) as exc:
+        labbrdf.read(p)
+    msg = str(exc.value)
+    for name in ("agilent-cary-winuv-csv", "labbrdf-dataset-csv", "labbrdf-specular-scan"):
+        assert name in msg
+    for name in ("zemax-bsdf", "galactic-spc", "woollam-wvase", "jcamp-dx"):
+        assert name not in msg
+
+
+def test_unrecognised_file_names_a_format_whose_keyword_it_carries(
+    real_exports: Path, tmp_path: Path
+) -> None:
+    # a JCAMP file without its ##JCAMP-DX line: the sniffer does not claim it, but ##TITLE
+    # in the first line makes jcamp-dx a candidate worth naming
+    src = real_exports / "jcamp-dx" / "dupinc1.jdx"
+    lines = src.read_bytes().split(b"\r\n")
+    p = tmp_path / "dupinc1.txt"
+    p.write_bytes(b"\r\n".join(ln for ln in lines if not ln.startswith(b"##JCAMP")))
+    with pytest.raises(AdapterError) as exc:
+        labbrdf.read(p)
+    msg = str(exc.value)
+    assert "jcamp-dx" in msg
+    assert "filmsense" in msg  # a .txt format
+    assert "zemax-bsdf" not in msg and "galactic-spc" not in msg
+
+
+def test_unknown_extension_without_keywords_does_not_list_every_format(tmp_path: Path) -> None:
+    p = tmp_path / "data.xyz"
+    p.write_text("1 2 3\n4 5 6\n")
+    with pytest.raises(AdapterError, match=r"formats\(\)") as exc:
+        labbrdf.read(p)
+    assert "woollam-wvase" not in str(exc.value)

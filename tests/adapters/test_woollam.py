@@ -77,3 +77,49 @@ def test_sentech_mueller_matches_psi_delta_of_the_same_wafer_in_optics_conventio
         for i, j in ((1, 2), (2, 1), (3, 3), (3, 4), (4, 3), (4, 4)):
             # two instruments' scans of one wafer: agree to 0.02 (5 digits printed)
             assert got[f"mueller_{i}{j}"] == pytest.approx(ref[i - 1, j - 1], abs=0.02), (wl, i, j)
+
+
+def test_rp_angle_column_flat_from_0_to_50_deg_is_not_the_angle_of_incidence(
+    real_exports: Path,
+) -> None:
+    m = labbrdf.read(real_exports / WVASE / "ots_sio2_1mm_02262007_rp.dat")
+    d = m.data
+    assert len(d) == 4056 and set(d["quantity"]) == {"reflectance"}
+    assert set(d["channel"]) == {"p"}
+    # no specular geometry is claimed: the angle of incidence is unknown
+    assert d["theta_i_deg"].isna().all() and d["theta_r_deg"].isna().all()
+    assert d["phi_r_deg"].isna().all()
+    col = m.meta["angle_column"]
+    assert col["values_deg"] == [0.0, 10.0, 20.0, 30.0, 40.0, 50.0]
+    assert col["rows_per_value"] == [676] * 6
+    assert col["is_angle_of_incidence"] is False
+    assert m.meta["angles_deg"] == []
+    assert m.meta["reflectance_kind"] == "single-polarisation (p) ellipsometer reflectance"
+    # line 5: "pR	245.732520	0.000000	0.512108	0.0202422", still the first row
+    assert d["value"].iloc[0] == pytest.approx(0.512108, rel=1e-12)
+    assert d["wavelength_nm"].iloc[0] == pytest.approx(245.73252, rel=1e-12)
+    # the blocks stay in file order: row 676 is the first of the 10 deg block (line 681)
+    assert d["wavelength_nm"].iloc[676] == pytest.approx(245.73252, rel=1e-12)
+
+
+def test_rp_and_rs_at_45_deg_keep_their_angle_and_say_single_polarisation(
+    real_exports: Path,
+) -> None:
+    for name, ch in (("ta2o5_02262007_rp.dat", "p"), ("ta2o5_02262007_rs.dat", "s")):
+        m = labbrdf.read(real_exports / WVASE / name)
+        assert (m.data["theta_i_deg"] == 45.0).all()
+        assert "angle_column" not in m.meta
+        assert m.meta["reflectance_kind"] == f"single-polarisation ({ch}) ellipsometer reflectance"
+
+
+def test_rt_reflectance_that_changes_with_angle_keeps_the_angles(tmp_path: Path) -> None:
+    p = tmp_path / "rt_angles.dat"
+    p.write_bytes(
+        b"RT angles\nRTmethod[PolRT=-0.08, RevsRT=100, WVASE=3.616, Mon Feb 26 11:36:27 2007]\n"
+        b"Original[rt_angles.dat]\nnm\n"
+        b"pR\t500.0\t15.0\t0.30\t0.01\npR\t600.0\t15.0\t0.31\t0.01\n"
+        b"pR\t500.0\t55.0\t0.12\t0.01\npR\t600.0\t55.0\t0.13\t0.01\n"
+    )
+    m = labbrdf.read(p)
+    assert m.data["theta_i_deg"].tolist() == [15.0, 15.0, 55.0, 55.0]
+    assert "angle_column" not in m.meta
