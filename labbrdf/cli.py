@@ -786,7 +786,23 @@ def cmd_report(args: argparse.Namespace) -> int:
 
     check_input_files(args.files)
     check_report_dir(args.output, inputs=args.files)
-    return int(user_report(args.files, args.model, args.output))
+    options, start = _split_params(args.model, args.param)
+    selection = {
+        k: getattr(args, k)
+        for k in ("wavelength", "theta_i", "quantity", "sample")
+        if getattr(args, k) is not None
+    }
+    return int(
+        user_report(
+            args.files,
+            args.model,
+            args.output,
+            options=options,
+            start=start,
+            selection=selection,
+            progress=not args.quiet,
+        )
+    )
 
 
 # ------------------------------------------------------------------------------- main
@@ -932,7 +948,15 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("report", help="HTML report for your own files")
     s.add_argument("files", nargs="+", metavar="DATA")
     s.add_argument("--model", default="smooth3")
+    s.add_argument(
+        "--param",
+        action="append",
+        metavar="NAME=VALUE",
+        help="a model option (microfacet n=, k=, diffuse=true) or a parameter's start value",
+    )
     s.add_argument("-o", "--output", required=True, metavar="DIR")
+    s.add_argument("--quiet", action="store_true", help="no progress lines")
+    _add_selection(s)
     s.set_defaults(func=cmd_report)
     return p
 

@@ -278,3 +278,15 @@ def test_new_writers_refuse_inputs_and_wrong_suffixes(real_exports, tmp_path, ca
     assert capsys.readouterr().err.strip()
     assert {p: p.stat().st_mtime_ns for p in before} == before
     assert sorted(tmp_path.iterdir()) == []
+
+
+def test_report_takes_model_options_and_a_selection(real_exports: Path, tmp_path: Path):
+    out = tmp_path / "r"
+    argv = ["report", str(real_exports / BSDF), "--model", "microfacet", "--param", "n=1.5",
+            "--param", "k=0", "--param", "diffuse=true", "--theta-i", "40:50", "-o", str(out),
+            "--quiet"]  # fmt: skip
+    assert main(argv) == 0
+    res = json.loads((out / "results.json").read_text())
+    checks = {c["id"]: c["status"] for c in res["checks"]}
+    assert checks["fits.microfacet.success"] == "pass"
+    assert res["meta"]["options"] == {"n": 1.5, "k": 0.0, "diffuse": True}

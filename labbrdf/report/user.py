@@ -41,6 +41,8 @@ def user_report(
     scheduler: str | None = None,
     workers: int | None = None,
     title: str | None = None,
+    start: Mapping[str, float] | None = None,
+    selection: Mapping[str, Any] | None = None,
     **kw: Any,
 ) -> int:
     """Build a report for the given files and write it (atomically) to ``out``.
@@ -63,6 +65,11 @@ def user_report(
         Executor for the fits (:mod:`labbrdf.parallel`); None runs in this process.
     title : str, optional
         Page title.
+    start : mapping, optional
+        Starting values of model parameters (name -> value) for every fit.
+    selection : mapping, optional
+        Rows to keep, as :func:`labbrdf.selection.select` takes them (``wavelength``,
+        ``theta_i``, ``quantity``, ``sample``); applied to every file after reading.
     **kw :
         ``quick`` is accepted for symmetry with :func:`~labbrdf.report.validate` (no effect).
 
@@ -107,7 +114,13 @@ def user_report(
         },
     )
     ctx = Context(
-        b, scheduler=scheduler, workers=workers, progress=progress, method=method, seed=seed
+        b,
+        scheduler=scheduler,
+        workers=workers,
+        progress=progress,
+        method=method,
+        seed=seed,
+        fit_options={"params": dict(start)} if start else {},
     )
 
     def ingest(ctx: Context) -> None:
@@ -115,6 +128,21 @@ def user_report(
             f"{len(paths)} file(s) given; each was read with labbrdf.read into the common dataset."
         )
         ingest_files(ctx, paths)
+        if selection:
+            from ..selection import SelectionError, select
+
+            kept = []
+            for f in ctx.frames:
+                try:
+                    kept.append(select(f, **selection))
+                except SelectionError:
+                    continue
+            ctx.b.text(
+                "Selection applied to every file: "
+                + ", ".join(f"{k} {v}" for k, v in selection.items())
+                + f"; {sum(len(f) for f in kept)} of {sum(len(f) for f in ctx.frames)} rows kept."
+            )
+            ctx.frames[:] = [f for f in kept if len(f)]
 
     sections: list[Section] = [
         ("ingest", "Ingested files", ingest),
