@@ -1,7 +1,7 @@
 """Accurion nanofilm EP3/EP4 imaging-ellipsometer exports (``.dat``, ``.ds.dat``).
 
-Layout (docs/formats.md section 3, checked on every file in
-``shared/real-exports/accurion-ep4-dat``): TAB separated, a ``#``-line of column names, a
+Layout (docs/formats.md section 3, checked on every real EP3/EP4 export the test suite
+reads): TAB separated, a ``#``-line of column names, a
 ``#``-line of units (Latin-1: ``µm`` is byte 0xB5), then one row per measurement. Two column
 layouts are in use, so columns are matched by NAME (:data:`COLUMN_MAP`), never by position:
 

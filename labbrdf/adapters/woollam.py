@@ -1,7 +1,7 @@
 """J.A. Woollam ASCII data files: WVASE32 and CompleteEASE exports (``.dat``).
 
-Layout (docs/formats.md sections 1-2, checked on every real file in
-``shared/real-exports/woollam-*``): a header of up to five lines found by content, not by
+Layout (docs/formats.md sections 1-2, checked on every real WVASE and CompleteEASE export
+the test suite reads): a header of up to five lines found by content, not by
 position --
 
 1. a free-text title (may be empty: CompleteEASE 3.x),
