@@ -12,6 +12,7 @@ import stat
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from ..dataset import Measurement
 from ..errors import LabbrdfError
@@ -72,8 +73,19 @@ class AdapterError(LabbrdfError, ValueError):
         self.path = str(path)
         self.line = line
         self.reason = message
+        self.unit = unit
         where = f"{self.path}, {unit} {line}" if line is not None else self.path
         super().__init__(f"{where}: {message}")
+
+    def __reduce__(self) -> tuple[Any, tuple[Any, ...]]:
+        """Pickle by the constructor's arguments (an error raised on a dask worker)."""
+        return (_rebuild_adapter_error, (type(self), self.path, self.reason, self.line, self.unit))
+
+
+def _rebuild_adapter_error(
+    cls: type[AdapterError], path: str, reason: str, line: int | None, unit: str
+) -> AdapterError:
+    return cls(path, reason, line, unit=unit)
 
 
 @dataclass(frozen=True)

@@ -146,3 +146,17 @@ def test_unknown_extension_without_keywords_does_not_list_every_format(tmp_path:
     with pytest.raises(AdapterError, match=r"formats\(\)") as exc:
         labbrdf.read(p)
     assert "woollam-wvase" not in str(exc.value)
+
+
+def test_adapter_error_survives_pickling():
+    # errors raised on a dask or process-pool worker travel back pickled
+    import pickle
+
+    from labbrdf.adapters import AdapterError
+
+    e = AdapterError("x.dat", "expected a number", 7, unit="byte")
+    back = pickle.loads(pickle.dumps(e))
+    assert type(back) is AdapterError
+    assert (back.path, back.reason, back.line, back.unit, str(back)) == (
+        "x.dat", "expected a number", 7, "byte", "x.dat, byte 7: expected a number",
+    )  # fmt: skip
