@@ -534,6 +534,12 @@ def cmd_export(args: argparse.Namespace) -> int:
 
     if args.format != "zemax-bsdf":
         raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
+    if (args.model is None) == (args.trace is None):
+        raise UsageError("export a model (--model NAME --param ...) or a trace (--trace RUN.npz)")
+    if args.trace is not None:
+        return _export_trace(args)
+    if args.theta_i is None:
+        raise UsageError("--model needs --theta-i DEG [DEG ...]")
     options, values = _split_params(args.model, args.param)
     if args.nk_from:
         if args.wavelength is None:
@@ -560,6 +566,42 @@ def cmd_export(args: argparse.Namespace) -> int:
         theta_i_deg=np.asarray(args.theta_i, float),
         radial_deg=_grid(args.radial, "--radial"),
         azimuth_deg=_grid(args.azimuth, "--azimuth"),
+        overwrite=args.overwrite,
+    )
+    print(f"wrote {out}")
+    return 0
+
+
+def _export_trace(args: argparse.Namespace) -> int:
+    """``export --trace RUN.npz``: the tracer's unpolarized S0 on the scatter grid."""
+    from .adapters.zemax_bsdf import binned_to_bsdf
+    from .outputs import check_file_output, check_input_files
+    from .tracer import TraceResult
+
+    check_input_files([args.trace])
+    out = check_file_output(args.output, inputs=[args.trace], suffixes=(".bsdf",))
+    if out.exists() and not args.overwrite:
+        raise UsageError(f"-o {out}: exists; pass --overwrite to replace it")
+    if args.theta_i is not None or args.param or args.nk_from:
+        raise UsageError(
+            "--trace takes its angle and material from the run; drop --theta-i/--param"
+        )
+    try:
+        res = TraceResult.load(args.trace)
+    except (OSError, KeyError, ValueError) as exc:
+        raise UsageError(f"--trace {args.trace}: not a labbrdf trace file ({exc})") from None
+    cfg = res.config
+    binned_to_bsdf(
+        out,
+        theta_i_deg=cfg.theta_i_deg,
+        values=res.s0(),
+        theta_edges_deg=res.theta_r_edges_deg,
+        phi_edges_deg=res.phi_r_edges_deg,
+        radial_deg=_grid(args.radial, "--radial"),
+        azimuth_deg=_grid(args.azimuth, "--azimuth"),
+        wavelength_nm=cfg.wavelength_nm,
+        symmetry="Asymmetrical",
+        comments=(f"labbrdf trace S0 (unpolarized), {res.rays} rays, seed {cfg.seed}",),
         overwrite=args.overwrite,
     )
     print(f"wrote {out}")
@@ -898,11 +940,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("export", help="write a model BRDF in an exchange format")
     s.add_argument("--format", default="zemax-bsdf", help="zemax-bsdf")
-    s.add_argument("--model", required=True)
+    s.add_argument("--model", default=None, help="a model (with --param) ...")
+    s.add_argument("--trace", default=None, metavar="RUN.npz", help="... or a trace's S0")
     s.add_argument("--param", action="append", metavar="NAME=VALUE")
     s.add_argument("--nk-from", default=None, metavar="FILE")
     s.add_argument("--wavelength", type=float, default=None, help="[nm] for --nk-from")
-    s.add_argument("--theta-i", type=float, nargs="+", required=True, metavar="DEG")
+    s.add_argument("--theta-i", type=float, nargs="+", default=None, metavar="DEG")
     s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")
     s.add_argument("--azimuth", default="0:180:5", help="START:STOP:STEP [deg]")
     s.add_argument("-o", "--output", required=True)

@@ -290,3 +290,32 @@ def test_report_takes_model_options_and_a_selection(real_exports: Path, tmp_path
     checks = {c["id"]: c["status"] for c in res["checks"]}
     assert checks["fits.microfacet.success"] == "pass"
     assert res["meta"]["options"] == {"n": 1.5, "k": 0.0, "diffuse": True}
+
+
+@pytest.mark.slow
+def test_trace_exported_as_bsdf_is_read_back_and_fitted(tmp_path: Path, capsys):
+    from labbrdf.tracer import TraceResult
+
+    run, out = tmp_path / "al.npz", tmp_path / "al.bsdf"
+    assert main(["trace", "--substrate", "1.55+7.71j", "--alpha", "0.2", "--theta-i", "45",
+                 "--wavelength", "650", "--rays", "400000", "--seed", "1",
+                 "--single-scattering", "-o", str(run), "--scheduler", "serial"]) == 0  # fmt: skip
+    assert main(["export", "--trace", str(run), "--radial", "0:60:3", "--azimuth", "0:350:10",
+                 "-o", str(out)]) == 0  # fmt: skip
+    capsys.readouterr()
+    res, m = TraceResult.load(run), labbrdf.read(out)
+    d = m.data
+    assert m.meta["wavelength_stated"] and set(d.wavelength_nm) == {650.0}
+    # every written point is the S0 of the bin its direction falls in, to the 6 digits written
+    s0, te, pe = res.s0(), res.theta_r_edges_deg, res.phi_r_edges_deg
+    i = np.searchsorted(te, d.theta_r_deg.to_numpy(), side="right") - 1
+    phi = pe[0] + np.mod(d.phi_r_deg.to_numpy() - pe[0], 360.0)
+    j = np.searchsorted(pe, phi, side="right") - 1
+    np.testing.assert_allclose(d.value.to_numpy(), s0[i, j], rtol=5e-6, atol=1e-12)
+    # single scattering is the microfacet model: alpha comes back to the bins' smearing
+    # (1 deg bins against a lobe ~ 2 alpha = 23 deg wide: about 1 %)
+    fit = ["fit", str(out), "--model", "microfacet", "--param", "n=1.55", "--param", "k=7.71",
+           "--weighting", "uniform", "--scheduler", "serial", "--json"]  # fmt: skip
+    assert main(fit) == 0
+    (g,) = _json(capsys)
+    assert g["params"]["alpha"]["value"] == pytest.approx(0.2, rel=0.015)

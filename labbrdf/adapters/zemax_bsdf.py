@@ -58,6 +58,7 @@ __all__ = [
     "read_zemax_bsdf",
     "scatter_to_angles",
     "scatter_to_direction",
+    "binned_to_bsdf",
     "write_bsdf",
 ]
 
@@ -1080,6 +1081,86 @@ def model_to_bsdf(
         symmetry=symmetry,
         comments=(
             f"labbrdf model {name}",
+            *([f"{_WAVELENGTH_COMMENT}{float(wavelength_nm):.17g}"] if wavelength_nm else []),
+            *comments,
+        ),
+        digits=digits,
+        overwrite=overwrite,
+    )
+
+
+def binned_to_bsdf(
+    path: str | os.PathLike[str],
+    *,
+    theta_i_deg: float,
+    values: ArrayLike,
+    theta_edges_deg: ArrayLike,
+    phi_edges_deg: ArrayLike,
+    radial_deg: ArrayLike,
+    azimuth_deg: ArrayLike,
+    wavelength_nm: float | None = None,
+    symmetry: str = "PlaneSymmetrical",
+    comments: Iterable[str] = (),
+    digits: int = 6,
+    overwrite: bool = False,
+) -> Path:
+    """Write a BRDF binned on a (theta_r, phi_r) grid (a tracer's S0) as a ``.bsdf`` file.
+
+    Each scatter grid point (radial, azimuth about the specular direction of
+    ``theta_i_deg``) is converted to (theta_r, phi_r) by :func:`scatter_to_angles` and takes
+    the value of the bin it falls in; below the horizon it is 0.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Output file; an existing file is refused unless ``overwrite``.
+    theta_i_deg : float
+        Angle of incidence of the binned data [deg].
+    values : array_like, shape (n_theta, n_phi)
+        Bin-averaged BRDF [sr^-1], e.g. :meth:`labbrdf.tracer.TraceResult.s0`.
+    theta_edges_deg, phi_edges_deg : array_like
+        Bin edges [deg], ``n_theta + 1`` in [0, 90] and ``n_phi + 1`` in [0, 360]
+        (outward azimuth, source at 0).
+    radial_deg, azimuth_deg : array_like
+        The scatter grid to write [deg].
+    wavelength_nm : float, optional
+        Written as a ``#labbrdf wavelength_nm`` comment, read back by :func:`read_zemax_bsdf`.
+    symmetry, comments, digits, overwrite :
+        As in :func:`write_bsdf`.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Notes
+    -----
+    The file holds bin averages at the grid points, not point values: features narrower
+    than a bin (a near-specular spike of a smooth surface) are smeared over the bin width,
+    as in the binned data themselves. Choose a scatter grid no finer than the bins.
+    """
+    v = np.asarray(values, float)
+    te = np.asarray(theta_edges_deg, float)
+    pe = np.asarray(phi_edges_deg, float)
+    if v.ndim != 2 or v.shape != (te.size - 1, pe.size - 1):
+        raise ValueError(
+            f"values: expected shape ({te.size - 1}, {pe.size - 1}) from the edges, got {v.shape}"
+        )
+    v = np.where(np.isfinite(v), v, 0.0)
+    rad = np.atleast_1d(np.asarray(radial_deg, float))
+    az = np.atleast_1d(np.asarray(azimuth_deg, float))
+    tr, pr, above = scatter_to_angles(float(theta_i_deg), rad[None, :], az[:, None])
+    i = np.clip(np.searchsorted(te, tr, side="right") - 1, 0, v.shape[0] - 1)
+    phi = pe[0] + np.mod(pr - pe[0], 360.0)  # into the edges' period (they may start at -0.5)
+    j = np.clip(np.searchsorted(pe, phi, side="right") - 1, 0, v.shape[1] - 1)
+    grid = np.where(above, v[i, j], 0.0)
+    return write_bsdf(
+        path,
+        theta_i_deg=[float(theta_i_deg)],
+        radial_deg=rad,
+        azimuth_deg=az,
+        values=grid[None, None, None],
+        symmetry=symmetry,
+        comments=(
             *([f"{_WAVELENGTH_COMMENT}{float(wavelength_nm):.17g}"] if wavelength_nm else []),
             *comments,
         ),
