@@ -689,8 +689,17 @@ def cmd_hemispherical(args: argparse.Namespace) -> int:
     from . import models
     from .integrate import hemispherical_reflectance
 
-    model = models.get(args.model)
-    params = _parse_assignments(args.param, "--param")
+    options, params = _split_params(args.model, args.param)
+    if args.nk_from:
+        if args.wavelength is None:
+            raise UsageError("--nk-from needs --wavelength NM")
+        options["n"], options["k"] = _nk_at(
+            _nk_combined(args.nk_from), args.wavelength, args.nk_from
+        )
+    try:
+        model = models.get(args.model, **options)
+    except models.ModelError as exc:
+        raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
     theta = np.asarray(args.theta_i, dtype=float)
     rho = np.atleast_1d(hemispherical_reflectance(model, params, theta))
     if args.json:
@@ -956,6 +965,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--model", required=True)
     s.add_argument("--param", action="append", metavar="NAME=VALUE")
     s.add_argument("--theta-i", type=float, nargs="+", required=True, metavar="DEG")
+    s.add_argument("--nk-from", default=None, metavar="FILE", help="n, k from psi/Delta")
+    s.add_argument("--wavelength", type=float, default=None, help="[nm] for --nk-from")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_hemispherical)
 

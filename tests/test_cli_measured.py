@@ -319,3 +319,19 @@ def test_trace_exported_as_bsdf_is_read_back_and_fitted(tmp_path: Path, capsys):
     assert main(fit) == 0
     (g,) = _json(capsys)
     assert g["params"]["alpha"]["value"] == pytest.approx(0.2, rel=0.015)
+
+
+def test_hemispherical_of_microfacet_from_ellipsometer_nk(real_exports: Path, capsys):
+    # a nearly smooth microfacet surface reflects what Fresnel gives at normal incidence for
+    # the ellipsometer's n, k (single scattering loses < 0.1 % at alpha 0.01)
+    from labbrdf.ellipsometry import normal_reflectance
+    from labbrdf.nk import combined_table, nk_at
+
+    ta = str(real_exports / TA)
+    argv = ["hemispherical", "--model", "microfacet", "--nk-from", ta, "--wavelength", "550",
+            "--param", "alpha=0.01", "--theta-i", "0", "--json"]  # fmt: skip
+    assert main(argv) == 0
+    (row,) = _json(capsys)
+    at = nk_at(combined_table(labbrdf.read(ta)), 550.0)
+    r0, _ = normal_reflectance(float(at["n"]), float(at["k"]))
+    assert row["rho"] == pytest.approx(float(r0), rel=1e-3)
