@@ -212,6 +212,8 @@ def _stat_rows(st: Any) -> list[dict[str, Any]]:
             continue
         v = getattr(st, key)
         e = u.get(key)
+        if key == "anisotropy_angle_deg" and not math.isfinite(st.anisotropy_ratio):
+            v = e = float("nan")  # no direction without a ratio
         rows.append(
             {
                 "key": key,
@@ -358,8 +360,8 @@ def surface_section(ctx: Context) -> None:
         if hm.is_profile:
             b.note(
                 "profile",
-                "one direction is measured: alpha and the slope fits describe the surface "
-                "only if it is isotropic. No tracer maps (they need the 2-D slope "
+                "alpha and the slope fits from a profile assume an isotropic surface (one "
+                "direction is measured). No tracer maps (they need the 2-D slope "
                 "distribution of an areal map).",
             )
             albedo_rows.append(
