@@ -308,7 +308,8 @@ def surface_section(ctx: Context) -> None:
         b.figure(
             f"surface_{sid}",
             f"{name}: levelled heights, autocorrelation, slope distribution",
-            "Measured. Left: heights after removing the least-squares mean plane. Middle: "
+            "Measured. Left: heights after removing the least-squares mean plane (colour "
+            "scale: 0.5 to 99.5 percentiles, arrows = beyond). Middle: "
             "normalised ACF along the axes, with the 1/e level that defines the "
             "correlation lengths. Right: the measured slope magnitude |grad z| (areal "
             "map) or dz/dx (profile) with the densities of the maximum-likelihood GGX "
@@ -357,6 +358,16 @@ def surface_section(ctx: Context) -> None:
                 "map is not many correlation lengths wide, or long-wavelength form remains "
                 "after levelling), so alpha = sqrt(2) sigma / c is undefined too",
             )
+        per_axis = st.slope_rms_x if hm.is_profile else st.slope_rms / math.sqrt(2)
+        if math.isfinite(st.alpha) and not 2 / 3 <= st.alpha / per_axis <= 1.5:
+            b.note(
+                "alpha",
+                f"sqrt(2) sigma / c = {st.alpha:.3g} differs from the measured RMS slope per "
+                f"axis ({per_axis:.3g}): the two agree only for a Gaussian ACF sampled finely "
+                "enough. Here the slopes come from roughness on scales much shorter than c "
+                "(or the ACF is not Gaussian), so the ML alphas of the measured slopes, not "
+                "sqrt(2) sigma / c, describe the facets.",
+            )
         if hm.is_profile:
             b.note(
                 "profile",
@@ -400,6 +411,15 @@ def surface_section(ctx: Context) -> None:
                 s0_max=[_robust_max(r, m["s0"]) for (_, r), m in zip(pair, mp, strict=True)],
             ),
         )
+        if ggx_alpha < math.tan(math.radians(TRACE_STEP_DEG)):
+            b.note(
+                "tracer maps",
+                f"the slopes are so small (GGX alpha {ggx_alpha:.2g}) that the reflected lobe "
+                f"is narrower than one {TRACE_STEP_DEG:g}-degree bin: the maps show the "
+                "specular bin only; the albedos below are what the runs add.",
+            )
+        diff = r_meas.albedo() - r_ggx.albedo()
+        diff_u = math.hypot(r_meas.albedo_stderr(), r_ggx.albedo_stderr())
         for (lab, r), a in zip(pair, (r_meas.config.substrate.alpha, ggx_alpha), strict=True):
             albedo_rows.append(
                 {
@@ -410,6 +430,8 @@ def surface_section(ctx: Context) -> None:
                     "albedo_u": r.albedo_stderr(),
                     "absorbed": float(r.ledger["absorbed"]),
                     "rays": r.rays,
+                    "diff": diff if lab.startswith("measured") else None,
+                    "diff_u": diff_u if lab.startswith("measured") else None,
                     "reason": "",
                 }
             )
@@ -424,6 +446,8 @@ def surface_section(ctx: Context) -> None:
             ("albedo_u", "u(albedo) [1]", ".1e"),
             ("absorbed", "absorbed [1]", ".5f"),
             ("rays", "rays", "d"),
+            ("diff", "measured \u2212 GGX [1]", ".5f"),
+            ("diff_u", "u(difference) [1]", ".1e"),
             ("reason", "not run because", ""),
         ],
         albedo_rows,
