@@ -51,7 +51,8 @@ def user_report(
     Parameters
     ----------
     paths : sequence of path-like
-        Instrument export files (any format :func:`labbrdf.read` knows).
+        Instrument export files (any format :func:`labbrdf.read` knows), and topography
+        files (height maps, profiles) for the section ``surface``.
     model : str
         Registry name of the model to fit (``smooth3``, ``five_param``, ``microfacet``).
     out : path-like

@@ -86,7 +86,7 @@ def test_corrupt_topography_file_is_a_failed_ingest(tmp_path: Path) -> None:
     assert not any(ch["id"].endswith(".completed") for ch in res["checks"])
 
 
-def _acf_checks(monkeypatch: pytest.MonkeyPatch | None = None) -> dict[str, dict]:
+def _acf_checks() -> dict[str, dict]:
     b = Builder("t")
     with b.section("surface", "t"):
         surf.gaussian_acf_section(Context(b))
@@ -120,3 +120,20 @@ def test_acf_tolerance_holds_over_seeds(seed: int) -> None:
         assert max(surf.acf_deviation(z, L / N, (cx, cy))) <= tol
         zp = surf.printed_psd_surface(N, L, sigma, (cx, cy), 1000 + seed)
         assert min(surf.acf_deviation(zp, L / N, (cx, cy))) > tol
+
+
+def test_wvase_dat_stays_optical_beside_a_height_map(
+    real_exports: Path, fixtures_dir: Path, tmp_path: Path
+) -> None:
+    di = real_exports / "topography" / "di-1.di"
+    if not di.is_file():
+        pytest.skip(f"{di} absent")
+    wvase = fixtures_dir / "ellipsometry" / "al_bare_wvase.dat"
+    out = tmp_path / "rep"
+    user_report([wvase, di], "smooth3", out, progress=False)
+    res = json.loads((out / "results.json").read_text())
+    optical = [r["file"] for r in res["tables"]["ingested_files"]["rows"]]
+    maps = [r["file"] for r in res["tables"]["ingested_height_maps"]["rows"]]
+    assert optical == [wvase.name] and maps == [di.name]
+    c = _checks(res)
+    assert c["ingest.read"]["status"] == "pass" and c["ingest.topography"]["status"] == "pass"
