@@ -97,6 +97,7 @@ def test_acf_check_passes_with_corrected_exponent() -> None:
     c = _acf_checks()
     assert c["surface.gaussian_acf"]["status"] == "pass"
     assert c["surface.printed_exponent_fails"]["status"] == "pass"
+    assert c["surface.printed_exponent_fails"]["value"] > 1.0
 
 
 def test_acf_check_fails_with_printed_exponent(monkeypatch: pytest.MonkeyPatch) -> None:
