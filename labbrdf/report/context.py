@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .. import models, parallel
+from ..adapters.topography import HeightMap
 from ..fitting import fit
 from ..tracer import TraceResult
 from .builder import Builder, Unavailable, num
@@ -105,6 +106,8 @@ class Context:
     #: results kept for later sections (and tests): the compare fits, the factor-study runs
     compare_fits: dict[str, list[FitRecord]] = field(default_factory=dict)
     factor_runs: list[tuple[str, str, TraceResult]] = field(default_factory=list)
+    #: user report: height maps and profiles read from topography files (section ``surface``)
+    height_maps: list[HeightMap] = field(default_factory=list)
 
     @property
     def data(self) -> pd.DataFrame | None:

@@ -436,7 +436,9 @@ def surface_figure(
 
     Notes
     -----
-    The slope panel of an areal map shows the slope magnitude ``q = |grad z|`` against the
+    The colour scale of a map spans the 0.5 to 99.5 percentiles of the heights (arrows on
+    the colour bar: values beyond). The slope panel of an areal map shows the slope
+    magnitude ``q = |grad z|`` against the
     densities of the fitted 2-D slope distributions in q: GGX ``2 q / (a^2 (1 + q^2/a^2)^2)``
     and Beckmann ``2 q / a^2 exp(-q^2/a^2)`` (the slope-space densities times ``2 pi q``). A
     profile shows dz/dx against the 1-D densities of its fits, GGX
@@ -451,8 +453,10 @@ def surface_figure(
     ax = axes[0]
     if z.ndim == 2:
         ext = [0, z.shape[1] * px[1] * 1e6, z.shape[0] * px[0] * 1e6, 0]
-        im = ax.imshow(z * 1e9, extent=ext, cmap="viridis", aspect="equal")
-        fig.colorbar(im, ax=ax, label="height [nm]")
+        # colour range of the central 99 % of the heights: a few spikes would flatten it
+        lo_nm, hi_nm = (float(v) * 1e9 for v in np.nanpercentile(z, [0.5, 99.5]))
+        im = ax.imshow(z * 1e9, extent=ext, cmap="viridis", aspect="equal", vmin=lo_nm, vmax=hi_nm)
+        fig.colorbar(im, ax=ax, label="height [nm]", extend="both")
         ax.set_xlabel("y [\u00b5m]")
         ax.set_ylabel("x [\u00b5m]")
         ax.set_title("levelled height map")
@@ -474,8 +478,8 @@ def surface_figure(
     ax.axhline(np.exp(-1.0), color="0.5", ls=":", lw=1, label="1/e")
     ax.set_xlabel("lag [\u00b5m]")
     ax.set_ylabel("normalised ACF")
-    c = stats.c * 1e6 if np.isfinite(stats.c) else float("nan")
-    ax.set_title(f"autocorrelation (c = {c:.3g} \u00b5m)")
+    c_txt = f"{stats.c * 1e6:.3g} \u00b5m" if np.isfinite(stats.c) else "undefined"
+    ax.set_title(f"autocorrelation (c = {c_txt})")
     ax.legend(fontsize=8)
     ax = axes[2]
     sx, sy = slopes(z, px, valid)

@@ -16,7 +16,7 @@ from typing import Any
 from .. import __version__, models
 from ..provenance import versions
 from . import html
-from .builder import Builder, write_report
+from .builder import Builder, Unavailable, write_report
 from .context import METHOD, Context
 from .sections import Section, run
 from .sections.colour import colour_section
@@ -25,6 +25,7 @@ from .sections.ingest import ingest_files
 from .sections.physics import physics_section
 from .sections.scans import scans_section
 from .sections.spectra import spectra_section
+from .sections.surface import ingest_height_maps, surface_section
 
 __all__ = ["user_report"]
 
@@ -50,7 +51,8 @@ def user_report(
     Parameters
     ----------
     paths : sequence of path-like
-        Instrument export files (any format :func:`labbrdf.read` knows).
+        Instrument export files (any format :func:`labbrdf.read` knows), and topography
+        files (height maps, profiles) for the section ``surface``.
     model : str
         Registry name of the model to fit (``smooth3``, ``five_param``, ``microfacet``).
     out : path-like
@@ -125,9 +127,15 @@ def user_report(
 
     def ingest(ctx: Context) -> None:
         ctx.b.text(
-            f"{len(paths)} file(s) given; each was read with labbrdf.read into the common dataset."
+            f"{len(paths)} file(s) given; each was read with labbrdf.read into the common "
+            "dataset, or, for topography files (height maps and profiles), with "
+            "SurfaceTopography."
         )
-        ingest_files(ctx, paths)
+        optical = ingest_height_maps(ctx, paths)
+        if optical:
+            ingest_files(ctx, optical)
+        elif not ctx.height_maps:
+            raise Unavailable("no file could be read")
         if selection:
             from ..selection import SelectionError, select
 
@@ -159,6 +167,7 @@ def user_report(
         ),
         ("physics", "Energy conservation and reciprocity of every fit", physics_section),
         ("colour", "Sample colour from spectrophotometer reflectance", colour_section),
+        ("surface", "Measured surface topography", surface_section),
     ]
     run(ctx, sections)
     code = b.finish()

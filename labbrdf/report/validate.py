@@ -37,6 +37,7 @@ from .sections.ingest import fixture_files, fixtures_section
 from .sections.physics import physics_section
 from .sections.scans import scans_section
 from .sections.spectra import spectra_section
+from .sections.surface import gaussian_acf_section
 from .sections.tracer import factor_maps_section, validation_section
 
 __all__ = [
@@ -113,6 +114,11 @@ SECTIONS: list[Section] = [
         "tracer_validation",
         "Tracer validation: analytic limits and oracles",
         validation_section,
+    ),
+    (
+        "surface",
+        "Gaussian random surfaces: ACF of eq. (1) from the corrected PSD eq. (2) (2022)",
+        gaussian_acf_section,
     ),
     ("errata", "Paper errata this report depends on", errata_section),
 ]

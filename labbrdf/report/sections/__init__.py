@@ -20,6 +20,7 @@ module                    section id(s)
 :mod:`.colour`            ``colour``
 :mod:`.tracer`            ``tracer_maps``, ``tracer_validation``
 :mod:`.errata`            ``errata``
+:mod:`.surface`           ``surface`` (user: height maps; validation: Gaussian ACF)
 ========================  ==============================================================
 """
 

@@ -1,0 +1,140 @@
+"""The ``surface`` section of the user report and the Gaussian-ACF validation check."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+
+from labbrdf.report import user_report
+from labbrdf.report.builder import Builder
+from labbrdf.report.context import Context
+from labbrdf.report.sections import surface as surf
+
+pytest.importorskip("SurfaceTopography")
+
+
+def _checks(res: dict) -> dict[str, dict]:
+    return {c["id"]: c for c in res["checks"]}
+
+
+@pytest.fixture(scope="module")
+def topo_report(real_exports: Path, tmp_path_factory: pytest.TempPathFactory) -> dict:
+    d = real_exports / "topography"
+    if not (d / "di-1.di").is_file() or not (d / "opdx-3.opdx").is_file():
+        pytest.skip(f"{d} lacks di-1.di / opdx-3.opdx")
+    out = tmp_path_factory.mktemp("topo") / "rep"
+    code = user_report([d / "di-1.di", d / "opdx-3.opdx"], "smooth3", out, progress=False)
+    res = json.loads((out / "results.json").read_text())
+    return {"code": code, "res": res, "dir": d, "html": (out / "index.html").read_text()}
+
+
+def test_section_present_and_passes(topo_report: dict) -> None:
+    res = topo_report["res"]
+    sec = {s["id"]: s for s in res["sections"]}
+    assert sec["surface"]["status"] == "ok"
+    assert topo_report["code"] == 0
+    assert _checks(res)["ingest.topography"]["status"] == "pass"
+    files = {r["file"]: r for r in res["tables"]["ingested_height_maps"]["rows"]}
+    assert files["di-1.di"]["kind"] == "areal map"
+    assert files["opdx-3.opdx"]["kind"] == "profile"
+    assert "surface_di_1_di" in res["figures"]
+    assert "surface_tracer_di_1_di" in res["figures"]
+    assert "surface_tracer_opdx_3_opdx" not in res["figures"]
+
+
+@pytest.mark.parametrize("name", ["di-1.di", "opdx-3.opdx"])
+def test_sigma_matches_roughness_statistics(topo_report: dict, name: str) -> None:
+    from labbrdf.adapters.topography import read_height_map
+    from labbrdf.topography import roughness_statistics
+
+    hm = read_height_map(topo_report["dir"] / name)
+    st = roughness_statistics(hm.heights, hm.pixel_size)
+    sid = name.replace("-", "_").replace(".", "_")
+    rows = {r["key"]: r for r in topo_report["res"]["tables"][f"surface_stats_{sid}"]["rows"]}
+    assert rows["sigma"]["value"] * 1e-9 == pytest.approx(st.sigma, rel=1e-12)
+    assert rows["sigma"]["u"] * 1e-9 == pytest.approx(st.uncertainty["sigma"], rel=1e-12)
+    fits = {r["model"]: r for r in topo_report["res"]["tables"][f"surface_fits_{sid}"]["rows"]}
+    assert fits["ggx"]["alpha"] == pytest.approx(st.slope_fits.ggx.alpha, rel=1e-12)
+
+
+def test_tracer_albedos_for_map_not_profile(topo_report: dict) -> None:
+    rows = topo_report["res"]["tables"]["surface_tracer_albedo"]["rows"]
+    di = {r["case"]: r for r in rows if r["file"] == "di-1.di"}
+    assert set(di) == {"measured", "ggx"}
+    for r in di.values():
+        assert 0.0 < r["albedo"] < 1.0 and r["rays"] == surf.TRACE_RAYS
+        assert r["albedo_u"] < 0.5 / math.sqrt(r["rays"])
+    (prof,) = [r for r in rows if r["file"] == "opdx-3.opdx"]
+    assert prof["albedo"] is None and "profile" in prof["reason"]
+    assert "assume" in topo_report["html"] and "isotropic" in topo_report["html"]
+
+
+def test_corrupt_topography_file_is_a_failed_ingest(tmp_path: Path) -> None:
+    bad = tmp_path / "broken.di"
+    bad.write_bytes(b"\\*File list\r\n\\Version: 0x0\r\ngarbage" + bytes(range(256)) * 4)
+    code = user_report([bad], "smooth3", tmp_path / "rep", progress=False)
+    res = json.loads((tmp_path / "rep" / "results.json").read_text())
+    assert code == 1
+    c = _checks(res)["ingest.topography"]
+    assert c["status"] == "fail" and "broken.di" in c["reason"]
+    (row,) = res["tables"]["ingested_height_maps"]["rows"]
+    assert row["status"] == "error" and "SurfaceTopography" in row["error"]
+    assert not any(ch["id"].endswith(".completed") for ch in res["checks"])
+
+
+def _acf_checks() -> dict[str, dict]:
+    b = Builder("t")
+    with b.section("surface", "t"):
+        surf.gaussian_acf_section(Context(b))
+    return _checks(b.results)
+
+
+def test_acf_check_passes_with_corrected_exponent() -> None:
+    c = _acf_checks()
+    assert c["surface.gaussian_acf"]["status"] == "pass"
+    assert c["surface.printed_exponent_fails"]["status"] == "pass"
+    assert c["surface.printed_exponent_fails"]["value"] > 1.0
+
+
+def test_acf_check_fails_with_printed_exponent(monkeypatch: pytest.MonkeyPatch) -> None:
+    def printed(n: int, length: float, sigma: float, c: tuple, seed: int) -> SimpleNamespace:
+        return SimpleNamespace(z=surf.printed_psd_surface(n, length, sigma, c, seed))
+
+    monkeypatch.setattr(surf, "gaussian_surface", printed)
+    c = _acf_checks()
+    assert c["surface.gaussian_acf"]["status"] == "fail"
+    assert c["surface.gaussian_acf"]["value"] > 1.0
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_acf_tolerance_holds_over_seeds(seed: int) -> None:
+    L, N = surf.ACF_LENGTH_UM, surf.ACF_GRID
+    from labbrdf.surface import gaussian_surface
+
+    for sigma, cx, cy in surf.ACF_CASES:
+        tol = surf.ACF_TOL_FACTOR * math.sqrt(cx * cy) / L
+        z = gaussian_surface(N, L, sigma, (cx, cy), 1000 + seed).z
+        assert max(surf.acf_deviation(z, L / N, (cx, cy))) <= tol
+        zp = surf.printed_psd_surface(N, L, sigma, (cx, cy), 1000 + seed)
+        assert min(surf.acf_deviation(zp, L / N, (cx, cy))) > tol
+
+
+def test_wvase_dat_stays_optical_beside_a_height_map(
+    real_exports: Path, fixtures_dir: Path, tmp_path: Path
+) -> None:
+    di = real_exports / "topography" / "di-1.di"
+    if not di.is_file():
+        pytest.skip(f"{di} absent")
+    wvase = fixtures_dir / "ellipsometry" / "al_bare_wvase.dat"
+    out = tmp_path / "rep"
+    user_report([wvase, di], "smooth3", out, progress=False)
+    res = json.loads((out / "results.json").read_text())
+    optical = [r["file"] for r in res["tables"]["ingested_files"]["rows"]]
+    maps = [r["file"] for r in res["tables"]["ingested_height_maps"]["rows"]]
+    assert optical == [wvase.name] and maps == [di.name]
+    c = _checks(res)
+    assert c["ingest.read"]["status"] == "pass" and c["ingest.topography"]["status"] == "pass"
