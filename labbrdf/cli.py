@@ -632,6 +632,18 @@ def _height_map(path: str, channel: str | None) -> Any:
     return read_height_map(path, ch)
 
 
+def _ggx_alpha_of(path: str, channel: str | None) -> float:
+    """GGX alpha fitted by maximum likelihood to the slopes of a measured areal map."""
+    from .topography import fit_slope_distribution, level, slopes
+
+    hm = _height_map(path, channel)
+    if hm.heights.ndim != 2:
+        raise UsageError(f"{path}: a line profile; the coating needs an areal height map")
+    z = level(hm.heights, 1)
+    sx, sy = slopes(z, hm.pixel_size)
+    return float(fit_slope_distribution(sx, sy).ggx.alpha)
+
+
 def cmd_surface(args: argparse.Namespace) -> int:
     from .outputs import check_file_output, check_input_files
     from .topography import level, roughness_statistics
@@ -766,14 +778,22 @@ def cmd_trace(args: argparse.Namespace) -> int:
         coat = _complex(args.coating, "--coating")
         if args.thickness is None:
             raise UsageError("--coating needs --thickness (nm)")
+        if args.coating_alpha is not None and args.coating_surface is not None:
+            raise UsageError(
+                "give the coating roughness once: --coating-alpha or --coating-surface"
+            )
+        coat_alpha = args.coating_alpha if args.coating_alpha is not None else substrate.alpha
+        if args.coating_surface is not None:
+            coat_alpha = _ggx_alpha_of(args.coating_surface, args.channel)
         kw["coating"] = tracer.Coating(
-            n=coat.real,
-            k=coat.imag,
-            thickness_nm=args.thickness,
-            alpha=args.coating_alpha if args.coating_alpha is not None else substrate.alpha,
+            n=coat.real, k=coat.imag, thickness_nm=args.thickness, alpha=coat_alpha
         )
-    elif args.thickness is not None or args.coating_alpha is not None:
-        raise UsageError("--thickness and --coating-alpha need --coating")
+    elif (
+        args.thickness is not None
+        or args.coating_alpha is not None
+        or args.coating_surface is not None
+    ):
+        raise UsageError("--thickness, --coating-alpha and --coating-surface need --coating")
     config = tracer.TraceConfig(**kw)
     mapper: Any = map
     if args.scheduler != "serial":
@@ -981,6 +1001,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--coating", default=None, help="coating index, e.g. 1.5")
     s.add_argument("--thickness", type=float, default=None, help="coating thickness [nm]")
     s.add_argument("--coating-alpha", type=float, default=None)
+    s.add_argument(
+        "--coating-surface",
+        default=None,
+        metavar="FILE",
+        help="measured height map of the coating's top: its ML GGX alpha",
+    )
     s.add_argument("--theta-i", type=float, required=True, help="[deg]")
     s.add_argument("--wavelength", type=float, required=True, help="[nm]")
     s.add_argument("--rays", type=int, default=200_000)
@@ -1000,7 +1026,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_validate)
 
     s = sub.add_parser("report", help="HTML report for your own files")
-    s.add_argument("files", nargs="+", metavar="DATA")
+    s.add_argument(
+        "files",
+        nargs="+",
+        metavar="DATA",
+        help="instrument exports, .bsdf files, datasets and height maps (.di, .opdx, ...)",
+    )
     s.add_argument("--model", default="smooth3")
     s.add_argument(
         "--param",

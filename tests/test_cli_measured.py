@@ -335,3 +335,28 @@ def test_hemispherical_of_microfacet_from_ellipsometer_nk(real_exports: Path, ca
     at = nk_at(combined_table(labbrdf.read(ta)), 550.0)
     r0, _ = normal_reflectance(float(at["n"]), float(at["k"]))
     assert row["rho"] == pytest.approx(float(r0), rel=1e-3)
+
+
+def test_trace_coating_roughness_from_its_own_height_map(real_exports: Path, capsys):
+    # the coating's top interface takes the ML GGX alpha of its own measured map
+    from labbrdf.adapters.topography import read_height_map
+    from labbrdf.topography import fit_slope_distribution, level, slopes
+
+    di = real_exports / "topography" / "di-1.di"
+    argv = ["trace", "--substrate", "1.55+7.71j", "--alpha", "0.1", "--coating", "1.5",
+            "--thickness", "500", "--coating-surface", str(di), "--theta-i", "45",
+            "--wavelength", "650", "--rays", "2000", "--scheduler", "serial",
+            "--json"]  # fmt: skip
+    assert main(argv) == 0
+    s = _json(capsys)
+    hm = read_height_map(di)
+    sx, sy = slopes(level(hm.heights, 1), hm.pixel_size)
+    assert s["config"]["coating"]["alpha"] == pytest.approx(
+        fit_slope_distribution(sx, sy).ggx.alpha
+    )
+    assert s["config"]["substrate"]["alpha"] == 0.1
+    capsys.readouterr()
+    argv[argv.index("--coating-surface")] = "--coating-alpha"
+    argv[argv.index(str(di))] = "0.2"
+    assert main(argv + ["--coating-surface", str(di)]) == 2
+    assert "once" in capsys.readouterr().err
