@@ -348,6 +348,17 @@ def _maps(
     if not per:
         return
     panels = [_map_panel(r, ti, r.data) for ti, r in per]
+    off_plane = [
+        np.ptp(p["theta_r"] * np.sin(np.radians(p["phi_r"]))) > IN_PLANE_TOL_DEG for p in panels
+    ]
+    if not any(off_plane):
+        ctx.b.note(
+            "hemisphere maps",
+            f"{sample}, {wl_label(wl)}: every row lies in the plane of incidence, so there is "
+            "no hemisphere to map; see the in-plane cuts",
+        )
+        return
+    panels = [p for p, ok in zip(panels, off_plane, strict=True) if ok]
     half = bool(np.all(np.concatenate([p["phi_r"] for p in panels]) <= 180.0 + 1e-9))
     cover = (
         "The rows cover \u03c6r in [0, 180] deg only (a PlaneSymmetrical file: the other half "
