@@ -577,7 +577,7 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
 
     n = max(1, len(panels))
     half = all(np.all(np.asarray(p["phi_r"]) <= 180.0 + 1e-9) for p in panels)
-    h = 2.6 if half else 3.6
+    h = 2.1 if half else 3.4
     fig, axes = plt.subplots(n, 3, figsize=(11.0, h * n + 0.6), squeeze=False)
     for i, p in enumerate(panels):
         meas = np.asarray(p["measured"], float)
@@ -612,7 +612,7 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
     if title:
         fig.suptitle(_text(title), fontsize=10)
     fig.tight_layout()
-    return to_uri(fig)
+    return to_uri(fig, dpi=100)
 
 
 def brdf_residual_grid_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
@@ -649,7 +649,7 @@ def brdf_residual_grid_figure(panels: Sequence[Mapping[str, Any]], title: str = 
     )
     if title:
         fig.suptitle(_text(title), fontsize=10)
-    return to_uri(fig)
+    return to_uri(fig, dpi=100)
 
 
 def brdf_cuts_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:

@@ -242,9 +242,7 @@ def _fits_table(
     b = ctx.b
     first = fits[0][1]
     varying = [p for p, q in first.params.items() if q.get("vary", True)]
-    cols: list[tuple[str, str, str]] = [
-        ("sample", "sample", ""),
-        ("wavelength_nm", "\u03bb [nm]", "g"),
+    cols: list[tuple[str, str, str]] = _group_cols(fits) + [
         ("theta_i", "\u03b8i [deg]", ""),
         ("npoints", "points", "d"),
     ]
@@ -279,7 +277,7 @@ def _fits_table(
             flags += [f"{p}: {f}" for f in q["flags"]]
         row["flags"] = "; ".join(flags)
         row["redchi"] = num(r.summary.get("redchi"))
-        row["weighting"] = r.summary.get("weighting") or ""
+        row["weighting"] = str(r.summary.get("weighting") or "").split(":")[0]
         row["nmasked"] = r.summary.get("nmasked")
         row["nfev"] = r.summary.get("nfev")
         row["success"] = bool(r.summary.get("success"))
@@ -287,14 +285,15 @@ def _fits_table(
     opts = ", ".join(f"{k}={v}" for k, v in options.items()) or "defaults"
     b.table(
         "brdf_fits",
-        f"{model} ({opts}) fitted per angle of incidence and jointly",
+        f"{model} ({opts}) fitted per angle of incidence and jointly{_one_group(fits)}",
         cols,
         out,
         caption=f"Measured: the BRDF rows of each incidence angle \u03b8i ('joint': all angles "
         f"together). Modelled: {model} fitted with nlopt {ctx.method} (seed {ctx.seed}). "
         "95% interval from the t distribution with \u03c3 from the Jacobian at the optimum; "
-        "'masked' counts zero values left out; \u03c7\u00b2/\u03bd with relative weighting is "
-        "the mean squared relative residual, not a goodness of fit against a stated \u03c3.",
+        "'masked' counts zero values left out; weighting 'relative': \u03c3 = max(|y|, "
+        "floor x max|y|) (the fit's relative_floor), so \u03c7\u00b2/\u03bd is the mean squared "
+        "relative residual, not a goodness of fit against a stated \u03c3.",
     )
     bad = [
         f"{r.sample} \u03b8i={_label(ti)}: {r.summary.get('message', '')}"
@@ -311,6 +310,22 @@ def _fits_table(
         justification="value = converged fits, tolerance = fits run",
         reason="; ".join(bad)[:1000],
     )
+
+
+def _group_cols(fits: Sequence[tuple[float | None, FitRecord]]) -> list[tuple[str, str, str]]:
+    """Sample and wavelength columns, only when the fits span more than one of them."""
+    if len({(r.sample, r.wavelength_nm) for _, r in fits}) < 2:
+        return []
+    return [("sample", "sample", ""), ("wavelength_nm", "\u03bb [nm]", "g")]
+
+
+def _one_group(fits: Sequence[tuple[float | None, FitRecord]]) -> str:
+    """Title suffix "(sample, wavelength)" when all fits share them, else empty."""
+    keys = {(r.sample, r.wavelength_nm) for _, r in fits}
+    if len(keys) != 1:
+        return ""
+    s, w = next(iter(keys))
+    return f" ({s}, {wl_label(w)})"
 
 
 def _select(n: int) -> list[int]:
@@ -454,11 +469,7 @@ def _energy(ctx: Context, fits: Sequence[tuple[float | None, FitRecord]]) -> Non
     b = ctx.b
     rows = energy_rows(ctx, fits)
     has_file = any(r.get("tis") is not None for r in rows)
-    cols: list[tuple[str, str, str]] = [
-        ("sample", "sample", ""),
-        ("wavelength_nm", "\u03bb [nm]", "g"),
-        ("theta_i", "\u03b8i [deg]", "g"),
-    ]
+    cols: list[tuple[str, str, str]] = _group_cols(fits) + [("theta_i", "\u03b8i [deg]", "g")]
     if has_file:
         cols += [
             ("tis", "file TIS [1]", ".4f"),
@@ -477,7 +488,8 @@ def _energy(ctx: Context, fits: Sequence[tuple[float | None, FitRecord]]) -> Non
     cols += [("energy_ok", "\u03c1 \u2264 1", "")]
     b.table(
         "brdf_energy",
-        "Energy per angle of incidence: file TIS, grid integral of the data, model integral",
+        "Energy per angle of incidence: file TIS, grid integral of the data, model integral"
+        + _one_group(fits),
         cols,
         rows,
         caption="All values are fractions of the incident power. 'file TIS': the value the "
@@ -494,15 +506,7 @@ def _energy(ctx: Context, fits: Sequence[tuple[float | None, FitRecord]]) -> Non
         "grazing and the quadrature error of the grid.",
     )
     if has_file:
-        b.text(
-            "Why the columns differ: the grid integral misses the uncovered part of the "
-            "hemisphere, which grows with \u03b8i because the radial range about the specular "
-            "direction leaves more of the horizon side uncovered; the fitted model extends "
-            "its lobe and diffuse term into that part, so model \u03c1 exceeds the grid "
-            "integral by about 'model \u03c1 - model on grid'. The file's TIS is the "
-            "instrument's own integral (finer native sampling, its own treatment of the "
-            "horizon), so it need not equal either."
-        )
+        b.text(_energy_sentence(rows))
     bad = [
         f"{r['sample']} \u03b8i={r['theta_i']:g}: \u03c1={r['model']}"
         for r in rows
@@ -519,6 +523,36 @@ def _energy(ctx: Context, fits: Sequence[tuple[float | None, FitRecord]]) -> Non
         justification="a passive surface reflects at most the incident power; the quadrature "
         "is accurate to 1e-6 relative, far below any margin that matters here",
         reason="; ".join(bad)[:1000],
+    )
+
+
+def _span(rows: Sequence[Mapping[str, Any]], key: str) -> str:
+    v = [r[key] for r in rows if r.get(key) is not None]
+    return f"{min(v):+.4f} to {max(v):+.4f}" if v else "n/a"
+
+
+def _energy_sentence(rows: Sequence[Mapping[str, Any]]) -> str:
+    """Why the energy columns differ, with this report's numbers."""
+    misfit = [
+        r["model_grid"] - r["grid"]
+        for r in rows
+        if r.get("model_grid") is not None and r.get("grid") is not None
+    ]
+    outside = [r["model_outside"] for r in rows if r.get("model_outside") is not None]
+    dominated = sum(abs(a) > abs(b) for a, b in zip(misfit, outside, strict=True))
+    unc = _span(rows, "uncovered").replace("+", "")
+    return (
+        "Why the columns differ: model \u03c1 - grid = (model on grid - grid) + (model \u03c1 - "
+        "model on grid). The first term is the misfit on the measured directions ("
+        + (f"{min(misfit):+.4f} to {max(misfit):+.4f}" if misfit else "n/a")
+        + "); the second is what the model puts where the grid has no cells ("
+        + _span(rows, "model_outside")
+        + f"): the uncovered part of the hemisphere ({unc} of it) grows with \u03b8i because "
+        "the radial range about the specular direction leaves more of the horizon side out. "
+        f"Here the misfit is the larger term at {dominated} of {len(misfit)} angles (relative "
+        "weighting gives the many low off-specular points as much weight as the peak). "
+        "The file's TIS is the instrument's own integral (finer native sampling, its own "
+        "treatment of the horizon), so it need not equal either; TIS / grid shows by how much."
     )
 
 
