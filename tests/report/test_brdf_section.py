@@ -172,8 +172,10 @@ def test_in_plane_only_rows_have_cuts_not_maps(fixtures_dir: Path, tmp_path: Pat
     assert any("plane of incidence" in it["text"] for it in notes)
     assert any(k.startswith("brdf_cuts_") for k in res["figures"])
     assert not any(k.startswith("brdf_maps_") for k in res["figures"])
-    # no .bsdf file: the energy table has the model integral only
+    # no .bsdf file: the energy table has the model integral only; an in-plane scan does
+    # not constrain the model over the hemisphere, so the energy check is skipped
     assert all(r.get("tis") is None for r in res["tables"]["brdf_energy"]["rows"])
+    assert _check(res, "brdf.energy")["status"] == "skipped"
 
 
 def test_no_brdf_rows_skipped(fixtures_dir: Path, tmp_path: Path) -> None:
@@ -186,3 +188,27 @@ def test_no_brdf_rows_skipped(fixtures_dir: Path, tmp_path: Path) -> None:
     c = _check(res, "brdf.available")
     assert c["status"] == "skipped"
     assert not any(x["section"] == "brdf" and x["status"] == "pass" for x in res["checks"])
+
+
+def test_energy_check_fails_for_a_model_above_one(tmp_path: Path) -> None:
+    """A file made from a microfacet with rho > 1 (scale 30 held fixed, kd 0.5) fails the check."""
+    m = models.get("microfacet", **MICRO)
+    p = {"alpha": 0.3, "scale": 30.0, "kd": 0.5}
+    rho = float(integrate_rho(m, p, 30.0))
+    assert rho > 1.0
+    path = z.model_to_bsdf(
+        m,
+        p,
+        tmp_path / "bright.bsdf",
+        theta_i_deg=[30.0],
+        radial_deg=np.arange(0.0, 85.0, 10.0),
+        azimuth_deg=np.arange(0.0, 181.0, 30.0),
+    )
+    res = _report([path], tmp_path / "o", start={"scale": 30.0})
+    assert _check(res, "brdf.energy")["status"] == "fail"
+
+
+def integrate_rho(m: Any, p: dict, ti: float) -> float:
+    from labbrdf import integrate
+
+    return float(integrate.hemispherical_reflectance(m, p, [ti])[0])
