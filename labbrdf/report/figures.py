@@ -528,3 +528,181 @@ def save_surface_png(uri: str, path: Any) -> Any:
     with atomic_output(path) as tmp:
         Path(tmp).write_bytes(data)
     return Path(path)
+
+
+# --------------------------------------------------------------------------- measured BRDF
+
+
+def _disc(ax: Any, half: bool) -> None:
+    """Guide circles at theta_r = 30, 60, 90 deg on a projected-hemisphere axis [deg]."""
+    t = np.linspace(0.0, np.pi if half else 2.0 * np.pi, 181)
+    for r in (30.0, 60.0, 90.0):
+        ax.plot(r * np.cos(t), r * np.sin(t), color="0.6", lw=0.5)
+    ax.set_aspect("equal")
+    ax.set_xlim(-92, 92)
+    ax.set_ylim(-2 if half else -92, 92)
+    ax.tick_params(labelsize=6)
+
+
+def _tri(panel: Mapping[str, Any], z: np.ndarray) -> tuple[Any, np.ndarray]:
+    """Delaunay triangulation of a panel's directions in the projected disc; z per triangle."""
+    from matplotlib.tri import Triangulation
+
+    tr = np.radians(np.asarray(panel["phi_r"], float))
+    x = np.asarray(panel["theta_r"], float) * np.cos(tr)
+    y = np.asarray(panel["theta_r"], float) * np.sin(tr)
+    tri = Triangulation(x, y)
+    zt = np.mean(np.asarray(z, float)[tri.triangles], axis=1)
+    bad = ~np.isfinite(zt)
+    # no triangle wider than 25 deg (bridging a hole in the sampling)
+    xy = np.stack([x, y], axis=1)[tri.triangles]
+    span = np.max(np.linalg.norm(xy - np.roll(xy, 1, axis=1), axis=2), axis=1)
+    tri.set_mask(bad | (span > 25.0))
+    return tri, np.where(bad, 0.0, zt)
+
+
+def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
+    """Measured BRDF, fitted model and relative residual per angle of incidence (one row each).
+
+    Parameters
+    ----------
+    panels : sequence of mappings
+        ``{"label": str, "theta_r": array [deg], "phi_r": array [deg], "measured": array
+        [sr^-1], "model": array [sr^-1], "residual": array [1]}``.
+    title : str
+
+    Returns
+    -------
+    str
+        PNG data URI. Projected hemisphere: x = theta_r cos phi_r, y = theta_r sin phi_r
+        [deg]; BRDF on a log10 colour scale shared by measured and model in a row.
+    """
+    from matplotlib.colors import LogNorm
+
+    n = max(1, len(panels))
+    half = all(np.all(np.asarray(p["phi_r"]) <= 180.0 + 1e-9) for p in panels)
+    h = 2.1 if half else 3.4
+    fig, axes = plt.subplots(n, 3, figsize=(11.0, h * n + 0.6), squeeze=False)
+    for i, p in enumerate(panels):
+        meas = np.asarray(p["measured"], float)
+        mod = np.asarray(p["model"], float)
+        pos = np.concatenate([meas[meas > 0], mod[mod > 0]])
+        vmin = float(np.percentile(pos, 1)) if pos.size else 1e-3
+        vmax = float(np.max(pos)) if pos.size else 1.0
+        norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 10))
+        for j, (z, name) in enumerate(((meas, "measured"), (mod, "model (per-incidence fit)"))):
+            zz = np.where(z > 0, np.clip(z, vmin, None), np.nan)
+            tri, zt = _tri(p, zz)
+            ax = axes[i, j]
+            mesh = ax.tripcolor(
+                tri, facecolors=np.where(zt > 0, zt, vmin), cmap="inferno", norm=norm
+            )
+            _disc(ax, half)
+            ax.set_title(f"{_text(p['label'])}: {name}", fontsize=8)
+            cb = fig.colorbar(mesh, ax=ax, shrink=0.6 if half else 0.8)
+            cb.set_label(r"BRDF [sr$^{-1}$]", fontsize=7)
+            cb.ax.tick_params(which="both", labelsize=6)
+        tri, zt = _tri(p, np.clip(np.asarray(p["residual"], float), -1.0, 1.0))
+        ax = axes[i, 2]
+        mesh = ax.tripcolor(tri, facecolors=zt, cmap="RdBu_r", vmin=-1.0, vmax=1.0)
+        _disc(ax, half)
+        ax.set_title(f"{_text(p['label'])}: (model - measured) / measured", fontsize=8)
+        cb = fig.colorbar(mesh, ax=ax, shrink=0.6 if half else 0.8)
+        cb.set_label("relative residual [1]", fontsize=7)
+        cb.ax.tick_params(which="both", labelsize=6)
+        axes[i, 0].set_ylabel(r"$\theta_r \sin\varphi_r$ [deg]", fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel(r"$\theta_r \cos\varphi_r$ [deg]", fontsize=7)
+    if title:
+        fig.suptitle(_text(title), fontsize=10)
+    fig.tight_layout()
+    return to_uri(fig, dpi=100)
+
+
+def brdf_residual_grid_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
+    """Relative residual maps of every angle of incidence as small multiples (5 per row).
+
+    ``panels`` as for :func:`brdf_maps_figure` (``residual`` [1] is used).
+    """
+    n = max(1, len(panels))
+    ncol = min(5, n)
+    nrow = -(-n // ncol)
+    half = all(np.all(np.asarray(p["phi_r"]) <= 180.0 + 1e-9) for p in panels)
+    fig, axes = plt.subplots(
+        nrow,
+        ncol,
+        figsize=(2.4 * ncol + 1.0, (1.45 if half else 2.4) * nrow + 0.6),
+        squeeze=False,
+    )
+    mesh = None
+    for k, ax in enumerate(axes.ravel()):
+        if k >= len(panels):
+            ax.axis("off")
+            continue
+        p = panels[k]
+        tri, zt = _tri(p, np.clip(np.asarray(p["residual"], float), -1.0, 1.0))
+        mesh = ax.tripcolor(tri, facecolors=zt, cmap="RdBu_r", vmin=-1.0, vmax=1.0)
+        _disc(ax, half)
+        ax.set_title(_text(p["label"]), fontsize=8)
+    if mesh is not None:
+        cb = fig.colorbar(mesh, ax=axes.ravel().tolist(), shrink=0.8)
+        cb.set_label("(model - measured) / measured [1]", fontsize=7)
+        cb.ax.tick_params(which="both", labelsize=6)
+    fig.text(
+        0.01, 0.005, r"axes: $\theta_r\cos\varphi_r$, $\theta_r\sin\varphi_r$ [deg]", fontsize=7
+    )
+    if title:
+        fig.suptitle(_text(title), fontsize=10)
+    return to_uri(fig, dpi=100)
+
+
+def brdf_cuts_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
+    """In-plane BRDF cuts with model curves, one small panel per angle of incidence.
+
+    Parameters
+    ----------
+    panels : sequence of mappings
+        ``{"label": str, "x": array (signed theta_r [deg]), "y": array [sr^-1],
+        "grid": array [deg], "curves": {name: array [sr^-1]}, "specular": float [deg]}``.
+    title : str
+    """
+    n = max(1, len(panels))
+    ncol = min(4, n)
+    nrow = -(-n // ncol)
+    fig, axes = plt.subplots(
+        nrow, ncol, figsize=(2.9 * ncol, 2.3 * nrow + 0.4), squeeze=False, sharex=True
+    )
+    for k, ax in enumerate(axes.ravel()):
+        if k >= len(panels):
+            ax.axis("off")
+            continue
+        p = panels[k]
+        x, y = np.asarray(p["x"], float), np.asarray(p["y"], float)
+        ok = y > 0
+        ax.semilogy(x[ok], y[ok], "o", ms=3, color="k", label="measured")
+        for j, (name, c) in enumerate(p["curves"].items()):
+            c = np.asarray(c, float)
+            ax.semilogy(
+                p["grid"],
+                np.where(c > 0, c, np.nan),
+                ls=("-", "--")[j % 2],
+                color=_COLOURS[j],
+                lw=1.1,
+                label=_text(name),
+            )
+        ax.axvline(float(p["specular"]), color="0.5", ls=":", lw=0.8)
+        if ok.any():
+            ax.set_ylim(0.5 * float(y[ok].min()), 2.0 * float(y[ok].max()))
+        ax.set_title(_text(p["label"]), fontsize=8)
+        ax.tick_params(which="both", labelsize=6, labelbottom=True)
+        ax.grid(alpha=0.3)
+        if k % ncol == 0:
+            ax.set_ylabel(r"BRDF [sr$^{-1}$]", fontsize=7)
+        if k >= len(panels) - ncol:
+            ax.set_xlabel(r"signed $\theta_r$ [deg] (+: specular side)", fontsize=7)
+        if k == 0:
+            ax.legend(fontsize=6)
+    if title:
+        fig.suptitle(_text(title), fontsize=10)
+    fig.tight_layout()
+    return to_uri(fig)

@@ -19,6 +19,7 @@ from . import html
 from .builder import Builder, Unavailable, write_report
 from .context import METHOD, Context
 from .sections import Section, run
+from .sections.brdf import brdf_section
 from .sections.colour import colour_section
 from .sections.fits import fits_section
 from .sections.ingest import ingest_files
@@ -166,6 +167,11 @@ def user_report(
             lambda ctx: spectra_section(ctx, model),
         ),
         ("physics", "Energy conservation and reciprocity of every fit", physics_section),
+        (
+            "brdf",
+            f"Measured BRDF: {model} per angle of incidence, maps, energy, reciprocity",
+            lambda ctx: brdf_section(ctx, model, opts),
+        ),
         ("colour", "Sample colour from spectrophotometer reflectance", colour_section),
         ("surface", "Measured surface topography", surface_section),
     ]
