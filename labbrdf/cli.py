@@ -106,6 +106,7 @@ def _add_selection(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("selection")
     g.add_argument("--wavelength", default=None, metavar="MIN:MAX", help="[nm], e.g. 400:700")
     g.add_argument("--theta-i", default=None, metavar="MIN:MAX", help="[deg], e.g. 40:60")
+    g.add_argument("--theta-r", default=None, metavar="MIN:MAX", help="[deg], e.g. :70")
     g.add_argument("--quantity", default=None, help="comma-separated quantities")
     g.add_argument("--sample", default=None, help="comma-separated sample names")
 
@@ -115,15 +116,15 @@ def _selected(args: argparse.Namespace, m: Any) -> Any:
     from .dataset import Measurement
     from .selection import select
 
-    if all(
-        getattr(args, k, None) is None for k in ("wavelength", "theta_i", "quantity", "sample")
-    ):
+    chosen = {k: getattr(args, k, None) for k in SELECTION_KEYS}
+    chosen = {k: v for k, v in chosen.items() if v is not None}
+    if not chosen:
         return m
-    df = select(
-        m, wavelength=args.wavelength, theta_i=args.theta_i, quantity=args.quantity,
-        sample=args.sample,
-    )  # fmt: skip
-    return Measurement(df, m.meta)
+    return Measurement(select(m, **chosen), m.meta)
+
+
+#: the selection options (argparse destinations = :func:`labbrdf.selection.select` keywords)
+SELECTION_KEYS = ("wavelength", "theta_i", "theta_r", "quantity", "sample")
 
 
 def _add_scheduler(p: argparse.ArgumentParser) -> None:
@@ -858,11 +859,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     check_input_files(args.files)
     check_report_dir(args.output, inputs=args.files)
     options, start = _split_params(args.model, args.param)
-    selection = {
-        k: getattr(args, k)
-        for k in ("wavelength", "theta_i", "quantity", "sample")
-        if getattr(args, k) is not None
-    }
+    selection = {k: getattr(args, k) for k in SELECTION_KEYS if getattr(args, k) is not None}
     return int(
         user_report(
             args.files,

@@ -92,6 +92,7 @@ def select(
     *,
     wavelength: Range | str | None = None,
     theta_i: Range | str | None = None,
+    theta_r: Range | str | None = None,
     quantity: Sequence[str] | str | None = None,
     sample: Sequence[str] | str | None = None,
 ) -> pd.DataFrame:
@@ -101,9 +102,10 @@ def select(
     ----------
     data : Measurement or DataFrame
         Dataset-schema rows.
-    wavelength, theta_i : Range or str, optional
-        Closed ranges of ``wavelength_nm`` [nm] and ``theta_i_deg`` [deg] (see
-        :func:`parse_range`).
+    wavelength, theta_i, theta_r : Range or str, optional
+        Closed ranges of ``wavelength_nm`` [nm], ``theta_i_deg`` and ``theta_r_deg`` [deg]
+        (see :func:`parse_range`); rows without a ``theta_r_deg`` (NaN) are dropped by a
+        ``theta_r`` range.
     quantity, sample : str or sequence of str, optional
         Names to keep (comma-separated in a string).
 
@@ -122,6 +124,7 @@ def select(
     for col, rng, opt in (
         ("wavelength_nm", wavelength, "--wavelength"),
         ("theta_i_deg", theta_i, "--theta-i"),
+        ("theta_r_deg", theta_r, "--theta-r"),
     ):
         if rng is None:
             continue

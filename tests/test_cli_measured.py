@@ -360,3 +360,24 @@ def test_trace_coating_roughness_from_its_own_height_map(real_exports: Path, cap
     argv[argv.index(str(di))] = "0.2"
     assert main(argv + ["--coating-surface", str(di)]) == 2
     assert "once" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_bsdf_fits_are_consistent_once_vignetted_grazing_directions_are_left_out(
+    real_exports: Path, capsys
+):
+    # The imaging sphere's values beyond theta_r = 70 deg are partly vignetted (next to the
+    # horizon some are a third of their neighbours). With them, relative weighting lets
+    # them decide several angles (chi2/nu 0.2-0.6, alpha at its bound at 65 deg); without
+    # them every angle fits to a few % and alpha, kd change smoothly with the angle.
+    argv = ["fit", str(real_exports / BSDF), "--model", "microfacet", "--param", "n=1.5",
+            "--param", "k=0", "--param", "diffuse=true", "--by", "theta_i_deg",
+            "--theta-r", ":70", "--scheduler", "serial", "--json"]  # fmt: skip
+    assert main(argv) == 0
+    out = _json(capsys)
+    assert len(out) == 13 and all(g["success"] for g in out)
+    alpha = np.array([g["params"]["alpha"]["value"] for g in out])
+    kd = np.array([g["params"]["kd"]["value"] for g in out])
+    assert all(np.sqrt(g["redchi"]) < 0.25 for g in out)
+    assert np.all(np.diff(alpha) <= 0.01) and 0.2 < alpha.min() < alpha.max() < 0.35
+    assert 0.09 < kd.min() < kd.max() < 0.14
