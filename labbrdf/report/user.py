@@ -22,6 +22,8 @@ from .sections import Section, run
 from .sections.colour import colour_section
 from .sections.fits import fits_section
 from .sections.ingest import ingest_files
+from .sections.measured import measured_section
+from .sections.nk import nk_section
 from .sections.physics import physics_section
 from .sections.scans import scans_section
 from .sections.spectra import spectra_section
@@ -146,6 +148,8 @@ def user_report(
 
     sections: list[Section] = [
         ("ingest", "Ingested files", ingest),
+        ("measured", "Measured data, file by file", measured_section),
+        ("nk", "Optical constants and cross-instrument comparison", nk_section),
         (
             "fits",
             f"Fitted {model} parameters per sample and wavelength",

@@ -137,6 +137,7 @@ def ingest_files(
         tolerance=len(paths),
         justification="value = files read, tolerance = files given; all must read",
         reason="; ".join(failures)[:2000],
+        substantive=False,
     )
     if not ctx.frames:
         raise Unavailable("no file could be read")
