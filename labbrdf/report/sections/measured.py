@@ -37,7 +37,7 @@ QUANTITY_LABELS = {
 }
 
 #: at most this many series per panel (evenly picked), to keep legends readable
-MAX_SERIES = 8
+MAX_SERIES = 12
 #: stage positions closer than this are one spot [mm]
 SPOT_TOL_MM = 0.5
 
@@ -141,6 +141,7 @@ def _series(
 
 
 _FMT = {
+    "sample": "{}",
     "theta_i_deg": "\u03b8i {:.4g}\u00b0",
     "wavelength_nm": "{:.4g} nm",
     "channel": "{}",
@@ -160,6 +161,8 @@ def _spectral_panels(
     if not by_wl and g["theta_i_deg"].nunique() <= 1:
         x, xlabel = "wavelength_nm", "wavelength [nm]"
     keys = ["theta_i_deg"] if by_wl else ["wavelength_nm"]
+    if g["sample"].nunique() > 1:  # several samples in one file: one line each
+        keys = ["sample"] + keys
     times = _times(g)
     if times:
         g = g[g["time_s"].isin(_pick(times, 3))]
