@@ -419,7 +419,7 @@ def measured_section(ctx: Context) -> None:
     b.text(
         f"{len(frames)} file(s): one subsection each, with what was measured, its ranges and "
         "row count, and a figure of every quantity. Large panel sets (maps, Mueller grids) "
-        "are folded; click to open. Jump to: " + " \u00b7 ".join(src for src, _, _ in frames)
+        "are folded; click to open."
     )
     missing = []
     for i, (src, g, meta) in enumerate(frames):
