@@ -533,7 +533,7 @@ def panels_figure(
     panels: Sequence[Mapping[str, Any]],
     title: str = "",
     ncols: int = 3,
-    panel_size: tuple[float, float] = (3.6, 2.7),
+    panel_size: tuple[float, float] = (4.6, 3.2),
 ) -> str:
     """A grid of line/point panels, each with its own axes labels (measured quantities).
 

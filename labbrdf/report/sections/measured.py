@@ -214,12 +214,17 @@ def _kinetic_panels(g: pd.DataFrame, quantities: list[str]) -> list[dict[str, An
         gq = g[(g["quantity"] == q) & g["_wl"].isin(pick)]
         if gq.empty:
             continue
+        series = _series(gq, "time_s", ["wavelength_nm", "theta_i_deg"], _FMT)
+        for x in series:  # the change since the first time, so that drifts are visible
+            y0 = float(x["y"][0])
+            x["y"] = x["y"] - y0
+            x["label"] = f"{x['label']} (start {y0:.4g})"
         panels.append(
             {
-                "title": QUANTITY_LABELS.get(q, q) + " against time",
+                "title": QUANTITY_LABELS.get(q, q) + ": change since the first time",
                 "xlabel": "time [s]",
-                "ylabel": _label(q, _unit(gq)),
-                "series": _series(gq, "time_s", ["wavelength_nm", "theta_i_deg"], _FMT),
+                "ylabel": "change of " + _label(q, _unit(gq)),
+                "series": series,
             }
         )
     return panels
@@ -387,7 +392,8 @@ def _file(ctx: Context, i: int, src: str, g: pd.DataFrame, meta: Mapping[str, An
             b.figure(
                 f"{fid}_kinetic",
                 f"{src}: kinetic series, value against time",
-                "Measured values against time [s] at three wavelengths (first, middle, last "
+                "Measured values minus their value at the first time (given in the legend), "
+                "against time [s], at three wavelengths (first, middle, last "
                 f"of the file's {g['wavelength_nm'].round(6).nunique()}), per angle of "
                 "incidence. Error bars: the file's 1-sigma where given.",
                 figures.panels_figure(panels, ncols=min(3, len(panels))),
