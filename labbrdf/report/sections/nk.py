@@ -282,22 +282,29 @@ def nk_section(ctx: Context) -> None:
         n_ang = int(pts["theta_i_deg"].round(2).nunique())
         if not tested.any():
             verdict = (
-                "one angle of incidence per wavelength: the angle-to-angle consistency cannot "
-                "be tested"
-            )
-        elif frac_dep and frac_dep > 0.5:
-            verdict = (
-                f"the angles disagree at {100 * frac_dep:.0f}% of the wavelengths (p < "
-                f"{ell.P_ANGLE_DEPENDENT:g}): these are pseudo-constants of a film or "
-                "roughness, not of a bulk material"
-            )
-        elif frac_dep:
-            verdict = (
-                f"the angles agree at most wavelengths ({100 * frac_dep:.0f}% disagree, "
-                f"p < {ell.P_ANGLE_DEPENDENT:g}): consistent with a bulk material there"
-            )
+                "one angle of incidence per wavelength"
+                if int(comb["n_angles"].max()) < 2
+                else f"{int(comb['n_angles'].max())} angles per wavelength and no sigmas in the "
+                "file: too few for the scatter test"
+            ) + ": the angle-to-angle consistency cannot be tested"
         else:
-            verdict = "the angles agree at every wavelength: consistent with a bulk material"
+            # fraction of wavelengths flagged by chance alone: alpha, binomial 3-sigma margin
+            a = ell.P_ANGLE_DEPENDENT
+            chance = a + 3.0 * np.sqrt(a * (1.0 - a) / int(tested.sum()))
+            frac = frac_dep or 0.0
+            said = (
+                f"the angles disagree (p < {a:g}) at {100 * frac:.0f}% of the "
+                f"{int(tested.sum())} wavelengths, {100 * a:g}% expected by chance"
+            )
+            if frac > 0.5:
+                verdict = said + ": angle-dependent, a film or roughness, not a bulk material"
+            elif frac > chance:
+                verdict = (
+                    said + ": angle-dependent over part of the spectrum (a film or roughness, "
+                    "not a bulk material, there); elsewhere consistent with a bulk material"
+                )
+            else:
+                verdict = said + ": consistent with a bulk material"
         b.text(
             f"{len(pts)} psi/Delta pairs at {n_ang} angle(s), {len(comb)} combined "
             f"(wavelength{', series member' if len(_members(comb)) > 1 else ''}) rows. "
