@@ -225,6 +225,45 @@ def _compare(
     )
 
 
+def _r0_figure(ctx: Context, i: int, src: str, comb: pd.DataFrame) -> None:
+    """The predicted normal-incidence Fresnel reflectance from the combined n, k."""
+    b = ctx.b
+    first = _members(comb)[0][1]
+    r = ell.fresnel_reflectances(
+        np.maximum(first["n"].to_numpy(float), 0.0),
+        np.maximum(first["k"].to_numpy(float), 0.0),
+        np.zeros(len(first)),
+        n_sigma=first["n_sigma"].to_numpy(float),
+        k_sigma=first["k_sigma"].to_numpy(float),
+        nk_cov=first["nk_cov"].to_numpy(float),
+    )
+    x = first["wavelength_nm"].to_numpy(float)
+    b.figure(
+        f"nk_{i}_{slug(src)}_r0",
+        f"{src}: predicted normal-incidence reflectance",
+        "Modelled from the combined n, k (two-phase Fresnel, bare half-space): R_s, R_p and "
+        "their mean (R_s = R_p at normal incidence) [1] against wavelength [nm], band = "
+        "propagated 1-sigma. Meaningful for a bulk material only (see the verdict).",
+        figures.panels_figure(
+            [
+                {
+                    "title": "Fresnel R at 0\u00b0",
+                    "xlabel": "wavelength [nm]",
+                    "ylabel": "R [1]",
+                    "series": [
+                        {"label": "R_s", "x": x, "y": r.rs},
+                        {"label": "R_p", "x": x, "y": r.rp},
+                        {"label": "(R_s + R_p)/2", "x": x, "y": r.r, "band": r.r_sigma},
+                    ],
+                }
+            ],
+            ncols=1,
+            panel_size=(5.5, 3.2),
+        ),
+        details=True,
+    )
+
+
 def nk_section(ctx: Context) -> None:
     """Optical constants per psi/Delta file and their reflectance predictions."""
     b = ctx.b
@@ -287,6 +326,7 @@ def nk_section(ctx: Context) -> None:
                 else f"{int(comb['n_angles'].max())} angles per wavelength and no sigmas in the "
                 "file: too few for the scatter test"
             ) + ": the angle-to-angle consistency cannot be tested"
+            short = "not testable"
         else:
             # fraction of wavelengths flagged by chance alone: alpha, binomial 3-sigma margin
             a = ell.P_ANGLE_DEPENDENT
@@ -298,13 +338,16 @@ def nk_section(ctx: Context) -> None:
             )
             if frac > 0.5:
                 verdict = said + ": angle-dependent, a film or roughness, not a bulk material"
+                short = "angle-dependent: film or roughness"
             elif frac > chance:
                 verdict = (
                     said + ": angle-dependent over part of the spectrum (a film or roughness, "
                     "not a bulk material, there); elsewhere consistent with a bulk material"
                 )
+                short = "partly angle-dependent"
             else:
                 verdict = said + ": consistent with a bulk material"
+                short = "consistent with bulk"
         b.text(
             f"{len(pts)} psi/Delta pairs at {n_ang} angle(s), {len(comb)} combined "
             f"(wavelength{', series member' if len(_members(comb)) > 1 else ''}) rows. "
@@ -396,9 +439,10 @@ def nk_section(ctx: Context) -> None:
                 "k_500": a500["k"],
                 "chi2_dof": float(np.median(chi)) if len(chi) else None,
                 "frac_dep": frac_dep,
-                "verdict": verdict,
+                "verdict": short,
             }
         )
+        _r0_figure(ctx, i, src, comb)
         # the file's own reflectance rows
         if (g["quantity"] == "reflectance").any():
             _compare(ctx, f"{tag}_own", src, comb, g, src, cmp_rows)
@@ -408,12 +452,11 @@ def nk_section(ctx: Context) -> None:
         "Optical constants per file",
         [
             ("file", "file", ""),
-            ("sample", "sample", ""),
             ("points", "psi/\u0394 pairs", "d"),
             ("angles", "angles", "d"),
             ("wl_min", "\u03bb min [nm]", ".5g"),
             ("wl_max", "\u03bb max [nm]", ".5g"),
-            ("wl_500", "\u03bb near 500 nm [nm]", ".5g"),
+            ("wl_500", "\u03bb\u2248500 [nm]", ".5g"),
             ("n_500", "n there", ".4g"),
             ("k_500", "k there", ".4g"),
             ("chi2_dof", "median \u03c7\u00b2/dof", ".3g"),
@@ -422,44 +465,9 @@ def nk_section(ctx: Context) -> None:
         ],
         summary,
         caption="n, k at the measured wavelength nearest 500 nm; chi2/dof of the angle "
-        "agreement, median over wavelengths.",
+        "agreement, median over wavelengths; the verdict in full is in each file's text.",
     )
-    # normal-incidence prediction and cross-instrument comparisons
-    for i, (src, comb) in enumerate(combined.items()):
-        first = _members(comb)[0][1]
-        r = ell.fresnel_reflectances(
-            np.maximum(first["n"].to_numpy(float), 0.0),
-            np.maximum(first["k"].to_numpy(float), 0.0),
-            np.zeros(len(first)),
-            n_sigma=first["n_sigma"].to_numpy(float),
-            k_sigma=first["k_sigma"].to_numpy(float),
-            nk_cov=first["nk_cov"].to_numpy(float),
-        )
-        x = first["wavelength_nm"].to_numpy(float)
-        b.figure(
-            f"nk_{i}_{slug(src)}_r0",
-            f"{src}: predicted normal-incidence reflectance",
-            "Modelled from the combined n, k (two-phase Fresnel, bare half-space): R_s, R_p and "
-            "their mean (R_s = R_p at normal incidence) [1] against wavelength [nm], band = "
-            "propagated 1-sigma. Meaningful for a bulk material only (see the verdict).",
-            figures.panels_figure(
-                [
-                    {
-                        "title": "Fresnel R at 0\u00b0",
-                        "xlabel": "wavelength [nm]",
-                        "ylabel": "R [1]",
-                        "series": [
-                            {"label": "R_s", "x": x, "y": r.rs},
-                            {"label": "R_p", "x": x, "y": r.rp},
-                            {"label": "(R_s + R_p)/2", "x": x, "y": r.r, "band": r.r_sigma},
-                        ],
-                    }
-                ],
-                ncols=1,
-                panel_size=(5.5, 3.2),
-            ),
-            details=True,
-        )
+    # cross-instrument comparisons
     pairs = []
     for rs, rg, _ in refl:
         rsamples = {str(s).lower() for s in rg["sample"]}
