@@ -16,7 +16,7 @@ from typing import Any
 from .. import __version__, models
 from ..provenance import versions
 from . import html
-from .builder import Builder, write_report
+from .builder import Builder, Unavailable, write_report
 from .context import METHOD, Context
 from .sections import Section, run
 from .sections.colour import colour_section
@@ -29,6 +29,27 @@ from .sections.scans import scans_section
 from .sections.spectra import spectra_section
 
 __all__ = ["user_report"]
+
+
+#: fewest points of one (sample, wavelength) scan that a BRDF model is fitted to
+MIN_SCAN_POINTS = 4
+
+
+def _brdf_scans(ctx: Context) -> bool:
+    """True when there are BRDF scans to fit; else :class:`Unavailable` with the reason."""
+    try:
+        scans = ctx.scans()
+    except Unavailable as exc:
+        raise Unavailable(f"no BRDF rows: no BRDF fit ({exc})") from None
+    sizes = scans.groupby(["sample", "wavelength_nm"]).size()
+    if int(sizes.max()) < MIN_SCAN_POINTS:
+        q = ", ".join(sorted(set(scans["quantity"].astype(str))))
+        raise Unavailable(
+            f"no BRDF scans: the {q} rows have at most {int(sizes.max())} point(s) per "
+            f"(sample, wavelength), e.g. an ellipsometer's intensity at one angle; a fit "
+            f"needs {MIN_SCAN_POINTS} or more: no BRDF fit"
+        )
+    return True
 
 
 def user_report(
@@ -153,7 +174,7 @@ def user_report(
         (
             "fits",
             f"Fitted {model} parameters per sample and wavelength",
-            lambda ctx: fits_section(ctx, [(model, opts)]),
+            lambda ctx: fits_section(ctx, [(model, opts)]) if _brdf_scans(ctx) else None,
         ),
         ("scans", "Measured points and model curves", lambda ctx: scans_section(ctx, [model])),
         (

@@ -142,3 +142,13 @@ def test_all_real_exports_in_one_report(real_exports: Path, tmp_path: Path) -> N
     for name in read:
         assert _figures_of(res, Path(name).name), f"no figure for {name}"
     assert "pass" not in res["summary"]["headline"].split(",")[0] or res["summary"]["pass"] > 1
+
+
+def test_ellipsometer_intensity_is_not_fitted_as_brdf(real_exports: Path, tmp_path: Path) -> None:
+    res = _report(
+        [real_exports / "woollam-completeease-ascii/Woolam_staticTest.dat"], tmp_path / "rep"
+    )
+    fits = next(s for s in res["sections"] if s["id"] == "fits")
+    assert fits["status"] == "not available" and "no BRDF fit" in fits["reason"]
+    assert res["summary"]["exit_code"] == 0
+    assert any(f.endswith("_spectra") for f in res["figures"])  # uR and depolarisation drawn
