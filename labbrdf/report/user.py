@@ -1,6 +1,8 @@
 """``labbrdf report DATA... --model NAME -o DIR``: the report for a user's own files.
 
-The same kind of page as the validation report: what was ingested, the fits (per sample and
+The same kind of page as the validation report: what was ingested, a figure of every
+measured quantity per file, optical constants from psi/Delta with the Fresnel reflectance
+compared with measured reflectance, the fits (per sample and
 wavelength, with uncertainties, intervals, flags and RMSE), measured points with the model
 curves and residuals, parameter spectra, energy and reciprocity of every fit, and the sample
 colour when spectrophotometer reflectance is among the files.
