@@ -311,7 +311,8 @@ def _file(ctx: Context, i: int, src: str, g: pd.DataFrame, meta: Mapping[str, An
     b = ctx.b
     fid = f"measured_{i}_{slug(src)}"
     quantities = list(dict.fromkeys(g["quantity"]))
-    samples = ", ".join(sorted({str(s) for s in g["sample"]}))
+    names = sorted({str(s) for s in g["sample"]})
+    samples = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
     instr = ", ".join(sorted({str(s) for s in g["instrument"]}))
     b.heading(f"{src}: {samples}", anchor=fid)
     spots = _spots(g)
