@@ -37,6 +37,7 @@ __all__ = [
     "atomic_dir",
     "esc_pointer",
     "fmt",
+    "headline",
     "jsonable",
     "num",
     "resolve",
@@ -227,6 +228,10 @@ class Builder:
         """A paragraph of plain text (escaped on the page)."""
         self._sec()["items"].append({"kind": "text", "text": paragraph})
 
+    def heading(self, text: str, anchor: str = "") -> None:
+        """A subsection heading inside the current section (``anchor``: its HTML id)."""
+        self._sec()["items"].append({"kind": "heading", "text": text, "anchor": anchor})
+
     def note(self, label: str, body: str) -> None:
         """A labelled line, e.g. a "not available" part inside a section that runs."""
         self._sec()["items"].append({"kind": "note", "label": label, "text": body})
@@ -238,8 +243,10 @@ class Builder:
         columns: Sequence[tuple[str, str, str]],
         rows: Sequence[Mapping[str, Any]],
         caption: str = "",
+        *,
+        details: bool = False,
     ) -> None:
-        """Add a table.
+        """Add a table (``details``: folded into a details element on the page).
 
         Parameters
         ----------
@@ -257,17 +264,22 @@ class Builder:
             "columns": [{"key": k, "label": lab, "fmt": f} for k, lab, f in columns],
             "rows": [jsonable({k: r.get(k) for k, _, _ in columns}) for r in rows],
         }
-        self._sec()["items"].append({"kind": "table", "id": tid})
+        self._sec()["items"].append({"kind": "table", "id": tid, "details": details})
 
-    def figure(self, fid: str, title: str, caption: str, uri: str | None) -> None:
-        """Add an embedded figure (``uri`` is a ``data:image/png;base64,`` URI)."""
+    def figure(
+        self, fid: str, title: str, caption: str, uri: str | None, *, details: bool = False
+    ) -> None:
+        """Add an embedded figure (``uri`` is a ``data:image/png;base64,`` URI).
+
+        ``details`` folds it into a details element (closed; its title is the summary).
+        """
         if fid in self.results["figures"]:
             raise ValueError(f"duplicate figure id {fid!r}")
         if not uri:
             raise ValueError(f"figure {fid!r} has no image")
         self.results["figures"][fid] = {"title": title, "caption": caption}
         self.images[fid] = uri
-        self._sec()["items"].append({"kind": "figure", "id": fid})
+        self._sec()["items"].append({"kind": "figure", "id": fid, "details": details})
 
     def swatch(self, sid: str, hex_colour: str) -> None:
         """A colour swatch (hex ``#rrggbb`` computed by the report, never from a file)."""
@@ -288,8 +300,13 @@ class Builder:
         tolerance: Any = None,
         justification: str = "",
         reason: str = "",
+        substantive: bool = True,
     ) -> dict[str, Any]:
-        """Record a check: ``status`` is True/False or one of :data:`STATUSES`."""
+        """Record a check: ``status`` is True/False or one of :data:`STATUSES`.
+
+        ``substantive=False`` marks a bookkeeping check (e.g. "every file was read") that
+        counts for the exit code but not as a result in the page's headline.
+        """
         if isinstance(status, (bool, np.bool_)):
             status = "pass" if status else "fail"
         if status not in STATUSES:
@@ -306,6 +323,7 @@ class Builder:
                 "tolerance": tolerance,
                 "justification": justification,
                 "reason": reason,
+                "substantive": bool(substantive),
             }
         )
         self.results["checks"].append(c)
@@ -327,9 +345,37 @@ class Builder:
         for c in self.results["checks"]:
             counts[c["status"]] += 1
         code = 1 if counts["fail"] else 0
-        self.results["summary"] = {**counts, "total": sum(counts.values()), "exit_code": code}
+        self.results["summary"] = {
+            **counts,
+            "total": sum(counts.values()),
+            "exit_code": code,
+            "headline": headline(self.results["checks"]),
+        }
         self.results["meta"]["elapsed_s"] = round(time.perf_counter() - self._t0, 3)
         return code
+
+
+def headline(checks: Sequence[Mapping[str, Any]]) -> str:
+    """The page's one-line verdict: what was checked, never "pass" when nothing was.
+
+    Parameters
+    ----------
+    checks : sequence of mappings
+        ``results["checks"]`` (``status`` and, optionally, ``substantive``).
+
+    Returns
+    -------
+    str
+        ``"3 checks passed, 0 failed, 5 not applicable"``; ``"nothing checked (...)"`` when
+        no substantive check passed or failed.
+    """
+    sub = [c for c in checks if c.get("substantive", True)]
+    passed = sum(c["status"] == "pass" for c in sub)
+    failed = sum(c["status"] == "fail" for c in checks)
+    na = sum(c["status"] == "skipped" for c in checks)
+    if passed + failed == 0:
+        return f"nothing checked ({na} not applicable)"
+    return f"{passed} checks passed, {failed} failed, {na} not applicable"
 
 
 # --------------------------------------------------------------------------- output

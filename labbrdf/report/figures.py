@@ -706,3 +706,142 @@ def brdf_cuts_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
         fig.suptitle(_text(title), fontsize=10)
     fig.tight_layout()
     return to_uri(fig)
+
+
+# --------------------------------------------------------------------------- measured data
+
+
+def panels_figure(
+    panels: Sequence[Mapping[str, Any]],
+    title: str = "",
+    ncols: int = 3,
+    panel_size: tuple[float, float] = (4.6, 3.2),
+) -> str:
+    """A grid of line/point panels, each with its own axes labels (measured quantities).
+
+    Parameters
+    ----------
+    panels : sequence of mappings
+        ``{"title": str, "xlabel": str, "ylabel": str, "logy": bool (optional),
+        "series": [{"label": str, "x": array, "y": array, "yerr": array or None,
+        "band": array or None, "style": "line" | "points"}]}``. ``yerr`` draws error bars
+        (1 sigma), ``band`` a shaded y +- band.
+    title : str
+        Figure title.
+    ncols : int
+        Panels per row.
+    panel_size : (float, float)
+        Width and height of one panel [inch].
+
+    Returns
+    -------
+    str
+        PNG data URI.
+    """
+    n = max(1, len(panels))
+    ncols = max(1, min(ncols, n))
+    nrows = (n + ncols - 1) // ncols
+    fig, axes = plt.subplots(
+        nrows,
+        ncols,
+        figsize=(panel_size[0] * ncols, panel_size[1] * nrows + (0.4 if title else 0.0)),
+        squeeze=False,
+    )
+    for j, ax in enumerate(axes.ravel()):
+        if j >= len(panels):
+            ax.set_visible(False)
+            continue
+        p = panels[j]
+        series = list(p.get("series", []))
+        for k, s in enumerate(series):
+            c = _COLOURS[k % len(_COLOURS)] if len(series) <= len(_COLOURS) else None
+            x = np.asarray(s["x"], float)
+            y = np.asarray(s["y"], float)
+            order = np.argsort(x, kind="stable")
+            x, y = x[order], y[order]
+            yerr = s.get("yerr")
+            band = s.get("band")
+            points = s.get("style") == "points" or len(x) < 3
+            kw: dict[str, Any] = {"label": _text(s.get("label", "")) or None}
+            if c is not None:
+                kw["color"] = c
+            if yerr is not None and np.any(np.isfinite(yerr)):
+                e = np.asarray(yerr, float)[order]
+                every = max(1, len(x) // 60)
+                ax.errorbar(
+                    x,
+                    y,
+                    yerr=np.where(np.isfinite(e), e, 0.0),
+                    fmt="o" if points else "-",
+                    ms=2.5,
+                    lw=0.9,
+                    elinewidth=0.6,
+                    capsize=0,
+                    errorevery=every,
+                    **kw,
+                )
+            else:
+                ax.plot(x, y, "o" if points else "-", ms=2.5, lw=0.9, **kw)
+            if band is not None and np.any(np.isfinite(band)):
+                b = np.asarray(band, float)[order]
+                ax.fill_between(x, y - b, y + b, alpha=0.25, lw=0, color=c)
+        if p.get("logy"):
+            ax.set_yscale("log")
+        ax.set_xlabel(_text(p.get("xlabel", "")), fontsize=8)
+        ax.set_ylabel(_text(p.get("ylabel", "")), fontsize=8)
+        ax.set_title(_text(p.get("title", "")), fontsize=8.5)
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3)
+        if any(s.get("label") for s in series) and len(series) <= 12:
+            ax.legend(fontsize=6, loc="best")
+    if title:
+        fig.suptitle(_text(title), fontsize=10)
+    fig.tight_layout()
+    return to_uri(fig)
+
+
+def map_figure(
+    panels: Sequence[Mapping[str, Any]],
+    title: str = "",
+    ncols: int = 4,
+) -> str:
+    """Stage maps: one scatter panel per angle or wavelength, colour = measured value.
+
+    Parameters
+    ----------
+    panels : sequence of mappings
+        ``{"title": str, "x": array [mm], "y": array [mm], "value": array,
+        "label": str (colour-bar label with units)}``.
+    title : str
+        Figure title.
+    ncols : int
+        Panels per row.
+
+    Returns
+    -------
+    str
+        PNG data URI.
+    """
+    n = max(1, len(panels))
+    ncols = max(1, min(ncols, n))
+    nrows = (n + ncols - 1) // ncols
+    fig, axes = plt.subplots(nrows, ncols, figsize=(3.3 * ncols, 2.9 * nrows), squeeze=False)
+    for j, ax in enumerate(axes.ravel()):
+        if j >= len(panels):
+            ax.set_visible(False)
+            continue
+        p = panels[j]
+        sc = ax.scatter(p["x"], p["y"], c=p["value"], s=60, cmap="viridis", edgecolors="k")
+        cb = fig.colorbar(sc, ax=ax)
+        cb.set_label(_text(p.get("label", "")), fontsize=7)
+        cb.ax.tick_params(labelsize=6)
+        ax.set_xlabel("stage x [mm]", fontsize=8)
+        ax.set_ylabel("stage y [mm]", fontsize=8)
+        ax.set_title(_text(p.get("title", "")), fontsize=8.5)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.tick_params(labelsize=7)
+        ax.grid(alpha=0.3)
+    if title:
+        fig.suptitle(_text(title), fontsize=10)
+    fig.tight_layout()
+    return to_uri(fig)

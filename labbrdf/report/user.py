@@ -1,6 +1,8 @@
 """``labbrdf report DATA... --model NAME -o DIR``: the report for a user's own files.
 
-The same kind of page as the validation report: what was ingested, the fits (per sample and
+The same kind of page as the validation report: what was ingested, a figure of every
+measured quantity per file, optical constants from psi/Delta with the Fresnel reflectance
+compared with measured reflectance, the fits (per sample and
 wavelength, with uncertainties, intervals, flags and RMSE), measured points with the model
 curves and residuals, parameter spectra, energy and reciprocity of every fit, and the sample
 colour when spectrophotometer reflectance is among the files.
@@ -23,12 +25,35 @@ from .sections.brdf import brdf_section
 from .sections.colour import colour_section
 from .sections.fits import fits_section
 from .sections.ingest import ingest_files
+from .sections.measured import measured_section
+from .sections.nk import nk_section
 from .sections.physics import physics_section
 from .sections.scans import scans_section
 from .sections.spectra import spectra_section
 from .sections.surface import ingest_height_maps, surface_section
 
 __all__ = ["user_report"]
+
+
+#: fewest points of one (sample, wavelength) scan that a BRDF model is fitted to
+MIN_SCAN_POINTS = 4
+
+
+def _brdf_scans(ctx: Context) -> bool:
+    """True when there are BRDF scans to fit; else :class:`Unavailable` with the reason."""
+    try:
+        scans = ctx.scans()
+    except Unavailable as exc:
+        raise Unavailable(f"no BRDF rows: no BRDF fit ({exc})") from None
+    sizes = scans.groupby(["sample", "wavelength_nm"]).size()
+    if int(sizes.max()) < MIN_SCAN_POINTS:
+        q = ", ".join(sorted(set(scans["quantity"].astype(str))))
+        raise Unavailable(
+            f"no BRDF scans: the {q} rows have at most {int(sizes.max())} point(s) per "
+            f"(sample, wavelength), e.g. an ellipsometer's intensity at one angle; a fit "
+            f"needs {MIN_SCAN_POINTS} or more: no BRDF fit"
+        )
+    return True
 
 
 def user_report(
@@ -155,10 +180,12 @@ def user_report(
 
     sections: list[Section] = [
         ("ingest", "Ingested files", ingest),
+        ("measured", "Measured data, file by file", measured_section),
+        ("nk", "Optical constants and cross-instrument comparison", nk_section),
         (
             "fits",
             f"Fitted {model} parameters per sample and wavelength",
-            lambda ctx: fits_section(ctx, [(model, opts)]),
+            lambda ctx: fits_section(ctx, [(model, opts)]) if _brdf_scans(ctx) else None,
         ),
         ("scans", "Measured points and model curves", lambda ctx: scans_section(ctx, [model])),
         (

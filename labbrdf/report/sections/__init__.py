@@ -11,6 +11,8 @@ the sections they run as ``(id, title, function)``; :func:`run` runs such a list
 module                    section id(s)
 ========================  ==============================================================
 :mod:`.ingest`            ``ingest``
+:mod:`.measured`          ``measured``
+:mod:`.nk`                ``nk``
 :mod:`.fits`              ``fits``
 :mod:`.scans`             ``scans``
 :mod:`.spectra`           ``spectra``

@@ -5,6 +5,8 @@ CIE 1931 2 deg observer, illuminant D65, sRGB, computed with colour-science.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from .. import figures
@@ -25,6 +27,30 @@ def colour_section(ctx: Context) -> None:
     if d is None:
         raise Unavailable("no data ingested")
     spec = d[d["quantity"].isin(["hemispherical_reflectance", "reflectance"])]
+    # single-polarisation ellipsometer reflectance (R_s or R_p of one file) is not the
+    # sample's reflectance for unpolarised light: never a colour from it
+    polarised = {
+        Path(str(f.get("path", ""))).name: str(f["meta"]["reflectance_kind"])
+        for f in ctx.files
+        if (f.get("meta") or {}).get("reflectance_kind")
+    }
+    if "channel" in spec.columns:
+        ch = spec["channel"].astype(object)
+        for src in spec.loc[ch.isin(["s", "p"]), "source"].unique():
+            polarised.setdefault(str(src), "single-polarisation reflectance (channel s or p)")
+    left_out = sorted(set(spec["source"].astype(str)) & set(polarised))
+    for src in left_out:
+        ctx.b.note(
+            "no colour",
+            f"{src}: {polarised[src]}; a colour needs the reflectance of the sample for "
+            "unpolarised light (a spectrophotometer), so these rows are not used",
+        )
+        ctx.b.skip(
+            f"colour.{slug(src)}",
+            f"sample colour of {src}",
+            f"{polarised[src]}: not a colour source",
+        )
+    spec = spec[~spec["source"].astype(str).isin(left_out)]
     spec = spec[spec["theta_i_deg"].isna() | (spec["theta_i_deg"] < 10)] if len(spec) else spec
     if not len(spec):
         raise Unavailable(

@@ -58,6 +58,17 @@ def _meta_header(meta: Mapping[str, Any], limit: int = 3) -> str:
     return ""
 
 
+def _quantities(names: Sequence[str]) -> str:
+    """The quantities of a file, Mueller elements folded to one entry."""
+    mm = [q for q in names if q.startswith("mueller_")]
+    rest = [q for q in names if not q.startswith("mueller_")]
+    if len(mm) > 2:
+        rest.append(f"Mueller matrix ({len(mm)} elements)")
+    else:
+        rest.extend(mm)
+    return ", ".join(rest)
+
+
 def ingest_files(
     ctx: Context,
     paths: Sequence[str | os.PathLike[str]],
@@ -95,7 +106,7 @@ def ingest_files(
             "format": fmt_name,
             "sample": ", ".join(s["sample"]),
             "instrument": ", ".join(sorted(set(d["instrument"]))),
-            "quantities": ", ".join(s["quantities"]),
+            "quantities": _quantities(s["quantities"]),
             "rows": s["rows"],
             "wl_min": s["wavelength_nm"][0],
             "wl_max": s["wavelength_nm"][1],
@@ -137,6 +148,7 @@ def ingest_files(
         tolerance=len(paths),
         justification="value = files read, tolerance = files given; all must read",
         reason="; ".join(failures)[:2000],
+        substantive=False,
     )
     if not ctx.frames:
         raise Unavailable("no file could be read")

@@ -1,0 +1,529 @@
+"""Section ``nk``: optical constants from psi/Delta and the cross-instrument comparison.
+
+Per file with psi/Delta rows: the two-phase pseudo-constants of every point
+(:func:`labbrdf.nk.nk_table`), their per-wavelength combination over the angles of incidence
+with the angle-to-angle consistency test (:func:`labbrdf.nk.combined_table`), and a plain
+flag where the angles disagree. From the combined ``n, k``: the Fresnel reflectances
+``R_s, R_p`` and their mean at normal incidence, compared with measured reflectance rows
+(:func:`labbrdf.nk.compare_reflectance`) of the same file, of the same sample, or of the one
+spectrophotometer file in the report when there is exactly one ellipsometer file.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from ... import ellipsometry as ell
+from ... import nk as nkmod
+from .. import figures
+from ..builder import Unavailable, slug
+from ..context import Context
+from .measured import file_frames
+
+__all__ = ["P_AGREE", "nk_section"]
+
+#: significance level of the reflectance-agreement check (chi-square test of the z scores)
+P_AGREE = 1e-3
+
+_SERIES = ("time_s", "x_mm", "y_mm")
+
+
+def _members(c: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
+    """(label, rows) per member of a series (time or spot), or the whole table."""
+    keys = [k for k in _SERIES if k in c.columns]
+    if not keys:
+        return [("", c)]
+    out = []
+    for key, g in c.groupby(keys, sort=True, dropna=False):
+        key = key if isinstance(key, tuple) else (key,)
+        lab = ", ".join(f"{k.split('_')[0]} {v:g}" for k, v in zip(keys, key, strict=True))
+        out.append((lab, g))
+    return out
+
+
+def _nk_figure(src: str, c: pd.DataFrame) -> str:
+    members = _members(c)
+    by_wl = c["wavelength_nm"].round(6).nunique() > 1
+    panels = []
+    for q in ("n", "k"):
+        series = []
+        for lab, g in members[:6]:
+            series.append(
+                {
+                    "label": lab,
+                    "x": g["wavelength_nm"].to_numpy(float),
+                    "y": g[q].to_numpy(float),
+                    "band": g[f"{q}_sigma"].to_numpy(float),
+                    "style": "line" if by_wl else "points",
+                }
+            )
+        panels.append(
+            {
+                "title": f"combined {q}",
+                "xlabel": "wavelength [nm]",
+                "ylabel": f"{q} [1]",
+                "series": series,
+            }
+        )
+    return figures.panels_figure(panels, ncols=2)
+
+
+def _pseudo_figure(points: pd.DataFrame) -> str:
+    p = points.assign(theta=points["theta_i_deg"].round(2))
+    panels = []
+    for q in ("n", "k"):
+        series = []
+        for th, g in list(p.groupby("theta", sort=True))[:8]:
+            series.append(
+                {
+                    "label": f"\u03b8i {th:g}\u00b0",
+                    "x": g["wavelength_nm"].to_numpy(float),
+                    "y": g[q].to_numpy(float),
+                    "yerr": g[f"{q}_sigma"].to_numpy(float),
+                    "style": "points" if g["wavelength_nm"].nunique() < 3 else "line",
+                }
+            )
+        panels.append(
+            {
+                "title": f"pseudo-{q} per angle of incidence",
+                "xlabel": "wavelength [nm]",
+                "ylabel": f"<{q}> [1]",
+                "series": series,
+            }
+        )
+    return figures.panels_figure(panels, ncols=2)
+
+
+def _at(c: pd.DataFrame, wl: float) -> dict[str, float | None]:
+    if c.empty:
+        return {"n": None, "k": None}
+    i = int(np.argmin(np.abs(c["wavelength_nm"].to_numpy(float) - wl)))
+    r = c.iloc[i]
+    return {"wl": float(r["wavelength_nm"]), "n": float(r["n"]), "k": float(r["k"])}
+
+
+def _compare(
+    ctx: Context,
+    tag: str,
+    src: str,
+    comb: pd.DataFrame,
+    refl: pd.DataFrame,
+    rsrc: str,
+    rows_out: list[dict[str, Any]],
+) -> None:
+    """Fresnel prediction from ``comb`` against the reflectance rows of ``rsrc``."""
+    b = ctx.b
+    first = _members(comb)[0][1]
+    try:
+        cmp = nkmod.compare_reflectance(first, refl)
+    except ValueError as exc:
+        b.note("not compared", f"{rsrc} against n, k of {src}: {exc}")
+        b.skip(
+            f"nk.reflectance.{tag}",
+            f"{rsrc}: measured R agrees with Fresnel R from n, k of {src}",
+            str(exc),
+        )
+        return
+    z = cmp["z"].to_numpy(float)
+    ok = np.isfinite(z)
+    nz = int(ok.sum())
+    chi2 = float(np.sum(z[ok] ** 2))
+    p = float(stats.chi2.sf(chi2, nz)) if nz else float("nan")
+    has_sigma = bool(cmp["measured_sigma"].notna().any())
+    chan = sorted({str(x) for x in cmp["channel"] if x is not None and str(x) not in ("", "nan")})
+    kind = f"R_{'/'.join(chan)}" if chan else "(R_s + R_p)/2"
+    rows_out.append(
+        {
+            "nk_file": src,
+            "refl_file": rsrc,
+            "quantity": kind,
+            "theta_i": ", ".join(f"{t:g}" for t in sorted(cmp["theta_i_deg"].round(2).unique())),
+            "points": len(cmp),
+            "wl_min": float(cmp["wavelength_nm"].min()),
+            "wl_max": float(cmp["wavelength_nm"].max()),
+            "mean_diff": float(cmp["difference"].mean()),
+            "rms_diff": float(np.sqrt(np.mean(cmp["difference"] ** 2))),
+            "median_sigma": float(np.nanmedian(cmp["difference_sigma"])),
+            "chi2_dof": chi2 / nz if nz else None,
+            "p_value": p if nz else None,
+            "outside": int(cmp.attrs.get("outside_range", 0)),
+        }
+    )
+    x = cmp["wavelength_nm"].to_numpy(float)
+    series_m, series_d = [], []
+    cmp = cmp.assign(_ch=cmp["channel"].astype(object).where(cmp["channel"].notna(), ""))
+    for (ch, th), g in cmp.groupby(["_ch", cmp["theta_i_deg"].round(2)], sort=True):
+        lab = f"{ch or 'unpolarised'} \u03b8i {th:g}\u00b0"
+        series_m.append(
+            {
+                "label": f"measured {lab}",
+                "x": g["wavelength_nm"],
+                "y": g["measured"],
+                "yerr": g["measured_sigma"].to_numpy(float),
+                "style": "points" if len(g) < 30 else "line",
+            }
+        )
+        series_m.append(
+            {
+                "label": f"Fresnel from n, k {lab}",
+                "x": g["wavelength_nm"],
+                "y": g["predicted"],
+                "band": g["predicted_sigma"].to_numpy(float),
+            }
+        )
+        series_d.append(
+            {
+                "label": lab,
+                "x": g["wavelength_nm"],
+                "y": g["difference"],
+                "band": g["difference_sigma"].to_numpy(float),
+            }
+        )
+    b.figure(
+        f"nk_{tag}_refl",
+        f"Reflectance of {rsrc} against the Fresnel prediction from n, k of {src}",
+        f"Measured: {kind} [1] from {rsrc} ({len(x)} points, {x.min():.4g}-{x.max():.4g} nm). "
+        f"Modelled: Fresnel reflectance of a bare half-space with the combined n, k of {src} "
+        "(two-phase model), band = propagated 1-sigma of n, k. Right: measured - predicted with "
+        "the combined 1-sigma band"
+        + ("" if has_sigma else " (the prediction's sigma alone: the file gives none)")
+        + ".",
+        figures.panels_figure(
+            [
+                {
+                    "title": "reflectance",
+                    "xlabel": "wavelength [nm]",
+                    "ylabel": "R [1]",
+                    "series": series_m,
+                },
+                {
+                    "title": "difference",
+                    "xlabel": "wavelength [nm]",
+                    "ylabel": "measured - predicted [1]",
+                    "series": series_d,
+                },
+            ],
+            ncols=2,
+            panel_size=(5.0, 3.2),
+        ),
+    )
+    b.check(
+        f"nk.reflectance.{tag}",
+        f"{rsrc}: measured {kind} agrees with the Fresnel prediction from n, k of {src}",
+        nz > 0 and p >= P_AGREE,
+        against="Fresnel equations (two-phase) with the ellipsometric n, k",
+        value=p if nz else None,
+        tolerance=P_AGREE,
+        justification=f"chi-square test of z = difference / sigma over {nz} points "
+        f"(chi2/dof {chi2 / nz:.3g}); value = p-value, fails below the tolerance"
+        if nz
+        else "no point with a finite uncertainty",
+    )
+
+
+def _r0_figure(ctx: Context, i: int, src: str, comb: pd.DataFrame) -> None:
+    """The predicted normal-incidence Fresnel reflectance from the combined n, k."""
+    b = ctx.b
+    first = _members(comb)[0][1]
+    r = ell.fresnel_reflectances(
+        np.maximum(first["n"].to_numpy(float), 0.0),
+        np.maximum(first["k"].to_numpy(float), 0.0),
+        np.zeros(len(first)),
+        n_sigma=first["n_sigma"].to_numpy(float),
+        k_sigma=first["k_sigma"].to_numpy(float),
+        nk_cov=first["nk_cov"].to_numpy(float),
+    )
+    x = first["wavelength_nm"].to_numpy(float)
+    b.figure(
+        f"nk_{i}_{slug(src)}_r0",
+        f"{src}: predicted normal-incidence reflectance",
+        "Modelled from the combined n, k (two-phase Fresnel, bare half-space): R_s, R_p and "
+        "their mean (R_s = R_p at normal incidence) [1] against wavelength [nm], band = "
+        "propagated 1-sigma. Meaningful for a bulk material only (see the verdict).",
+        figures.panels_figure(
+            [
+                {
+                    "title": "Fresnel R at 0\u00b0",
+                    "xlabel": "wavelength [nm]",
+                    "ylabel": "R [1]",
+                    "series": [
+                        {"label": "R_s", "x": x, "y": r.rs},
+                        {"label": "R_p", "x": x, "y": r.rp},
+                        {"label": "(R_s + R_p)/2", "x": x, "y": r.r, "band": r.r_sigma},
+                    ],
+                }
+            ],
+            ncols=1,
+            panel_size=(5.5, 3.2),
+        ),
+        details=True,
+    )
+
+
+def nk_section(ctx: Context) -> None:
+    """Optical constants per psi/Delta file and their reflectance predictions."""
+    b = ctx.b
+    frames = file_frames(ctx)
+    if not frames:
+        raise Unavailable("no data ingested")
+
+    def ordinary(g: pd.DataFrame) -> pd.DataFrame:
+        pd_rows = g[g["quantity"].isin(["psi", "delta"])]
+        if "channel" in pd_rows.columns:
+            ch = pd_rows["channel"].astype(object)
+            pd_rows = pd_rows[ch.isna() | ch.isin(["", "pp"])]
+        return pd_rows
+
+    ellips = [(s, g, m) for s, g, m in frames if len(ordinary(g))]
+    refl = [(s, g, m) for s, g, m in frames if (g["quantity"] == "reflectance").any()]
+    if not ellips:
+        b.skip(
+            "nk.constants",
+            "optical constants from psi/Delta",
+            "no psi/Delta rows: no optical constants",
+        )
+        raise Unavailable(
+            "no psi/Delta rows ingested: no optical constants, no Fresnel prediction"
+        )
+    b.text(
+        "Two-phase (bare substrate, ambient n = 1) pseudo-optical constants <N> = n + ik of "
+        "every psi/Delta point, combined per wavelength over the angles of incidence "
+        "(inverse-covariance weighted mean where the file gives sigmas). The consistency "
+        "of the angles is a chi-square test (p-value); a bulk, clean, isotropic material "
+        "gives the same n, k at every angle, while a film or roughness makes the pseudo "
+        "constants depend on the angle."
+    )
+    summary: list[dict[str, Any]] = []
+    cmp_rows: list[dict[str, Any]] = []
+    combined: dict[str, pd.DataFrame] = {}
+    for i, (src, g, _meta) in enumerate(ellips):
+        tag = f"{i}_{slug(src)}"
+        rows = ordinary(g)
+        b.heading(f"{src}: optical constants", anchor=f"nk_{tag}")
+        try:
+            pts = nkmod.nk_table(rows, on_ill_conditioned="ignore")
+            comb = nkmod.combined_table(pts)
+        except (ValueError, KeyError) as exc:
+            b.note("no optical constants", f"{src}: {exc}")
+            b.skip(f"nk.constants.{tag}", f"{src}: optical constants", str(exc))
+            continue
+        combined[src] = comb
+        cond_bad = int((pts["cond"] > ell_cond_limit()).sum())
+        dof = comb["dof"].to_numpy(int)
+        tested = dof > 0
+        frac_dep = float(comb.loc[tested, "angle_dependent"].mean()) if tested.any() else None
+        chi = comb.loc[tested, "chi2"].to_numpy(float) / np.maximum(dof[tested], 1)
+        a500 = _at(comb, 500.0)
+        n_ang = int(pts["theta_i_deg"].round(2).nunique())
+        if not tested.any():
+            verdict = (
+                "one angle of incidence per wavelength"
+                if int(comb["n_angles"].max()) < 2
+                else f"{int(comb['n_angles'].max())} angles per wavelength and no sigmas in the "
+                "file: too few for the scatter test"
+            ) + ": the angle-to-angle consistency cannot be tested"
+            short = "not testable"
+        else:
+            # fraction of wavelengths flagged by chance alone: alpha, binomial 3-sigma margin
+            a = ell.P_ANGLE_DEPENDENT
+            chance = a + 3.0 * np.sqrt(a * (1.0 - a) / int(tested.sum()))
+            frac = frac_dep or 0.0
+            said = (
+                f"the angles disagree (p < {a:g}) at {100 * frac:.0f}% of the "
+                f"{int(tested.sum())} wavelengths, {100 * a:g}% expected by chance"
+            )
+            if frac > 0.5:
+                verdict = said + ": angle-dependent, a film or roughness, not a bulk material"
+                short = "angle-dependent: film or roughness"
+            elif frac > chance:
+                verdict = (
+                    said + ": angle-dependent over part of the spectrum (a film or roughness, "
+                    "not a bulk material, there); elsewhere consistent with a bulk material"
+                )
+                short = "partly angle-dependent"
+            else:
+                verdict = said + ": consistent with a bulk material"
+                short = "consistent with bulk"
+        b.text(
+            f"{len(pts)} psi/Delta pairs at {n_ang} angle(s), {len(comb)} combined "
+            f"(wavelength{', series member' if len(_members(comb)) > 1 else ''}) rows. "
+            f"Verdict: {verdict}."
+            + (
+                f" {cond_bad} point(s) are ill-conditioned (condition number above "
+                f"{ell_cond_limit():g}): their n, k carry large uncertainties."
+                if cond_bad
+                else ""
+            )
+            + (
+                f" The file is a series of {len(_members(comb))} members (times or spots); "
+                "the figure shows up to six of them."
+                if len(_members(comb)) > 1
+                else ""
+            )
+        )
+        b.figure(
+            f"nk_{tag}_combined",
+            f"{src}: combined optical constants n and k",
+            "Derived from measured psi/Delta: n [1] and k [1] against wavelength [nm], "
+            "combined over the angles of incidence; band = 1-sigma (propagated from the "
+            "file's sigmas, or the angle-to-angle scatter where that is larger or sigmas are "
+            "missing).",
+            _nk_figure(src, comb),
+        )
+        cols = [k for k in _SERIES if k in comb.columns]
+        b.table(
+            f"nk_{tag}",
+            f"{src}: combined n, k per wavelength",
+            [(c, c, ".6g") for c in cols]
+            + [
+                ("wavelength_nm", "\u03bb [nm]", ".6g"),
+                ("n", "n", ".5g"),
+                ("n_sigma", "\u03c3n", ".2g"),
+                ("k", "k", ".5g"),
+                ("k_sigma", "\u03c3k", ".2g"),
+                ("chi2", "\u03c7\u00b2", ".3g"),
+                ("dof", "dof", "d"),
+                ("p_value", "p", ".2g"),
+                ("angle_dependent", "angle-dependent", ""),
+                ("n_angles", "angles", "d"),
+            ],
+            comb.to_dict("records"),
+            caption="n, k combined over the angles of incidence; chi2/dof and p test their "
+            f"agreement; angle-dependent = p < {ell.P_ANGLE_DEPENDENT:g}.",
+            details=True,
+        )
+        b.figure(
+            f"nk_{tag}_pseudo",
+            f"{src}: pseudo-constants per angle of incidence",
+            "Derived from measured psi/Delta, one line per angle of incidence: two-phase "
+            "pseudo n and k [1] against wavelength [nm] with propagated 1-sigma error bars. "
+            "Lines that do not overlap mean the sample is not a bare bulk material.",
+            _pseudo_figure(pts),
+            details=True,
+        )
+        nk_ok = ~comb["angle_dependent"].to_numpy(bool) & tested
+        if nk_ok.any():
+            c_ok = comb[nk_ok]
+            neg = c_ok["k"].to_numpy(float) < -3 * np.nan_to_num(c_ok["k_sigma"].to_numpy(float))
+            b.check(
+                f"nk.k_physical.{tag}",
+                f"{src}: k >= 0 within 3 sigma where the angles agree",
+                not neg.any(),
+                against="absorbing or transparent media have k >= 0",
+                value=int(neg.sum()),
+                tolerance=0,
+                justification=f"value = wavelengths with k < -3 sigma among {len(c_ok)} "
+                "where the angle test passes",
+            )
+        else:
+            b.skip(
+                f"nk.k_physical.{tag}",
+                f"{src}: k >= 0 within 3 sigma where the angles agree",
+                "no wavelength where the angles agree (or only one angle): pseudo-constants "
+                "of a layered sample need not have k >= 0",
+            )
+        summary.append(
+            {
+                "file": src,
+                "sample": ", ".join(sorted({str(s) for s in rows["sample"]})),
+                "points": len(pts),
+                "angles": n_ang,
+                "wl_min": float(comb["wavelength_nm"].min()),
+                "wl_max": float(comb["wavelength_nm"].max()),
+                "wl_500": a500.get("wl"),
+                "n_500": a500["n"],
+                "k_500": a500["k"],
+                "chi2_dof": float(np.median(chi)) if len(chi) else None,
+                "frac_dep": frac_dep,
+                "verdict": short,
+            }
+        )
+        _r0_figure(ctx, i, src, comb)
+        # the file's own reflectance rows
+        if (g["quantity"] == "reflectance").any():
+            _compare(ctx, f"{tag}_own", src, comb, g, src, cmp_rows)
+    b.heading("Summary and reflectance predictions", anchor="nk_summary")
+    b.table(
+        "nk_summary",
+        "Optical constants per file",
+        [
+            ("file", "file", ""),
+            ("points", "psi/\u0394 pairs", "d"),
+            ("angles", "angles", "d"),
+            ("wl_min", "\u03bb min [nm]", ".5g"),
+            ("wl_max", "\u03bb max [nm]", ".5g"),
+            ("wl_500", "\u03bb\u2248500 [nm]", ".5g"),
+            ("n_500", "n there", ".4g"),
+            ("k_500", "k there", ".4g"),
+            ("chi2_dof", "median \u03c7\u00b2/dof", ".3g"),
+            ("frac_dep", "fraction angle-dependent", ".2f"),
+            ("verdict", "verdict", ""),
+        ],
+        summary,
+        caption="n, k at the measured wavelength nearest 500 nm; chi2/dof of the angle "
+        "agreement, median over wavelengths; the verdict in full is in each file's text.",
+    )
+    # cross-instrument comparisons
+    pairs = []
+    for rs, rg, _ in refl:
+        rsamples = {str(s).lower() for s in rg["sample"]}
+        match = [
+            s
+            for s, _g, _m in ellips
+            if s != rs and s in combined and rsamples & {str(x).lower() for x in _g["sample"]}
+        ]
+        if not match and len(combined) == 1 and rs not in combined:
+            match = list(combined)
+        if not match and rs not in combined:
+            b.note(
+                "not compared",
+                f"reflectance of {rs}: no ellipsometer file of the same sample (and not exactly "
+                "one ellipsometer file in the report) - give the two files together to compare",
+            )
+        for s in match:
+            pairs.append((s, rs, rg))
+    for j, (s, rs, rg) in enumerate(pairs):
+        _compare(ctx, f"x{j}_{slug(rs)}", s, combined[s], rg, rs, cmp_rows)
+    if not refl:
+        b.note(
+            "not compared", "no reflectance rows ingested: nothing to compare the predictions with"
+        )
+        b.skip(
+            "nk.reflectance",
+            "measured reflectance agrees with Fresnel R from n, k",
+            "no reflectance rows",
+        )
+    if cmp_rows:
+        b.table(
+            "nk_reflectance_comparison",
+            "Measured reflectance against the Fresnel prediction from ellipsometric n, k",
+            [
+                ("nk_file", "n, k from", ""),
+                ("refl_file", "reflectance from", ""),
+                ("quantity", "compared", ""),
+                ("theta_i", "\u03b8i [deg]", ""),
+                ("points", "points", "d"),
+                ("wl_min", "\u03bb min [nm]", ".5g"),
+                ("wl_max", "\u03bb max [nm]", ".5g"),
+                ("mean_diff", "mean diff [1]", ".3g"),
+                ("rms_diff", "rms diff [1]", ".3g"),
+                ("median_sigma", "median \u03c3 diff [1]", ".2g"),
+                ("chi2_dof", "\u03c7\u00b2/dof", ".3g"),
+                ("p_value", "p", ".2g"),
+                ("outside", "rows outside n, k range", "d"),
+            ],
+            cmp_rows,
+            caption="diff = measured - predicted; sigma diff adds the measurement's and the "
+            "prediction's 1-sigma in quadrature (the prediction's alone where the file has "
+            "none: a lower bound). Spectrophotometer rows without an angle are taken at "
+            "normal incidence.",
+        )
+
+
+def ell_cond_limit() -> float:
+    """Condition number above which a pseudo-n, k point counts as ill-conditioned [1]."""
+    return float(ell.COND_WARN)
