@@ -492,6 +492,26 @@ def _nk_at(table: Any, wavelength_nm: float, path: str) -> tuple[float, float]:
     return n, k
 
 
+def _model_from_args(args: argparse.Namespace) -> tuple[Any, dict[str, float]]:
+    """Build the model of ``--model`` and return it with the ``--param`` parameter values.
+
+    Model options come from ``--param`` (and ``--nk-from``'s n, k at ``--wavelength``).
+    """
+    from . import models
+
+    options, values = _split_params(args.model, args.param)
+    if args.nk_from:
+        if args.wavelength is None:
+            raise UsageError("--nk-from needs --wavelength NM")
+        options["n"], options["k"] = _nk_at(
+            _nk_combined(args.nk_from), args.wavelength, args.nk_from
+        )
+    try:
+        return models.get(args.model, **options), values
+    except models.ModelError as exc:
+        raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
+
+
 def cmd_nk(args: argparse.Namespace) -> int:
     from . import adapters
     from .nk import combined_table, nk_json, nk_table
@@ -529,7 +549,6 @@ def cmd_nk(args: argparse.Namespace) -> int:
 def cmd_export(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from . import models
     from .adapters.zemax_bsdf import model_to_bsdf
     from .outputs import check_file_output
 
@@ -541,17 +560,7 @@ def cmd_export(args: argparse.Namespace) -> int:
         return _export_trace(args)
     if args.theta_i is None:
         raise UsageError("--model needs --theta-i DEG [DEG ...]")
-    options, values = _split_params(args.model, args.param)
-    if args.nk_from:
-        if args.wavelength is None:
-            raise UsageError("--nk-from needs --wavelength NM")
-        options["n"], options["k"] = _nk_at(
-            _nk_combined(args.nk_from), args.wavelength, args.nk_from
-        )
-    try:
-        model = models.get(args.model, **options)
-    except models.ModelError as exc:
-        raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
+    model, values = _model_from_args(args)
     unknown = [k for k in values if k not in model.params]
     if unknown:
         raise UsageError(f"--param {unknown}: {args.model} parameters are {list(model.params)}")
@@ -699,20 +708,9 @@ def cmd_surface(args: argparse.Namespace) -> int:
 def cmd_hemispherical(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from . import models
     from .integrate import hemispherical_reflectance
 
-    options, params = _split_params(args.model, args.param)
-    if args.nk_from:
-        if args.wavelength is None:
-            raise UsageError("--nk-from needs --wavelength NM")
-        options["n"], options["k"] = _nk_at(
-            _nk_combined(args.nk_from), args.wavelength, args.nk_from
-        )
-    try:
-        model = models.get(args.model, **options)
-    except models.ModelError as exc:
-        raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
+    model, params = _model_from_args(args)
     theta = np.asarray(args.theta_i, dtype=float)
     rho = np.atleast_1d(hemispherical_reflectance(model, params, theta))
     if args.json:
