@@ -368,6 +368,9 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
             processes=True,
             host="127.0.0.1",
             dashboard_address="127.0.0.1:8787" if dash else None,
+            # each worker's own HTTP server (metrics): older distributed releases (2024.8)
+            # bind it to 0.0.0.0 unless told
+            worker_dashboard_address="127.0.0.1:0",
             scheduler_kwargs={
                 "allowed_failures": key[1],
                 "dashboard": dash,
