@@ -644,14 +644,12 @@ def _height_map(path: str, channel: str | None) -> Any:
 
 def _ggx_alpha_of(path: str, channel: str | None) -> float:
     """GGX alpha fitted by maximum likelihood to the slopes of a measured areal map."""
-    from .topography import fit_slope_distribution, level, slopes
+    from .tracer import Substrate
 
     hm = _height_map(path, channel)
     if hm.heights.ndim != 2:
         raise UsageError(f"{path}: a line profile; the coating needs an areal height map")
-    z = level(hm.heights, 1)
-    sx, sy = slopes(z, hm.pixel_size)
-    return float(fit_slope_distribution(sx, sy).ggx.alpha)
+    return float(Substrate.from_surface(hm.heights, hm.pixel_size).alpha)
 
 
 def cmd_surface(args: argparse.Namespace) -> int:
@@ -664,11 +662,11 @@ def cmd_surface(args: argparse.Namespace) -> int:
     hm = _height_map(args.file, args.channel)
     st = roughness_statistics(hm.heights, hm.pixel_size, degree=args.degree, blocks=args.blocks)
     if args.png:
-        from .report.figures import save_surface_png, surface_figure
+        from .report.figures import save_png, surface_figure
 
         z = level(hm.heights, args.degree)
         uri = surface_figure(z, hm.pixel_size, st, title=f"{Path(args.file).name} ({hm.channel})")
-        save_surface_png(uri, args.png)
+        save_png(uri, args.png)
     d = st.to_dict()
     d["file"] = str(args.file)
     d["channel"] = hm.channel
@@ -754,11 +752,9 @@ def cmd_trace(args: argparse.Namespace) -> int:
     else:
         sub = _complex(args.substrate, "--substrate")
     if args.surface is not None:
-        from .topography import level
-
         hm = _height_map(args.surface, args.channel)
         substrate = tracer.Substrate.from_surface(
-            level(hm.heights, 1), hm.pixel_size, n=sub.real, k=sub.imag
+            hm.heights, hm.pixel_size, n=sub.real, k=sub.imag
         )
     elif args.alpha is None:
         raise UsageError("give the substrate roughness with --alpha A or --surface FILE")

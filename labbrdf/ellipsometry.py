@@ -70,7 +70,8 @@ COND_WARN = 30.0
 #: Above this condition number :func:`pseudo_nk` raises (by default): 0.02 deg of psi or
 #: Delta then moves ``|N|`` by more than 10 %. Reached below about 6 deg for Si or Ta,
 #: 4 deg for glass; the condition number grows as ``1/theta^2`` towards normal incidence.
-COND_MAX = 300.0
+#: The same threshold at which :func:`labbrdf.optics.nk_from_psi_delta` warns.
+COND_MAX = optics.NK_COND_MAX
 #: p-value below which the pseudo-constants of several angles are flagged angle-dependent.
 P_ANGLE_DEPENDENT = 0.01
 

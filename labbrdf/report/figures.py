@@ -57,6 +57,14 @@ def _finish(fig: Any, ax: Any, title: str | None) -> str:
     return to_uri(fig)
 
 
+def _finish_grid(fig: Any, title: str | None, fontsize: float = 12.0, dpi: int = DPI) -> str:
+    """Figure title (if any), tight layout, then the figure as a PNG data URI."""
+    if title:
+        fig.suptitle(_text(title), fontsize=fontsize)
+    fig.tight_layout()
+    return to_uri(fig, dpi=dpi)
+
+
 def _text(s: Any) -> str:
     # matplotlib mathtext interprets $...$: show file text literally
     return str(s).replace("$", r"\$")
@@ -126,10 +134,7 @@ def scan_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
         ax.grid(alpha=0.3)
         axr.grid(alpha=0.3)
     axes[0, 0].legend(fontsize=6.5, loc="best")
-    if title:
-        fig.suptitle(_text(title), fontsize=11)
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish_grid(fig, title, fontsize=11)
 
 
 def spectra_figure(
@@ -185,10 +190,7 @@ def spectra_figure(
         ax.set_ylabel(f"{p} [{units.get(p, '1')}]")
         ax.grid(alpha=0.3)
     axes[0, 0].legend(fontsize=7)
-    if title:
-        fig.suptitle(_text(title), fontsize=11)
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish_grid(fig, title, fontsize=11)
 
 
 def compare_models_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
@@ -219,10 +221,7 @@ def compare_models_figure(panels: Sequence[Mapping[str, Any]], title: str = "") 
             ax.set_ylabel(r"BRDF [sr$^{-1}$]")
         ax.grid(alpha=0.3)
     axes[0, 0].legend(fontsize=7)
-    if title:
-        fig.suptitle(_text(title), fontsize=11)
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish_grid(fig, title, fontsize=11)
 
 
 def hemispherical_figure(
@@ -371,10 +370,7 @@ def polar_maps_figure(
         r"$\theta_r$ [deg]",
         fontsize=7,
     )
-    if title:
-        fig.suptitle(_text(title), fontsize=11)
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish_grid(fig, title, fontsize=11)
 
 
 def save_trace_maps_png(result: Any, path: str | Any, stokes_in: Any = (1, 0, 0, 0)) -> Any:
@@ -393,8 +389,6 @@ def save_trace_maps_png(result: Any, path: str | Any, stokes_in: Any = (1, 0, 0,
     -------
     pathlib.Path
     """
-    from pathlib import Path
-
     m = np.asarray(result.mueller, float)
     s = m @ np.asarray(stokes_in, float)
     s0 = s[..., 0]
@@ -408,9 +402,7 @@ def save_trace_maps_png(result: Any, path: str | Any, stokes_in: Any = (1, 0, 0,
         np.asarray(result.phi_r_edges_deg, float),
         title=f"input Stokes {list(stokes_in)}",
     )
-    p = Path(path)
-    p.write_bytes(base64.b64decode(uri.split(",", 1)[1]))
-    return p
+    return save_png(uri, path)
 
 
 def surface_figure(
@@ -513,13 +505,23 @@ def surface_figure(
     ax.set_ylabel("density")
     ax.set_title("slope distribution")
     ax.legend(fontsize=8)
-    fig.suptitle(_text(title))
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish_grid(fig, title)
 
 
-def save_surface_png(uri: str, path: Any) -> Any:
-    """Write a figure data URI of :func:`surface_figure` to a PNG file (atomically)."""
+def save_png(uri: str, path: Any) -> Any:
+    """Write a figure's PNG data URI to ``path`` atomically (never a half-written file).
+
+    Parameters
+    ----------
+    uri : str
+        ``data:image/png;base64,...`` as the figure functions return it.
+    path : path-like
+        Output ``.png``.
+
+    Returns
+    -------
+    pathlib.Path
+    """
     from pathlib import Path
 
     from labbrdf.outputs import atomic_output
@@ -613,10 +615,7 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
         axes[i, 0].set_ylabel(r"$\theta_r \sin\varphi_r$ [deg]", fontsize=7)
     for ax in axes[-1]:
         ax.set_xlabel(r"$\theta_r \cos\varphi_r$ [deg]", fontsize=7)
-    if title:
-        fig.suptitle(_text(title), fontsize=10)
-    fig.tight_layout()
-    return to_uri(fig, dpi=100)
+    return _finish_grid(fig, title, fontsize=10, dpi=100)
 
 
 def brdf_residual_grid_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
@@ -702,10 +701,7 @@ def brdf_cuts_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
             ax.set_xlabel(r"signed $\theta_r$ [deg] (+: specular side)", fontsize=7)
         if k == 0:
             ax.legend(fontsize=6)
-    if title:
-        fig.suptitle(_text(title), fontsize=10)
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish_grid(fig, title, fontsize=10)
 
 
 # --------------------------------------------------------------------------- measured data
@@ -794,10 +790,7 @@ def panels_figure(
         ax.grid(alpha=0.3)
         if any(s.get("label") for s in series) and len(series) <= 12:
             ax.legend(fontsize=6, loc="best")
-    if title:
-        fig.suptitle(_text(title), fontsize=10)
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish_grid(fig, title, fontsize=10)
 
 
 def map_figure(
@@ -841,7 +834,4 @@ def map_figure(
         ax.set_aspect("equal", adjustable="datalim")
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)
-    if title:
-        fig.suptitle(_text(title), fontsize=10)
-    fig.tight_layout()
-    return to_uri(fig)
+    return _finish_grid(fig, title, fontsize=10)
