@@ -115,7 +115,9 @@ def test_report_refuses_the_current_folder(tmp_path, capsys, monkeypatch):
     assert snapshot(tmp_path) == before
 
 
-def test_report_refuses_a_non_empty_folder_and_replaces_an_earlier_report(tmp_path, capsys):
+def test_report_refuses_a_non_empty_folder_and_replaces_an_earlier_report_on_request(
+    tmp_path, capsys
+):
     bad = tmp_path / "bad.xyz"  # unreadable: a failed check, but a quick report
     bad.write_text("x\n")
     out = tmp_path / "rep"
@@ -125,10 +127,14 @@ def test_report_refuses_a_non_empty_folder_and_replaces_an_earlier_report(tmp_pa
     assert (out / "mine.txt").read_text() == "mine"
     (out / "mine.txt").unlink()
     assert main(["report", str(bad), "-o", str(out)]) == 1
-    assert main(["report", str(bad), "-o", str(out)]) == 1  # an earlier report: replaced
+    first = snapshot(out)
+    expect_refused(capsys, ["report", str(bad), "-o", str(out)], "earlier", "--overwrite")
+    assert snapshot(out) == first
+    assert main(["report", str(bad), "-o", str(out), "--overwrite"]) == 1  # replaced
     assert (out / ".labbrdf-report").is_file()
     (out / "tables" / "extra.xlsx").write_text("mine")
-    expect_refused(capsys, ["report", str(bad), "-o", str(out)], "tables/extra.xlsx")
+    argv = ["report", str(bad), "-o", str(out), "--overwrite"]
+    expect_refused(capsys, argv, "tables/extra.xlsx")
     assert (out / "tables" / "extra.xlsx").read_text() == "mine"
 
 
