@@ -910,11 +910,9 @@ def cmd_trace(args: argparse.Namespace) -> int:
     if args.output:
         result.save(args.output)
     if args.png:
-        from .outputs import atomic_output
         from .report.figures import save_trace_maps_png
 
-        with atomic_output(args.png) as tmp:
-            save_trace_maps_png(result, tmp)
+        save_trace_maps_png(result, args.png)  # atomically
     summary = tracer.trace_summary(result)
     summary["seconds"] = seconds
     if args.json:

@@ -112,9 +112,10 @@ _LIBRARY_POLICY = WritePolicy()
 _POLICY: ContextVar[WritePolicy | None] = ContextVar("labbrdf_write_policy", default=None)
 
 
-#: temporary files of this process's open :func:`atomic_output` blocks: a nested block
-#: writing onto one of them (a writer given the temporary name) replaces it
-_OWN_TMPS: set[str] = set()
+#: temporary files of this process's open :func:`atomic_output` blocks and their targets:
+#: a nested block writing onto one of them (a writer given the temporary name) replaces
+#: it, and names the real target in its messages
+_OWN_TMPS: dict[str, Path] = {}
 
 
 def _current() -> WritePolicy:
@@ -194,7 +195,7 @@ def _pid_alive(pid: int) -> bool:
 
 
 def _display(path: Path | str) -> str:
-    return str(path)
+    return str(_OWN_TMPS.get(os.path.abspath(path), path))
 
 
 def _wraps_oserror(path: Path | str, what: str, exc: OSError) -> OutputError:
@@ -468,7 +469,7 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
     except OSError as exc:
         raise _wraps_oserror(target, "cannot write", exc) from None
     os.close(fd)
-    _OWN_TMPS.add(os.path.abspath(tmp))
+    _OWN_TMPS[os.path.abspath(tmp)] = _OWN_TMPS.get(os.path.abspath(target), target)
     try:
         try:
             yield tmp
@@ -486,15 +487,13 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
             os.chmod(tmp, mode if mode is not None else 0o666 & ~_umask())
             if target.is_dir():
                 raise OutputError(f"cannot write {target}: is an existing folder")
-            _put_in_place(
-                tmp, target, policy.overwrite or os.path.abspath(target) in _OWN_TMPS
-            )
+            _put_in_place(tmp, target, policy.overwrite or os.path.abspath(target) in _OWN_TMPS)
         except OutputError:
             raise
         except OSError as exc:
             raise _wraps_oserror(target, "cannot write", exc) from None
     finally:
-        _OWN_TMPS.discard(os.path.abspath(tmp))
+        _OWN_TMPS.pop(os.path.abspath(tmp), None)
         if os.path.lexists(tmp):
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
