@@ -321,15 +321,7 @@ def _fake_height_map(path, channel):
     rng = np.random.default_rng(3)
     z = rng.normal(size=(64, 64))
     z = (z + np.roll(z, 1, 0) + np.roll(z, 1, 1) + np.roll(z, 1, (0, 1))) * 1e-9
-    return HeightMap(
-        heights=z,
-        pixel_size=(1e-7, 1e-7),
-        path=str(path),
-        channel="height",
-        channels=("height",),
-        meta={},
-        warnings=(),
-    )
+    return HeightMap(heights=z, pixel_size=(1e-7, 1e-7), path=str(path), channel="height")
 
 
 def _fake_validate(out="reports/validation", **kw):
