@@ -26,7 +26,7 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
 report: $(STAMP)
-	$(BIN)/labbrdf validate --out reports/validation
+	$(BIN)/labbrdf validate --out reports/validation --overwrite
 
 lint: $(STAMP)
 	$(BIN)/ruff check labbrdf tests benchmarks

@@ -7,18 +7,24 @@ or output error (unreadable file, unknown name, an output path that is refused o
 written, ...), 3 ``fit``: some groups could not be fitted or did not converge (listed with
 ``success`` false and the reason), 141 the reader of our output went away; the error is on
 stderr. Every output path goes through :mod:`labbrdf.outputs`.
+
+Arguments that name files are declared as :class:`InputPath` or :class:`OutputPath`; before
+a command runs, :func:`_checked_outputs` checks all its outputs against all its inputs and
+runs it under one rule (:func:`labbrdf.outputs.write_policy`): an existing output is
+replaced only with ``--overwrite``, an input never, and every write is atomic.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import json
 import math
 import os
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any, Literal
 
@@ -29,6 +35,117 @@ __all__ = ["main"]
 
 class UsageError(Exception):
     """A command-line input error: printed, exit code 2."""
+
+
+# ------------------------------------------------------------------------- input/output paths
+
+
+class InputPath(argparse.Action):
+    """An option or positional argument that names files the command reads.
+
+    Every output of the command refuses all of them (see :func:`_checked_outputs`), so
+    an option declared with ``action=InputPath`` cannot be forgotten by a writer.
+    """
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        setattr(namespace, self.dest, values)
+
+
+class OutputPath(argparse.Action):
+    """An option that names an output the command writes; checked before it runs.
+
+    ``kind`` is ``"file"`` (with the accepted ``suffixes``) or ``"dir"`` (a report folder).
+    """
+
+    def __init__(
+        self,
+        option_strings: Sequence[str],
+        dest: str,
+        *,
+        suffixes: Sequence[str] = (),
+        kind: Literal["file", "dir"] = "file",
+        **kw: Any,
+    ) -> None:
+        super().__init__(option_strings, dest, **kw)
+        self.suffixes = tuple(suffixes)
+        self.kind = kind
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        setattr(namespace, self.dest, values)
+
+
+def path_actions(parser: argparse.ArgumentParser) -> list[argparse.Action]:
+    """The :class:`InputPath` and :class:`OutputPath` arguments of a (sub)parser."""
+    return [a for a in parser._actions if isinstance(a, InputPath | OutputPath)]
+
+
+def _option_name(a: argparse.Action) -> str:
+    return a.option_strings[0] if a.option_strings else str(a.metavar or a.dest)
+
+
+def _named_paths(args: argparse.Namespace, kind: type) -> list[tuple[argparse.Action, str]]:
+    out: list[tuple[argparse.Action, str]] = []
+    actions: Sequence[argparse.Action] = getattr(args, "path_actions", ())
+    for a in actions:
+        v = getattr(args, a.dest, None)
+        if isinstance(a, kind) and v is not None:
+            out.extend((a, str(p)) for p in (v if isinstance(v, list) else [v]))
+    return out
+
+
+def _inputs(args: argparse.Namespace) -> list[str]:
+    """Every file the command reads, whichever option names it."""
+    return [p for _, p in _named_paths(args, InputPath)]
+
+
+@contextlib.contextmanager
+def _checked_outputs(args: argparse.Namespace) -> Iterator[None]:
+    """Check every input and output of the command, then run it under the output rule.
+
+    The rule (:func:`labbrdf.outputs.write_policy`): an existing output is replaced only
+    with ``--overwrite``, an input never; every file written inside, sidecars included,
+    follows it.
+    """
+    from .outputs import check_file_output, check_input_files, check_report_dir, write_policy
+
+    inputs = _inputs(args)
+    with write_policy(overwrite=bool(getattr(args, "overwrite", False)), inputs=inputs):
+        check_input_files(inputs)
+        seen: dict[Path, str] = {}
+        for a, path in _named_paths(args, OutputPath):
+            if not isinstance(a, OutputPath):  # pragma: no cover - _named_paths filtered
+                continue
+            name = _option_name(a)
+            if a.kind == "dir":
+                out = check_report_dir(path, option=name)
+            else:
+                out = check_file_output(path, suffixes=a.suffixes, option=name)
+            key = Path(os.path.abspath(out))
+            if key in seen:
+                raise UsageError(f"{name} {path}: also given to {seen[key]}; expected two names")
+            seen[key] = name
+        yield
+
+
+def _add_overwrite(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace existing outputs (never an input); without it an existing file is "
+        "refused before any work",
+    )
 
 
 def _emit_json(obj: Any) -> None:
@@ -136,9 +253,23 @@ def _add_scheduler(p: argparse.ArgumentParser) -> None:
         "a trusted network only)",
     )
     p.add_argument("--workers", type=int, default=None, help="worker processes (default: cores)")
-    p.add_argument("--tls-ca", default=None, metavar="PEM", help="CA certificate (tls://)")
-    p.add_argument("--tls-cert", default=None, metavar="PEM", help="this client's certificate")
-    p.add_argument("--tls-key", default=None, metavar="PEM", help="this client's private key")
+    p.add_argument(
+        "--tls-ca", action=InputPath, default=None, metavar="PEM", help="CA certificate (tls://)"
+    )
+    p.add_argument(
+        "--tls-cert",
+        action=InputPath,
+        default=None,
+        metavar="PEM",
+        help="this client's certificate",
+    )
+    p.add_argument(
+        "--tls-key",
+        action=InputPath,
+        default=None,
+        metavar="PEM",
+        help="this client's private key",
+    )
     p.add_argument(
         "--dashboard", action="store_true", help="start the local cluster's dashboard (127.0.0.1)"
     )
@@ -190,16 +321,17 @@ def _executor_errors(cmd: Any) -> Any:
 def cmd_ingest(args: argparse.Namespace) -> int:
     from . import adapters
     from .dataset import concat, write
-    from .outputs import check_file_output, check_input_files
+    from .outputs import check_file_output
 
-    check_input_files(args.files)
     out = None
-    if args.output:
-        out = check_file_output(args.output, inputs=args.files, suffixes=(".parquet", ".csv"))
+    if args.output:  # checked with the inputs by _checked_outputs
+        out = Path(args.output)
         if out.suffix.lower() == ".csv":  # its metadata goes to a sidecar beside it
             from .dataset import sidecar_path
 
-            check_file_output(sidecar_path(out), inputs=args.files, suffixes=(".json",))
+            check_file_output(
+                sidecar_path(out), suffixes=(".json",), option=f"-o {out}: its metadata file"
+            )
     from .selection import SelectionError
 
     rows: list[dict[str, Any]] = []
@@ -317,12 +449,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
     from . import adapters, models
     from .fitting import fit_many
-    from .outputs import check_file_output, check_input_files
 
     _check_executor(args)
-    check_input_files(args.files)
-    if args.output:
-        check_file_output(args.output, inputs=args.files, suffixes=(".csv",))
     data = _selected(args, adapters.read_many(args.files))
     fix = _parse_assignments(args.fix, "--fix")
     options, start = _split_params(args.model, args.param)
@@ -515,11 +643,8 @@ def _model_from_args(args: argparse.Namespace) -> tuple[Any, dict[str, float]]:
 def cmd_nk(args: argparse.Namespace) -> int:
     from . import adapters
     from .nk import combined_table, nk_json, nk_table
-    from .outputs import atomic_output, check_file_output, check_input_files, csv_safe_frame
+    from .outputs import atomic_output, csv_safe_frame
 
-    check_input_files(args.files)
-    if args.output:
-        check_file_output(args.output, inputs=args.files, suffixes=(".csv",))
     data = _selected(args, adapters.read_many(args.files))
     on_ill: Literal["warn", "raise"] = "warn" if args.allow_ill_conditioned else "raise"
     table = nk_table(data, on_ill_conditioned=on_ill, theta_sigma_deg=args.theta_sigma)
@@ -550,7 +675,6 @@ def cmd_export(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .adapters.zemax_bsdf import model_to_bsdf
-    from .outputs import check_file_output
 
     if args.format != "zemax-bsdf":
         raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
@@ -564,11 +688,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     unknown = [k for k in values if k not in model.params]
     if unknown:
         raise UsageError(f"--param {unknown}: {args.model} parameters are {list(model.params)}")
-    out = check_file_output(
-        args.output, inputs=[args.nk_from] if args.nk_from else [], suffixes=(".bsdf",)
-    )
-    if out.exists() and not args.overwrite:
-        raise UsageError(f"-o {out}: exists; pass --overwrite to replace it")
+    out = Path(args.output)  # checked with the inputs by _checked_outputs
     model_to_bsdf(
         model,
         values,
@@ -585,13 +705,9 @@ def cmd_export(args: argparse.Namespace) -> int:
 def _export_trace(args: argparse.Namespace) -> int:
     """``export --trace RUN.npz``: the tracer's unpolarized S0 on the scatter grid."""
     from .adapters.zemax_bsdf import binned_to_bsdf
-    from .outputs import check_file_output, check_input_files
     from .tracer import TraceResult
 
-    check_input_files([args.trace])
-    out = check_file_output(args.output, inputs=[args.trace], suffixes=(".bsdf",))
-    if out.exists() and not args.overwrite:
-        raise UsageError(f"-o {out}: exists; pass --overwrite to replace it")
+    out = Path(args.output)  # checked with the inputs by _checked_outputs
     if args.theta_i is not None or args.param or args.nk_from:
         raise UsageError(
             "--trace takes its angle and material from the run; drop --theta-i/--param"
@@ -736,14 +852,9 @@ def _complex(text: str, what: str) -> complex:
 def cmd_trace(args: argparse.Namespace) -> int:
 
     from . import tracer
-    from .outputs import check_file_output
     from .parallel import imap
 
-    _check_executor(args)
-    if args.output:
-        check_file_output(args.output, suffixes=(".npz",))
-    if args.png:
-        check_file_output(args.png, suffixes=(".png",), option="--png")
+    _check_executor(args)  # the outputs were checked with the inputs by _checked_outputs
     if (args.substrate is None) == (args.nk_from is None):
         raise UsageError("give the substrate index with --substrate N+Kj or --nk-from FILE")
     if args.nk_from is not None:
@@ -805,11 +916,9 @@ def cmd_trace(args: argparse.Namespace) -> int:
     if args.output:
         result.save(args.output)
     if args.png:
-        from .outputs import atomic_output
         from .report.figures import save_trace_maps_png
 
-        with atomic_output(args.png) as tmp:
-            save_trace_maps_png(result, tmp)
+        save_trace_maps_png(result, args.png)  # atomically
     summary = tracer.trace_summary(result)
     summary["seconds"] = seconds
     if args.json:
@@ -834,7 +943,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from .report.validate import default_fixtures_dir
 
     _check_executor(args)
-    check_report_dir(args.out, inputs=[default_fixtures_dir()], option="--out")
+    check_report_dir(args.out, inputs=[default_fixtures_dir()], option="--out")  # the fixtures
     return int(
         validate(
             out=args.out,
@@ -847,11 +956,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    from .outputs import check_input_files, check_report_dir
     from .report import user_report
 
-    check_input_files(args.files)
-    check_report_dir(args.output, inputs=args.files)
     options, start = _split_params(args.model, args.param)
     selection = {k: getattr(args, k) for k in SELECTION_KEYS if getattr(args, k) is not None}
     return int(
@@ -882,9 +988,17 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     s = sub.add_parser("ingest", help="read instrument exports into one dataset")
-    s.add_argument("files", nargs="+", metavar="FILE")
+    s.add_argument("files", nargs="+", action=InputPath, metavar="FILE")
     s.add_argument("--format", default=None, help="force an adapter (see `labbrdf formats`)")
-    s.add_argument("-o", "--output", default=None, help="write OUT.parquet or OUT.csv")
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".parquet", ".csv"),
+        default=None,
+        help="write OUT.parquet, or OUT.csv and its metadata OUT.meta.json",
+    )
+    _add_overwrite(s)
     s.add_argument("--json", action="store_true", help="print a JSON list, one object per file")
     s.add_argument("--keep-going", action="store_true", help="read the rest after a failure")
     _add_selection(s)
@@ -895,7 +1009,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_formats)
 
     s = sub.add_parser("fit", help="fit a model per group (sample, wavelength)")
-    s.add_argument("files", nargs="+", metavar="FILE_OR_DATASET")
+    s.add_argument("files", nargs="+", action=InputPath, metavar="FILE_OR_DATASET")
     s.add_argument("--model", required=True)
     s.add_argument("--by", default="sample,wavelength_nm", help="comma-separated group columns")
     s.add_argument("--method", default="GN_CRS2_LM+LN_BOBYQA", help="nlopt GLOBAL[+LOCAL]")
@@ -912,7 +1026,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--free", action="append", metavar="NAME", help="vary a parameter fixed by default"
     )
     s.add_argument(
-        "--nk-from", default=None, metavar="FILE", help="n, k from psi/Delta (microfacet)"
+        "--nk-from",
+        action=InputPath,
+        default=None,
+        metavar="FILE",
+        help="n, k from psi/Delta (microfacet)",
     )
     s.add_argument(
         "--nk-wavelength",
@@ -929,15 +1047,31 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s.add_argument("--relative-floor", type=float, default=1e-3, help="of max |y| (relative)")
     s.add_argument("--keep-zeros", action="store_true", help="fit points with value 0 too")
-    s.add_argument("-o", "--output", default=None, help="write the parameter table (CSV)")
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".csv",),
+        default=None,
+        help="write the parameter table (CSV)",
+    )
+    _add_overwrite(s)
     s.add_argument("--json", action="store_true")
     _add_selection(s)
     _add_scheduler(s)
     s.set_defaults(func=cmd_fit)
 
     s = sub.add_parser("nk", help="optical constants n, k from ellipsometer psi/Delta")
-    s.add_argument("files", nargs="+", metavar="FILE")
-    s.add_argument("-o", "--output", default=None, help="write the table (CSV)")
+    s.add_argument("files", nargs="+", action=InputPath, metavar="FILE")
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".csv",),
+        default=None,
+        help="write the table (CSV)",
+    )
+    _add_overwrite(s)
     s.add_argument("--combined", action="store_true", help="-o writes the per-wavelength table")
     s.add_argument("--theta-sigma", type=float, default=0.0, help="angle uncertainty [deg]")
     s.add_argument(
@@ -950,43 +1084,64 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_nk)
 
     s = sub.add_parser("surface", help="roughness statistics of a height map or profile")
-    s.add_argument("file", metavar="FILE")
+    s.add_argument("file", action=InputPath, metavar="FILE")
     s.add_argument("--channel", default=None, help="channel name or index (default: height)")
     s.add_argument("--degree", type=int, default=1, help="levelling polynomial (1 = plane)")
     s.add_argument("--blocks", type=int, default=None, help="tiles per axis for uncertainties")
-    s.add_argument("--png", default=None, help="write map, ACF and slope histogram (.png)")
+    s.add_argument(
+        "--png",
+        action=OutputPath,
+        suffixes=(".png",),
+        default=None,
+        help="write map, ACF and slope histogram (.png)",
+    )
+    _add_overwrite(s)
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_surface)
 
     s = sub.add_parser("export", help="write a model BRDF in an exchange format")
     s.add_argument("--format", default="zemax-bsdf", help="zemax-bsdf")
     s.add_argument("--model", default=None, help="a model (with --param) ...")
-    s.add_argument("--trace", default=None, metavar="RUN.npz", help="... or a trace's S0")
+    s.add_argument(
+        "--trace", action=InputPath, default=None, metavar="RUN.npz", help="... or a trace's S0"
+    )
     s.add_argument("--param", action="append", metavar="NAME=VALUE")
-    s.add_argument("--nk-from", default=None, metavar="FILE")
+    s.add_argument("--nk-from", action=InputPath, default=None, metavar="FILE")
     s.add_argument("--wavelength", type=float, default=None, help="[nm] for --nk-from")
     s.add_argument("--theta-i", type=float, nargs="+", default=None, metavar="DEG")
     s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")
     s.add_argument("--azimuth", default="0:180:5", help="START:STOP:STEP [deg]")
-    s.add_argument("-o", "--output", required=True)
-    s.add_argument("--overwrite", action="store_true")
+    s.add_argument("-o", "--output", action=OutputPath, suffixes=(".bsdf",), required=True)
+    _add_overwrite(s)
     s.set_defaults(func=cmd_export)
 
     s = sub.add_parser("hemispherical", help="directional-hemispherical reflectance of a model")
     s.add_argument("--model", required=True)
     s.add_argument("--param", action="append", metavar="NAME=VALUE")
     s.add_argument("--theta-i", type=float, nargs="+", required=True, metavar="DEG")
-    s.add_argument("--nk-from", default=None, metavar="FILE", help="n, k from psi/Delta")
+    s.add_argument(
+        "--nk-from", action=InputPath, default=None, metavar="FILE", help="n, k from psi/Delta"
+    )
     s.add_argument("--wavelength", type=float, default=None, help="[nm] for --nk-from")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_hemispherical)
 
     s = sub.add_parser("trace", help="Monte Carlo polarization ray tracing (pBRDF)")
     s.add_argument("--substrate", default=None, help="complex index, e.g. 1.55+7.71j")
-    s.add_argument("--nk-from", default=None, metavar="FILE", help="substrate n, k from psi/Delta")
+    s.add_argument(
+        "--nk-from",
+        action=InputPath,
+        default=None,
+        metavar="FILE",
+        help="substrate n, k from psi/Delta",
+    )
     s.add_argument("--alpha", type=float, default=None, help="GGX roughness of the substrate")
     s.add_argument(
-        "--surface", default=None, metavar="FILE", help="measured height map: its slope table"
+        "--surface",
+        action=InputPath,
+        default=None,
+        metavar="FILE",
+        help="measured height map: its slope table",
     )
     s.add_argument("--channel", default=None, help="height channel of --surface")
     s.add_argument("--coating", default=None, help="coating index, e.g. 1.5")
@@ -994,6 +1149,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--coating-alpha", type=float, default=None)
     s.add_argument(
         "--coating-surface",
+        action=InputPath,
         default=None,
         metavar="FILE",
         help="measured height map of the coating's top: its ML GGX alpha",
@@ -1004,14 +1160,29 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=int, default=1)
     s.add_argument("--single-scattering", action="store_true")
     s.add_argument("--coherent", action="store_true")
-    s.add_argument("-o", "--output", default=None, help="write the pBRDF (.npz)")
-    s.add_argument("--png", default=None, help="write S0/DOP hemisphere maps (.png)")
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".npz",),
+        default=None,
+        help="write the pBRDF (.npz)",
+    )
+    s.add_argument(
+        "--png",
+        action=OutputPath,
+        suffixes=(".png",),
+        default=None,
+        help="write S0/DOP hemisphere maps (.png)",
+    )
+    _add_overwrite(s)
     s.add_argument("--json", action="store_true")
     _add_scheduler(s)
     s.set_defaults(func=cmd_trace)
 
     s = sub.add_parser("validate", help="run the whole validation and write the HTML report")
-    s.add_argument("--out", default="reports/validation")
+    s.add_argument("--out", action=OutputPath, kind="dir", default="reports/validation")
+    _add_overwrite(s)
     s.add_argument("--quick", action="store_true", help="small scale (tests, previews)")
     _add_scheduler(s)
     s.set_defaults(func=cmd_validate)
@@ -1020,6 +1191,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument(
         "files",
         nargs="+",
+        action=InputPath,
         metavar="DATA",
         help="instrument exports, .bsdf files, datasets and height maps (.di, .opdx, ...)",
     )
@@ -1030,10 +1202,13 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="NAME=VALUE",
         help="a model option (microfacet n=, k=, diffuse=true) or a parameter's start value",
     )
-    s.add_argument("-o", "--output", required=True, metavar="DIR")
+    s.add_argument("-o", "--output", action=OutputPath, kind="dir", required=True, metavar="DIR")
+    _add_overwrite(s)
     s.add_argument("--quiet", action="store_true", help="no progress lines")
     _add_selection(s)
     s.set_defaults(func=cmd_report)
+    for sp in sub.choices.values():  # what _checked_outputs checks, per command
+        sp.set_defaults(path_actions=tuple(path_actions(sp)))
     return p
 
 
@@ -1042,7 +1217,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.func(args))
+        with _checked_outputs(args):
+            return int(args.func(args))
     except UsageError as exc:
         print(f"labbrdf {args.command}: {exc}", file=sys.stderr)
         return 2
