@@ -60,17 +60,28 @@ templates_path = ["_templates"]
 html_theme_options = {"description": "Optical metrology of surfaces: files to fits to reports"}
 
 
+def _top_level() -> dict[str, object]:
+    import labbrdf
+
+    return {name: getattr(labbrdf, name) for name in labbrdf._LAZY}
+
+
 def _skip_shadowed(app, what, name, obj, skip, options):  # noqa: ANN001, ANN202, ARG001
     """Skip a package attribute named like one of its submodules.
 
     ``labbrdf.report.validate`` is both a function (re-exported by the package) and a
-    module; the function is documented on its module's page, where it is defined.
+    module; the function is documented on its module's page, where it is defined. A class
+    that ``labbrdf`` offers at the top (``Substrate``) is documented once, as
+    ``labbrdf.Substrate``, not again on the pages of the modules that define or re-export it.
     """
     if isinstance(obj, types.GenericAlias):
         return True  # a type alias (``Section``): autodoc cannot sign it; its #: comment stays
     module = getattr(obj, "__module__", None) or ""
     if what == "module" and module.endswith("." + name):
         return True
+    if what == "module" and isinstance(obj, type) and _top_level().get(name) is obj:
+        return True  # a class labbrdf offers at the top is documented once, there
+
     return None
 
 

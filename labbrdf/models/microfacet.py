@@ -117,10 +117,11 @@ def stokes_from_jones(jones: NDArray) -> NDArray[np.float64]:
 class Microfacet(Model):
     """GGX microfacet BRDF with Smith G1 G1 and the exact Fresnel factor of a substrate.
 
-    Options (exactly one of the first three)
-    ----------------------------------------
+    Other Parameters
+    ----------------
     n, k : float
-        Complex index N = n + ik of the substrate (k >= 0), ambient index 1.
+        Complex index N = n + ik of the substrate (k >= 0), ambient index 1. Give exactly
+        one of ``n, k``, ``psi_delta`` and ``ideal_mirror``.
     psi_delta : tuple of float
         ``(psi_deg, delta_deg, theta_deg)`` measured by an ellipsometer on the same sample;
         N comes from the two-phase inversion :func:`labbrdf.optics.nk_from_psi_delta`.
