@@ -102,7 +102,9 @@ def _plain_math(app, what, name, obj, options, lines):  # noqa: ANN001, ANN202, 
         parts = re.split(r"(``.*?``)", line)
         for j in range(0, len(parts), 2):  # outside inline literals only
             text = _BARS.sub(r"\\|\1\\|", parts[j])
-            parts[j] = _CITE.sub(lambda m: m.group(0) if m.group(1) in own else f"[{m.group(1)}]", text)
+            parts[j] = _CITE.sub(
+                lambda m: m.group(0) if m.group(1) in own else m.group(0)[:-1], text
+            )
         lines[i] = "".join(parts)
 
 

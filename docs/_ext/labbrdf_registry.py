@@ -18,6 +18,7 @@ class FormatsTable(SphinxDirective):
     has_content = False
 
     def run(self) -> list[nodes.Node]:
+        """The table node, one row per format of the registry."""
         from labbrdf import adapters
 
         rows = adapters.formats()

@@ -94,7 +94,8 @@ def smith_g1_ggx(cos_v: ArrayLike, alpha: float) -> NDArray[np.float64]:
 def stokes_from_jones(jones: NDArray) -> NDArray[np.float64]:
     """Mueller matrix (..., 4, 4) of Jones matrices (..., 2, 2) in the LB Stokes convention.
 
-    ``S0 = |Es|^2 + |Ep|^2``, ``S1 = |Es|^2 - |Ep|^2``, ``S2 = 2 Re(Es Ep*)``, ``S3 = 2 Im(Es* Ep)``
+    ``S0 = |Es|^2 + |Ep|^2``, ``S1 = |Es|^2 - |Ep|^2``, ``S2 = 2 Re(Es Ep*)``,
+    ``S3 = 2 Im(Es* Ep)``
     (oracles README section 2: S3 = +1 when E turns from s towards p, time factor exp(-iwt)).
 
     Parameters
