@@ -1045,7 +1045,12 @@ def build_parser() -> argparse.ArgumentParser:
         default="auto",
         help="auto: 1/sigma^2 where every point has sigma, else relative",
     )
-    s.add_argument("--relative-floor", type=float, default=1e-3, help="of max |y| (relative)")
+    s.add_argument(
+        "--relative-floor",
+        type=float,
+        default=1e-3,
+        help="floor of --weighting relative, a fraction of the largest absolute value",
+    )
     s.add_argument("--keep-zeros", action="store_true", help="fit points with value 0 too")
     s.add_argument(
         "-o",

@@ -11,7 +11,7 @@ Text export (``jasco-spectramanager-text``)
     the keys we know are also given in English in ``meta["footer_en"]``. ``NPOINTS`` must
     match the data rows and every X must lie on ``FIRSTX + i * DELTAX``.
 
-Binary ``.jws``/``.jrs`` (``jasco-jws``), Spectra Manager 2 ("``L~S ``" magic)
+Binary ``.jws``/``.jrs`` (``jasco-jws``), Spectra Manager 2 (magic bytes ``"L~S "``)
     Little-endian fixed offsets (docs/formats.md section 7, confirmed on three V-730 files):
     NPOINTS int32 at 0x84; FIRSTX, LASTX, DELTAX float64 at 0x88/0x90/0x98; x-unit code
     (byte) at 0xA0 (3 = nm); y-mode code (byte) at 0xA4 (0 = %T, 2 = %R, 3 = Abs, 8-10 =

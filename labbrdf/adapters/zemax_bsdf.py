@@ -1117,7 +1117,7 @@ def binned_to_bsdf(
     theta_i_deg : float
         Angle of incidence of the binned data [deg].
     values : array_like, shape (n_theta, n_phi)
-        Bin-averaged BRDF [sr^-1], e.g. :meth:`labbrdf.tracer.TraceResult.s0`.
+        Bin-averaged BRDF [sr^-1], e.g. :meth:`labbrdf.TraceResult.s0`.
     theta_edges_deg, phi_edges_deg : array_like
         Bin edges [deg], ``n_theta + 1`` in [0, 90] and ``n_phi + 1`` in [0, 360]
         (outward azimuth, source at 0).

@@ -74,8 +74,8 @@ class FiveParam(Model):
     + diffuse`` [sr^-1], where ``a`` is the facet tilt, ``g`` the local incidence angle and
     ``a_`` the parameter ``a``.
 
-    Options
-    -------
+    Other Parameters
+    ----------------
     shadowing : {"ts", "none", "mb"} or callable, default "ts"
         G: Torrance-Sparrow V-groove in Blinn's form, 1, or Maxwell-Beard (adds the fixed
         parameters ``Omega`` and ``tau`` [rad]); a callable

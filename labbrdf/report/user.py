@@ -1,4 +1,4 @@
-"""``labbrdf report DATA... --model NAME -o DIR``: the report for a user's own files.
+"""The report for a user's own files (``labbrdf report DATA --model NAME -o DIR``).
 
 The same kind of page as the validation report: what was ingested, a figure of every
 measured quantity per file, optical constants from psi/Delta with the Fresnel reflectance
