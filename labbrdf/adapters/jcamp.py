@@ -35,11 +35,11 @@ Checks (each raises AdapterError with the line)
 Quantities: YUNITS ``ABSORBANCE``/``A`` -> ``absorbance``; ``TRANSMITTANCE`` (a fraction in
 JCAMP-DX) or ``%T``/``PERCENT TRANSMITTANCE`` (percent) -> ``transmittance``;
 ``REFLECTANCE``/``%R`` likewise -> ``reflectance``, or ``hemispherical_reflectance`` when a
-record of the block mentions an integrating sphere. XUNITS must be NANOMETERS/NM,
-MICROMETERS (converted) or 1/CM (wavenumbers, lambda [nm] = 1e7 / nu), also spelled out (``Wavelength (nm)``,
-``Wavenumber (cm-1)``); YUNITS may be spelled out too (``Transmittance (%)``). A DOS
-end-of-file byte (0x1A) after the last ``##END=`` is ignored. The sample of each block
-is its ``TITLE``.
+record of the block mentions an integrating sphere. XUNITS must be NANOMETERS/NM, MICROMETERS
+(converted) or 1/CM (wavenumbers, lambda [nm] = 1e7 / nu), also spelled out (``Wavelength
+(nm)``, ``Wavenumber (cm-1)``); YUNITS may be spelled out too (``Transmittance (%)``). A DOS
+end-of-file byte (0x1A) after the last ``##END=`` is ignored. The sample of each block is its
+``TITLE``.
 
 Notes
 -----

@@ -53,9 +53,7 @@ _MODES: tuple[tuple[re.Pattern[str], str, float], ...] = (
     (re.compile(r"reflect(?:ion|ance)", re.IGNORECASE), "reflectance", PERCENT),
 )
 #: modes without a dataset quantity, refused by name
-_REFUSED = re.compile(
-    r"scope|irradiance|counts|raw|dark|reference|relative|fluorescence|raman", re.IGNORECASE
-)
+_REFUSED = re.compile(r"scope|irradiance|counts|fluorescence|raman", re.IGNORECASE)
 
 
 def _sniff(head: bytes) -> bool:
@@ -136,12 +134,12 @@ def read_oceanoptics(path: str | os.PathLike[str]) -> Measurement:
             header["title"] = s[:1000]
     mode = header.get("XAxis mode")
     if mode is not None and mode.strip().lower() != "wavelengths":
-        line = next(i for i, s in enumerate(lines[:begin], start=1) if s.startswith("XAxis"))
+        at = next(i for i, s in enumerate(lines[:begin], start=1) if s.startswith("XAxis"))
         raise AdapterError(
             path,
             f"XAxis mode {mode!r}: only Wavelengths is supported (save the spectrum with "
             "the wavelength axis)",
-            line,
+            at,
         )
     quantity, scale, basis = _mode(path, data_from)
     xs: list[float] = []
@@ -174,16 +172,16 @@ def read_oceanoptics(path: str | os.PathLike[str]) -> Measurement:
         raise AdapterError(path, "no data rows after the spectral data marker", begin + 1)
     declared = header.get("Number of Pixels in Spectrum")
     if declared is not None:
-        line = next(
+        at = next(
             i for i, s in enumerate(lines[:begin], start=1) if s.startswith("Number of Pixels")
         )
-        count = number(declared, path, line, "Number of Pixels in Spectrum")
+        count = number(declared, path, at, "Number of Pixels in Spectrum")
         if count != len(xs):
             raise AdapterError(
                 path,
                 f"Number of Pixels in Spectrum is {declared} but the file has {len(xs)} rows "
                 "(truncated?)",
-                line,
+                at,
             )
     x = np.asarray(xs)
     k = np.flatnonzero(np.diff(x) <= 0)
