@@ -61,7 +61,9 @@ def open_ole2(path: str | os.PathLike[str], what: str) -> Iterator[Any]:
             unit="byte",
         )
     try:
-        ole = olefile.OleFileIO(os.fspath(path))
+        # strict: a defect that olefile would log and work around (a sector index past the
+        # end of a truncated file, a bad directory entry) is an error here
+        ole = olefile.OleFileIO(os.fspath(path), raise_defects=olefile.DEFECT_INCORRECT)
     except (OSError, ValueError, IndexError, KeyError, TypeError, AssertionError) as exc:
         # olefile raises OSError ("not an OLE2 structured storage file", truncated sectors)
         # and, on a corrupt FAT or directory, assorted lookup errors
