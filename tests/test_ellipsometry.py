@@ -50,6 +50,18 @@ def _independent_nk(psi_deg, delta_deg, theta_deg) -> tuple[np.ndarray, np.ndarr
             lambda x: _rho_of_w(x, theta) - target, start, tol=1e-14, maxiter=200, disp=False
         )
         residual = np.abs(_rho_of_w(w, theta) - target)
+        # psi near 90 deg puts the target near the pole of rho (w = cos theta), where the
+        # secant steps overshoot; 1/rho has a zero there instead, so solve for that
+        again = ~(residual < 1e-12 * np.maximum(1.0, np.abs(target)))
+        if again.any():
+            w[again] = optimize.newton(
+                lambda x: 1.0 / _rho_of_w(x, theta[again]) - 1.0 / target[again],
+                start[again],
+                tol=1e-14,
+                maxiter=200,
+                disp=False,
+            )
+            residual[again] = np.abs(_rho_of_w(w[again], theta[again]) - target[again])
     big_n = np.sqrt(w * w + np.sin(np.radians(theta)) ** 2)
     big_n = np.where(big_n.real + big_n.imag < 0, -big_n, big_n)  # N and -N: same rho
     return big_n, residual < 1e-12 * np.maximum(1.0, np.abs(target))
