@@ -10,6 +10,7 @@ file and the stream.
 from __future__ import annotations
 
 import os
+import struct
 from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
@@ -25,6 +26,20 @@ OLE2_MAGIC = b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1"
 #: Largest stream read [bytes]: a UV-Vis-NIR or FTIR spectrum of MAX_POINTS float64 values
 #: is 16 MB; a stream that claims more is a corrupt directory entry.
 MAX_STREAM_BYTES = 64 << 20
+#: What olefile raises on a corrupt container: its own OleFileError (an OSError), struct
+#: errors on short buffers, lookup errors on bad sector or entry indices, RecursionError on
+#: a deep directory tree.
+_OLE_ERRORS = (
+    OSError,
+    ValueError,
+    IndexError,
+    KeyError,
+    TypeError,
+    AssertionError,
+    OverflowError,
+    RecursionError,
+    struct.error,
+)
 
 
 def is_ole2(head: bytes) -> bool:
@@ -64,7 +79,7 @@ def open_ole2(path: str | os.PathLike[str], what: str) -> Iterator[Any]:
         # strict: a defect that olefile would log and work around (a sector index past the
         # end of a truncated file, a bad directory entry) is an error here
         ole = olefile.OleFileIO(os.fspath(path), raise_defects=olefile.DEFECT_INCORRECT)
-    except (OSError, ValueError, IndexError, KeyError, TypeError, AssertionError) as exc:
+    except _OLE_ERRORS as exc:
         # olefile raises OSError ("not an OLE2 structured storage file", truncated sectors)
         # and, on a corrupt FAT or directory, assorted lookup errors
         raise AdapterError(
@@ -92,7 +107,7 @@ def read_stream(ole: Any, path: str | os.PathLike[str], name: str, what: str) ->
             data: bytes = fh.read()
     except AdapterError:
         raise
-    except (OSError, ValueError, IndexError, KeyError, TypeError, AssertionError) as exc:
+    except _OLE_ERRORS as exc:
         raise AdapterError(
             path, f"{what}: stream {name!r} cannot be read ({exc}): corrupt or truncated"
         ) from None
