@@ -280,3 +280,10 @@ def test_not_an_ole2_file_is_refused_by_the_spc_reader(tmp_path: Path) -> None:
     p = write(tmp_path, "plain.spc", b"\x00\x4b" + b"\x00" * 600)
     with pytest.raises(AdapterError, match=r"byte 0: expected a Shimadzu UVProbe .spc"):
         read_uvprobe_spc(p)
+
+
+def test_cli_ingest_of_a_broken_spc_exits_2_naming_the_file(tmp_path: Path, make_ole2, capsys):
+    p = write(tmp_path, "broken.spc", make_ole2(spc_streams(mode="Energy")))
+    assert main(["ingest", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert str(p) in err and "measuring mode 'Energy'" in err and "Traceback" not in err
