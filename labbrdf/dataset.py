@@ -473,8 +473,8 @@ def make_frame(
 ) -> pd.DataFrame:
     """Build a schema table from arrays and scalars (broadcast to one length).
 
-    A scalar string becomes a one-category Categorical (``validate`` turns it into an
-    object column that holds one shared string), and a ``sample`` longer than
+    A scalar string becomes an object column of references to that one string (never n
+    copies), and a ``sample`` longer than
     :data:`MAX_NAME_CHARS` is cut by :func:`capped_name`: memory stays a small multiple of
     the data whatever a header holds.
 
@@ -506,9 +506,11 @@ def make_frame(
     out: dict[str, Any] = {}
     for k, v in cols.items():
         if isinstance(v, str):
-            # one category and n one-byte codes: a list of n strings would become a string
+            # n references to one str object: a list of n strings would become a string
             # array of n copies under pandas >= 3 (a 5 MB title times the rows)
-            out[k] = pd.Categorical.from_codes(np.zeros(n, dtype=np.int8), categories=[v])
+            fill = np.empty(n, dtype=object)
+            fill[:] = v
+            out[k] = pd.Series(fill, dtype=object, copy=False)
         elif np.ndim(v) == 0:
             out[k] = [v] * n
         else:
