@@ -340,7 +340,7 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     unselected: list[str] = []
     for f in args.files:
         try:
-            m = adapters.read(f, args.format)
+            m = adapters.read(f, args.format, columns=args.columns)
         except (ValueError, NotImplementedError) as exc:
             if not args.keep_going:
                 print(f"labbrdf ingest: {exc}", file=sys.stderr)
@@ -990,6 +990,13 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("ingest", help="read instrument exports into one dataset")
     s.add_argument("files", nargs="+", action=InputPath, metavar="FILE")
     s.add_argument("--format", default=None, help="force an adapter (see `labbrdf formats`)")
+    s.add_argument(
+        "--columns",
+        default=None,
+        metavar="NAMES",
+        help="declare the columns of a headerless numeric file (implies --format columns), "
+        "e.g. wavelength_nm,absorbance; see docs/formats.md",
+    )
     s.add_argument(
         "-o",
         "--output",
