@@ -153,6 +153,11 @@ class Microfacet(Model):
         "EGSR 2007 (GGX D, Smith G1); Fresnel amplitudes of the substrate"
     )
     doi = "10.2312/EGWR/EGSR07/195-206"
+    reciprocity_note = (
+        "microfacet is reciprocal by construction (the GGX term "
+        "F D G1 G1 / (4 cos\u03b8i cos\u03b8r) and the Lambertian kd / pi are symmetric in the "
+        "two directions)."
+    )
     linear: tuple[str, ...] = ("scale",)
 
     def __init__(

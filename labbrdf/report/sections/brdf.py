@@ -22,15 +22,6 @@ __all__ = ["brdf_section", "brdf_fit_options", "energy_rows"]
 
 #: rows closer than this to the plane of incidence count as in-plane [deg]
 IN_PLANE_TOL_DEG = 1e-6
-#: what each model's form says about reciprocity (Helmholtz: f(i, o) = f(o, i))
-RECIPROCITY_NOTE = {
-    "microfacet": "microfacet is reciprocal by construction (the GGX term "
-    "F D G1 G1 / (4 cos\u03b8i cos\u03b8r) and the Lambertian kd / pi are symmetric in the "
-    "two directions).",
-    "five_param": "five_param is not reciprocal in general: its diffuse term k_d / cos\u03b8i "
-    "depends on the incidence direction alone; it is reciprocal only for k_d = 0.",
-    "smooth3": "smooth3 is reciprocal only for k2 = 0.",
-}
 #: direction pairs (theta_a, theta_b, phi) [deg] of the reciprocity table
 RECIP_PAIRS = ((15.0, 45.0, 180.0), (30.0, 60.0, 180.0), (20.0, 70.0, 90.0), (45.0, 10.0, 135.0))
 
@@ -655,7 +646,7 @@ def _reciprocity(ctx: Context, fits: Sequence[tuple[float | None, FitRecord]]) -
         "(labbrdf.integrate.reciprocity_defect).",
     )
     name = fits[0][1].model
-    general = RECIPROCITY_NOTE.get(name, "")
+    general = models.MODELS[name].reciprocity_note if name in models.MODELS else ""
     b.text(
         (general + " " if general else "")
         + (
