@@ -35,6 +35,7 @@ __all__ = [
     "MODELS",
     "REFERENCE_TABLES",
     "Cauchy",
+    "Constant",
     "Dispersion",
     "DispersionError",
     "Drude",
@@ -116,6 +117,39 @@ class Dispersion(ABC):
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe form ``{"model": name, **params}`` (inverse: :func:`from_dict`)."""
         return {"model": self.name, **self.params}
+
+
+# --------------------------------------------------------------------------------------
+# constant index
+# --------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Constant(Dispersion):
+    """A wavelength-independent index ``N = n + ik`` (an ambient, or a quick trial layer).
+
+    Parameters
+    ----------
+    n : float
+        Refractive index, > 0 [1].
+    k : float
+        Extinction coefficient, >= 0 [1].
+    """
+
+    name: ClassVar[str] = "constant"
+    BOUNDS: ClassVar[dict[str, tuple[float, float]]] = {"n": (1.0, 5.0), "k": (0.0, 5.0)}
+
+    n: float = 1.0
+    k: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (self.n > 0 and self.k >= 0 and math.isfinite(self.n) and math.isfinite(self.k)):
+            raise DispersionError(f"constant: needs n > 0 and k >= 0, got n={self.n}, k={self.k}")
+
+    def nk(self, wavelength_nm: ArrayLike) -> ComplexArray:
+        """Complex index ``n + ik`` (``k >= 0``) at vacuum wavelength(s) [nm]."""
+        lam = _wavelength(wavelength_nm)
+        return np.full(lam.shape, complex(self.n, self.k))
 
 
 # --------------------------------------------------------------------------------------
@@ -748,7 +782,7 @@ def _pseudo_constants(
 
 #: registry name -> class
 MODELS: dict[str, type[Dispersion]] = {
-    c.name: c for c in (Cauchy, Sellmeier, TaucLorentz, Drude, Lorentz, Tabulated)
+    c.name: c for c in (Constant, Cauchy, Sellmeier, TaucLorentz, Drude, Lorentz, Tabulated)
 }
 
 
