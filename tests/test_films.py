@@ -1,4 +1,4 @@
-"""Layer / Stack objects, roughness, serialisation, and TOML model files with line-numbered errors."""
+"""Layer and Stack objects, roughness, serialisation, TOML model files and their errors."""
 
 from __future__ import annotations
 
