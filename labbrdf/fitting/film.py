@@ -279,10 +279,32 @@ class FilmFit:
             out[lay] = entry
         return out
 
+    @property
+    def misfit_scale(self) -> float | None:
+        """``sqrt(chi2/nu)`` when chi-square rejects the model at the 1 % level, else None.
+
+        The model then misses the data by more than the files' sigmas (a systematic
+        misfit: the substrate's table, an unmodelled layer, the instrument's calibration);
+        intervals from the sigmas alone are too narrow, and ``*_scaled`` intervals (stderr
+        times this factor, lmfit's ``scale_covar``) are reported beside them.
+        """
+        res = self.result
+        if res.nfree <= 0 or not math.isfinite(res.chisqr):
+            return None
+        if special.chdtrc(res.nfree, res.chisqr) >= 0.01:
+            return None
+        return math.sqrt(res.redchi)
+
     def notes(self) -> list[str]:
-        """Plain-language identifiability notes (thickness-index trade-offs, bounds)."""
+        """Plain-language notes: misfit, thickness-index trade-offs, bounds."""
         res = self.result
         notes = []
+        if self.misfit_scale is not None:
+            notes.append(
+                f"chi2/nu = {res.redchi:.3g}: the model misses the data by more than the files' "
+                "sigmas (p < 0.01); the intervals from the sigmas alone are too narrow; "
+                f"*_scaled intervals multiply them by sqrt(chi2/nu) = {self.misfit_scale:.3g}"
+            )
         for k in res.var_names:
             q = res.params[k]
             for other, c in (q.correl or {}).items():
@@ -322,15 +344,31 @@ class FilmFit:
         """
         res = self.result
         nk = self._nk_at(NK_REPORT_NM) if self._covers(NK_REPORT_NM) else {}
+        scale = self.misfit_scale
+        tq = float(special.stdtrit(max(res.nfree, 1), 0.975))
+        if scale is not None:
+            for entry in nk.values():
+                for part in ("n", "k"):
+                    se = entry.get(f"{part}_stderr")
+                    if se is not None:
+                        v = entry[part]
+                        entry[f"{part}_stderr_scaled"] = se * scale
+                        entry[f"{part}_ci95_scaled"] = [v - tq * se * scale, v + tq * se * scale]
 
         def param(k: str) -> dict[str, Any]:
             q = res.params[k]
             d: dict[str, Any] = {"value": q.value, "vary": q.vary, "units": q.units}
             if q.vary:
-                t_se = q.stderr
-                d["stderr"] = t_se
+                d["stderr"] = q.stderr
                 d["ci95"] = list(q.ci95) if q.ci95 is not None else None
                 d["ci_method"] = res.ci_method
+                if scale is not None and q.stderr is not None:
+                    se = q.stderr * scale
+                    d["stderr_scaled"] = se
+                    d["ci95_scaled"] = [
+                        max(q.value - tq * se, q.min),
+                        min(q.value + tq * se, q.max),
+                    ]
                 d["bounds"] = [q.min, q.max]
                 d["flags"] = res.flags.get(k, [])
             return d
