@@ -439,6 +439,99 @@ class FilmFit:
             Path(tmp).write_text(json.dumps(self.summary(), indent=2, allow_nan=False) + "\n")
         return p
 
+    def compare_reflectance(self, reflectance: Any) -> pd.DataFrame:
+        """Measured specular reflectance against the best-fit stack's prediction.
+
+        Parameters
+        ----------
+        reflectance : Measurement, DataFrame or list of them
+            Rows with ``quantity == "reflectance"``: channel ``s``/``p`` (R_s, R_p) or none
+            (``(R_s + R_p)/2``); no angle means normal incidence.
+
+        Returns
+        -------
+        pandas.DataFrame
+            The columns of :func:`labbrdf.nk.compare_reflectance` (``sample, source,
+            wavelength_nm, theta_i_deg, channel, measured, measured_sigma, predicted,
+            predicted_sigma, difference, difference_sigma, z``), so a report treats both
+            alike. ``predicted_sigma`` propagates the fit's covariance (scaled by
+            :attr:`misfit_scale` when chi-square rejects the model) through the stack.
+            Rows outside the wavelengths the stack's tables cover are dropped and counted
+            in ``attrs["outside_range"]``.
+
+        Raises
+        ------
+        FilmError
+            No reflectance rows, or none the stack covers.
+        """
+        df = _frame(reflectance)
+        rows = df[df["quantity"].astype(str) == "reflectance"]
+        if rows.empty:
+            raise FilmError("no reflectance rows in the data to compare with")
+        wl = rows["wavelength_nm"].to_numpy(float)
+        ok = np.array([self._covers(float(w)) for w in np.unique(wl)])
+        covered = np.isin(wl, np.unique(wl)[ok])
+        outside = int((~covered).sum())
+        rows = rows[covered]
+        if rows.empty:
+            raise FilmError("no reflectance row within the wavelengths the stack covers")
+        wl = rows["wavelength_nm"].to_numpy(float)
+        theta = np.nan_to_num(rows["theta_i_deg"].to_numpy(float), nan=0.0)
+        if "channel" in rows.columns:
+            channel = rows["channel"].astype(object).to_numpy()
+        else:
+            channel = np.full(len(rows), None, dtype=object)
+        is_s, is_p = channel == "s", channel == "p"
+
+        def predict(st: Stack) -> NDArray:
+            rs, rp = st.reflectance(wl, theta)
+            return np.where(is_s, rs, np.where(is_p, rp, 0.5 * (rs + rp)))
+
+        predicted = predict(self.stack)
+        res = self.result
+        names = list(res.var_names)
+        cov = None if res.covar is None else np.asarray(res.covar, float)
+        psig = np.full(len(rows), np.nan)
+        if cov is not None and cov.shape == (len(names), len(names)) and np.all(np.isfinite(cov)):
+            vals = {k: res.params[k].value for k in names}
+            G = np.empty((len(rows), len(names)))
+            for j, k in enumerate(names):
+                q = res.params[k]
+                h = 1e-6 * max(abs(q.value), 1e-3)
+                up, dn = dict(vals), dict(vals)
+                up[k] = min(q.value + h, q.max)
+                dn[k] = max(q.value - h, q.min)
+                G[:, j] = (
+                    predict(self.model.stack.with_values(up))
+                    - predict(self.model.stack.with_values(dn))
+                ) / (up[k] - dn[k])
+            var = np.einsum("ij,jk,ik->i", G, cov, G) * (self.misfit_scale or 1.0) ** 2
+            psig = np.sqrt(np.maximum(var, 0.0))
+        measured = rows["value"].to_numpy(float)
+        msig = rows["sigma"].to_numpy(float)
+        diff = measured - predicted
+        dsig = np.where(np.isnan(msig), psig, np.hypot(msig, np.nan_to_num(psig)))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z = diff / dsig
+        out = pd.DataFrame(
+            {
+                "sample": rows["sample"].astype(object).to_numpy(),
+                "source": rows["source"].astype(object).to_numpy(),
+                "wavelength_nm": wl,
+                "theta_i_deg": rows["theta_i_deg"].to_numpy(float),
+                "channel": channel,
+                "measured": measured,
+                "measured_sigma": msig,
+                "predicted": predicted,
+                "predicted_sigma": psig,
+                "difference": diff,
+                "difference_sigma": dsig,
+                "z": z,
+            }
+        )
+        out.attrs["outside_range"] = outside
+        return out
+
     def nk_table(self, wavelength_nm: ArrayLike | None = None) -> pd.DataFrame:
         """n, k of every layer and the substrate on the fitted wavelengths (or given ones)."""
         wl = (
