@@ -143,7 +143,8 @@ def test_native_oxide_on_silicon_from_the_completeease_file(real_exports, capsys
 def test_film_without_a_substrate_table_covering_the_data_exits_2(tmp_path, capsys):
     wl = np.array([200.0, 300.0, 400.0])
     df = pd.DataFrame(
-        {"sample": "w", "instrument": "sim", "source": "x", "quantity": ["psi"] * 3 + ["delta"] * 3,
+        {"sample": "w", "instrument": "sim", "source": "x",
+         "quantity": ["psi"] * 3 + ["delta"] * 3,
          "value": [20.0] * 3 + [100.0] * 3, "sigma": 0.01, "unit": "deg",
          "wavelength_nm": np.r_[wl, wl], "theta_i_deg": 70.0, "theta_r_deg": 70.0,
          "phi_r_deg": 180.0}
