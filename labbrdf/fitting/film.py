@@ -362,6 +362,11 @@ class FilmFit:
                 d["stderr"] = q.stderr
                 d["ci95"] = list(q.ci95) if q.ci95 is not None else None
                 d["ci_method"] = res.ci_method
+                if q.stderr is not None:
+                    d["ci95_wald"] = [
+                        max(q.value - tq * q.stderr, q.min),
+                        min(q.value + tq * q.stderr, q.max),
+                    ]
                 if scale is not None and q.stderr is not None:
                     se = q.stderr * scale
                     d["stderr_scaled"] = se
