@@ -27,7 +27,7 @@ def test_native_oxide_on_silicon_is_about_2_nm(real_exports):
 
 
 @pytest.mark.slow
-def test_ta2o5_trio_fits_jointly_on_tantalum_and_predicts_the_p_reflectance(real_exports):
+def test_ta2o5_trio_fits_on_tantalum_and_its_psi_delta_stack_predicts_r_p(real_exports):
     d = real_exports / "woollam-wvase-ascii"
     files = [
         d / "w1_12082006.dat",
@@ -38,6 +38,7 @@ def test_ta2o5_trio_fits_jointly_on_tantalum_and_predicts_the_p_reflectance(real
     # every third wavelength: the same fit at a third of the cost
     keep = np.unique(data.wavelength_nm.to_numpy())[::3]
     data = data[data.wavelength_nm.isin(keep)]
+    ellipsometry = data[data.quantity.isin(["psi", "delta"])]
     ta = Tabulated.from_file(d / "w2_10102006.dat")  # the same lab's bare Ta wafer
     layer = Layer(Cauchy(A=2.1, B=0.02), 200.0, "ta2o5")
     box = {
@@ -48,11 +49,14 @@ def test_ta2o5_trio_fits_jointly_on_tantalum_and_predicts_the_p_reflectance(real
     }
     on_ta = fit_film(FilmModel(Stack([layer], ta), box), data, wavelength_range_nm=(350, 1450))
     on_si = fit_film(FilmModel(Stack([layer], "si"), box), data, wavelength_range_nm=(350, 1450))
+    alone = fit_film(  # psi/Delta alone: the reflectance below is then a prediction
+        FilmModel(Stack([layer], ta), box), ellipsometry, wavelength_range_nm=(350, 1450)
+    )
     assert on_ta.mse < 0.2 * on_si.mse  # the substrate is tantalum, not silicon
     s = on_ta.summary()
     assert 150 < s["layers"][0]["parameters"]["thickness_nm"]["value"] < 220
     assert 2.1 < s["layers"][0]["nk_at_633nm"]["n"] < 2.3  # Ta2O5 at 633 nm
     refl = adapters.read(files[1]).data
     refl = refl[(refl.wavelength_nm >= 350) & (refl.wavelength_nm <= 1450)]
-    z = on_ta.compare_reflectance(refl)["z"].to_numpy()
+    z = alone.compare_reflectance(refl)["z"].to_numpy()
     assert np.mean(z**2) < 1.0  # R_p within the file's sigmas (two-phase n, k gave R = 1)
