@@ -23,7 +23,7 @@ Binary ``.jws``/``.jrs`` (``jasco-jws``), Spectra Manager 2 (magic bytes ``"L~S 
     (OLE2 compound documents, magic ``D0 CF 11 E0``) are read as below.
 
 Legacy ``.jws`` (Spectra Manager 1.x, the same format name ``jasco-jws``)
-    An OLE2 compound document (:mod:`labbrdf.adapters._ole2`). Stream ``DataInfo`` (96 bytes,
+    An OLE2 compound document (``labbrdf.adapters._ole2``). Stream ``DataInfo`` (96 bytes,
     little-endian, the layout used by the public jwsProcessor/pyjws readers): six uint32
     (the fourth is the number of channels, the sixth NPOINTS), FIRSTX, LASTX, DELTAX as
     float64 at 24/32/40, then one uint32 data-type code per axis from byte 48: the X code

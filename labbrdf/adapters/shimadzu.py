@@ -12,7 +12,7 @@ Text export (``shimadzu-uvprobe-text``)
 
 Binary ``.spc`` (``shimadzu-uvprobe-spc``)
     Not a Galactic SPC, although it has the same extension: an OLE2 compound document (see
-    :mod:`labbrdf.adapters._ole2`). Layout, established on the shared sample and its text
+    ``labbrdf.adapters._ole2``). Layout, established on the shared sample and its text
     export (values agree to the 3 decimals of the text):
 
     * ``DataStorage1/DataSetGroup/DataSet<k>/`` holds data set ``k`` (1, 2, ...);
