@@ -9,6 +9,8 @@ so that ``import labbrdf`` stays cheap, and ``dir(labbrdf)`` lists them all:
   psi/Delta with propagated sigmas)
 - models and fits: :mod:`models` (:func:`labbrdf.models.get`), :func:`fit`,
   :func:`fit_many`, :class:`FitResult`, :func:`hemispherical_reflectance`
+- films: :class:`Stack`, :class:`Layer`, :func:`fit_film` (thin-film stacks fitted to
+  psi/Delta and reflectance)
 - roughness: :func:`read_height_map`, :func:`roughness_statistics`
 - the tracer: :func:`trace`, :class:`TraceConfig`, :class:`Substrate`, :class:`Coating`,
   :class:`TraceResult`
@@ -40,6 +42,9 @@ _LAZY: dict[str, tuple[str, str]] = {
     "fit_many": ("labbrdf.fitting", "fit_many"),
     "FitResult": ("labbrdf.fitting", "FitResult"),
     "hemispherical_reflectance": ("labbrdf.integrate", "hemispherical_reflectance"),
+    "Stack": ("labbrdf.films", "Stack"),
+    "Layer": ("labbrdf.films", "Layer"),
+    "fit_film": ("labbrdf.films", "fit_film"),
     "read_height_map": ("labbrdf.adapters.topography", "read_height_map"),
     "roughness_statistics": ("labbrdf.topography", "roughness_statistics"),
     "trace": ("labbrdf.tracer", "trace"),
@@ -60,8 +65,10 @@ _MODULES = (
     "adapters",
     "cli",
     "dataset",
+    "dispersion",
     "ellipsometry",
     "errors",
+    "films",
     "fitting",
     "integrate",
     "jsonsafe",
@@ -73,6 +80,7 @@ _MODULES = (
     "provenance",
     "report",
     "selection",
+    "stack",
     "surface",
     "topography",
     "tracer",
@@ -85,8 +93,10 @@ if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__
         adapters,
         cli,
         dataset,
+        dispersion,
         ellipsometry,
         errors,
+        films,
         fitting,
         integrate,
         jsonsafe,
@@ -98,6 +108,7 @@ if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__
         provenance,
         report,
         selection,
+        stack,
         surface,
         topography,
         tracer,
@@ -106,6 +117,7 @@ if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__
     from .adapters.topography import read_height_map
     from .dataset import DatasetError, Measurement
     from .errors import LabbrdfError
+    from .films import Layer, Stack, fit_film
     from .fitting import FitError, FitResult, fit, fit_many
     from .integrate import hemispherical_reflectance
     from .models import ModelError

@@ -226,7 +226,7 @@ def woollam_mse(chisqr: float, n_values: int, n_params: int) -> float:
 
 @dataclass
 class FilmFit:
-    """A film fit: the core's :class:`~labbrdf.fitting.FitResult` and the best-fit stack."""
+    """A film fit: the core's :class:`~labbrdf.FitResult` and the best-fit stack."""
 
     result: FitResult
     model: FilmModel
