@@ -142,6 +142,14 @@ def _add_scheduler(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--dashboard", action="store_true", help="start the local cluster's dashboard (127.0.0.1)"
     )
+    p.add_argument(
+        "--worker-timeout",
+        type=float,
+        default=None,
+        metavar="SECONDS",
+        help="how long to wait for a worker on a tcp:// or tls:// scheduler that has none "
+        "(default 60)",
+    )
 
 
 def _check_executor(args: argparse.Namespace) -> None:
@@ -158,6 +166,7 @@ def _check_executor(args: argparse.Namespace) -> None:
             tls_ca=args.tls_ca,
             tls_cert=args.tls_cert,
             tls_key=args.tls_key,
+            worker_timeout=args.worker_timeout,
         )
     except ValueError as exc:
         raise UsageError(str(exc)) from None
