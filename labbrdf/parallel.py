@@ -451,7 +451,7 @@ def _wait_for_a_worker(client: Any, scheduler: str) -> None:
     timeout = _OPTIONS["worker_timeout"] or DEFAULT_WORKER_TIMEOUT
     try:
         client.wait_for_workers(1, timeout=timeout)
-    except (TimeoutError, asyncio.TimeoutError):
+    except TimeoutError:  # asyncio.TimeoutError is TimeoutError since Python 3.11
         client.close()
         raise ParallelError(
             f"the dask scheduler {scheduler} has no worker: none attached within "

@@ -563,8 +563,11 @@ def _pole_repeats(shape: tuple[int, ...], radial_deg: NDArray[np.float64]) -> ND
 def _table_frame(
     t: BsdfTable, path: str | os.PathLike[str], wavelength_nm: float
 ) -> tuple[pd.DataFrame, int, int]:
-    """Rows above the horizon in the dataset schema, the number dropped below it, and the
-    number of repeated pole points left out (the pole is one row per block)."""
+    """Rows above the horizon in the dataset schema, and the counts left out.
+
+    Returns the frame, the number of points below the horizon, and the number of repeated
+    pole points (the pole is one row per block).
+    """
     nrot, nch, naoi, naz, nrad = t.values.shape
     full = t.values.shape
     theta_r, phi_r, above = (
@@ -573,6 +576,7 @@ def _table_frame(
             t.theta_i_deg[:, None, None], t.radial_deg[None, None, :], t.azimuth_deg[None, :, None]
         )
     )
+    above = above.astype(bool)
     repeat = _pole_repeats(full, t.radial_deg).reshape(-1)
     keep = np.flatnonzero(above & ~repeat)
     values = t.values.copy()

@@ -124,8 +124,11 @@ def slug(s: str) -> str:
 
 
 def wl_label(x: float, *, stated: bool = True) -> str:
-    """A wavelength for text: ``"550 nm"``, or "wavelength not stated" when ``x`` is only a
-    label (a file that states no wavelength, ``meta["wavelength_stated"]`` False)."""
+    """A wavelength for text: ``"550 nm"``, or "wavelength not stated".
+
+    ``stated=False``: ``x`` is only a label (a file that states no wavelength,
+    ``meta["wavelength_stated"]`` False).
+    """
     return f"{x:g} nm" if stated else "wavelength not stated"
 
 
@@ -400,20 +403,25 @@ def headline(counts: Mapping[str, int] | Sequence[Mapping[str, Any]]) -> str:
     -------
     str
         ``"4 checks passed (2 of them bookkeeping), 1 failed, 6 not applicable"``, every
-        number that of the tally; ``"nothing checked: ..."`` when only bookkeeping checks
-        passed and none failed.
+        number that of the tally; ``"nothing checked beyond bookkeeping (...)"`` when only
+        bookkeeping checks passed and none failed.
     """
     t = counts if isinstance(counts, Mapping) else tally(counts)
     passed, book, failed, na = t["pass"], t["bookkeeping"], t["fail"], t["skipped"]
     plural = "check" if passed == 1 else "checks"
     book_text = f" ({book} of them bookkeeping)" if book else ""
     if passed - book + failed == 0:
-        return f"nothing checked: {passed} bookkeeping {plural} passed, {na} not applicable"
+        return (
+            f"nothing checked beyond bookkeeping ({passed} bookkeeping {plural}, "
+            f"{na} not applicable)"
+        )
     return f"{passed} {plural} passed{book_text}, {failed} failed, {na} not applicable"
 
 
 def not_applicable(results: Mapping[str, Any]) -> list[dict[str, Any]]:
-    """The sections that did not apply: not available, and nothing in them but text and
+    """The sections that did not apply.
+
+    A section did not apply when it is not available and holds nothing but text and
     skipped checks.
 
     Returns

@@ -346,8 +346,11 @@ def _one_group(ctx: Context, fits: Sequence[tuple[float | None, FitRecord]]) -> 
 
 
 def _wl_text(ctx: Context, sample: str, wl: float) -> str:
-    """``"550 nm"``, or "wavelength not stated" when every file of the sample at ``wl``
-    states none (a .bsdf file without a wavelength comment: ``wl`` is a label)."""
+    """``"550 nm"``, or "wavelength not stated" for a label.
+
+    The label case: every file of the sample at ``wl`` states no wavelength (a .bsdf file
+    without a wavelength comment).
+    """
     unstated = {
         Path(str(f.get("path", ""))).name
         for f in ctx.files
@@ -401,8 +404,8 @@ def _maps(
     if not any(off_plane):
         ctx.b.note(
             "hemisphere maps",
-            f"{sample}, {_wl_text(ctx, sample, wl)}: every row lies in the plane of incidence, so there is "
-            "no hemisphere to map; see the in-plane cuts",
+            f"{sample}, {_wl_text(ctx, sample, wl)}: every row lies in the plane of incidence, "
+            "so there is no hemisphere to map; see the in-plane cuts",
         )
         return
     panels = [p for p, ok in zip(panels, off_plane, strict=True) if ok]

@@ -331,7 +331,9 @@ def _file(ctx: Context, i: int, src: str, g: pd.DataFrame, meta: Mapping[str, An
     if meta.get("reflectance_kind"):
         extra.append(str(meta["reflectance_kind"]))
     b.text(
-        f"{instr}: {', '.join(quantities)}; {_ranges(g, meta.get('wavelength_stated') is not False)}; {len(g)} rows; 1-sigma given: "
+        f"{instr}: {', '.join(quantities)}; "
+        f"{_ranges(g, meta.get('wavelength_stated') is not False)}; {len(g)} rows; "
+        "1-sigma given: "
         + ("yes" if g["sigma"].notna().any() else "no")
         + (f"; {'; '.join(extra)}" if extra else "")
         + "."
