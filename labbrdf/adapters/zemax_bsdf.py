@@ -570,13 +570,13 @@ def _table_frame(
     """
     nrot, nch, naoi, naz, nrad = t.values.shape
     full = t.values.shape
-    theta_r, phi_r, above = (
+    theta_r, phi_r, above_f = (
         np.broadcast_to(x, full).reshape(-1)
         for x in scatter_to_angles(
             t.theta_i_deg[:, None, None], t.radial_deg[None, None, :], t.azimuth_deg[None, :, None]
         )
     )
-    above = above.astype(bool)
+    above = np.asarray(above_f, dtype=bool)
     repeat = _pole_repeats(full, t.radial_deg).reshape(-1)
     keep = np.flatnonzero(above & ~repeat)
     values = t.values.copy()
