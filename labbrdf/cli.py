@@ -156,11 +156,7 @@ def _check_executor(args: argparse.Namespace) -> None:
     """Reject a bad ``--scheduler`` / ``--workers`` before any work is done."""
     from .parallel import check_scheduler, configure
 
-    try:
-        check_scheduler(args.scheduler)
-    except ValueError as exc:
-        raise UsageError(f"--scheduler: {exc}") from None
-    try:
+    try:  # first: certificates given here decide what --scheduler local needs
         configure(
             dashboard=True if args.dashboard else None,
             tls_ca=args.tls_ca,
@@ -170,6 +166,10 @@ def _check_executor(args: argparse.Namespace) -> None:
         )
     except ValueError as exc:
         raise UsageError(str(exc)) from None
+    try:
+        check_scheduler(args.scheduler)
+    except ValueError as exc:
+        raise UsageError(f"--scheduler: {exc}") from None
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be >= 1, got {args.workers}")
 

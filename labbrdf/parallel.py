@@ -110,6 +110,13 @@ _DASK_HINT = (
 )
 
 
+_CRYPTOGRAPHY_HINT = (
+    "the local dask cluster runs on TLS and needs the cryptography package to make its "
+    "temporary credentials: `pip install cryptography` (or `pip install labbrdf[dask]`), "
+    "or configure certificates (--tls-ca, --tls-cert, --tls-key)"
+)
+
+
 class ParallelError(LabbrdfError, RuntimeError):
     """A worker died (retries used up) or the dask scheduler is unreachable.
 
@@ -135,7 +142,9 @@ def check_scheduler(scheduler: str) -> str:
         address.
     ImportError
         For a dask scheduler (``local``, an address) when dask.distributed is not
-        installed; the message says how to install it.
+        installed, or for ``local`` without certificates when the ``cryptography``
+        package (its temporary TLS credentials) is missing; the message says how to
+        install it.
     """
     if not isinstance(scheduler, str):
         raise ValueError(f"scheduler must be a string, got {type(scheduler).__name__}")
@@ -143,6 +152,11 @@ def check_scheduler(scheduler: str) -> str:
         return scheduler
     if scheduler == "local" or scheduler.startswith(("tcp://", "tls://")):
         _import_dask()
+        if scheduler == "local" and _tls_files() is None:
+            try:
+                import cryptography  # noqa: F401 - the temporary TLS credentials need it
+            except ImportError as exc:
+                raise ImportError(_CRYPTOGRAPHY_HINT) from exc
         return scheduler
     raise ValueError(
         f"unknown scheduler {scheduler!r}; use one of {list(SCHEDULERS)} "
@@ -252,11 +266,7 @@ def _temporary_security() -> Any:
     try:
         return Security.temporary()
     except ImportError as exc:
-        raise ImportError(
-            "the local dask cluster runs on TLS and needs the cryptography package to make "
-            "its temporary credentials: `pip install cryptography` (or `pip install "
-            "labbrdf[dask]`), or configure certificates (--tls-ca, --tls-cert, --tls-key)"
-        ) from exc
+        raise ImportError(_CRYPTOGRAPHY_HINT) from exc
 
 
 def _tls_files() -> tuple[str, str, str | None] | None:

@@ -977,6 +977,11 @@ def test_local_cluster_without_cryptography_says_how_to_install_it(monkeypatch):
     with pytest.raises(ImportError, match=r"cryptography.*pip install cryptography"):
         parallel.run(abs, [1], scheduler="local", workers=1)
     assert "client" not in parallel._LOCAL
+    # checked up front too (the CLI and validate call check_scheduler before any work)
+    monkeypatch.setitem(sys.modules, "cryptography", None)
+    with pytest.raises(ImportError, match=r"pip install cryptography"):
+        parallel.check_scheduler("local")
+    assert parallel.check_scheduler("serial") == "serial"
 
 
 # --------------------------------------------------------------------------- no workers
