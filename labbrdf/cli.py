@@ -273,25 +273,34 @@ def _add_scheduler(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--dashboard", action="store_true", help="start the local cluster's dashboard (127.0.0.1)"
     )
+    p.add_argument(
+        "--worker-timeout",
+        type=float,
+        default=None,
+        metavar="SECONDS",
+        help="how long to wait for a worker on a tcp:// or tls:// scheduler that has none "
+        "(default 60)",
+    )
 
 
 def _check_executor(args: argparse.Namespace) -> None:
     """Reject a bad ``--scheduler`` / ``--workers`` before any work is done."""
     from .parallel import check_scheduler, configure
 
-    try:
-        check_scheduler(args.scheduler)
-    except ValueError as exc:
-        raise UsageError(f"--scheduler: {exc}") from None
-    try:
+    try:  # first: certificates given here decide what --scheduler local needs
         configure(
             dashboard=True if args.dashboard else None,
             tls_ca=args.tls_ca,
             tls_cert=args.tls_cert,
             tls_key=args.tls_key,
+            worker_timeout=args.worker_timeout,
         )
     except ValueError as exc:
         raise UsageError(str(exc)) from None
+    try:
+        check_scheduler(args.scheduler)
+    except ValueError as exc:
+        raise UsageError(f"--scheduler: {exc}") from None
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be >= 1, got {args.workers}")
 
@@ -361,7 +370,10 @@ def cmd_ingest(args: argparse.Namespace) -> int:
                 "sample": s["sample"][0] if len(s["sample"]) == 1 else s["sample"],
                 "rows": s["rows"],
                 "quantities": s["quantities"],
+                "channels": _channels(m.data),
                 "wavelength_nm": s["wavelength_nm"],
+                # False: the file states none and wavelength_nm is a label (.bsdf)
+                "wavelength_stated": m.meta.get("wavelength_stated") is not False,
                 "theta_i_deg": s["theta_i_deg"],
             }
         )
@@ -385,6 +397,31 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     return 2 if failures else 0
 
 
+def _channels(d: Any) -> dict[str, list[str]]:
+    """The channels of each quantity that has any, in file order.
+
+    ``p``/``s`` reflectance, generalised ellipsometry ``pp``/``ps``/``sp``, tristimulus
+    ``X``/``Y``/``Z``; quantities without a channel are left out.
+    """
+    if "channel" not in d.columns:
+        return {}
+    out: dict[str, list[str]] = {}
+    for q, c in d[["quantity", "channel"]].drop_duplicates().itertuples(index=False):
+        if c:
+            out.setdefault(str(q), []).append(str(c))
+    return out
+
+
+def _channels_cell(channels: dict[str, list[str]]) -> str:
+    """``"p"``; ``"pp,ps,sp"`` when every quantity has the same; else per quantity."""
+    if not channels:
+        return "-"
+    lists = {tuple(v) for v in channels.values()}
+    if len(lists) == 1:
+        return ",".join(next(iter(lists)))
+    return " ".join(f"{q}:{','.join(v)}" for q, v in channels.items())
+
+
 def _short(text: str, width: int = 36) -> str:
     return text if len(text) <= width else text[: width - 3] + "..."
 
@@ -400,7 +437,16 @@ def _quantities_cell(qs: list[str]) -> str:
 
 
 def _print_ingest_table(rows: list[dict[str, Any]]) -> None:
-    head = ["file", "format", "sample", "quantities", "wavelength_nm", "theta_i_deg", "rows"]
+    head = [
+        "file",
+        "format",
+        "sample",
+        "quantities",
+        "channel",
+        "wavelength_nm",
+        "theta_i_deg",
+        "rows",
+    ]
     table = []
     for r in rows:
         wl = r["wavelength_nm"]
@@ -415,7 +461,8 @@ def _print_ingest_table(rows: list[dict[str, Any]]) -> None:
                     else f"{len(r['sample'])} samples: {r['sample'][0]}, ..."
                 ),
                 _quantities_cell(r["quantities"]),
-                f"{wl[0]:.6g}-{wl[1]:.6g}",
+                _channels_cell(r["channels"]),
+                f"{wl[0]:.6g}-{wl[1]:.6g}" if r["wavelength_stated"] else "not stated",
                 ",".join(f"{t:g}" for t in th[:8]) + (",..." if len(th) > 8 else "") or "-",
                 str(r["rows"]),
             ]

@@ -47,7 +47,9 @@ def test_ingest_json_lists_one_object_per_file(dataset_files, capsys):
         "sample",
         "rows",
         "quantities",
+        "channels",
         "wavelength_nm",
+        "wavelength_stated",
         "theta_i_deg",
     }
     assert first["format"] == "labbrdf-parquet"
@@ -65,6 +67,7 @@ def test_ingest_table_names_columns(dataset_files, capsys):
         "format",
         "sample",
         "quantities",
+        "channel",
         "wavelength_nm",
         "theta_i_deg",
         "rows",

@@ -56,6 +56,11 @@ def _brdf_scans(ctx: Context) -> bool:
     return True
 
 
+def _fitted(results: Mapping[str, Any]) -> bool:
+    """Whether a fit section ran: the specular fits or the BRDF fits."""
+    return any(s["id"] in ("fits", "brdf") and s["status"] == "ok" for s in results["sections"])
+
+
 def user_report(
     paths: Sequence[str | os.PathLike[str]],
     model: str,
@@ -92,7 +97,8 @@ def user_report(
     scheduler, workers :
         Executor for the fits (:mod:`labbrdf.parallel`); None runs in this process.
     title : str, optional
-        Page title.
+        Page title (default: "labbrdf report: <model> fits", or "... nothing fitted"
+        when no section could fit the model).
     start : mapping, optional
         Starting values of model parameters (name -> value) for every fit.
     selection : mapping, optional
@@ -203,6 +209,8 @@ def user_report(
         ("surface", "Measured surface topography", surface_section),
     ]
     run(ctx, sections)
+    if title is None and not _fitted(b.results):
+        b.results["title"] = f"labbrdf report: {len(paths)} file(s), nothing fitted"
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
     write_report(out, b.results, page, inputs=paths)
