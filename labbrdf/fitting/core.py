@@ -260,6 +260,77 @@ def _run_stage(
 #: stage code of a local stage that met :data:`CHI2_TOL` over a whole round (not an nlopt code)
 CHI2_CONVERGED = 100
 
+#: name of the stage record of the final polish (see :func:`_polish`)
+POLISH = "polish (scipy least_squares, trf)"
+#: residual evaluations of the polish per search dimension, Jacobian columns included
+#: (Gauss-Newton from a point in the optimum's basin needs a handful of iterations)
+_POLISH_MAXEVAL_PER_DIM = 200
+#: relative tolerances of the polish on chi-square change, step and scaled gradient
+_POLISH_TOL = 1e-12
+
+
+def _polish(obj: Objective, x: NDArray, nfree: int, weighted: bool) -> tuple[NDArray, dict]:
+    """A bounded Gauss-Newton polish from ``x``: ends at a stationary point, not a stall.
+
+    The nlopt local stage stops on the gain of its last steps (``ftol_rel``, ``xtol_rel``)
+    or of its last round (:data:`CHI2_TOL`). Along a flat valley that point may lie far from
+    the minimum: a derivative-free trust region that has shrunk makes tiny steps whatever
+    the remaining descent (measured: five_param at OSR 860 nm stopped with kr at its upper
+    bound 118.58 against 118.4853 at the minimum, depending on the seed). This polish is
+    scipy's trust-region reflective least squares (Branch, Coleman and Li 1999) on the
+    weighted residual vector, with a finite-difference Jacobian, in the same bounded
+    search box (amplitudes profiled as in the stages: variable projection). Its Gauss-Newton
+    model sees the whole valley's curvature, and it stops on the scaled gradient, the step
+    or the chi-square change (relative :data:`_POLISH_TOL`), i.e. at a first-order stationary
+    point. The best point seen is kept, so the polish never raises chi-square.
+    """
+    nfev0 = obj.nfev
+    lo, hi = obj.bounds()
+    x0 = np.clip(np.asarray(x, float), lo, hi)
+    f0 = obj.solve(obj.from_vector(x0))[1]
+    budget = _POLISH_MAXEVAL_PER_DIM * obj.n
+    try:
+        res = optimize.least_squares(
+            obj.residual_vector,
+            x0,
+            bounds=(lo, hi),
+            method="trf",
+            x_scale="jac",
+            ftol=_POLISH_TOL,
+            xtol=_POLISH_TOL,
+            gtol=_POLISH_TOL,
+            max_nfev=budget,
+        )
+        status, why = int(res.status), str(res.message)
+    except (ValueError, np.linalg.LinAlgError) as exc:  # non-finite start, singular step
+        status, why = -1, f"failed ({exc})"
+    x1, f1 = x0, f0
+    if obj.best_x is not None and obj.best_f < f0:
+        x1, f1 = np.asarray(obj.best_x, float), float(obj.best_f)
+    scale = 1.0 if weighted else max(f1 / max(nfree, 1), 1e-300)
+    gain = (f0 - f1) / scale
+    if status > 0:
+        msg = (
+            f"polished to a stationary point ({why.rstrip('.')}; chi-square lowered by "
+            f"{gain:.2g} noise units)"
+        )
+    elif status == 0:
+        msg = (
+            f"polish stopped at its budget of {budget} evaluations ({gain:.2g} noise "
+            "units gained): not converged"
+        )
+    else:
+        msg = f"polish {why}; the local stage's point is kept"
+    info = {
+        "algorithm": POLISH,
+        "nfev": obj.nfev - nfev0,
+        "chisqr": f1,
+        "code": status,
+        "message": msg,
+        "gain": float(gain),
+    }
+    return x1, info
+
 
 def _run_local(
     obj: Objective,
@@ -522,6 +593,13 @@ def fit(
                 )
             stage_info.append(info)
             last_code, message = info["code"], info["message"]
+        converged = last_code in _OK_CODES or last_code == CHI2_CONVERGED
+        if obj.n and cons is None and stages and not _is_global(stages[-1]) and converged:
+            x, info = _polish(obj, x, n_pts - nvarys, use_sigma)
+            stage_info.append(info)
+            message = f"{message}; {info['message']}"
+            if info["code"] == 0:
+                last_code = nlopt.MAXEVAL_REACHED
 
     # ---- final values and statistics
     with np.errstate(all="ignore"):
