@@ -729,16 +729,21 @@ def _profile_chi2(
     value: float,
     seed: int,
 ) -> float:
-    """Minimum chi-square over the other parameters with ``name`` held at ``value``."""
+    """Minimum chi-square over the other parameters with ``name`` held at ``value``.
+
+    One BOBYQA stage from the optimum's other values, polished like the fit itself.
+    """
     pf = _copy_params(best)
     pf[name].value, pf[name].vary = float(value), False
     obj = Objective(model, fd, pf, weights, [k for k in prof if k != name])
     if obj.n == 0:
         return obj.solve(dict(obj.base))[1]
     n = obj.n
-    _, info = _run_stage(
+    x, info = _run_stage(
         obj, "LN_BOBYQA", _LOCAL_MAXEVAL_PER_DIM * n, obj.to_vector(obj.base), seed, None
     )
+    if info["code"] in _OK_CODES:  # finish a stall along a valley, as fit() does
+        _polish(obj, x, max(len(fd) - n, 1), True)
     return min(info["chisqr"], obj.best_f)
 
 
