@@ -277,7 +277,7 @@ def _polish(obj: Objective, x: NDArray, nfree: int, weighted: bool) -> tuple[NDA
     The nlopt local stage stops on the gain of its last steps (``ftol_rel``, ``xtol_rel``)
     or of its last round (:data:`CHI2_TOL`). Along a flat valley that point may lie far from
     the minimum: a derivative-free trust region that has shrunk makes tiny steps whatever
-    the remaining descent (measured: five_param at OSR 860 nm stopped with kr at its upper
+    the remaining descent (measured: five_param at OSR 860 nm stopped with a at its upper
     bound 118.58 against 118.4853 at the minimum, depending on the seed). This polish is
     scipy's trust-region reflective least squares (Branch, Coleman and Li 1999) on the
     weighted residual vector, with a finite-difference Jacobian, in the same bounded
@@ -322,7 +322,7 @@ def _polish(obj: Objective, x: NDArray, nfree: int, weighted: bool) -> tuple[NDA
             "units gained): not converged"
         )
     else:
-        msg = f"polish {why}; the local stage's point is kept"
+        msg = f"polish {why}; the best point found is kept"
     info = {
         "algorithm": POLISH,
         "nfev": obj.nfev - nfev0,
