@@ -198,9 +198,19 @@ class Objective:
 
     def solve(self, vals: dict[str, float]) -> tuple[dict[str, float], float]:
         """Fill in the profiled parameters; return the values and chi-square."""
+        vals, r = self.residuals(vals)
+        return vals, float(r @ r)
+
+    def residuals(self, vals: dict[str, float]) -> tuple[dict[str, float], NDArray[np.float64]]:
+        """Fill in the profiled parameters; return the values and the weighted residuals.
+
+        The residuals are ``sqrt(w) (y - f)``; chi-square is their sum of squares. With
+        profiled amplitudes this is the variable-projection residual of Golub and Pereyra
+        (1973): the amplitudes are the exact bounded linear least-squares solution at the
+        nonlinear parameters ``vals``.
+        """
         if not self.profile:
-            r = self.sw * (self.y - self.model_values(vals))
-            return vals, float(r @ r)
+            return vals, self.sw * (self.y - self.model_values(vals))
         comps = self.model.linear_components(vals, self.ti, self.tr, self.pr, self.wl)
         if comps is None:
             raise FitError(f"model {self.model.name!r} gave no linear components to profile")
@@ -219,14 +229,12 @@ class Objective:
             p0 = g / G if G > 0 else 0.0
             p0 = min(max(p0, float(self._lin_lo[0])), float(hi[0]))
             vals[self.profile[0]] = p0
-            r = c - p0 * a
-            return vals, float(r @ r)
+            return vals, c - p0 * a
         A = np.stack([comps[k] for k in self.profile], axis=1) * self.sw[:, None]
         p = _bounded_lsq(A.T @ A, A.T @ c, self._lin_lo, hi)
         for k, v in zip(self.profile, p, strict=True):
             vals[k] = float(v)
-        r = c - A @ p
-        return vals, float(r @ r)
+        return vals, c - A @ p
 
     def __call__(self, x: NDArray, grad: NDArray | None = None) -> float:
         """chi-square at search vector ``x`` (nlopt signature; finite-difference gradient)."""
@@ -248,3 +256,18 @@ class Objective:
         if chi2 < self.best_f:
             self.best_f, self.best_x = chi2, np.array(x, float)
         return chi2
+
+    def residual_vector(self, x: NDArray) -> NDArray[np.float64]:
+        """Weighted residuals at search vector ``x``, counted in :attr:`nfev` like a call.
+
+        Non-finite residuals (model overflow at grazing angles) become ``sqrt(_PENALTY /
+        m)`` each, so their chi-square is the penalty value the nlopt stages see.
+        """
+        self.nfev += 1
+        _, r = self.residuals(self.from_vector(x))
+        if not np.all(np.isfinite(r)):
+            return np.full(r.size, math.sqrt(_PENALTY / max(r.size, 1)))
+        chi2 = float(r @ r)
+        if chi2 < self.best_f:
+            self.best_f, self.best_x = chi2, np.array(x, float)
+        return r

@@ -95,7 +95,10 @@ class FitResult:
         Points dropped by ``nan_policy='omit'``.
     stages : list of dict
         Per stage: algorithm, nfev, chisqr, nlopt return code and message; a local stage
-        also lists its ``rounds`` (restarts from the best point, see :func:`labbrdf.fit`).
+        also lists its ``rounds`` (restarts from the best point, each with the chi-square
+        it started from, see :func:`labbrdf.fit`). A final record with algorithm
+        ``"polish (scipy least_squares, trf)"`` describes the polish of a converged local
+        stage (code: the scipy status, > 0 converged, 0 budget spent).
     energy : dict or None
         The energy constraint: incidence grid [deg] and max rho at the optimum.
     warnings : list of str

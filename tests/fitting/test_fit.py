@@ -256,8 +256,7 @@ def test_default_method_reaches_the_long_global_search_optimum(sample: str, wl: 
     fd = noisy(ZOU2013[sample][wl], seed=7)
     quick = fit("smooth3", fd)
     slow = fit("smooth3", fd, maxeval=(4000, None), guess=False)
-    # same basin: chi2 agrees far below the Delta chi2 ~ 4 that sets a 95% interval (the
-    # local stages stop on ftol_rel 1e-13 per step, which can leave ~1e-7 relative)
+    # same basin: chi2 agrees far below the Delta chi2 ~ 4 that sets a 95% interval
     assert quick.chisqr <= slow.chisqr + 1e-4
 
 
