@@ -15,6 +15,7 @@ __all__ = ["Coating", "Substrate", "TraceConfig"]
 
 SCATTERING = ("single", "multiple")
 TERMINATION = ("threshold", "roulette")
+ESTIMATORS = ("auto", "evaluated", "counting")
 
 
 def _check(cond: bool, name: str, expected: str, value: Any) -> None:
@@ -212,6 +213,17 @@ class TraceConfig:
         not an ideal mirror); the facets use the coating's alpha.
     block_rays : int
         Rays per random-number block (part of the definition of the random streams).
+    estimator : {"auto", "evaluated", "counting"}
+        How the map is estimated (``docs/tracer.md``). ``"counting"``: exiting rays are
+        counted into bins (the paper's estimator). ``"evaluated"`` (single scattering
+        with a rough first interface only): the first interface's reflection is evaluated
+        in closed form at every bin, the walk below it follows reflection and refraction
+        with their Mueller weights instead of a random choice, and the exit through a
+        rough top interface is applied as an operator on the up-going internal
+        directions. ``"auto"``: evaluated wherever it applies, else counting.
+    batches : int
+        Independent batches (ray index modulo ``batches``) of the evaluated estimator,
+        for its standard errors; part of the definition of its floating-point sums.
     fold_blocks : int
         Consecutive blocks that a worker adds up (in block order) before returning one
         tally; the driver then adds these group tallies in group order. Part of the
@@ -235,6 +247,8 @@ class TraceConfig:
     coherent: bool = False
     block_rays: int = 32768
     fold_blocks: int = 4
+    estimator: str = "auto"
+    batches: int = 8
 
     def __post_init__(self) -> None:
         if isinstance(self.substrate, dict):
@@ -305,6 +319,23 @@ class TraceConfig:
             self.fold_blocks,
         )
         _check(
+            self.estimator in ESTIMATORS, "estimator", f"one of {ESTIMATORS}", self.estimator
+        )
+        _check(
+            isinstance(self.batches, int) and not isinstance(self.batches, bool)
+            and self.batches >= 2,
+            "batches",
+            "an integer >= 2",
+            self.batches,
+        )
+        _check(
+            self.estimator != "evaluated" or self.evaluated_applies,
+            "estimator",
+            "'counting' or 'auto' here: 'evaluated' needs scattering='single' and a rough "
+            "first interface (alpha > 0)",
+            self.estimator,
+        )
+        _check(
             not self.coherent or self.coating is not None,
             "coherent",
             "False when there is no coating",
@@ -333,6 +364,27 @@ class TraceConfig:
             "False with an ideal-mirror substrate (the film needs n + ik)",
             self.coherent,
         )
+
+    @property
+    def evaluated_applies(self) -> bool:
+        """Whether ``estimator="evaluated"`` covers this run.
+
+        It needs single scattering (the multiple-scattering walk's exits are counted) and a
+        rough first interface (the coating's top, or the substrate, or the coherent facets),
+        whose reflection has a closed form; a coating's top must be GGX.
+        """
+        if self.scattering != "single":
+            return False
+        if self.coating is not None:
+            return self.coating.alpha > 0
+        return self.substrate.ndf is not None or self.substrate.alpha > 0
+
+    @property
+    def resolved_estimator(self) -> str:
+        """``"evaluated"`` or ``"counting"`` (``"auto"`` resolved)."""
+        if self.estimator == "auto":
+            return "evaluated" if self.evaluated_applies else "counting"
+        return self.estimator
 
     @property
     def n_blocks(self) -> int:
