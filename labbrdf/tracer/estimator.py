@@ -87,7 +87,7 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
         p = phi_c[jp[sl]] + dphi[b[sl]]
         wo = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)])
         M = reflection_mueller(k_in, s_in, wo, abcs, d_of, g1_of)
-        rows = M.reshape(16, -1) * w[a[sl], b[sl]]
+        rows = M.reshape(16, -1) * w[it[sl], a[sl], b[sl]]
         for e in range(16):
             out[e] += np.bincount(flat[sl], weights=rows[e], minlength=nt * npf)
     return out.T.reshape(nt, npf, 4, 4)

@@ -50,10 +50,11 @@ DFunc = Callable[[F64], F64]
 def bin_nodes(grid: Grid, n_theta: int, n_phi: int) -> tuple[F64, F64, F64]:
     """Gauss-Legendre nodes of the cos-weighted average over each bin.
 
-    The cos-weighted solid angle is ``cos(theta) dOmega = d(sin^2 theta) dphi / 2``,
-    uniform in ``(u = sin^2 theta, phi)``: a product Gauss-Legendre rule in u and phi
-    averages ``f`` over a bin exactly as the counting estimator's ``W / (N Omega_cos)``
-    does (:mod:`.binning`).
+    The bin average of the counting estimator, ``W / (N Omega_cos)`` (:mod:`.binning`),
+    is the average of ``f`` with the weight ``cos(theta) dOmega = sin(theta) cos(theta)
+    dtheta dphi``. A product Gauss-Legendre rule in theta and phi with that weight folded
+    into the node weights is used (not a rule in sin^2 theta: f is not smooth in
+    sin^2 theta at the pole, where it goes like its square root).
 
     Returns
     -------
@@ -61,17 +62,18 @@ def bin_nodes(grid: Grid, n_theta: int, n_phi: int) -> tuple[F64, F64, F64]:
         Polar nodes of each polar row.
     dphi : ndarray, shape (n_phi,) [rad]
         Azimuth offsets of the nodes from the bin centre.
-    weight : ndarray, shape (n_theta, n_phi)
-        Weights of the node pairs, summing to 1.
+    weight : ndarray, shape (n_theta_bins, n_theta, n_phi)
+        Weights of the node pairs, summing to 1 in each row.
     """
     x, w = np.polynomial.legendre.leggauss(n_theta)
     t = np.radians(grid.theta_edges_deg)
-    u_lo, u_hi = np.sin(t[:-1]) ** 2, np.sin(t[1:]) ** 2
-    u = u_lo[:, None] + (u_hi - u_lo)[:, None] * (x[None, :] + 1) / 2
-    theta = np.arcsin(np.sqrt(np.clip(u, 0.0, 1.0)))
+    lo, hi = t[:-1, None], t[1:, None]
+    theta = lo + (hi - lo) * (x[None, :] + 1) / 2
+    wt = w[None, :] * np.sin(theta) * np.cos(theta)
+    wt = wt / wt.sum(axis=1, keepdims=True)
     xp, wp = np.polynomial.legendre.leggauss(n_phi)
     dphi = xp * np.radians(grid.phi_step_deg) / 2
-    weight = (w[:, None] / 2) * (wp[None, :] / 2)
+    weight = wt[:, :, None] * (wp[None, None, :] / 2)
     return theta, dphi, weight
 
 

@@ -140,7 +140,7 @@ def build_exit_operator(
     theta_o, dphi_o, w = bin_nodes(grid, *nodes)
     theta_u = cell_centroids(grid)
     step = np.radians(grid.phi_step_deg)
-    ni, nj = w.shape
+    ni, nj = w.shape[1:]
 
     def abcs_t(c: NDArray[np.float64]) -> tuple:
         return fresnel_abcs(n_below, n_above, c)[1]
@@ -155,7 +155,6 @@ def build_exit_operator(
     a, iu, dj = np.meshgrid(np.arange(ni * nj), np.arange(nt), np.arange(half), indexing="ij")
     a, iu, dj = a.ravel(), iu.ravel(), dj.ravel()
     ai, aj = a // nj, a % nj
-    wt = w[ai, aj]
     flat = iu * half + dj
     tu = theta_u[iu]
     ku = np.stack([np.sin(tu), np.zeros_like(tu), np.cos(tu)])
@@ -166,7 +165,7 @@ def build_exit_operator(
         th = theta_o[io, ai]
         wo = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)])
         M = transmission_mueller(ku, wo, n_below, n_above, abcs_t, d_of, g1_of)
-        rows = M.reshape(16, -1) * wt
+        rows = M.reshape(16, -1) * w[io, ai, aj]
         T = np.empty((16, nt * half))
         for e in range(16):
             T[e] = np.bincount(flat, weights=rows[e], minlength=nt * half)

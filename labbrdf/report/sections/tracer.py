@@ -393,6 +393,7 @@ def validation_section(ctx: Context) -> None:
                     rays=n,
                     seed=10 + k,
                     scattering="single",
+                    estimator="counting",
                 ),
             )
             A = albedo(res)
