@@ -768,6 +768,7 @@ def cmd_trace(args: argparse.Namespace) -> int:
         "seed": args.seed,
         "scattering": "single" if args.single_scattering else "multiple",
         "coherent": args.coherent,
+        "estimator": args.estimator,
     }
     if args.coating is not None:
         coat = _complex(args.coating, "--coating")
@@ -1004,6 +1005,14 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=int, default=1)
     s.add_argument("--single-scattering", action="store_true")
     s.add_argument("--coherent", action="store_true")
+    s.add_argument(
+        "--estimator",
+        choices=("auto", "evaluated", "counting"),
+        default="auto",
+        help="evaluated: closed-form first surface + exit operator (single scattering with "
+        "a rough first interface); counting: exits counted into bins; auto (default): "
+        "evaluated where it applies",
+    )
     s.add_argument("-o", "--output", default=None, help="write the pBRDF (.npz)")
     s.add_argument("--png", default=None, help="write S0/DOP hemisphere maps (.png)")
     s.add_argument("--json", action="store_true")
