@@ -19,8 +19,10 @@ from labbrdf.tracer import Coating, Grid, Substrate, TraceConfig, trace
 from labbrdf.tracer.operator import PARITY, build_exit_operator, cache_dir, exit_operator
 
 AL = Substrate(n=1.55, k=7.71, alpha=0.2)
-# counting bins with fewer rays have a skewed per-ray error (not yet Gaussian)
-MIN_COUNT = 100
+# counting bins with fewer rays have a skewed per-ray error (not yet Gaussian): the
+# off-diagonal elements' ray weights at a rough dielectric have both signs and heavy tails,
+# and with ~100 rays their per-ray error estimate still gives |z| ~ 5-6 once in ~1e4
+MIN_COUNT = 400
 
 
 # ----------------------------------------------------- independent closed form (test-only)
@@ -336,7 +338,7 @@ def test_operator_transmittance_equals_a_sampled_facet_average():
     from labbrdf.tracer.sampling import sample_vndf, smith_g1
 
     alpha, nc = 0.3, 1.5
-    grid = Grid(1.0, 1.0)
+    grid = Grid(2.0, 2.0)
     op = build_exit_operator(grid, nc, alpha, nodes=(2, 2))
     nt, npf = grid.n_theta, grid.n_phi
     T = np.fft.irfft(op.spectrum.astype(np.complex128), n=npf, axis=0).reshape(
@@ -344,7 +346,7 @@ def test_operator_transmittance_equals_a_sampled_facet_average():
     )
     omega = grid.cos_solid_angle_sr[:, 0]
     rng = np.random.default_rng(0)
-    for iu in (5, 25, 50):
+    for iu in (3, 12, 25):
         integral = float((T[:, :, 0, iu, 0] * omega[None, :]).sum())
         from labbrdf.tracer.evaluate import cell_centroids
 
@@ -361,7 +363,7 @@ def test_operator_transmittance_equals_a_sampled_facet_average():
         kt /= np.linalg.norm(kt, axis=0)
         w = np.where(tr[0] > 0, tr[0] * smith_g1(kt[2], alpha), 0.0)
         mc, se = w.mean(), w.std() / np.sqrt(n)
-        # 1-degree cells and bins: the discretisation bias is far below 1e-3
+        # 2-degree cells and bins: the discretisation bias is below 1e-3
         assert integral == pytest.approx(mc, abs=4 * se + 2e-3), iu
 
 
