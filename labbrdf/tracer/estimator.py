@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from .binning import Grid
 from .config import TraceConfig
 from .evaluate import bin_nodes, reflection_mueller
-from .operator import exit_operator
+from .operator import PARITY, exit_operator
 from .sampling import ggx_d, smith_g1
 from .walk import _Setup
 
@@ -74,13 +74,14 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
     theta, dphi, w = bin_nodes(grid, n, n)
     nt, npf = grid.n_theta, grid.n_phi
     phi_c = np.radians(grid.phi_centres_deg)
-    # all (row, col, node_t, node_p) points
+    # the incidence plane is a mirror plane: evaluate phi in [0, 180] deg, mirror the rest
+    half = npf // 2 + 1
     it, jp, a, b = np.meshgrid(
-        np.arange(nt), np.arange(npf), np.arange(n), np.arange(n), indexing="ij"
+        np.arange(nt), np.arange(half), np.arange(n), np.arange(n), indexing="ij"
     )
     it, jp, a, b = it.ravel(), jp.ravel(), a.ravel(), b.ravel()
-    out = np.zeros((16, nt * npf))
-    flat = it * npf + jp
+    out = np.zeros((16, nt * half))
+    flat = it * half + jp
     for s0 in range(0, it.size, chunk):
         sl = slice(s0, s0 + chunk)
         t = theta[it[sl], a[sl]]
@@ -89,8 +90,12 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
         M = reflection_mueller(k_in, s_in, wo, abcs, d_of, g1_of)
         rows = M.reshape(16, -1) * w[it[sl], a[sl], b[sl]]
         for e in range(16):
-            out[e] += np.bincount(flat[sl], weights=rows[e], minlength=nt * npf)
-    return out.T.reshape(nt, npf, 4, 4)
+            out[e] += np.bincount(flat[sl], weights=rows[e], minlength=nt * half)
+    f = np.empty((nt, npf, 4, 4))
+    f[:, :half] = out.T.reshape(nt, half, 4, 4)
+    rest = np.arange(half, npf)
+    f[:, half:] = f[:, npf - rest] * PARITY
+    return f
 
 
 def _ggx(alpha: float, what: str):  # noqa: ANN202

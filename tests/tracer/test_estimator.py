@@ -134,6 +134,8 @@ def test_first_surface_point_values_equal_scatmech(oracles):
 @functools.cache
 def _pair(key: str):
     coarse = {"theta_step_deg": 2.0, "phi_step_deg": 4.0, "scattering": "single"}
+    # broad lobes spread the counted rays thin: coarser bins keep >= MIN_COUNT in each
+    broad = {"theta_step_deg": 5.0, "phi_step_deg": 10.0, "scattering": "single"}
     cases = {
         "bare-0.1": TraceConfig(theta_i_deg=45.0, substrate=Substrate(alpha=0.1), **coarse),
         "bare-0.4": TraceConfig(theta_i_deg=45.0, substrate=Substrate(alpha=0.4), **coarse),
@@ -148,13 +150,14 @@ def _pair(key: str):
             f"coated-{t:g}": TraceConfig(
                 theta_i_deg=t, substrate=AL, coating=Coating(alpha=0.2), **coarse
             )
-            for t in (0.0, 45.0, 60.0, 75.0)
+            for t in (45.0, 60.0, 75.0)
         },
+        "coated-0": TraceConfig(theta_i_deg=0.0, substrate=AL, coating=Coating(alpha=0.2), **broad),
         "coated-absorbing-0.4": TraceConfig(
             theta_i_deg=45.0,
             substrate=Substrate(alpha=0.4),
             coating=Coating(k=0.002, thickness_nm=3000.0, alpha=0.4),
-            **coarse,
+            **broad,
         ),
     }
     cfg = cases[key]
