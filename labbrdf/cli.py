@@ -769,6 +769,7 @@ def cmd_trace(args: argparse.Namespace) -> int:
         "scattering": "single" if args.single_scattering else "multiple",
         "coherent": args.coherent,
         "estimator": args.estimator,
+        "scalar": args.scalar,
     }
     if args.coating is not None:
         coat = _complex(args.coating, "--coating")
@@ -1012,6 +1013,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="evaluated: closed-form first surface + exit operator (single scattering with "
         "a rough first interface); counting: exits counted into bins; auto (default): "
         "evaluated where it applies",
+    )
+    s.add_argument(
+        "--scalar",
+        action="store_true",
+        help="unpolarized Fresnel reflectance at every vertex (only M00; how scalar codes "
+        "compute)",
     )
     s.add_argument("-o", "--output", default=None, help="write the pBRDF (.npz)")
     s.add_argument("--png", default=None, help="write S0/DOP hemisphere maps (.png)")

@@ -221,6 +221,10 @@ class TraceConfig:
         with their Mueller weights instead of a random choice, and the exit through a
         rough top interface is applied as an operator on the up-going internal
         directions. ``"auto"``: evaluated wherever it applies, else counting.
+    scalar : bool
+        Scalar mode: the unpolarized Fresnel reflectance/transmittance ``(Rs + Rp) / 2``
+        at every vertex and no polarization carried between vertices (what scalar codes
+        such as pbrt-v4 or layerlab compute); only the M00 element is non-zero.
     batches : int
         Independent batches (ray index modulo ``batches``) of the evaluated estimator,
         for its standard errors; part of the definition of its floating-point sums.
@@ -249,6 +253,7 @@ class TraceConfig:
     fold_blocks: int = 4
     estimator: str = "auto"
     batches: int = 8
+    scalar: bool = False
 
     def __post_init__(self) -> None:
         if isinstance(self.substrate, dict):
@@ -321,6 +326,7 @@ class TraceConfig:
         _check(
             self.estimator in ESTIMATORS, "estimator", f"one of {ESTIMATORS}", self.estimator
         )
+        _check(isinstance(self.scalar, bool), "scalar", "True or False", self.scalar)
         _check(
             isinstance(self.batches, int) and not isinstance(self.batches, bool)
             and self.batches >= 2,

@@ -68,6 +68,8 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
         else:
             d_of = _ggx(su.alpha_sub, "d")
             g1_of = _ggx(su.alpha_sub, "g1")
+    if cfg.scalar:
+        abcs = _scalar_abcs(abcs)
     n = first_surface_nodes(alpha, min(cfg.theta_step_deg, cfg.phi_step_deg))
     if su.ndf_sub is not None and not su.layered:
         n = 6  # a table's D is piecewise smooth between its cells: no h^(2n) law
@@ -95,7 +97,20 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
     f[:, :half] = out.T.reshape(nt, half, 4, 4)
     rest = np.arange(half, npf)
     f[:, half:] = f[:, npf - rest] * PARITY
+    if cfg.scalar:
+        m00 = f[..., 0, 0].copy()
+        f[...] = 0.0
+        f[..., 0, 0] = m00
     return f
+
+
+def _scalar_abcs(abcs):  # noqa: ANN001, ANN202
+    def inner(c: NDArray) -> tuple:
+        a = abcs(c)[0]
+        z = np.zeros_like(a)
+        return a, z, z, z
+
+    return inner
 
 
 def _ggx(alpha: float, what: str):  # noqa: ANN202
@@ -121,5 +136,18 @@ def exit_map(
     """
     su = _Setup(cfg)
     grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
-    op = exit_operator(grid, su.n_coat, su.alpha_top)
+    # one output node per degree of bin width (a coarse bin is not one point)
+    nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
+    op = exit_operator(grid, su.n_coat, su.alpha_top, nodes=nodes)
+    if cfg.scalar:
+        # the scalar walk carries M00 alone; the operator's (0, 0) element is the scalar
+        # transmission (A of the transmission matrix: B = 0 leaves M00 unrotated)
+        cells = cells.copy()
+        cells[..., 1:, :] = 0.0
+        cells[..., :, 1:] = 0.0
+        out = op.apply(cells)
+        m00 = out[..., 0, 0].copy()
+        out[...] = 0.0
+        out[..., 0, 0] = m00
+        return out, {"operator_seconds": op.seconds, "operator_mb": op.nbytes / 1e6}
     return op.apply(cells), {"operator_seconds": op.seconds, "operator_mb": op.nbytes / 1e6}

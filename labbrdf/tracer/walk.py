@@ -109,6 +109,7 @@ class _Setup:
         # tabulated substrate distribution (None: GGX everywhere, the original path)
         self.ndf_sub = None if cfg.coherent else sub.ndf
         self.evaluated = cfg.resolved_estimator == "evaluated"
+        self.scalar = bool(cfg.scalar)
 
     def lambda_of(
         self,
@@ -145,6 +146,12 @@ class _Setup:
     def substrate_abcs(
         self, cos_i: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray]:
+        out = self._substrate_abcs(cos_i)
+        return _scalar(out) if self.scalar else out
+
+    def _substrate_abcs(
+        self, cos_i: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray]:
         if self.coherent:
             from ..optics import film_amplitudes
 
@@ -165,6 +172,14 @@ class _Setup:
         self, cos_i: NDArray[np.float64], on_top: NDArray[np.bool_], below: NDArray[np.bool_]
     ) -> tuple[tuple, tuple, NDArray[np.float64], NDArray[np.float64]]:
         """Reflection/transmission numbers for a mix of top-interface and substrate rays."""
+        refl, tr, cos_t, eta = self._layered_abcs(cos_i, on_top, below)
+        if self.scalar:
+            refl, tr = _scalar(refl), _scalar(tr)
+        return refl, tr, cos_t, eta
+
+    def _layered_abcs(
+        self, cos_i: NDArray[np.float64], on_top: NDArray[np.bool_], below: NDArray[np.bool_]
+    ) -> tuple[tuple, tuple, NDArray[np.float64], NDArray[np.float64]]:
         nc = self.n_coat
         n1 = np.where(on_top & below, nc, np.where(on_top, 1.0, nc)).astype(np.complex128)
         n2 = np.where(on_top, np.where(below, 1.0, nc), 0.0).astype(np.complex128)
@@ -318,6 +333,8 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
         if not su.layered:
             A, B, C, S = su.substrate_abcs(cos_i)
             apply_fresnel(M, A, B, C, S)
+            if su.scalar:
+                M[1:] = 0.0
             knew = kr
             if su.evaluated:
                 # the first (and only followed) event: its reflection is evaluated in
@@ -375,6 +392,8 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
                 refl[2] * wr + tr[2] * wt,
                 refl[3] * wr + tr[3] * wt,
             )
+            if su.scalar:
+                M[1:] = 0.0
             if trans.any():
                 kt = eta * k + (eta * cos_i - cos_t) * m
                 knew = np.where(trans, kt, kr)
@@ -470,6 +489,17 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
         cell_sums=cell_sums,
         batch_rays=batch_rays,
     )
+
+
+def _scalar(abcs: tuple) -> tuple:
+    """Scalar mode: the unpolarized reflectance A alone, B = C = S = 0.
+
+    With the rows 1-3 of M zeroed after each vertex the ray then carries only S0, weighted
+    by ``(|r_s|^2 + |r_p|^2) / 2`` (or the transmittance) at every vertex, which is what
+    a scalar (unpolarized) code computes.
+    """
+    z = np.zeros_like(abcs[0])
+    return abcs[0], z, z, z
 
 
 def _deposit(

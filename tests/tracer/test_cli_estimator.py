@@ -41,3 +41,8 @@ def test_evaluated_without_single_scattering_exits_2_naming_the_option(capsys):
     err = capsys.readouterr().err
     assert "estimator" in err and "single" in err
     assert "Traceback" not in err
+
+
+def test_scalar_flag_reaches_the_run(capsys):
+    assert main([*BASE, "--single-scattering", "--scalar"]) == 0
+    assert json.loads(capsys.readouterr().out)["config"]["scalar"] is True
