@@ -323,12 +323,11 @@ class TraceConfig:
             "an integer >= 1",
             self.fold_blocks,
         )
-        _check(
-            self.estimator in ESTIMATORS, "estimator", f"one of {ESTIMATORS}", self.estimator
-        )
+        _check(self.estimator in ESTIMATORS, "estimator", f"one of {ESTIMATORS}", self.estimator)
         _check(isinstance(self.scalar, bool), "scalar", "True or False", self.scalar)
         _check(
-            isinstance(self.batches, int) and not isinstance(self.batches, bool)
+            isinstance(self.batches, int)
+            and not isinstance(self.batches, bool)
             and self.batches >= 2,
             "batches",
             "an integer >= 2",

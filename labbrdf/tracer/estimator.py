@@ -62,7 +62,7 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
         g1_of = _ggx(alpha, "g1")
     else:
         alpha = su.alpha_sub
-        abcs = su.substrate_abcs
+        abcs = su.substrate_abcs  # type: ignore[assignment]
         if su.ndf_sub is not None:
             d_of, g1_of = su.ndf_sub.d, su.ndf_sub.smith_g1
         else:

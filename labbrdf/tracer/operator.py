@@ -152,8 +152,8 @@ def build_exit_operator(
         return smith_g1(v[2], alpha)
 
     # per output row: every (node, cell row, azimuth difference in [0, 180] deg) point
-    a, iu, dj = np.meshgrid(np.arange(ni * nj), np.arange(nt), np.arange(half), indexing="ij")
-    a, iu, dj = a.ravel(), iu.ravel(), dj.ravel()
+    grids = np.meshgrid(np.arange(ni * nj), np.arange(nt), np.arange(half), indexing="ij")
+    a, iu, dj = (g.ravel() for g in grids)
     ai, aj = a // nj, a % nj
     flat = iu * half + dj
     tu = theta_u[iu]

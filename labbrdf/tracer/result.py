@@ -224,6 +224,11 @@ class TraceResult:
         return final
 
     def _savez(self, fh: Any) -> None:
+        extra: dict[str, Any] = {}
+        if self.stderr is not None:
+            extra["stderr"] = self.stderr
+        if self.batch_mueller is not None:
+            extra["batch_mueller"] = self.batch_mueller
         np.savez_compressed(
             fh,
             mueller=self.mueller,
@@ -243,8 +248,7 @@ class TraceResult:
             seconds=np.array(self.seconds),
             events=np.array(self.events),
             info=np.array(json.dumps(self.info, sort_keys=True)),
-            **({} if self.stderr is None else {"stderr": self.stderr}),
-            **({} if self.batch_mueller is None else {"batch_mueller": self.batch_mueller}),
+            **extra,
         )
 
     @classmethod

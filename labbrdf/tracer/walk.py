@@ -372,15 +372,16 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
                 entry = on_top & ~below
                 up_ = on_top & below
                 other = np.where(entry, 1.0, 0.0), np.where(up_, 1.0, 0.0)
-                w_o = (
-                    (refl[0] * other[0] + tr[0] * other[1]) * M[0, 0]
-                    + (refl[1] * other[0] + tr[1] * other[1]) * M[1, 0]
-                )
+                w_o = (refl[0] * other[0] + tr[0] * other[1]) * M[0, 0] + (
+                    refl[1] * other[0] + tr[1] * other[1]
+                ) * M[1, 0]
                 kt_ = eta * k + (eta * cos_i - cos_t) * m
                 k_o = np.where(entry, kr, kt_)
                 k_o = k_o / np.sqrt((k_o * k_o).sum(axis=0))
                 g = np.where(
-                    entry | up_, su.g1_of(k_o, k_o[2], np.zeros_like(on_top), su.alpha_top), 0.0
+                    entry | up_,
+                    su.g1_of(k_o, k_o[2], np.zeros_like(on_top), np.full(m_, su.alpha_top)),
+                    0.0,
                 )
                 booked += float((w_o * g).sum())
                 terminated += float((w_o * (1.0 - g)).sum())
@@ -577,6 +578,7 @@ def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
         t = trace_block(cfg, b)
         if cells is not None:
             assert t.cell_keys is not None and t.cell_sums is not None
+            assert brays is not None and t.batch_rays is not None
             cells[t.cell_keys] = cells[t.cell_keys] + t.cell_sums
             brays = brays + t.batch_rays
         sums = sums + t.sums

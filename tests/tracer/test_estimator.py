@@ -152,7 +152,9 @@ def _pair(key: str):
             )
             for t in (45.0, 60.0, 75.0)
         },
-        "coated-0": TraceConfig(theta_i_deg=0.0, substrate=AL, coating=Coating(alpha=0.2), **coarse),
+        "coated-0": TraceConfig(
+            theta_i_deg=0.0, substrate=AL, coating=Coating(alpha=0.2), **coarse
+        ),
         "coated-absorbing-0.4": TraceConfig(
             theta_i_deg=45.0,
             substrate=Substrate(alpha=0.4),
@@ -346,9 +348,7 @@ def test_operator_transmittance_equals_a_sampled_facet_average():
     grid = Grid(2.0, 2.0)
     op = build_exit_operator(grid, nc, alpha, nodes=(2, 2))
     nt, npf = grid.n_theta, grid.n_phi
-    T = np.fft.irfft(op.spectrum.astype(np.complex128), n=npf, axis=0).reshape(
-        npf, nt, 4, nt, 4
-    )
+    T = np.fft.irfft(op.spectrum.astype(np.complex128), n=npf, axis=0).reshape(npf, nt, 4, nt, 4)
     omega = grid.cos_solid_angle_sr[:, 0]
     rng = np.random.default_rng(0)
     for iu in (3, 12, 25):
@@ -390,9 +390,7 @@ def test_operator_cache_is_written_atomically_and_reread(tmp_path, monkeypatch):
     assert len(list(cache_dir().glob("*.npy"))) == 2
 
 
-def test_operator_cache_dir_that_cannot_be_written_costs_only_the_rebuild(
-    tmp_path, monkeypatch
-):
+def test_operator_cache_dir_that_cannot_be_written_costs_only_the_rebuild(tmp_path, monkeypatch):
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")
     monkeypatch.setenv("XDG_CACHE_HOME", str(blocker))

@@ -253,7 +253,10 @@ def _evaluated_maps(ctx: Context, rays: int, step: float) -> list[dict[str, Any]
             figures.polar_maps_figure(
                 [lab for lab, _ in items],
                 [m["s0"] for m in mp],
-                [np.where(d <= DOP_SE_MAX, m["dop"], np.nan) for m, d in zip(mp, dse, strict=True)],
+                [
+                    np.where(d <= DOP_SE_MAX, m["dop"], np.nan)
+                    for m, d in zip(mp, dse, strict=True)
+                ],
                 mp[0]["theta_edges"],
                 mp[0]["phi_edges"],
                 title=f"{study} (single scattering, evaluated)",
@@ -293,8 +296,8 @@ def _evaluated_maps(ctx: Context, rays: int, step: float) -> list[dict[str, Any]
             "evaluated map = counted map in the mean",
             f"only {z.size} elements in bins with >= 400 counted rays at this scale",
         )
-    for r in rows:
-        r.pop("dop_se_lobe")
+    for row in rows:
+        row.pop("dop_se_lobe")
     return rows
 
 
