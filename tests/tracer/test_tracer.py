@@ -192,7 +192,9 @@ def test_single_scattering_energy_below_multiple_scattering():
         TraceConfig(rays=5000, substrate=AL, scattering="multiple"),
         TraceConfig(rays=5000, substrate=AL, coating=Coating(k=0.01, thickness_nm=2000.0)),
         TraceConfig(rays=5000, coating=Coating(), termination="roulette", tau=0.05),
-        TraceConfig(rays=5000, coating=Coating(), scattering="single", tau=0.05),
+        TraceConfig(
+            rays=5000, coating=Coating(), scattering="single", tau=0.05, estimator="counting"
+        ),
         TraceConfig(rays=5000, coating=Coating(), max_bounces=2),
     ],
     ids=["single", "multiple", "absorbing-coat", "roulette", "coat-single", "max-bounces"],
