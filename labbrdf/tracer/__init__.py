@@ -169,8 +169,12 @@ def trace(
     batch_mueller = stderr = None
     info: dict[str, float] = {}
     if cells is not None:
-        batch_mueller, info = _evaluated(config, grid, cells, batch_rays)
-        f = np.tensordot(batch_rays / n, batch_mueller, axes=(0, 0))
+        first, exit_sums, info = _evaluated(config, grid, cells)
+        # f = first + sum_b exit_b / N, f_b = first + exit_b / N_b (plain sums, no BLAS:
+        # a bare substrate's batches are then bit-identical and its error exactly 0)
+        f = first + exit_sums.sum(axis=0) / n
+        per = np.where(batch_rays > 0, 1.0 / np.maximum(batch_rays, 1), 0.0)
+        batch_mueller = first + exit_sums * per[:, None, None, None, None]
         omega = grid.cos_solid_angle_sr[:, :, None, None]
         sums = (f * (n * omega)).reshape(nb, 16)
         sumsq = np.zeros_like(sums)
@@ -205,20 +209,18 @@ def trace(
 
 
 def _evaluated(
-    config: TraceConfig, grid: Grid, cells: np.ndarray, batch_rays: np.ndarray
-) -> tuple[np.ndarray, dict[str, float]]:
-    """Per-batch Mueller BRDF maps of the evaluated estimator, (B, n_theta, n_phi, 4, 4)."""
+    config: TraceConfig, grid: Grid, cells: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
+    """First-surface map (n_theta, n_phi, 4, 4) and per-batch exit sums (B, ...) [sr^-1]."""
     from .estimator import exit_map, first_surface_map
 
     t0 = time.perf_counter()
     first = first_surface_map(config)
     info = {"first_surface_seconds": time.perf_counter() - t0}
     shape = (config.batches, grid.n_theta, grid.n_phi, 4, 4)
-    out = np.broadcast_to(first, shape).copy()
     if config.coating is not None and not config.coherent:
         sums, more = exit_map(config, cells.reshape(shape))
         info.update(more)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            per = np.where(batch_rays > 0, 1.0 / np.maximum(batch_rays, 1), 0.0)
-        out += sums * per[:, None, None, None, None]
-    return out, info
+    else:
+        sums = np.zeros(shape)
+    return first, sums, info
