@@ -23,7 +23,7 @@ from .operator import PARITY, exit_operator
 from .sampling import ggx_d, smith_g1
 from .walk import _Setup
 
-__all__ = ["exit_map", "first_surface_map", "first_surface_nodes"]
+__all__ = ["exit_map", "first_surface_map", "first_surface_nodes", "first_surface_point"]
 
 
 def first_surface_nodes(alpha: float, step_deg: float) -> int:
@@ -37,18 +37,9 @@ def first_surface_nodes(alpha: float, step_deg: float) -> int:
     return int(min(16, max(4, np.ceil(4 * h / 0.2))))
 
 
-def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.float64]:
-    """Bin-averaged Mueller BRDF of the first interface's single reflection [sr^-1].
-
-    Returns
-    -------
-    ndarray, shape (n_theta, n_phi, 4, 4)
-    """
+def _first_surface(cfg: TraceConfig) -> tuple:  # noqa: ANN401
+    """(abcs, D, G1, alpha for the node count) of the config's first interface."""
     su = _Setup(cfg)
-    grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
-    th = np.radians(cfg.theta_i_deg)
-    k_in = np.array([-np.sin(th), 0.0, -np.cos(th)])
-    s_in = np.array([0.0, 1.0, 0.0])
     if su.layered:
         alpha = su.alpha_top
         n_c = su.n_coat
@@ -70,6 +61,52 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
             g1_of = _ggx(su.alpha_sub, "g1")
     if cfg.scalar:
         abcs = _scalar_abcs(abcs)
+    return abcs, d_of, g1_of, alpha
+
+
+def first_surface_point(
+    cfg: TraceConfig, theta_r_deg: NDArray[np.float64], phi_r_deg: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Point Mueller BRDF of the first interface's single reflection [sr^-1].
+
+    Parameters
+    ----------
+    cfg : TraceConfig
+    theta_r_deg, phi_r_deg : ndarray, shape (n,)
+        Exit directions [deg] (theta_r > 0: the meridional frame needs an azimuth).
+
+    Returns
+    -------
+    ndarray, shape (n, 4, 4)
+    """
+    abcs, d_of, g1_of, _ = _first_surface(cfg)
+    th = np.radians(cfg.theta_i_deg)
+    t, p = np.radians(np.asarray(theta_r_deg, float)), np.radians(np.asarray(phi_r_deg, float))
+    wo = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)])
+    M = reflection_mueller(
+        np.array([-np.sin(th), 0.0, -np.cos(th)]), np.array([0.0, 1.0, 0.0]), wo, abcs, d_of, g1_of
+    )
+    out = np.moveaxis(M, 2, 0)
+    if cfg.scalar:
+        m00 = out[:, 0, 0].copy()
+        out[...] = 0.0
+        out[:, 0, 0] = m00
+    return out
+
+
+def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.float64]:
+    """Bin-averaged Mueller BRDF of the first interface's single reflection [sr^-1].
+
+    Returns
+    -------
+    ndarray, shape (n_theta, n_phi, 4, 4)
+    """
+    su = _Setup(cfg)
+    grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
+    th = np.radians(cfg.theta_i_deg)
+    k_in = np.array([-np.sin(th), 0.0, -np.cos(th)])
+    s_in = np.array([0.0, 1.0, 0.0])
+    abcs, d_of, g1_of, alpha = _first_surface(cfg)
     n = first_surface_nodes(alpha, min(cfg.theta_step_deg, cfg.phi_step_deg))
     if su.ndf_sub is not None and not su.layered:
         n = 6  # a table's D is piecewise smooth between its cells: no h^(2n) law

@@ -99,9 +99,7 @@ def test_bare_substrate_equals_closed_form_bin_average(alpha):
 
 def test_first_surface_point_values_equal_scatmech(oracles):
     pd = pytest.importorskip("pandas")
-    from labbrdf.tracer.estimator import _ggx
-    from labbrdf.tracer.evaluate import reflection_mueller
-    from labbrdf.tracer.interfaces import fresnel_abcs
+    from labbrdf.tracer.estimator import first_surface_point
 
     cols = [f"f_M{i}{j}" for i in range(4) for j in range(4)]
     for table in ("inplane", "outofplane"):
@@ -111,21 +109,14 @@ def test_first_surface_point_values_equal_scatmech(oracles):
         # alone does not carry (bin averages never evaluate the pole itself)
         d = d[d.theta_r_deg > 0]
         for (alpha, theta), g in d.groupby(["alpha", "theta_i_deg"]):
-            ti = np.radians(theta)
-            to = np.radians(g.theta_r_deg.to_numpy())
-            po = np.radians(g.phi_r_deg.to_numpy())
-            wo = np.stack([np.sin(to) * np.cos(po), np.sin(to) * np.sin(po), np.cos(to)])
-            M = reflection_mueller(
-                np.array([-np.sin(ti), 0.0, -np.cos(ti)]),
-                np.array([0.0, 1.0, 0.0]),
-                wo,
-                lambda c: fresnel_abcs(1.0, complex(1.55, 7.71), c)[0],
-                _ggx(alpha, "d"),
-                _ggx(alpha, "g1"),
+            cfg = TraceConfig(
+                theta_i_deg=float(theta), substrate=Substrate(alpha=alpha), scattering="single"
             )
-            got = M.reshape(16, -1).T
+            got = first_surface_point(cfg, g.theta_r_deg.to_numpy(), g.phi_r_deg.to_numpy())
             ref = g[cols].to_numpy(float)
-            np.testing.assert_allclose(got, ref, rtol=0, atol=1e-8 * ref[:, 0].max())
+            np.testing.assert_allclose(
+                got.reshape(-1, 16), ref, rtol=0, atol=1e-8 * ref[:, 0].max()
+            )
 
 
 # ------------------------------------------------------------- agreement with counting
