@@ -318,7 +318,9 @@ def _evaluated_oracle(ctx: Context, shared: Path | None, no_shared: str) -> None
         if df is None:
             continue
         d = df[(df["source"] == "scatmech_facet_ggx_smith") & (df["theta_r_deg"] > 0)]
-        for (mat, n, k, alpha, ti), g in d.groupby(["material", "n", "k", "alpha", "theta_i_deg"]):
+        for (_mat, n, k, alpha, ti), g in d.groupby(
+            ["material", "n", "k", "alpha", "theta_i_deg"]
+        ):
             cfg = TraceConfig(
                 theta_i_deg=float(ti),
                 substrate=Substrate(float(n), float(k), float(alpha)),
