@@ -18,12 +18,18 @@ from numpy.typing import NDArray
 
 from .binning import Grid
 from .config import TraceConfig
-from .evaluate import bin_nodes, reflection_mueller
+from .evaluate import bin_nodes, reflection_mueller, transmission_mueller
 from .operator import PARITY, exit_operator
 from .sampling import ggx_d, smith_g1
 from .walk import _Setup
 
-__all__ = ["exit_map", "first_surface_map", "first_surface_nodes", "first_surface_point"]
+__all__ = [
+    "exit_map",
+    "first_surface_map",
+    "first_surface_nodes",
+    "first_surface_point",
+    "nee_exit",
+]
 
 
 def first_surface_nodes(alpha: float, step_deg: float) -> int:
@@ -188,3 +194,74 @@ def exit_map(
         out[..., 0, 0] = m00
         return out, {"operator_seconds": op.seconds, "operator_mb": op.nbytes / 1e6}
     return op.apply(cells), {"operator_seconds": op.seconds, "operator_mb": op.nbytes / 1e6}
+
+
+def nee_exit(
+    cfg: TraceConfig, bins: list[tuple[int, int]], nodes: int = 3
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Exit part of selected bins by direct evaluation per recorded ray (next-event style).
+
+    The independent check of the exit operator: every up-going ray recorded below the top
+    interface is carried through the closed-form BTDF (:func:`.evaluate.transmission_mueller`)
+    from its *exact* direction to ``nodes x nodes`` Gauss-Legendre points of each bin, with
+    no cells and no FFT. Costs per bin, so only for a few bins.
+
+    Returns
+    -------
+    mean : ndarray, shape (len(bins), 4, 4)
+        Exit Mueller BRDF of each bin [sr^-1].
+    stderr : ndarray, shape (len(bins), 4, 4)
+        Its standard error from the batches of ``cfg`` [sr^-1].
+    """
+    from .interfaces import fresnel_abcs
+    from .walk import trace_block
+
+    if cfg.resolved_estimator != "evaluated" or cfg.coating is None or cfg.coherent:
+        raise ValueError("nee_exit needs an evaluated run with an incoherent coating")
+    su = _Setup(cfg)
+    grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
+    theta, dphi, w = bin_nodes(grid, nodes, nodes)
+    phi_c = np.radians(grid.phi_centres_deg)
+    nc, alpha = su.n_coat, su.alpha_top
+
+    def abcs_t(c: NDArray) -> tuple:
+        a, b, c_, s = fresnel_abcs(nc, 1.0, c)[1]
+        if cfg.scalar:
+            z = np.zeros_like(a)
+            return a, z, z, z
+        return a, b, c_, s
+
+    d_of, g1_of = _ggx(alpha, "d"), _ggx(alpha, "g1")
+    nb = cfg.batches
+    acc = np.zeros((nb, len(bins), 4, 4))
+    for block in range(cfg.n_blocks):
+        raw: list = []
+        trace_block(cfg, block, raw=raw)
+        if not raw:
+            continue
+        rid = np.concatenate([r[0] for r in raw])
+        ku = np.concatenate([r[1] for r in raw], axis=1)
+        rows = np.concatenate([r[2] for r in raw], axis=1).reshape(4, 4, -1)
+        batch = rid % nb
+        for q, (i, j) in enumerate(bins):
+            for a in range(nodes):
+                for b in range(nodes):
+                    t, p = theta[i, a], phi_c[j] + dphi[b]
+                    wo = np.array([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)])
+                    T = transmission_mueller(
+                        ku,
+                        np.repeat(wo[:, None], ku.shape[1], axis=1),
+                        nc,
+                        1.0,
+                        abcs_t,
+                        d_of,
+                        g1_of,
+                    )
+                    contrib = np.einsum("ikn,kjn->nij", T, rows) * w[i, a, b]
+                    for bb in range(nb):
+                        acc[bb, q] += contrib[batch == bb].sum(axis=0)
+    n_b = np.bincount(np.arange(cfg.rays) % nb, minlength=nb).astype(float)
+    per = acc / n_b[:, None, None, None]
+    mean = acc.sum(axis=0) / cfg.rays
+    var = (n_b[:, None, None, None] * (per - mean) ** 2).sum(axis=0) / cfg.rays / (nb - 1)
+    return mean, np.sqrt(var)

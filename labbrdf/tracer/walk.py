@@ -200,7 +200,9 @@ class _Setup:
         return refl, tr, cos_t, eta
 
 
-def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
+def trace_block(
+    cfg: TraceConfig, block: int, *, raw: list[tuple[NDArray, NDArray, NDArray]] | None = None
+) -> BlockTally:
     """Trace the rays of block ``block`` with generator ``SeedSequence([seed, block])``.
 
     Parameters
@@ -208,6 +210,10 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
     cfg : TraceConfig
     block : int
         Block index in ``range(cfg.n_blocks)``.
+    raw : list or None
+        Evaluated estimator: if given, every recorded up-going ray is also appended as
+        ``(global ray index, direction (3, n), Mueller rows (16, n) in its meridional
+        frame)``, for checks of the exit operator by direct evaluation.
 
     Returns
     -------
@@ -360,7 +366,7 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
                     wt = np.where(trans, 1.0, 0.0)
                     up_ = on_top & below
                     if up_.any():
-                        _deposit(grid, cfg.batches, k, s_loc, M, up_, rid, dep_key, dep_rows)
+                        _deposit(grid, cfg.batches, k, s_loc, M, up_, rid, dep_key, dep_rows, raw)
                 else:
                     trans = u[2] >= pr
                     wr = np.where(trans, 0.0, 1.0 / np.where(trans, 1.0, pr))
@@ -513,6 +519,7 @@ def _deposit(
     rid: NDArray[np.int64],
     keys: list[NDArray],
     rows: list[NDArray],
+    raw: list[tuple[NDArray, NDArray, NDArray]] | None = None,
 ) -> None:
     """Record the selected up-going rays just below the top interface.
 
@@ -527,6 +534,8 @@ def _deposit(
     rotate_frame(Mc, ks, s[:, sel], s_det)
     keys.append((rid[sel] % batches) * grid.n_bins + idx)
     rows.append(Mc.reshape(16, -1))
+    if raw is not None:
+        raw.append((rid[sel], ks, Mc.reshape(16, -1)))
 
 
 @dataclass
