@@ -161,8 +161,10 @@ def _symmetry_z(res: TraceResult, what: str, min_count: int) -> float:
 
 
 def _populated(res: TraceResult, min_count: int) -> np.ndarray:
-    """Bins whose values can be judged: >= min_count counted rays, or (evaluated
-    estimator, which counts no rays) S0 > 0 with a finite DOP error.
+    """Bins whose values can be judged.
+
+    Counting: at least ``min_count`` counted rays. Evaluated (which counts no rays):
+    S0 > 0 with a finite DOP error.
     """
     if res.estimator == "evaluated":
         return (res.s0() > 0) & np.isfinite(res.dop_stderr())
