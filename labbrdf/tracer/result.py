@@ -124,8 +124,13 @@ class TraceResult:
 
     @property
     def estimator(self) -> str:
-        """``"evaluated"`` or ``"counting"``."""
-        return self.config.resolved_estimator
+        """``"evaluated"`` or ``"counting"``: what produced this result.
+
+        Read from the result itself (its batch errors), not from the config: a file
+        written before the evaluated estimator existed holds a counting run whatever its
+        config would resolve to today.
+        """
+        return "evaluated" if self.stderr is not None else "counting"
 
     @property
     def mueller_stderr(self) -> NDArray[np.float64]:
