@@ -515,3 +515,12 @@ def test_exit_operator_equals_per_bin_evaluation_from_exact_directions(theta_i, 
         np.testing.assert_allclose(
             res.mueller_stderr[i, j, 0, 0], se[q, 0, 0], rtol=0.1, err_msg=(i, j)
         )
+
+
+def test_per_bin_evaluation_needs_an_evaluated_coated_run():
+    from labbrdf.tracer.estimator import nee_exit
+
+    with pytest.raises(ValueError, match="incoherent coating"):
+        nee_exit(_small(coating=None), [(0, 0)])
+    with pytest.raises(ValueError, match="incoherent coating"):
+        nee_exit(_small(estimator="counting"), [(0, 0)])
