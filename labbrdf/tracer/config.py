@@ -150,15 +150,53 @@ class Coating:
     thickness_nm : float
         Physical thickness [nm] >= 0.
     alpha : float
-        GGX roughness of the top (air/coating) interface [1].
+        GGX roughness of the top (air/coating) interface [1] (kept for reference when
+        ``ndf`` is given).
+    ndf : TabulatedNDF or None
+        Tabulated slope distribution of the top interface (a measured table, or
+        :meth:`TabulatedNDF.beckmann` / :meth:`TabulatedNDF.ggx`), seen from above; seen
+        from below the walk uses its mirror image (the point reflection of the slopes).
+        None = GGX with ``alpha``. The exit operator of the evaluated estimator is built
+        for GGX, so a table on the coating is traced with counting.
     """
 
     n: float = 1.5
     k: float = 0.0
     thickness_nm: float = 162.5
     alpha: float = 0.2
+    ndf: TabulatedNDF | None = None
+
+    @classmethod
+    def from_surface(
+        cls, heights: Any, pixel_size: Any = None, *, bins: int = 64, **kw: Any
+    ) -> Coating:
+        """Coating whose top interface follows the slopes of a measured height map.
+
+        As :meth:`Substrate.from_surface` (levelled, table of ``bins`` cells per axis);
+        ``alpha`` = the ML GGX alpha of the same slopes; ``**kw``: n, k, thickness_nm.
+        """
+        sub = Substrate.from_surface(heights, pixel_size, bins=bins)
+        return cls(alpha=sub.alpha, ndf=sub.ndf, **kw)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe dict (the table, if any, as :meth:`TabulatedNDF.to_dict`)."""
+        return {
+            "n": self.n,
+            "k": self.k,
+            "thickness_nm": self.thickness_nm,
+            "alpha": self.alpha,
+            "ndf": None if self.ndf is None else self.ndf.to_dict(),
+        }
 
     def __post_init__(self) -> None:
+        if isinstance(self.ndf, dict):
+            object.__setattr__(self, "ndf", TabulatedNDF.from_dict(self.ndf))
+        _check(
+            self.ndf is None or isinstance(self.ndf, TabulatedNDF),
+            "coating.ndf",
+            "a TabulatedNDF or None",
+            type(self.ndf).__name__,
+        )
         _check(_finite(self.n) and self.n > 0, "coating.n", "a finite number > 0", self.n)
         _check(_finite(self.k) and self.k >= 0, "coating.k", "a finite number >= 0", self.k)
         _check(
@@ -337,7 +375,7 @@ class TraceConfig:
             self.estimator != "evaluated" or self.evaluated_applies,
             "estimator",
             "'counting' or 'auto' here: 'evaluated' needs scattering='single' and a rough "
-            "first interface (alpha > 0)",
+            "first interface (alpha > 0; a GGX coating top, not a table)",
             self.estimator,
         )
         _check(
@@ -364,6 +402,12 @@ class TraceConfig:
             self.coherent,
         )
         _check(
+            not (self.coherent and self.coating is not None and self.coating.ndf is not None),
+            "coherent",
+            "False with a tabulated coating NDF (the coherent facets are GGX)",
+            self.coherent,
+        )
+        _check(
             not (self.coherent and self.substrate.mirror),
             "coherent",
             "False with an ideal-mirror substrate (the film needs n + ik)",
@@ -381,7 +425,7 @@ class TraceConfig:
         if self.scattering != "single":
             return False
         if self.coating is not None:
-            return self.coating.alpha > 0
+            return self.coating.alpha > 0 and self.coating.ndf is None
         return self.substrate.ndf is not None or self.substrate.alpha > 0
 
     @property
@@ -416,10 +460,12 @@ class TraceConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-safe dict."""
-        if self.substrate.ndf is None:
+        coat_table = self.coating is not None and self.coating.ndf is not None
+        if self.substrate.ndf is None and not coat_table:
             return asdict(self)
-        d = asdict(self.replace(substrate=Substrate()))
+        d = asdict(self.replace(substrate=Substrate(), coating=None))
         d["substrate"] = self.substrate.to_dict()
+        d["coating"] = None if self.coating is None else self.coating.to_dict()
         return d
 
     def to_json(self) -> str:

@@ -119,8 +119,10 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
     theta, dphi, w = bin_nodes(grid, n, n)
     nt, npf = grid.n_theta, grid.n_phi
     phi_c = np.radians(grid.phi_centres_deg)
-    # the incidence plane is a mirror plane: evaluate phi in [0, 180] deg, mirror the rest
-    half = npf // 2 + 1
+    # the incidence plane is a mirror plane of an isotropic interface: evaluate phi in
+    # [0, 180] deg and mirror the rest; a slope table need not be symmetric: all of it
+    table = su.ndf_sub is not None and not su.layered
+    half = npf if table else npf // 2 + 1
     it, jp, a, b = np.meshgrid(
         np.arange(nt), np.arange(half), np.arange(n), np.arange(n), indexing="ij"
     )
@@ -138,8 +140,9 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
             out[e] += np.bincount(flat[sl], weights=rows[e], minlength=nt * half)
     f = np.empty((nt, npf, 4, 4))
     f[:, :half] = out.T.reshape(nt, half, 4, 4)
-    rest = np.arange(half, npf)
-    f[:, half:] = f[:, npf - rest] * PARITY
+    if half < npf:
+        rest = np.arange(half, npf)
+        f[:, half:] = f[:, npf - rest] * PARITY
     if cfg.scalar:
         m00 = f[..., 0, 0].copy()
         f[...] = 0.0

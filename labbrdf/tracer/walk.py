@@ -108,6 +108,8 @@ class _Setup:
         self.n_above_sub = self.n_coat if self.layered else 1.0
         # tabulated substrate distribution (None: GGX everywhere, the original path)
         self.ndf_sub = None if cfg.coherent else sub.ndf
+        # tabulated top interface (seen from above; from below: its point reflection)
+        self.ndf_top = coat.ndf if (coat is not None and self.layered) else None
         self.evaluated = cfg.resolved_estimator == "evaluated"
         self.scalar = bool(cfg.scalar)
 
@@ -117,13 +119,31 @@ class _Setup:
         kz_loc: NDArray[np.float64],
         on_sub: NDArray[np.bool_],
         alpha: NDArray[np.float64],
+        below: NDArray[np.bool_] | None = None,
     ) -> NDArray[np.float64]:
-        """Smith Lambda of the travel directions (GGX, or the substrate's table)."""
+        """Smith Lambda of the travel directions (GGX, or the interfaces' tables)."""
         lam = smith_lambda(kz_loc, alpha)
         if self.ndf_sub is not None and on_sub.any():
             # the substrate is always seen from above: its local frame is the global one
             lam[on_sub] = self.ndf_sub.smith_lambda(k[:, on_sub])
+        if self.ndf_top is not None and not on_sub.all():
+            top = ~on_sub
+            lam[top] = self.ndf_top.smith_lambda(self._top_dirs(k, top, below))
         return lam
+
+    @staticmethod
+    def _top_dirs(
+        k: NDArray[np.float64], top: NDArray[np.bool_], below: NDArray[np.bool_] | None
+    ) -> NDArray[np.float64]:
+        """Directions of top-interface rays in the frame of the table seen from above.
+
+        The lower side of a height field, seen through the point reflection r -> -r, has
+        the same slope distribution as the upper side: a direction k below is -k above.
+        """
+        d = k[:, top]
+        if below is None:
+            return d
+        return np.where(below[top], -d, d)
 
     def g1_of(
         self,
@@ -131,11 +151,15 @@ class _Setup:
         kz_loc: NDArray[np.float64],
         on_sub: NDArray[np.bool_],
         alpha: NDArray[np.float64],
+        below: NDArray[np.bool_] | None = None,
     ) -> NDArray[np.float64]:
-        """Smith G1 of the travel directions (GGX, or the substrate's table)."""
+        """Smith G1 of the travel directions (GGX, or the interfaces' tables)."""
         g = smith_g1(kz_loc, alpha)
         if self.ndf_sub is not None and on_sub.any():
             g[on_sub] = self.ndf_sub.smith_g1(k[:, on_sub])
+        if self.ndf_top is not None and not on_sub.all():
+            top = ~on_sub
+            g[top] = self.ndf_top.smith_g1(self._top_dirs(k, top, below))
         return g
 
     def beer_lambert(self, kz: NDArray[np.float64]) -> NDArray[np.float64] | None:
@@ -264,12 +288,12 @@ def trace_block(
                 terminated += float(M[0, 0, back].sum())
                 alive &= ~back
                 go = leave & ~back
-                g = np.where(go, su.g1_of(k, kz_loc, iface == SUB, alpha), 1.0)
+                g = np.where(go, su.g1_of(k, kz_loc, iface == SUB, alpha, below), 1.0)
                 terminated += float((M[0, 0] * (1.0 - g))[go].sum())
                 M *= g
                 leave = go
         else:
-            lam = su.lambda_of(k, kz_loc, iface == SUB, alpha)
+            lam = su.lambda_of(k, kz_loc, iface == SUB, alpha, below)
             leave, h_new = sample_height(kz_loc, lam, h, rng.random(m_))
             h = np.where(leave, h, h_new)
 
@@ -298,7 +322,7 @@ def trace_block(
                         # travels towards it)
                         kz_new = np.where(up, -k[2, ci], k[2, ci])
                         a_new = np.where(up, su.alpha_top, su.alpha_sub)
-                        lam_new = su.lambda_of(k[:, ci], kz_new, ~up, a_new)
+                        lam_new = su.lambda_of(k[:, ci], kz_new, ~up, a_new, up)
                         _, h[ci] = sample_height(
                             kz_new, lam_new, np.full(ci.size, np.inf), rng.random(ci.size)
                         )
@@ -329,6 +353,10 @@ def trace_block(
             on_sub = ~on_top
             m[:, on_sub] = su.ndf_sub.sample_visible(wi[:, on_sub], rng)
         m[2] = np.where(below, -m[2], m[2])
+        if su.ndf_top is not None and on_top.any():
+            # from below: the point reflection of the table's visible normals for k
+            sign = np.where(below[on_top], -1.0, 1.0)
+            m[:, on_top] = sign * su.ndf_top.sample_visible(-k[:, on_top] * sign, rng)
         cos_i = np.clip(-(k[0] * m[0] + k[1] * m[1] + k[2] * m[2]), 0.0, 1.0)
         s_loc = s_axis(k, m, s)
         rotate_frame(M, k, s, s_loc)
