@@ -16,6 +16,8 @@ __all__ = ["Coating", "Substrate", "TraceConfig"]
 SCATTERING = ("single", "multiple")
 TERMINATION = ("threshold", "roulette")
 ESTIMATORS = ("auto", "evaluated", "counting")
+# each batch holds (n_bins x 16) float64 sums: 4.2 MB on the 1-degree grid
+MAX_BATCHES = 64
 
 
 def _check(cond: bool, name: str, expected: str, value: Any) -> None:
@@ -366,9 +368,9 @@ class TraceConfig:
         _check(
             isinstance(self.batches, int)
             and not isinstance(self.batches, bool)
-            and self.batches >= 2,
+            and 2 <= self.batches <= MAX_BATCHES,
             "batches",
-            "an integer >= 2",
+            f"an integer in [2, {MAX_BATCHES}] (each batch keeps a map of all bins)",
             self.batches,
         )
         _check(
