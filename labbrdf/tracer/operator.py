@@ -227,8 +227,11 @@ def exit_operator(
     shape = (npf // 2 + 1, 4 * nt, 4 * nt)
     t0 = time.perf_counter()
     try:
-        spec = np.load(path, allow_pickle=False)
-        if spec.shape == shape and spec.dtype == np.complex64:
+        # memory-mapped first: the header's shape is checked before anything is read
+        mm = np.load(path, allow_pickle=False, mmap_mode="r")
+        if mm.shape == shape and mm.dtype == np.complex64:
+            spec = np.array(mm)
+            del mm
             return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
     except (OSError, ValueError, EOFError):
         pass

@@ -376,6 +376,10 @@ def test_operator_cache_is_written_atomically_and_reread(tmp_path, monkeypatch):
     files[0].write_bytes(files[0].read_bytes()[:100])
     c = exit_operator(grid, 1.5, 0.3)
     assert np.array_equal(a.spectrum, c.spectrum)
+    # a valid file of another shape (say, another grid's) is rebuilt too
+    np.save(files[0], np.zeros((2, 2), dtype=np.complex64))
+    d = exit_operator(grid, 1.5, 0.3)
+    assert np.array_equal(a.spectrum, d.spectrum)
     # another index is another file
     exit_operator(grid, 1.4, 0.3)
     assert len(list(cache_dir().glob("*.npy"))) == 2
