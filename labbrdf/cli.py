@@ -970,14 +970,26 @@ def _height_map(path: str, channel: str | None) -> Any:
     return read_height_map(path, ch)
 
 
-def _ggx_alpha_of(path: str, channel: str | None) -> float:
-    """GGX alpha fitted by maximum likelihood to the slopes of a measured areal map."""
+def _slope_table_of(path: str, channel: str | None) -> tuple[float, Any]:
+    """(ML GGX alpha, slope table) of a measured areal map, for the coating's top."""
     from .tracer import Substrate
 
     hm = _height_map(path, channel)
     if hm.heights.ndim != 2:
         raise UsageError(f"{path}: a line profile; the coating needs an areal height map")
-    return float(Substrate.from_surface(hm.heights, hm.pixel_size).alpha)
+    s = Substrate.from_surface(hm.heights, hm.pixel_size)
+    return float(s.alpha), s.ndf
+
+
+def _analytic_table(args: argparse.Namespace, alpha: float) -> Any:
+    """``--distribution beckmann``: the Beckmann slope table of ``alpha``; GGX: None."""
+    if args.distribution == "ggx":
+        return None
+    from .tracer.sampling import TabulatedNDF
+
+    if not alpha > 0:
+        raise UsageError("--distribution beckmann needs a roughness alpha > 0")
+    return TabulatedNDF.beckmann(alpha)
 
 
 def cmd_surface(args: argparse.Namespace) -> int:
@@ -1082,7 +1094,9 @@ def cmd_trace(args: argparse.Namespace) -> int:
     elif args.alpha is None:
         raise UsageError("give the substrate roughness with --alpha A or --surface FILE")
     else:
-        substrate = tracer.Substrate(n=sub.real, k=sub.imag, alpha=args.alpha)
+        substrate = tracer.Substrate(
+            n=sub.real, k=sub.imag, alpha=args.alpha, ndf=_analytic_table(args, args.alpha)
+        )
     kw: dict[str, Any] = {
         "wavelength_nm": args.wavelength,
         "theta_i_deg": args.theta_i,
@@ -1091,6 +1105,8 @@ def cmd_trace(args: argparse.Namespace) -> int:
         "seed": args.seed,
         "scattering": "single" if args.single_scattering else "multiple",
         "coherent": args.coherent,
+        "estimator": args.estimator,
+        "scalar": args.scalar,
     }
     if args.coating is not None:
         coat = _complex(args.coating, "--coating")
@@ -1101,10 +1117,11 @@ def cmd_trace(args: argparse.Namespace) -> int:
                 "give the coating roughness once: --coating-alpha or --coating-surface"
             )
         coat_alpha = args.coating_alpha if args.coating_alpha is not None else substrate.alpha
+        coat_ndf = _analytic_table(args, coat_alpha)
         if args.coating_surface is not None:
-            coat_alpha = _ggx_alpha_of(args.coating_surface, args.channel)
+            coat_alpha, coat_ndf = _slope_table_of(args.coating_surface, args.channel)
         kw["coating"] = tracer.Coating(
-            n=coat.real, k=coat.imag, thickness_nm=args.thickness, alpha=coat_alpha
+            n=coat.real, k=coat.imag, thickness_nm=args.thickness, alpha=coat_alpha, ndf=coat_ndf
         )
     elif (
         args.thickness is not None
@@ -1420,7 +1437,15 @@ def build_parser() -> argparse.ArgumentParser:
         action=InputPath,
         default=None,
         metavar="FILE",
-        help="measured height map of the coating's top: its ML GGX alpha",
+        help="measured height map of the coating's top: its slope table (and, for "
+        "reference, its ML GGX alpha)",
+    )
+    s.add_argument(
+        "--distribution",
+        choices=("ggx", "beckmann"),
+        default="ggx",
+        help="microfacet distribution of the interfaces given by an alpha (measured maps "
+        "always use their own slope table)",
     )
     s.add_argument("--theta-i", type=float, required=True, help="[deg]")
     s.add_argument("--wavelength", type=float, required=True, help="[nm]")
@@ -1428,6 +1453,20 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=int, default=1)
     s.add_argument("--single-scattering", action="store_true")
     s.add_argument("--coherent", action="store_true")
+    s.add_argument(
+        "--estimator",
+        choices=("auto", "evaluated", "counting"),
+        default="auto",
+        help="evaluated: closed-form first surface + exit operator (single scattering with "
+        "a rough first interface); counting: exits counted into bins; auto (default): "
+        "evaluated where it applies",
+    )
+    s.add_argument(
+        "--scalar",
+        action="store_true",
+        help="unpolarized Fresnel reflectance at every vertex (only M00; how scalar codes "
+        "compute)",
+    )
     s.add_argument(
         "-o",
         "--output",
