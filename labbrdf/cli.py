@@ -514,6 +514,7 @@ def _model_from_args(args: argparse.Namespace) -> tuple[Any, dict[str, float]]:
 
 def cmd_nk(args: argparse.Namespace) -> int:
     from . import adapters
+    from .ellipsometry import P_ANGLE_DEPENDENT
     from .nk import combined_table, nk_json, nk_table
     from .outputs import atomic_output, check_file_output, check_input_files, csv_safe_frame
 
@@ -540,8 +541,11 @@ def cmd_nk(args: argparse.Namespace) -> int:
     flagged = int(comb["angle_dependent"].fillna(False).astype(bool).sum())
     if flagged:
         print(
-            f"{flagged} of {len(comb)} wavelengths have angle-dependent pseudo-constants "
-            "(p < 0.01): a film or roughness, not a bulk material"
+            f"{flagged} of {len(comb)} wavelengths: the angles of incidence disagree "
+            f"(p < {P_ANGLE_DEPENDENT:g}), so the values there are pseudo-constants of a stack "
+            "(a film or roughness), not a material's n, k. They are not combined (n, k empty "
+            "above; per angle with -o FILE or --json) and predict no reflectance; fit a stack "
+            "model for the layers' constants."
         )
     return 0
 

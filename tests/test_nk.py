@@ -141,3 +141,118 @@ def test_measurement_input_and_unpaired_rows():
     df = df.drop(index=df.index[-1])  # the last delta: its psi has no partner
     t = nk.nk_table(Measurement(df, {}))
     assert len(t) == 8 and t.attrs["unpaired"] == 1
+
+
+# --------------------------------------------------------------------------------------
+# a film: pseudo-constants of a stack are reported as such
+# --------------------------------------------------------------------------------------
+
+
+def _film_rows(wl=(400.0, 500.0, 600.0, 700.0), theta=(60.0, 65.0, 70.0, 75.0), sig=0.01):
+    """psi/Delta of 100 nm of n = 2.1 on n = 3.9 + 0.02i (exact, Airy), sigma ``sig``."""
+    rows = []
+    for w in wl:
+        for t in theta:
+            rs, rp = optics.film_amplitudes(1.0, 2.1, 3.9 + 0.02j, 100.0, w, t)
+            rho = complex(rp / rs)
+            psi = float(np.degrees(np.arctan(abs(rho))))
+            delta = float(np.degrees(np.angle(rho))) % 360.0
+            for q, v in (("psi", psi), ("delta", delta)):
+                rows.append(
+                    dict(sample="film", instrument="x", source="film.dat", quantity=q,
+                         value=v, sigma=sig, unit="deg", wavelength_nm=w, theta_i_deg=t,
+                         theta_r_deg=t, phi_r_deg=180.0)
+                )  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def test_film_pseudo_constants_are_not_combined():
+    c = nk.combined_table(_film_rows())
+    assert c["angle_dependent"].all() and not c["combined"].any()
+    assert c[["n", "k", "n_sigma", "k_sigma", "nk_cov"]].isna().all().all()
+    # the per-wavelength statistics stay: chi2/dof far above 1
+    assert (c["chi2"] / c["dof"] > 100).all()
+    v = nk.angle_verdict(c)
+    assert v.kind == "stack" and v.fraction == 1.0 and "pseudo-constants of a stack" in v.text
+    out = nk.nk_json(_film_rows())
+    assert out["combined"]["n"] == [None] * 4 and len(out["n"]) == 16  # per angle: kept
+
+
+def test_bulk_sample_is_combined_and_judged_bulk():
+    c = nk.combined_table(_synthetic())
+    assert c["combined"].all() and nk.angle_verdict(c).kind == "bulk"
+
+
+def test_chance_agreement_in_a_stack_is_not_given():
+    # one wavelength where the film's angles agree (one angle only there) among many
+    # where they disagree: the group is a stack, so that wavelength gets no n, k either
+    rows = pd.concat(
+        [_film_rows(), _synthetic(wl=(800.0,), theta=(65.0, 70.0)).assign(
+            sample="film", source="film.dat")],
+        ignore_index=True,
+    )  # fmt: skip
+    c = nk.combined_table(rows)
+    at800 = c[c["wavelength_nm"] == 800.0].iloc[0]
+    assert not at800["angle_dependent"] and not at800["combined"] and np.isnan(at800["n"])
+
+
+def test_partly_angle_dependent_sample_keeps_the_consistent_wavelengths():
+    rows = pd.concat(
+        [_film_rows(wl=(400.0,)), _synthetic(wl=(500.0, 600.0, 700.0)).assign(
+            sample="film", source="film.dat")],
+        ignore_index=True,
+    )  # fmt: skip
+    c = nk.combined_table(rows)
+    v = nk.angle_verdict(c)
+    assert v.kind == "partly" and v.fraction == pytest.approx(0.25)
+    assert c["combined"].tolist() == [False, True, True, True]
+    at = nk.nk_at(c, [550.0, 650.0])
+    np.testing.assert_allclose(at["n"], 2.0, rtol=1e-12)
+    with pytest.raises(ValueError, match="pseudo-constants of a stack"):
+        nk.nk_at(c, 450.0)  # between a flagged and a combined wavelength
+    nan = nk.nk_at(c, [400.0, 450.0, 500.0], on_angle_dependent="nan")
+    assert np.isnan(nan["n"][:2]).all() and nan["n"][2] == pytest.approx(2.0)
+
+
+def test_angle_verdict_untested_with_one_angle():
+    c = nk.combined_table(_synthetic(theta=(70.0,)))
+    v = nk.angle_verdict(c)
+    assert v.kind == "untested" and "one angle" in v.text and c["combined"].all()
+
+
+def _refl_rows(wl, theta=65.0):
+    rs, rp = optics.reflectance(1.0, 2 + 3j, theta)
+    return pd.DataFrame(
+        [
+            dict(sample="film", instrument="x", source="r.dat", quantity="reflectance",
+                 value=float(v), sigma=1e-3, unit="1", wavelength_nm=w, theta_i_deg=theta,
+                 theta_r_deg=theta, phi_r_deg=180.0, channel=ch)
+            for w in wl for ch, v in (("s", rs), ("p", rp))
+        ]
+    )  # fmt: skip
+
+
+def test_compare_reflectance_refuses_a_stack():
+    c = nk.combined_table(_film_rows())
+    with pytest.raises(ValueError, match="pseudo-constants of a stack.*does not apply"):
+        nk.compare_reflectance(c, _refl_rows([450.0, 550.0]))
+
+
+def test_compare_reflectance_skips_the_angle_dependent_wavelengths():
+    rows = pd.concat(
+        [_film_rows(wl=(400.0,)), _synthetic(wl=(500.0, 600.0, 700.0)).assign(
+            sample="film", source="film.dat")],
+        ignore_index=True,
+    )  # fmt: skip
+    cmp = nk.compare_reflectance(nk.combined_table(rows), _refl_rows([450.0, 550.0, 650.0]))
+    assert cmp.attrs["angle_dependent"] == 2 and len(cmp) == 4
+    np.testing.assert_allclose(cmp["difference"], 0.0, atol=1e-12)
+
+
+def test_oxide_coated_wafer_gives_no_constants(real_exports):
+    m = labbrdf.read(real_exports / "woollam-wvase-ascii" / "w1_12082006.dat")
+    c = nk.combined_table(m, on_ill_conditioned="ignore")
+    assert nk.angle_verdict(c).kind == "stack"
+    assert not c["combined"].any() and c["n"].isna().all()
+    with pytest.raises(ValueError, match="pseudo-constants of a stack"):
+        nk.nk_at(c, 500.0)
