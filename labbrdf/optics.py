@@ -881,14 +881,18 @@ def film_amplitudes(
     -----
     The Airy sum uses ``r10 = -r01`` and ``t01 t10 = 1 - r01^2``, which hold for both
     polarizations in the LB frames ({s, p, k} right-handed, s common to all rays in the
-    plane of incidence). ``exp(2 i beta)`` follows from ``exp(-i omega t)``.
+    plane of incidence). ``exp(2 i beta)`` follows from ``exp(-i omega t)``. Computed by
+    :func:`labbrdf.stack.amplitudes` (one layer), the one coherent multilayer of labbrdf.
     """
-    (r01s, r01p, _, _), _, (r12s, r12p, _, _), beta = _film(
-        n_ambient, n_film, n_substrate, thickness_nm, wavelength_nm, theta_i_deg
-    )
-    ph = np.exp(2j * beta)
-    rs = (r01s + r12s * ph) / (1.0 + r01s * r12s * ph)
-    rp = (r01p + r12p * ph) / (1.0 + r01p * r12p * ph)
+    # the one coherent multilayer implementation (imported here: stack builds on this module)
+    from .stack import amplitudes
+
+    media = [_index(k, v) for k, v in (("n_ambient", n_ambient), ("n_film", n_film))]
+    media.append(_index("n_substrate", n_substrate))
+    d = _nonneg("thickness_nm", thickness_nm)
+    lam = _nonneg("wavelength_nm", wavelength_nm, strict=True)
+    theta = _angle("theta_i_deg", theta_i_deg)
+    rs, rp, _, _ = amplitudes(media, [d], lam, theta)
     return _arrays(rs, rp)
 
 

@@ -1,0 +1,509 @@
+"""The film fit: a layer stack as a model of the one fitting core.
+
+:func:`fit_film` turns psi/Delta (any angles), polarised or unpolarised reflectance and
+transmittance rows of one sample (one or several files, fitted jointly) into residual
+components with the files' sigmas, and fits the free parameters of a
+:class:`~labbrdf.films.FilmModel` with :func:`labbrdf.fitting.fit` (global then local,
+seeded): no second fitter. :class:`FilmFit` reports thicknesses and n, k with intervals,
+chi2/nu beside Woollam's MSE, correlations and identifiability notes. Re-exported by
+:mod:`labbrdf.films`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from numpy.typing import ArrayLike, NDArray
+from scipy import special
+
+from .. import dispersion as disp
+from .. import stack as stk
+from ..dataset import Measurement
+from ..films import FILM_QUANTITIES, NK_REPORT_NM, FilmError, FilmModel, Stack, load_model
+from ..jsonsafe import jsonable
+from ..models import Model, Parameters
+from .core import fit
+from .data import FitData, FitError
+from .result import FitResult
+from .uncertainty import CORREL_MAX
+
+__all__ = ["FilmFit", "fit_film", "woollam_mse"]
+
+
+class _FilmFitModel(Model):
+    """The film as a :class:`~labbrdf.models.base.Model` of the fitting core.
+
+    Each data row carries a channel (psi, Delta, R_s, R_p, R, T_s, T_p, T); ``_evaluate``
+    returns the model value of every row. For Delta rows it returns the measured value
+    plus the angular difference, so the core's residual ``y - model`` is the wrapped
+    difference in (-180, 180] deg whatever the branch.
+    """
+
+    name = "film"
+    reference = "coherent transfer matrices (labbrdf.stack) with labbrdf.dispersion materials"
+
+    _CH = {"psi": 0, "delta": 1, "rs": 2, "rp": 3, "r": 4, "ts": 5, "tp": 6, "t": 7}
+
+    def __init__(self, fm: FilmModel, channels: NDArray, y: NDArray) -> None:
+        self.fm = fm
+        self.channels = np.asarray(channels, int)
+        self.y = np.asarray(y, float)
+        super().__init__()
+
+    def default_params(self) -> Parameters:
+        p = Parameters()
+        vals = self.fm.stack.values()
+        units = self.fm.stack.units()
+        for k, v in vals.items():
+            lo, hi = self.fm.free.get(k, (-math.inf, math.inf))
+            vary = k in self.fm.free
+            start = min(max(v, lo), hi) if vary else v
+            lo, hi = (lo, hi) if vary else (-math.inf, math.inf)
+            p.add(k, start, lo, hi, vary, units.get(k, "1"))
+        return p
+
+    def rows(self, p: Mapping[str, float], ti_deg: NDArray, wl: NDArray) -> NDArray:
+        s = self.fm.stack.with_values({k: p[k] for k in self.fm.free})
+        idx = s.indices(wl)
+        th = np.clip(ti_deg, 0.0, 90.0)
+        rs, rp, ts, tp, kz0, kzs = stk._stack(idx, s._thicknesses(), wl, th)
+        ch = self.channels
+        out = np.full(ch.shape, np.nan)
+        psi = np.degrees(np.arctan2(np.abs(rp), np.abs(rs)))
+        delta = np.degrees(np.angle(rs * np.conj(rp)))
+        d = (delta - self.y + 180.0) % 360.0 - 180.0
+        out = np.where(ch == 0, psi, out)
+        out = np.where(ch == 1, self.y + d, out)
+        Rs, Rp = np.abs(rs) ** 2, np.abs(rp) ** 2
+        out = np.where(ch == 2, Rs, out)
+        out = np.where(ch == 3, Rp, out)
+        out = np.where(ch == 4, 0.5 * (Rs + Rp), out)
+        if np.any(ch >= 5):
+            Ts, Tp = stk.transmittance(idx, s._thicknesses(), wl, th)
+            out = np.where(ch == 5, Ts, out)
+            out = np.where(ch == 6, Tp, out)
+            out = np.where(ch == 7, 0.5 * (Ts + Tp), out)
+        return out
+
+    def _evaluate(self, p, theta_i, theta_r, phi_r, wavelength):
+        if wavelength is None or np.shape(theta_i) != self.channels.shape:
+            raise FitError("film model: evaluated on rows other than the fitted data")
+        try:
+            return self.rows(p, np.degrees(theta_i), np.asarray(wavelength, float))
+        except ValueError:  # parameters outside the physical domain (n < 0, C > 2 E0, ...)
+            return np.full(self.channels.shape, np.nan)
+
+
+# --------------------------------------------------------------------------------------
+# data
+# --------------------------------------------------------------------------------------
+
+
+def _frame(data: Any) -> pd.DataFrame:
+    if isinstance(data, Measurement):
+        return data.data
+    if isinstance(data, pd.DataFrame):
+        return data
+    if isinstance(data, (list, tuple)):
+        return pd.concat([_frame(d) for d in data], ignore_index=True)
+    raise FilmError(
+        f"data: expected a Measurement or a dataset DataFrame, got {type(data).__name__}"
+    )
+
+
+def _film_rows(
+    data: Any,
+    wl_range: tuple[float, float] | None,
+    default_sigma: Mapping[str, float] | None,
+) -> tuple[pd.DataFrame, NDArray]:
+    """The rows a film fit uses and their channel codes."""
+    df = _frame(data)
+    df = df[df["quantity"].astype(str).isin(FILM_QUANTITIES)].copy()
+    if "channel" in df.columns:
+        ch = df["channel"].astype(object).where(df["channel"].notna(), "").astype(str)
+    else:
+        ch = pd.Series("", index=df.index)
+    ell = df["quantity"].astype(str).isin(["psi", "delta"])
+    bad = ell & ~ch.isin(["", "pp"])
+    df, ch, ell = df[~bad], ch[~bad], ell[~bad]  # generalised-ellipsometry cross channels
+    if wl_range is not None:
+        keep = (df["wavelength_nm"] >= wl_range[0]) & (df["wavelength_nm"] <= wl_range[1])
+        df, ch, ell = df[keep], ch[keep], ell[keep]
+    if df.empty:
+        raise FilmError(
+            "data: no psi, delta, reflectance or transmittance rows"
+            + (f" in {wl_range[0]:g}-{wl_range[1]:g} nm" if wl_range else "")
+        )
+    q = df["quantity"].astype(str)
+    code = np.full(len(df), -1)
+    code[(q == "psi").to_numpy()] = 0
+    code[(q == "delta").to_numpy()] = 1
+    for qty, base in (("reflectance", 2), ("transmittance", 5)):
+        m = (q == qty).to_numpy()
+        c = ch.to_numpy()
+        code[m & (c == "s")] = base
+        code[m & (c == "p")] = base + 1
+        code[m & np.isin(c, ["", "u", "unpolarized", "unpolarised"])] = base + 2
+        odd = m & (code == -1)
+        if odd.any():
+            raise FilmError(
+                f"data: {qty} rows with channel {sorted(set(c[odd]))}; expected s, p or none"
+            )
+    theta = df["theta_i_deg"].to_numpy(float).copy()
+    no_angle = ~np.isfinite(theta)
+    if np.any(no_angle & ell.to_numpy()):
+        raise FilmError("data: psi/delta rows without an angle of incidence")
+    theta[no_angle] = 0.0  # spectrophotometer R, T without an angle: normal incidence
+    df["theta_i_deg"] = theta
+    sig = df["sigma"].to_numpy(float).copy()
+    missing = ~(np.isfinite(sig) & (sig > 0))
+    if missing.any():
+        for qty in sorted(set(q[missing])):
+            if default_sigma and qty in default_sigma:
+                sig[missing & (q == qty).to_numpy()] = float(default_sigma[qty])
+            else:
+                raise FilmError(
+                    f"data: {int((missing & (q == qty).to_numpy()).sum())} {qty} row(s) have no "
+                    f"sigma; a film fit weights by the files' sigmas: give default_sigma="
+                    f"{{'{qty}': ...}} (CLI --sigma {qty}=VALUE) in the value's units"
+                )
+    df["sigma"] = sig
+    return df.reset_index(drop=True), code
+
+
+def _check_coverage(fm: FilmModel, wl: NDArray) -> None:
+    mats = [("substrate", fm.stack.substrate), ("ambient", fm.stack.ambient)]
+    mats += [(lay.name, lay.material) for lay in fm.stack.layers]
+    for name, m in mats:
+        if isinstance(m, disp.Tabulated) and not m.covers(wl):
+            lo, hi = m.range_nm
+            raise FilmError(
+                f"{fm.source}: {name} material {m.source} covers {lo:g}-{hi:g} nm but the "
+                f"data span {float(wl.min()):g}-{float(wl.max()):g} nm; restrict the fit "
+                "with wavelength_nm = [min, max] (CLI --wavelength-range MIN MAX) or use a "
+                "table that covers the data"
+            )
+
+
+# --------------------------------------------------------------------------------------
+# the fit
+# --------------------------------------------------------------------------------------
+
+
+def woollam_mse(chisqr: float, n_values: int, n_params: int) -> float:
+    """Woollam's mean squared error of a fit.
+
+    ``MSE = sqrt( 1/(2N - M) sum_i [ ((psi_mod - psi_exp)/sigma_psi)^2 +
+    ((Delta_mod - Delta_exp)/sigma_Delta)^2 ] )`` for N (psi, Delta) pairs and M fitted
+    parameters (J. A. Woollam Co., *Guide to Using WVASE32*, section "Mean Squared Error";
+    C. M. Herzinger et al., J. Appl. Phys. 83, 3323 (1998), eq. (1)), i.e.
+    ``sqrt(chi2 / nu)`` with the ``2N`` measured values; with reflectance or transmittance
+    rows in a joint fit their weighted squares count the same way.
+
+    Notes
+    -----
+    CompleteEASE's default MSE is computed from N = cos 2psi, C and S = sin 2psi cos/sin
+    Delta (times 1000), not from psi and Delta: it is a different number for the same fit.
+    """
+    nu = n_values - n_params
+    return math.sqrt(chisqr / nu) if nu > 0 else math.nan
+
+
+@dataclass
+class FilmFit:
+    """A film fit: the core's :class:`~labbrdf.fitting.FitResult` and the best-fit stack."""
+
+    result: FitResult
+    model: FilmModel
+    stack: Stack
+    data: pd.DataFrame
+    channels: NDArray
+    sources: list[str]
+
+    @property
+    def mse(self) -> float:
+        """Woollam's MSE (:func:`woollam_mse`)."""
+        return woollam_mse(self.result.chisqr, self.result.ndata, self.result.nvarys)
+
+    def _nk_at(self, wl: float) -> dict[str, dict[str, Any]]:
+        """n, k of each layer at ``wl`` with stderr and 95 % intervals from the covariance."""
+        res = self.result
+        names = list(res.var_names)
+        cov = None if res.covar is None else np.asarray(res.covar, float)
+        base = self.stack.nk(wl)
+        out: dict[str, dict[str, Any]] = {}
+        vals = {k: res.params[k].value for k in names}
+        grads: dict[str, list[complex]] = {k: [] for k in base}
+        for k in names:
+            q = res.params[k]
+            h = 1e-6 * max(abs(q.value), 1e-3)
+            lo_ok = q.value - h >= q.min
+            up = dict(vals)
+            dn = dict(vals)
+            up[k] = q.value + h if q.value + h <= q.max else q.value
+            dn[k] = q.value - h if lo_ok else q.value
+            step = up[k] - dn[k]
+            try:
+                a = self.model.stack.with_values(up).nk(wl)
+                b = self.model.stack.with_values(dn).nk(wl)
+            except ValueError:
+                a = b = base
+                step = 1.0
+            for lay in base:
+                grads[lay].append(complex((a[lay] - b[lay]) / step) if step else 0j)
+        for lay, nk in base.items():
+            entry: dict[str, Any] = {"n": float(nk.real), "k": float(nk.imag)}
+            g = np.asarray(grads[lay]) if names else np.zeros(0, complex)
+            for part, gv in (("n", g.real), ("k", g.imag)):
+                if cov is not None and cov.shape == (len(names), len(names)) and np.any(gv):
+                    var = float(gv @ cov @ gv)
+                    se = math.sqrt(var) if var >= 0 and math.isfinite(var) else None
+                elif names:
+                    se = 0.0 if not np.any(gv) else None
+                else:
+                    se = 0.0
+                entry[f"{part}_stderr"] = se
+                if se is not None:
+                    t = float(special.stdtrit(max(res.nfree, 1), 0.975))
+                    entry[f"{part}_ci95"] = [entry[part] - t * se, entry[part] + t * se]
+                else:
+                    entry[f"{part}_ci95"] = None
+            out[lay] = entry
+        return out
+
+    def notes(self) -> list[str]:
+        """Plain-language identifiability notes (thickness-index trade-offs, bounds)."""
+        res = self.result
+        notes = []
+        for k in res.var_names:
+            q = res.params[k]
+            for other, c in (q.correl or {}).items():
+                if k < other and abs(c) >= CORREL_MAX:
+                    a_th, b_th = k.endswith("thickness_nm"), other.endswith("thickness_nm")
+                    if a_th != b_th:
+                        notes.append(
+                            f"{k} and {other} trade off (correlation {c:+.3f}): the data fix "
+                            "their combination (optical thickness) better than each alone; "
+                            "typical of thin films (Aspnes' d-n correlation below ~10 nm)"
+                        )
+                    else:
+                        notes.append(f"{k} and {other} are strongly correlated ({c:+.3f})")
+        for k, fl in res.flags.items():
+            for reason in res.flag_reasons.get(k, []):
+                notes.append(f"{k}: {reason}")
+            if "at_bound" in fl and not res.flag_reasons.get(k):
+                notes.append(f"{k}: at a bound of its box")
+        return notes
+
+    def channel_stats(self) -> dict[str, dict[str, float]]:
+        """chi2 and count per data channel (psi, delta, R_s, ...)."""
+        names = {0: "psi", 1: "delta", 2: "R_s", 3: "R_p", 4: "R", 5: "T_s", 6: "T_p", 7: "T"}
+        r = np.asarray(self.result.residual, float) / self.data["sigma"].to_numpy(float)
+        out = {}
+        for code, nm in names.items():
+            m = self.channels == code
+            if m.any():
+                out[nm] = {"n": int(m.sum()), "chi2": float(np.sum(r[m] ** 2))}
+        return out
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-safe summary of the fit.
+
+        Layers (thickness, material parameters, n and k at 633 nm with
+        stderr and 95 % intervals), chi2, nu, chi2/nu, MSE, flags, correlations, notes.
+        """
+        res = self.result
+        nk = self._nk_at(NK_REPORT_NM) if self._covers(NK_REPORT_NM) else {}
+
+        def param(k: str) -> dict[str, Any]:
+            q = res.params[k]
+            d: dict[str, Any] = {"value": q.value, "vary": q.vary, "units": q.units}
+            if q.vary:
+                t_se = q.stderr
+                d["stderr"] = t_se
+                d["ci95"] = list(q.ci95) if q.ci95 is not None else None
+                d["ci_method"] = res.ci_method
+                d["bounds"] = [q.min, q.max]
+                d["flags"] = res.flags.get(k, [])
+            return d
+
+        layers = []
+        for lay in self.stack.layers:
+            keys = [f"{lay.name}.{k}" for k in lay.params]
+            layers.append(
+                {
+                    "name": lay.name,
+                    "material": lay.material.to_dict(),
+                    "parameters": {k.split(".", 1)[1]: param(k) for k in keys},
+                    f"nk_at_{NK_REPORT_NM:g}nm": nk.get(lay.name),
+                }
+            )
+        sub_keys = [f"substrate.{k}" for k in self.stack.substrate.params]
+        return jsonable(
+            {
+                "kind": "labbrdf film fit",
+                "sources": self.sources,
+                "stack": self.stack.to_dict(),
+                "layers": layers,
+                "substrate": {
+                    "material": self.stack.substrate.to_dict(),
+                    "parameters": {k.split(".", 1)[1]: param(k) for k in sub_keys},
+                    f"nk_at_{NK_REPORT_NM:g}nm": nk.get("substrate"),
+                },
+                "wavelength_range_nm": [
+                    float(self.data["wavelength_nm"].min()),
+                    float(self.data["wavelength_nm"].max()),
+                ],
+                "ndata": res.ndata,
+                "nvarys": res.nvarys,
+                "nfree": res.nfree,
+                "chisqr": res.chisqr,
+                "redchi": res.redchi,
+                "mse": self.mse,
+                "channels": self.channel_stats(),
+                "success": res.success,
+                "message": res.message,
+                "method": res.method,
+                "seed": res.seed,
+                "nfev": res.nfev,
+                "elapsed_s": res.elapsed_s,
+                "ci_method": res.ci_method,
+                "flags": res.flags,
+                "correlations": {
+                    k: res.params[k].correl for k in res.var_names if res.params[k].correl
+                },
+                "notes": self.notes(),
+                "warnings": list(res.warnings),
+            }
+        )
+
+    def _covers(self, wl: float) -> bool:
+        try:
+            self.stack.nk(wl)
+        except ValueError:
+            return False
+        return True
+
+    def save_json(self, path: str | os.PathLike[str]) -> Path:
+        """Write :meth:`summary` as JSON, atomically (a new file or a complete replacement)."""
+        from ..outputs import atomic_output
+
+        p = Path(path)
+        with atomic_output(p) as tmp:
+            Path(tmp).write_text(json.dumps(self.summary(), indent=2, allow_nan=False) + "\n")
+        return p
+
+    def nk_table(self, wavelength_nm: ArrayLike | None = None) -> pd.DataFrame:
+        """n, k of every layer and the substrate on the fitted wavelengths (or given ones)."""
+        wl = (
+            np.unique(self.data["wavelength_nm"].to_numpy(float))
+            if wavelength_nm is None
+            else np.asarray(wavelength_nm, float)
+        )
+        nk = self.stack.nk(wl)
+        cols: dict[str, Any] = {"wavelength_nm": wl}
+        for name, v in nk.items():
+            cols[f"{name}_n"] = v.real
+            cols[f"{name}_k"] = v.imag
+        return pd.DataFrame(cols)
+
+
+def fit_film(
+    stack_or_model: Stack | FilmModel | str | os.PathLike[str],
+    data: Any,
+    *,
+    free: Mapping[str, tuple[float, float]] | None = None,
+    wavelength_range_nm: tuple[float, float] | None = None,
+    default_sigma: Mapping[str, float] | None = None,
+    method: str = "GN_CRS2_LM+LN_BOBYQA",
+    seed: int = 0,
+    ci: str = "wald",
+    maxeval: int | Sequence[int | None] | None = None,
+) -> FilmFit:
+    """Fit a film stack's thicknesses and dispersion parameters to measured data.
+
+    Parameters
+    ----------
+    stack_or_model : Stack, FilmModel or path
+        A :class:`Stack` (every layer's thickness and parametric material parameters vary,
+        :meth:`FilmModel.default`), a :class:`FilmModel`, or a TOML model file
+        (:func:`load_model`).
+    data : Measurement, DataFrame or list of them
+        Rows with quantity psi, delta (ordinary ellipsometry, any angles), reflectance or
+        transmittance (channel ``s``, ``p`` or unpolarised; no angle = normal incidence), of
+        one sample: several files are fitted jointly.
+    free : mapping, optional
+        ``"<layer>.<name>" -> (min, max)``: replaces the model's varying parameters.
+    wavelength_range_nm : (float, float), optional
+        Fit only these wavelengths (overrides the model file's).
+    default_sigma : mapping, optional
+        quantity -> sigma for rows whose file gives none.
+    method, seed, maxeval
+        As :func:`labbrdf.fitting.fit` (global then local; seeded).
+    ci : {"wald", "profile"}
+        95 % intervals from the covariance or from the profile of chi-square.
+
+    Returns
+    -------
+    FilmFit
+
+    Raises
+    ------
+    FilmError
+        No usable rows, a row without sigma, a table that does not cover the data.
+    FitError
+        From the core (too few points, unknown method, ...).
+    """
+    if isinstance(stack_or_model, Stack):
+        fm = FilmModel.default(stack_or_model)
+    elif isinstance(stack_or_model, FilmModel):
+        fm = stack_or_model
+    elif isinstance(stack_or_model, (str, os.PathLike)):
+        fm = load_model(stack_or_model)
+    else:
+        raise FilmError(
+            f"expected a Stack, a FilmModel or a model file, got {type(stack_or_model).__name__}"
+        )
+    if free is not None:
+        known = fm.stack.values()
+        bad = sorted(set(free) - set(known))
+        if bad:
+            raise FilmError(f"free: unknown parameter(s) {bad}; parameters: {sorted(known)}")
+        fm = FilmModel(fm.stack, {k: (float(a), float(b)) for k, (a, b) in free.items()},
+                       fm.wavelength_range_nm, fm.source)  # fmt: skip
+    wl_range = wavelength_range_nm or fm.wavelength_range_nm
+    rows, codes = _film_rows(data, wl_range, default_sigma)
+    wl = rows["wavelength_nm"].to_numpy(float)
+    _check_coverage(fm, wl)
+    for k, (lo, hi) in fm.free.items():
+        if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+            raise FilmError(f"{fm.source}: {k}: bounds [{lo}, {hi}] must be finite with min < max")
+    model = _FilmFitModel(fm, codes, rows["value"].to_numpy(float))
+    fd = FitData(
+        rows["theta_i_deg"].to_numpy(float),
+        rows["theta_i_deg"].to_numpy(float),
+        rows["value"].to_numpy(float),
+        rows["sigma"].to_numpy(float),
+        180.0,
+        wl,
+        "film",
+        "mixed",
+    )
+    res = fit(model, fd, method=method, seed=seed, ci=ci, maxeval=maxeval, guess=False)
+    best = fm.stack.with_values({k: res.params[k].value for k in fm.free})
+    return FilmFit(
+        result=res,
+        model=fm,
+        stack=best,
+        data=rows,
+        channels=codes,
+        sources=sorted(set(rows["source"].astype(str))) if "source" in rows else [],
+    )

@@ -1,0 +1,157 @@
+"""Layer and Stack objects, roughness, serialisation, TOML model files and their errors."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from labbrdf import stack as stk
+from labbrdf.dispersion import Cauchy, Sellmeier, Tabulated
+from labbrdf.films import FilmError, Layer, Roughness, Stack, load_model
+
+
+def _oxide_on_si(d=100.0):
+    return Stack([Layer(Sellmeier(), d, "oxide")], substrate="si")
+
+
+def test_stack_psi_delta_is_the_stack_optics_of_its_materials():
+    s = _oxide_on_si()
+    lam = np.array([400.0, 633.0, 900.0])
+    psi, delta = s.psi_delta(lam, 70.0)
+    n_ox, n_si = Sellmeier().nk(lam), Tabulated.reference("si").nk(lam)
+    psi0, delta0 = stk.ellipsometry([1.0, n_ox, n_si], [100.0], lam, 70.0)
+    np.testing.assert_array_equal(psi, psi0)
+    np.testing.assert_array_equal(delta, delta0)
+    rs, rp = s.reflectance(lam, 70.0)
+    assert np.all((rs > 0) & (rs < 1) & (rp >= 0) & (rp < 1))
+
+
+def test_nk_per_layer_and_substrate():
+    nk = _oxide_on_si().nk(633.0)
+    assert list(nk) == ["oxide", "substrate"]
+    assert nk["oxide"] == pytest.approx(1.457, abs=1e-3)
+    assert nk["substrate"].real == pytest.approx(3.879 + 0.3 * (3.861 - 3.879), abs=1e-12)
+
+
+def test_roughness_layer_is_the_bruggeman_half_mixture_of_the_medium_below_and_ambient():
+    s = Stack([Layer(Roughness(), 3.0, "rough")], substrate="si")
+    idx = s.indices(633.0)
+    eps_si = Tabulated.reference("si").nk(633.0) ** 2
+    assert idx[1] ** 2 == pytest.approx(stk.bruggeman(eps_si, 1.0, 0.5), rel=1e-12)
+
+
+def test_to_dict_round_trip_and_with_values():
+    s = Stack(
+        [Layer(Roughness(0.4), 2.0, "rough"), Layer(Cauchy(A=2.0, B=0.02), 50.0, "film")],
+        substrate="si",
+    )
+    again = Stack.from_dict(json.loads(json.dumps(s.to_dict())))
+    lam = np.linspace(300, 1000, 8)
+    np.testing.assert_array_equal(again.psi_delta(lam, 65.0)[0], s.psi_delta(lam, 65.0)[0])
+    t = s.with_values({"film.thickness_nm": 60.0, "film.A": 2.1, "rough.fraction": 0.5})
+    assert t.layers[1].thickness_nm == 60.0 and t.layers[1].material.A == 2.1
+    assert t.layers[0].material.fraction == 0.5
+    assert s.layers[1].thickness_nm == 50.0  # the original is unchanged
+    with pytest.raises(FilmError, match="unknown stack parameter 'film.Q'"):
+        s.with_values({"film.Q": 1.0})
+
+
+@pytest.mark.parametrize(
+    ("build", "match"),
+    [
+        (lambda: Stack([Layer(1.5, 1.0, "a"), Layer(1.6, 1.0, "a")], "si"), "repeated"),
+        (lambda: Layer(1.5, -1.0), "thickness_nm must be >= 0"),
+        (lambda: Stack([], "roughness"), "roughness is a layer"),
+        (lambda: Stack([Layer("unobtainium", 1.0)], "si"), "unknown material"),
+        (lambda: Roughness(1.5), "fraction"),
+    ],
+)
+def test_invalid_stacks_raise_film_errors(build, match):
+    with pytest.raises(FilmError, match=match):
+        build()
+
+
+# ---- TOML model files
+
+GOOD = """\
+# native oxide on silicon
+wavelength_nm = [300, 1000]
+
+[substrate]
+material = "si"
+
+[[layer]]
+name = "oxide"
+material = "cauchy"
+thickness_nm = [0, 10]
+A = [1.3, 1.7]
+B = 0.0036
+C = {value = 0.0, min = -0.01, max = 0.01}
+"""
+
+
+def test_load_model_reads_layers_fixed_and_free_parameters(tmp_path):
+    p = tmp_path / "m.toml"
+    p.write_text(GOOD)
+    fm = load_model(p)
+    assert fm.wavelength_range_nm == (300.0, 1000.0)
+    assert [lay.name for lay in fm.stack.layers] == ["oxide"]
+    assert fm.free == {
+        "oxide.thickness_nm": (0.0, 10.0),
+        "oxide.A": (1.3, 1.7),
+        "oxide.C": (-0.01, 0.01),
+    }
+    assert fm.stack.layers[0].thickness_nm == 5.0  # mid-box start
+    assert fm.stack.layers[0].material.B == 0.0036
+
+
+@pytest.mark.parametrize(
+    ("edit", "match"),
+    [
+        (lambda t: t.replace("B = 0.0036", "Q = 1.0"), r"line 12: unknown parameter 'Q'"),
+        (lambda t: t.replace("A = [1.3, 1.7]", "A = [1.7, 1.3]"), r"line 11: .*impossible bounds"),
+        (
+            lambda t: t.replace('material = "cauchy"', 'material = "nope"'),
+            r"line 9: unknown material",
+        ),
+        (lambda t: t.replace("[[layer]]", "[[layers]]"), r"line 7: unknown key or table 'layers'"),
+        (lambda t: t.replace("thickness_nm = [0, 10]\n", ""), r"line 7: layer 'oxide' has no"),
+        (lambda t: t.replace("B = 0.0036", "B = 0.0036 ="), r"not valid TOML.*line 12"),
+        (
+            lambda t: t.replace('[substrate]\nmaterial = "si"\n', ""),
+            r"line 1: missing \[substrate\]",
+        ),
+        (
+            lambda t: t.replace("C = {value = 0.0,", "C = {value = 0.0, step = 1,"),
+            r"line 13: .*step",
+        ),
+        (
+            lambda t: t.replace("wavelength_nm = [300, 1000]", "wavelength_nm = [1000, 300]"),
+            r"line 2: wavelength_nm",
+        ),
+    ],
+)
+def test_bad_model_file_names_the_file_and_line(tmp_path, edit, match):
+    p = tmp_path / "bad.toml"
+    p.write_text(edit(GOOD))
+    with pytest.raises(FilmError, match=match) as exc:
+        load_model(p)
+    assert "bad.toml" in str(exc.value)
+
+
+def test_model_file_with_a_table_file_substrate_relative_to_the_model(tmp_path):
+    (tmp_path / "metal.csv").write_text("300,1.5,3.0\n1200,2.0,4.0\n")
+    p = tmp_path / "m.toml"
+    p.write_text(
+        '[substrate]\nfile = "metal.csv"\n\n[[layer]]\nmaterial = "sio2"\nthickness_nm = 10\n'
+    )
+    fm = load_model(p)
+    assert fm.stack.substrate.nk(750.0) == pytest.approx(1.75 + 3.5j)
+    assert fm.free == {}
+
+
+def test_missing_model_file_is_a_film_error(tmp_path):
+    with pytest.raises(FilmError, match="cannot read the model file"):
+        load_model(tmp_path / "absent.toml")
