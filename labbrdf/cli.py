@@ -867,6 +867,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             start=start,
             selection=selection,
             progress=not args.quiet,
+            film_model=args.film_model,
         )
     )
 
@@ -1035,6 +1036,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="a model option (microfacet n=, k=, diffuse=true) or a parameter's start value",
     )
     s.add_argument("-o", "--output", required=True, metavar="DIR")
+    s.add_argument(
+        "--film-model",
+        default=None,
+        metavar="FILE.toml",
+        help="fit this film stack to psi/Delta files whose angles disagree; 'default': "
+        "one transparent Cauchy layer on c-Si, thickness free",
+    )
     s.add_argument("--quiet", action="store_true", help="no progress lines")
     _add_selection(s)
     s.set_defaults(func=cmd_report)

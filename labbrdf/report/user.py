@@ -23,6 +23,7 @@ from .context import METHOD, Context
 from .sections import Section, run
 from .sections.brdf import brdf_section
 from .sections.colour import colour_section
+from .sections.film import film_model_of, film_section
 from .sections.fits import fits_section
 from .sections.ingest import ingest_files
 from .sections.measured import measured_section
@@ -70,6 +71,7 @@ def user_report(
     title: str | None = None,
     start: Mapping[str, float] | None = None,
     selection: Mapping[str, Any] | None = None,
+    film_model: str | os.PathLike[str] | None = None,
     **kw: Any,
 ) -> int:
     """Build a report for the given files and write it (atomically) to ``out``.
@@ -98,6 +100,11 @@ def user_report(
     selection : mapping, optional
         Rows to keep, as :func:`labbrdf.selection.select` takes them (``wavelength``,
         ``theta_i``, ``quantity``, ``sample``); applied to every file after reading.
+    film_model : path-like or "default", optional
+        A film model (TOML, :func:`labbrdf.films.load_model`) fitted to every psi/Delta
+        file whose angles of incidence disagree (section ``film``), or ``"default"``
+        for one transparent Cauchy layer on c-Si with the thickness free
+        (:func:`labbrdf.report.sections.film.default_film_model`). None: no film fit.
     **kw :
         ``quick`` is accepted for symmetry with :func:`~labbrdf.report.validate` (no effect).
 
@@ -110,7 +117,8 @@ def user_report(
     Raises
     ------
     ValueError
-        No paths, an unknown model name or option, or an output folder that is refused
+        No paths, an unknown model name or option, a film model file with an error
+        (naming the file and the line), or an output folder that is refused
         (:class:`labbrdf.outputs.OutputError`), all before any work.
     """
     unknown = set(kw) - {"quick"}
@@ -127,6 +135,7 @@ def user_report(
         models.get(model, **opts)
     except Exception as exc:
         raise ValueError(f"model: {exc}") from None
+    film, film_how = film_model_of(None if film_model is None else str(film_model))
     b = Builder(
         title or f"labbrdf report: {model} fits",
         progress=progress,
@@ -138,6 +147,7 @@ def user_report(
             "method": method,
             "seed": seed,
             "files": [str(p) for p in paths],
+            "film_model": None if film_model is None else str(film_model),
             "environment": versions(),
         },
     )
@@ -182,6 +192,11 @@ def user_report(
         ("ingest", "Ingested files", ingest),
         ("measured", "Measured data, file by file", measured_section),
         ("nk", "Optical constants and cross-instrument comparison", nk_section),
+        (
+            "film",
+            "Film stacks fitted to angle-dependent psi/Delta",
+            lambda ctx: film_section(ctx, film, how=film_how),
+        ),
         (
             "fits",
             f"Fitted {model} parameters per sample and wavelength",
