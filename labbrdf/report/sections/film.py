@@ -39,8 +39,18 @@ DEFAULT_MODEL = "default"
 
 #: most wavelengths on which layer n, k and their bands are drawn
 _NK_POINTS = 120
-#: most angles of incidence drawn in the psi/Delta figure
-_MAX_ANGLES = 8
+#: most angles of incidence (or channel-angle pairs) drawn per figure, one colour each
+_MAX_ANGLES = 6
+_COLOURS = ("C0", "C1", "C2", "C3", "C4", "C5")
+
+
+def _describe(m: Any) -> str:
+    """A material in a few words: its model name and, for a table, its source."""
+    src = getattr(m, "source", "")
+    if m.name == "constant":
+        v = complex(np.asarray(m.nk(500.0)).ravel()[0])
+        return f"n = {v.real:.4g}" + (f" + {v.imag:.4g}i" if v.imag else "")
+    return f"{m.name} {src}".strip()
 
 
 def default_film_model() -> films.FilmModel:
@@ -121,7 +131,7 @@ def _psi_delta_figure(fit: films.FilmFit) -> str:
     for q, unit in (("psi", "\u03c8"), ("delta", "\u0394")):
         series, resid = [], []
         rows = ell[ell["quantity"].astype(str) == q]
-        for th in th_all:
+        for col, th in zip(_COLOURS, th_all, strict=False):
             g = rows[rows["theta_i_deg"].round(2) == th].sort_values("wavelength_nm")
             if g.empty:
                 continue
@@ -132,15 +142,11 @@ def _psi_delta_figure(fit: films.FilmFit) -> str:
             r = meas - model
             if q == "delta":
                 r = (r + 180.0) % 360.0 - 180.0
-            series.append({"label": f"\u03b8i {th:g}\u00b0", "x": x, "y": meas, "style": "points"})
-            series.append({"label": "", "x": x, "y": model, "style": "line"})
+            lab = f"\u03b8i {th:g}\u00b0"
+            series.append({"label": lab, "x": x, "y": meas, "style": "points", "colour": col})
+            series.append({"label": "", "x": x, "y": model, "style": "line", "colour": "k"})
             resid.append(
-                {
-                    "label": f"\u03b8i {th:g}\u00b0",
-                    "x": x,
-                    "y": r,
-                    "band": g["sigma"].to_numpy(float),
-                }
+                {"label": lab, "x": x, "y": r, "band": g["sigma"].to_numpy(float), "colour": col}
             )
         panels.append(
             {
@@ -233,18 +239,25 @@ def _reflectance(
     if len(groups) > _MAX_ANGLES:
         keep = np.linspace(0, len(groups) - 1, _MAX_ANGLES).round().astype(int)
         groups = [groups[i] for i in sorted(set(keep))]
-    for (c, th), g in groups:
+    for col, ((c, th), g) in zip(_COLOURS, groups, strict=False):
         g = g.sort_values("wl")
         lab = f"{c or 'unpolarised'} \u03b8i {th:g}\u00b0"
-        series_m.append({"label": f"measured {lab}", "x": g["wl"], "y": g["m"], "style": "points"})
-        series_m.append({"label": "", "x": g["wl"], "y": g["p"], "band": g["ps"].to_numpy()})
-        series_d.append({"label": lab, "x": g["wl"], "y": g["d"], "band": g["ds"].to_numpy()})
+        series_m.append(
+            {"label": lab, "x": g["wl"], "y": g["m"], "style": "points", "colour": col}
+        )
+        series_m.append(
+            {"label": "", "x": g["wl"], "y": g["p"], "band": g["ps"].to_numpy(), "colour": "k"}
+        )
+        series_d.append(
+            {"label": lab, "x": g["wl"], "y": g["d"], "band": g["ds"].to_numpy(), "colour": col}
+        )
     b.figure(
         f"film_{tag}_refl",
         f"Reflectance of {rsrc} against the stack fitted to {src}",
-        f"Measured: {kind} [1] of {rsrc} ({len(r)} points; not used by the fit). Modelled "
-        f"(lines): the stack fitted to the psi/Delta of {src}, coherent transfer matrices, "
-        "band = 1-sigma propagated from the fit's covariance. Right: measured - predicted "
+        f"Measured: {kind} [1] of {rsrc} ({len(r)} points, not used by the fit; coloured, "
+        f"at most {_MAX_ANGLES} channel-angle pairs drawn). Modelled (black lines): the "
+        f"stack fitted to the psi/Delta of {src}, coherent transfer matrices, band = "
+        "1-sigma propagated from the fit's covariance. Right: measured - predicted "
         "with the measurement's and the prediction's 1-sigma in quadrature.",
         figures.panels_figure(
             [
@@ -346,8 +359,9 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
         )
     free = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in model.free.items())
     b.text(
-        f"Film model ({how or model.source}): {model.stack!r}; ambient "
-        f"{model.stack.ambient.name}. Fitted: {free or 'nothing'}"
+        f"Film model ({how or model.source}): ambient {_describe(model.stack.ambient)} / "
+        + " / ".join(f"{lay.name} ({_describe(lay.material)})" for lay in model.stack.layers)
+        + f" / substrate ({_describe(model.stack.substrate)}). Fitted: {free or 'nothing'}"
         + (
             f"; fit window {model.wavelength_range_nm[0]:g}-{model.wavelength_range_nm[1]:g} nm"
             if model.wavelength_range_nm
@@ -382,6 +396,14 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
             f"{s['nvarys']} parameters: chi2/nu {s['redchi']:.4g}, Woollam MSE "
             f"{s['mse']:.4g}; {s['message']}."
             + (" Notes: " + "; ".join(s["notes"]) + "." if s["notes"] else "")
+            + (
+                f" chi2 = {s['chisqr']:.4g} on {s['nfree']} degrees of freedom (p < "
+                f"{P_AGREE:g}): the model misses structure of the data beyond the file's "
+                "sigmas (which are usually repeatability only), so the intervals below are "
+                "statistical and understate the model error."
+                if s["nfree"] and stats.chi2.sf(s["chisqr"], s["nfree"]) < P_AGREE
+                else ""
+            )
         )
         b.table(
             f"film_{tag}_params",
@@ -403,9 +425,10 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
         b.figure(
             f"film_{tag}_psi_delta",
             f"{src}: psi and Delta against wavelength per angle, with the fit",
-            "Measured psi and Delta [deg] (points) and the fitted stack's (lines) against "
-            "wavelength [nm], one colour per angle of incidence (at most eight shown); "
-            "right: measured - fit, band = the file's 1-sigma.",
+            "Measured psi and Delta [deg] (coloured points, one colour per angle of "
+            f"incidence, at most {_MAX_ANGLES} angles spread over the range) and the fitted "
+            "stack's (black lines) against wavelength [nm]; right: measured - fit, band = the "
+            "file's 1-sigma.",
             _psi_delta_figure(fit),
         )
         b.figure(
