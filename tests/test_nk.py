@@ -156,7 +156,7 @@ def _film_rows(wl=(400.0, 500.0, 600.0, 700.0), theta=(60.0, 65.0, 70.0, 75.0), 
             rs, rp = optics.film_amplitudes(1.0, 2.1, 3.9 + 0.02j, 100.0, w, t)
             rho = complex(rp / rs)
             psi = float(np.degrees(np.arctan(abs(rho))))
-            delta = float(np.degrees(np.angle(rho))) % 360.0
+            delta = -float(np.degrees(np.angle(rho))) % 360.0  # Nebraska, as optics
             for q, v in (("psi", psi), ("delta", delta)):
                 rows.append(
                     dict(sample="film", instrument="x", source="film.dat", quantity=q,

@@ -47,3 +47,10 @@ def test_coated_wafer_gives_no_constants_and_no_prediction(trio: dict) -> None:
     assert "nk_0_w1_12082006_dat_pseudo" in figs
     assert not any(f.endswith("_r0") or f.endswith("_combined") for f in figs)
     assert "pseudo-constants of a stack" in trio["_page"]
+
+
+def test_coated_wafer_without_a_film_model_says_how_to_fit_one(trio: dict) -> None:
+    film = next(s for s in trio["sections"] if s["id"] == "film")
+    assert film["status"] == "not available"
+    assert "w1_12082006.dat: pseudo-constants of a stack" in film["reason"]
+    assert "--film-model" in film["reason"]
