@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from labbrdf.cli import main
@@ -67,9 +68,9 @@ def _files(tmp: Path) -> tuple[Path, Path]:
         for ch, r in (("s", rs), ("p", rp)):
             f = make_frame(sample="wafer A", instrument="synthetic", source="wafer_R.csv",
                            quantity="reflectance", value=np.abs(r) ** 2, sigma=0.002, unit="1",
-                           wavelength_nm=WL, theta_i_deg=th, theta_r_deg=th, phi_r_deg=180.0)  # fmt: skip
+                           wavelength_nm=WL, theta_i_deg=th, theta_r_deg=th,
+                           phi_r_deg=180.0)  # fmt: skip
             refl.append(f.assign(channel=ch))
-    import pandas as pd
 
     pe, pr = tmp / "wafer_psi.csv", tmp / "wafer_R.csv"
     write_csv(Measurement(pd.concat(ell, ignore_index=True), {}), pe)
