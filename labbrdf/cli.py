@@ -773,9 +773,23 @@ def cmd_trace(args: argparse.Namespace) -> int:
         "scattering": "single" if args.single_scattering else "multiple",
         "coherent": args.coherent,
     }
-    if args.coating is not None:
+    coat: complex | None = None
+    thickness = args.thickness
+    if args.coating_from is not None:
+        if args.coating is not None or args.thickness is not None:
+            raise UsageError(
+                "give the coating once: --coating-from FIT.json, or --coating and --thickness"
+            )
+        from .nk import coating_from_fit
+
+        try:
+            coat, thickness = coating_from_fit(args.coating_from, args.wavelength)
+        except ValueError as exc:
+            raise UsageError(f"--coating-from {exc}") from None
+    elif args.coating is not None:
         coat = _complex(args.coating, "--coating")
-        if args.thickness is None:
+    if coat is not None:
+        if thickness is None:
             raise UsageError("--coating needs --thickness (nm)")
         if args.coating_alpha is not None and args.coating_surface is not None:
             raise UsageError(
@@ -785,14 +799,16 @@ def cmd_trace(args: argparse.Namespace) -> int:
         if args.coating_surface is not None:
             coat_alpha = _ggx_alpha_of(args.coating_surface, args.channel)
         kw["coating"] = tracer.Coating(
-            n=coat.real, k=coat.imag, thickness_nm=args.thickness, alpha=coat_alpha
+            n=coat.real, k=coat.imag, thickness_nm=thickness, alpha=coat_alpha
         )
     elif (
         args.thickness is not None
         or args.coating_alpha is not None
         or args.coating_surface is not None
     ):
-        raise UsageError("--thickness, --coating-alpha and --coating-surface need --coating")
+        raise UsageError(
+            "--thickness, --coating-alpha and --coating-surface need --coating (or --coating-from)"
+        )
     config = tracer.TraceConfig(**kw)
     mapper: Any = map
     if args.scheduler != "serial":
@@ -995,6 +1011,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s.add_argument("--channel", default=None, help="height channel of --surface")
     s.add_argument("--coating", default=None, help="coating index, e.g. 1.5")
+    s.add_argument(
+        "--coating-from",
+        default=None,
+        metavar="FIT.json",
+        help="coating index at --wavelength and thickness from a one-layer film fit",
+    )
     s.add_argument("--thickness", type=float, default=None, help="coating thickness [nm]")
     s.add_argument("--coating-alpha", type=float, default=None)
     s.add_argument(

@@ -31,8 +31,10 @@ two-phase quantity).
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
@@ -45,6 +47,7 @@ __all__ = [
     "POSITION_TOL_MM",
     "AngleVerdict",
     "angle_verdict",
+    "coating_from_fit",
     "combined_table",
     "compare_reflectance",
     "microfacet_hemispherical",
@@ -759,3 +762,58 @@ def microfacet_hemispherical(
     g_k = (albedo(n, k + h) - albedo(n, k - hk)) / (h + hk)
     var = (g_n * n_sigma) ** 2 + (g_k * k_sigma) ** 2 + 2.0 * g_n * g_k * nk_cov
     return rho, np.sqrt(np.maximum(var, 0.0))
+
+
+def coating_from_fit(path: str | os.PathLike[str], wavelength_nm: float) -> tuple[complex, float]:
+    """The coating of a one-layer film fit: its index at a wavelength and its thickness.
+
+    Parameters
+    ----------
+    path : path-like
+        A film fit's JSON (:meth:`labbrdf.films.FilmFit.save_json`, ``labbrdf film
+        --json``) whose stack has exactly one layer over the substrate (the tracer's one
+        coating).
+    wavelength_nm : float
+        Vacuum wavelength [nm], inside the fitted wavelength range.
+
+    Returns
+    -------
+    N : complex
+        The layer's fitted index ``n + ik`` at ``wavelength_nm`` [1].
+    thickness_nm : float
+        Its fitted thickness [nm].
+
+    Raises
+    ------
+    ValueError
+        The file is not a film fit (:class:`labbrdf.films.FilmError`, naming the file and
+        line), its stack has no layer, several layers or a roughness layer, or the
+        wavelength lies outside the fitted range (a dispersion model is not extrapolated
+        beyond the data that fixed it).
+    """
+    import json
+
+    from .films import Roughness, Stack  # the film objects, imported where needed
+
+    p = Path(path)
+    stack = Stack.from_fit_json(p)
+    names = [lay.name for lay in stack.layers]
+    if len(stack.layers) != 1 or isinstance(stack.layers[0].material, Roughness):
+        raise ValueError(
+            f"{p}: the tracer has one coating over the substrate; this fit's stack has "
+            f"{len(names)} layer(s) {names} (fit one layer, or give --coating and --thickness)"
+        )
+    wl = float(wavelength_nm)
+    doc = json.loads(p.read_text("utf-8"))
+    rng = doc.get("wavelength_range_nm")
+    if not (isinstance(rng, list) and len(rng) == 2):
+        raise ValueError(f"{p}: no 'wavelength_range_nm' (not a film fit of labbrdf)")
+    lo, hi = float(rng[0]), float(rng[1])
+    if not (math.isfinite(wl) and lo <= wl <= hi):
+        raise ValueError(
+            f"{p}: {wl:g} nm is outside the fitted range [{lo:g}, {hi:g}] nm; the layer's "
+            "dispersion is not extrapolated"
+        )
+    layer = stack.layers[0]
+    big_n = complex(np.asarray(stack.nk(wl)[layer.name]).ravel()[0])
+    return big_n, float(layer.thickness_nm)
