@@ -308,11 +308,11 @@ def combined_table(
     depend on the angle; they are no material's constants. Their inverse-covariance mean
     would be one more angle-dependent number, with a sigma that only measures how well
     each angle is measured, not how far apart the angles are (on an oxide-coated wafer:
-    negative n with sigma 3e-4 at chi2/dof 2e5). It is therefore not given: the per-angle
-    pseudo-constants stay in :func:`nk_table`, and a stack model (:mod:`labbrdf.films`)
-    gives the layers' constants. In a group where the angles disagree at most
-    wavelengths (verdict ``stack``), the few where they agree do so by chance and are not
-    given either.
+    n = -0.705 with sigma 3e-4 at 500 nm, chi2/dof 1.5e4). It is therefore not given: the
+    per-angle pseudo-constants stay in :func:`nk_table`, and a stack model
+    (:mod:`labbrdf.films`) gives the layers' constants. In a group where the angles
+    disagree at most wavelengths (verdict ``stack``), the few where they agree do so by
+    chance and are not given either.
     """
     table = data if "n" in _frame(data).columns else nk_table(data, **nk_options)
     table = _spot_labels(_frame(table))
