@@ -550,6 +550,171 @@ def cmd_nk(args: argparse.Namespace) -> int:
     return 0
 
 
+def _film_value(text: str, what: str) -> tuple[float, tuple[float, float] | None]:
+    """``V`` (fixed) or ``LO..HI`` (fitted, started mid-box) of a --layer field."""
+    lo_s, sep, hi_s = text.partition("..")
+    try:
+        if not sep:
+            return float(text), None
+        lo, hi = float(lo_s), float(hi_s)
+    except ValueError:
+        raise UsageError(f"{what}: {text!r} is not a number or LO..HI") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise UsageError(f"{what}: impossible bounds {text!r} (need LO < HI)")
+    return (lo + hi) / 2, (lo, hi)
+
+
+def _film_model(args: argparse.Namespace) -> Any:
+    """The FilmModel of --model FILE, or of --substrate and --layer, or the default."""
+    from . import films
+    from .dispersion import Tabulated
+
+    if args.model is not None:
+        if args.layer or args.substrate:
+            raise UsageError("give --model FILE or --substrate/--layer, not both")
+        return films.load_model(args.model)
+    if not args.layer:
+        if args.substrate not in (None, "si"):
+            raise UsageError("--substrate without --layer: give the layers with --layer")
+        return films.FilmModel.cauchy_on_silicon()
+    sub_text = args.substrate or "si"
+    try:
+        sub = (
+            films.as_material(sub_text)
+            if not os.path.exists(sub_text)
+            else Tabulated.from_file(sub_text)
+        )
+    except ValueError as exc:
+        raise UsageError(f"--substrate {sub_text}: {exc}") from None
+    layers, free = [], {}
+    for j, spec in enumerate(args.layer, 1):
+        fields = spec.split(":")
+        if len(fields) < 3:
+            raise UsageError(
+                f"--layer {spec!r}: expected NAME:MATERIAL:THICKNESS[:PARAM=V|LO..HI ...], "
+                "e.g. oxide:cauchy:0..20:A=1.3..1.7"
+            )
+        name, mat, thick = fields[0] or f"layer{j}", fields[1], fields[2]
+        d, dbox = _film_value(thick, f"--layer {name}: thickness")
+        try:
+            m = films.as_material(mat) if not os.path.exists(mat) else Tabulated.from_file(mat)
+        except ValueError as exc:
+            raise UsageError(f"--layer {name}: {exc}") from None
+        values = {}
+        for item in fields[3:]:
+            key, sep, val = item.partition("=")
+            if not sep or key not in m.params:
+                raise UsageError(
+                    f"--layer {name}: {item!r}: expected PARAM=V or PARAM=LO..HI with PARAM "
+                    f"one of {sorted(m.params) or 'none (a table)'}"
+                )
+            values[key], box = _film_value(val, f"--layer {name}: {key}")
+            if box is not None:
+                free[f"{name}.{key}"] = box
+        try:
+            m = films._with_params(m, values)
+            layers.append(films.Layer(m, d, name))
+        except ValueError as exc:
+            raise UsageError(f"--layer {name}: {exc}") from None
+        if dbox is not None:
+            free[f"{name}.thickness_nm"] = dbox
+    try:
+        stack = films.Stack(layers, sub)
+    except ValueError as exc:
+        raise UsageError(f"--layer: {exc}") from None
+    return films.FilmModel(stack, free, None, "--layer")
+
+
+def _film_table(summary: dict[str, Any]) -> str:
+    """The text table of a film fit summary."""
+
+    def fmt(p: dict[str, Any]) -> str:
+        v = p["value"]
+        if not p.get("vary"):
+            return f"{v:.6g} (fixed)"
+        se, ci = p.get("stderr"), p.get("ci95")
+        out = f"{v:.6g}"
+        if se is not None:
+            out += f" +- {se:.2g}"
+        if ci:
+            out += f"  [{ci[0]:.6g}, {ci[1]:.6g}]"
+        sc = p.get("ci95_scaled")
+        if sc:
+            out += f"  scaled [{sc[0]:.6g}, {sc[1]:.6g}]"
+        if p.get("flags"):
+            out += "  " + ",".join(p["flags"])
+        return out
+
+    lines = []
+    for lay in summary["layers"]:
+        mat = lay["material"].get("model", "?")
+        lines.append(f"layer {lay['name']} ({mat})")
+        for k, p in lay["parameters"].items():
+            lines.append(f"  {k:<14s} {fmt(p)}")
+        nk = lay.get("nk_at_633nm")
+        if nk:
+            n_se = nk.get("n_stderr")
+            k_se = nk.get("k_stderr")
+            n_txt = f"{nk['n']:.5f}" + (f" +- {n_se:.2g}" if n_se is not None else "")
+            k_txt = f"{nk['k']:.5f}" + (f" +- {k_se:.2g}" if k_se is not None else "")
+            lines.append(f"  n, k at 633 nm: {n_txt}, {k_txt}")
+    lines.append(f"substrate ({summary['substrate']['material'].get('model', '?')})")
+    wl = summary["wavelength_range_nm"]
+    lines.append(
+        f"fit: {summary['ndata']} values, {wl[0]:g}-{wl[1]:g} nm, {summary['nvarys']} free; "
+        f"chi2/nu = {summary['redchi']:.4g}, MSE = {summary['mse']:.4g} (Woollam); "
+        f"{summary['nfev']} evaluations, {summary['method']}, seed {summary['seed']}, "
+        f"intervals: {summary['ci_method']}"
+    )
+    if not summary["success"]:
+        lines.append(f"fit did not converge: {summary['message']}")
+    lines.extend(f"note: {n}" for n in summary["notes"])
+    lines.extend(f"warning: {w}" for w in summary["warnings"])
+    return "\n".join(lines)
+
+
+def cmd_film(args: argparse.Namespace) -> int:
+    from . import adapters, films
+    from .outputs import atomic_output, check_file_output, check_input_files, csv_safe_frame
+
+    check_input_files(args.files)
+    extra_inputs = [x for x in (args.model,) if x]
+    outs = []
+    for path, suffix, opt in ((args.output, ".csv", "-o"), (args.fit_json, ".json", "--fit-json")):
+        if path:
+            out = check_file_output(path, inputs=[*args.files, *extra_inputs], suffixes=(suffix,),
+                                    option=opt)  # fmt: skip
+            if out.exists() and not args.overwrite:
+                raise UsageError(f"{opt} {out}: exists; pass --overwrite to replace it")
+            outs.append(out)
+    fm = _film_model(args)
+    sigma = _parse_assignments(args.sigma, "--sigma")
+    wl_range = tuple(args.wavelength_range) if args.wavelength_range else None
+    if wl_range is not None and not 0 < wl_range[0] < wl_range[1]:
+        raise UsageError("--wavelength-range: expected MIN MAX with 0 < MIN < MAX [nm]")
+    data = _selected(args, adapters.read_many(args.files))
+    res = films.fit_film(
+        fm,
+        data,
+        wavelength_range_nm=wl_range,
+        default_sigma=sigma or None,
+        method=args.method,
+        seed=args.seed,
+        ci=args.ci,
+    )
+    summary = res.summary()
+    if args.output:
+        with atomic_output(args.output) as tmp:
+            csv_safe_frame(res.nk_table()).to_csv(tmp, index=False)
+    if args.fit_json:
+        res.save_json(args.fit_json)
+    if args.json:
+        _emit_json(summary)
+    else:
+        print(_film_table(summary))
+    return 0
+
+
 def cmd_export(args: argparse.Namespace) -> int:
     import numpy as np
 
@@ -969,6 +1134,50 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true")
     _add_selection(s)
     s.set_defaults(func=cmd_nk)
+
+    s = sub.add_parser(
+        "film",
+        help="fit a thin-film stack (thicknesses, n, k) to psi/Delta, R and T of one sample",
+    )
+    s.add_argument("files", nargs="+", metavar="FILE", help="files of one sample (joint fit)")
+    s.add_argument("--model", default=None, metavar="MODEL.toml", help="a film model file")
+    s.add_argument(
+        "--substrate",
+        default=None,
+        metavar="NAME|FILE",
+        help="si, sio2, a dispersion model, or an n,k or ellipsometer file (default si)",
+    )
+    s.add_argument(
+        "--layer",
+        action="append",
+        default=[],
+        metavar="NAME:MATERIAL:THICKNESS[:P=V|LO..HI]",
+        help="a layer, top first (repeat); LO..HI values are fitted, e.g. "
+        "oxide:cauchy:0..20:A=1.3..1.7:B=0.004 (no --model/--layer: one Cauchy layer on Si)",
+    )
+    s.add_argument("--wavelength-range", nargs=2, type=float, default=None, metavar=("MIN", "MAX"))
+    s.add_argument(
+        "--sigma",
+        action="append",
+        metavar="QUANTITY=VALUE",
+        help="sigma for rows whose file gives none (e.g. reflectance=0.005)",
+    )
+    s.add_argument(
+        "--ci",
+        choices=("wald", "profile"),
+        default="profile",
+        help="95%% intervals from the profile of chi2 (default) or the covariance",
+    )
+    s.add_argument("--method", default="GN_CRS2_LM+LN_BOBYQA", help="nlopt stages")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("-o", "--output", default=None, metavar="NK.csv",
+                   help="write each layer's n, k on the fitted wavelengths")  # fmt: skip
+    s.add_argument("--fit-json", default=None, metavar="FIT.json",
+                   help="write the fit (best-fit stack, intervals) as JSON")  # fmt: skip
+    s.add_argument("--overwrite", action="store_true", help="replace existing outputs")
+    s.add_argument("--json", action="store_true")
+    _add_selection(s)
+    s.set_defaults(func=cmd_film)
 
     s = sub.add_parser("surface", help="roughness statistics of a height map or profile")
     s.add_argument("file", metavar="FILE")

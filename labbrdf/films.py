@@ -384,6 +384,18 @@ class FilmModel:
     source: str = "<model>"
 
     @classmethod
+    def cauchy_on_silicon(cls) -> FilmModel:
+        """The stated default for one transparent layer on silicon.
+
+        A Cauchy layer (``A`` in [1.3, 2.6], ``B`` in [0, 0.1] um^2, ``C = 0``, ``k = 0``,
+        thickness in [0, 1000] nm) on crystalline Si (Green 2008 table), fitted over the
+        table's 250-1450 nm: a native or thermal oxide, nitride or polymer film on a wafer.
+        """
+        layer = Layer(disp.Cauchy(A=1.5, B=0.005), 100.0, "film")
+        free = {"film.thickness_nm": (0.0, 1000.0), "film.A": (1.3, 2.6), "film.B": (0.0, 0.1)}
+        return cls(Stack([layer], "si"), free, (250.0, 1450.0), "default: Cauchy layer on Si")
+
+    @classmethod
     def default(cls, stack: Stack, thickness_max_nm: float | None = None) -> FilmModel:
         """The default fit of a stack.
 

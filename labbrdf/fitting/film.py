@@ -279,10 +279,32 @@ class FilmFit:
             out[lay] = entry
         return out
 
+    @property
+    def misfit_scale(self) -> float | None:
+        """``sqrt(chi2/nu)`` when chi-square rejects the model at the 1 % level, else None.
+
+        The model then misses the data by more than the files' sigmas (a systematic
+        misfit: the substrate's table, an unmodelled layer, the instrument's calibration);
+        intervals from the sigmas alone are too narrow, and ``*_scaled`` intervals (stderr
+        times this factor, lmfit's ``scale_covar``) are reported beside them.
+        """
+        res = self.result
+        if res.nfree <= 0 or not math.isfinite(res.chisqr):
+            return None
+        if special.chdtrc(res.nfree, res.chisqr) >= 0.01:
+            return None
+        return math.sqrt(res.redchi)
+
     def notes(self) -> list[str]:
-        """Plain-language identifiability notes (thickness-index trade-offs, bounds)."""
+        """Plain-language notes: misfit, thickness-index trade-offs, bounds."""
         res = self.result
         notes = []
+        if self.misfit_scale is not None:
+            notes.append(
+                f"chi2/nu = {res.redchi:.3g}: the model misses the data by more than the files' "
+                "sigmas (p < 0.01); the intervals from the sigmas alone are too narrow; "
+                f"*_scaled intervals multiply them by sqrt(chi2/nu) = {self.misfit_scale:.3g}"
+            )
         for k in res.var_names:
             q = res.params[k]
             for other, c in (q.correl or {}).items():
@@ -322,15 +344,31 @@ class FilmFit:
         """
         res = self.result
         nk = self._nk_at(NK_REPORT_NM) if self._covers(NK_REPORT_NM) else {}
+        scale = self.misfit_scale
+        tq = float(special.stdtrit(max(res.nfree, 1), 0.975))
+        if scale is not None:
+            for entry in nk.values():
+                for part in ("n", "k"):
+                    se = entry.get(f"{part}_stderr")
+                    if se is not None:
+                        v = entry[part]
+                        entry[f"{part}_stderr_scaled"] = se * scale
+                        entry[f"{part}_ci95_scaled"] = [v - tq * se * scale, v + tq * se * scale]
 
         def param(k: str) -> dict[str, Any]:
             q = res.params[k]
             d: dict[str, Any] = {"value": q.value, "vary": q.vary, "units": q.units}
             if q.vary:
-                t_se = q.stderr
-                d["stderr"] = t_se
+                d["stderr"] = q.stderr
                 d["ci95"] = list(q.ci95) if q.ci95 is not None else None
                 d["ci_method"] = res.ci_method
+                if scale is not None and q.stderr is not None:
+                    se = q.stderr * scale
+                    d["stderr_scaled"] = se
+                    d["ci95_scaled"] = [
+                        max(q.value - tq * se, q.min),
+                        min(q.value + tq * se, q.max),
+                    ]
                 d["bounds"] = [q.min, q.max]
                 d["flags"] = res.flags.get(k, [])
             return d
@@ -400,6 +438,99 @@ class FilmFit:
         with atomic_output(p) as tmp:
             Path(tmp).write_text(json.dumps(self.summary(), indent=2, allow_nan=False) + "\n")
         return p
+
+    def compare_reflectance(self, reflectance: Any) -> pd.DataFrame:
+        """Measured specular reflectance against the best-fit stack's prediction.
+
+        Parameters
+        ----------
+        reflectance : Measurement, DataFrame or list of them
+            Rows with ``quantity == "reflectance"``: channel ``s``/``p`` (R_s, R_p) or none
+            (``(R_s + R_p)/2``); no angle means normal incidence.
+
+        Returns
+        -------
+        pandas.DataFrame
+            The columns of :func:`labbrdf.nk.compare_reflectance` (``sample, source,
+            wavelength_nm, theta_i_deg, channel, measured, measured_sigma, predicted,
+            predicted_sigma, difference, difference_sigma, z``), so a report treats both
+            alike. ``predicted_sigma`` propagates the fit's covariance (scaled by
+            :attr:`misfit_scale` when chi-square rejects the model) through the stack.
+            Rows outside the wavelengths the stack's tables cover are dropped and counted
+            in ``attrs["outside_range"]``.
+
+        Raises
+        ------
+        FilmError
+            No reflectance rows, or none the stack covers.
+        """
+        df = _frame(reflectance)
+        rows = df[df["quantity"].astype(str) == "reflectance"]
+        if rows.empty:
+            raise FilmError("no reflectance rows in the data to compare with")
+        wl = rows["wavelength_nm"].to_numpy(float)
+        ok = np.array([self._covers(float(w)) for w in np.unique(wl)])
+        covered = np.isin(wl, np.unique(wl)[ok])
+        outside = int((~covered).sum())
+        rows = rows[covered]
+        if rows.empty:
+            raise FilmError("no reflectance row within the wavelengths the stack covers")
+        wl = rows["wavelength_nm"].to_numpy(float)
+        theta = np.nan_to_num(rows["theta_i_deg"].to_numpy(float), nan=0.0)
+        if "channel" in rows.columns:
+            channel = rows["channel"].astype(object).to_numpy()
+        else:
+            channel = np.full(len(rows), None, dtype=object)
+        is_s, is_p = channel == "s", channel == "p"
+
+        def predict(st: Stack) -> NDArray:
+            rs, rp = st.reflectance(wl, theta)
+            return np.where(is_s, rs, np.where(is_p, rp, 0.5 * (rs + rp)))
+
+        predicted = predict(self.stack)
+        res = self.result
+        names = list(res.var_names)
+        cov = None if res.covar is None else np.asarray(res.covar, float)
+        psig = np.full(len(rows), np.nan)
+        if cov is not None and cov.shape == (len(names), len(names)) and np.all(np.isfinite(cov)):
+            vals = {k: res.params[k].value for k in names}
+            G = np.empty((len(rows), len(names)))
+            for j, k in enumerate(names):
+                q = res.params[k]
+                h = 1e-6 * max(abs(q.value), 1e-3)
+                up, dn = dict(vals), dict(vals)
+                up[k] = min(q.value + h, q.max)
+                dn[k] = max(q.value - h, q.min)
+                G[:, j] = (
+                    predict(self.model.stack.with_values(up))
+                    - predict(self.model.stack.with_values(dn))
+                ) / (up[k] - dn[k])
+            var = np.einsum("ij,jk,ik->i", G, cov, G) * (self.misfit_scale or 1.0) ** 2
+            psig = np.sqrt(np.maximum(var, 0.0))
+        measured = rows["value"].to_numpy(float)
+        msig = rows["sigma"].to_numpy(float)
+        diff = measured - predicted
+        dsig = np.where(np.isnan(msig), psig, np.hypot(msig, np.nan_to_num(psig)))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            z = diff / dsig
+        out = pd.DataFrame(
+            {
+                "sample": rows["sample"].astype(object).to_numpy(),
+                "source": rows["source"].astype(object).to_numpy(),
+                "wavelength_nm": wl,
+                "theta_i_deg": rows["theta_i_deg"].to_numpy(float),
+                "channel": channel,
+                "measured": measured,
+                "measured_sigma": msig,
+                "predicted": predicted,
+                "predicted_sigma": psig,
+                "difference": diff,
+                "difference_sigma": dsig,
+                "z": z,
+            }
+        )
+        out.attrs["outside_range"] = outside
+        return out
 
     def nk_table(self, wavelength_nm: ArrayLike | None = None) -> pd.DataFrame:
         """n, k of every layer and the substrate on the fitted wavelengths (or given ones)."""

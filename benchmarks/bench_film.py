@@ -1,0 +1,136 @@
+"""Speed of the film fit: one Cauchy layer on Si, 700 wavelengths x 3 angles of psi/Delta.
+
+Run: ``python benchmarks/bench_film.py [--repeat N]``
+
+Synthetic data (a 105 nm Cauchy film, A = 1.46, B = 0.004 um^2, on Green's c-Si) at
+300-1000 nm and 55/65/75 deg, with Gaussian noise of 0.01 deg (psi) and 0.03 deg (Delta),
+the sigmas of a WVASE file in the visible. Prints, for
+
+* ``labbrdf``: :func:`labbrdf.films.fit_film` (GN_CRS2_LM global stage inside the box, then
+  LN_BOBYQA; Wald intervals), from the box [0, 300] nm x [1.3, 1.8] x [0, 0.02];
+* ``pyElli``: pyElli's own forward model (``Structure.evaluate`` with its 2x2 solver and
+  its ``Cauchy`` dispersion) minimised by ``scipy.optimize.least_squares`` from the box
+  centre, the local least-squares fit from a starting guess that pyElli's fitting
+  examples run (only when pyElli is installed);
+
+the median wall time, the number of model evaluations, chi-square and the fitted
+thickness. Not a timed test: numbers depend on the machine and its load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+import pandas as pd
+
+from labbrdf.dispersion import Cauchy
+from labbrdf.films import FilmModel, Layer, Stack, fit_film
+
+TRUE = Stack([Layer(Cauchy(A=1.46, B=0.004), 105.0, "film")], "si")
+BOX = {"film.thickness_nm": (0.0, 300.0), "film.A": (1.3, 1.8), "film.B": (0.0, 0.02)}
+SIG_PSI, SIG_DELTA = 0.01, 0.03
+
+
+def synthetic(seed: int = 0) -> pd.DataFrame:
+    wl = np.linspace(300, 1000, 700)
+    W, T = np.meshgrid(wl, [55.0, 65.0, 75.0], indexing="ij")
+    w, t = W.ravel(), T.ravel()
+    psi, delta = TRUE.psi_delta(w, t)
+    rng = np.random.default_rng(seed)
+    parts = []
+    for q, v, s in (("psi", psi, SIG_PSI), ("delta", delta, SIG_DELTA)):
+        parts.append(
+            pd.DataFrame(
+                {
+                    "sample": "bench",
+                    "instrument": "sim",
+                    "source": "bench.dat",
+                    "quantity": q,
+                    "value": v + rng.normal(0, s, v.size),
+                    "sigma": s,
+                    "unit": "deg",
+                    "wavelength_nm": w,
+                    "theta_i_deg": t,
+                    "theta_r_deg": t,
+                    "phi_r_deg": 180.0,
+                }
+            )
+        )
+    return pd.concat(parts, ignore_index=True)
+
+
+def bench_labbrdf(df: pd.DataFrame) -> dict:
+    t0 = time.perf_counter()
+    f = fit_film(FilmModel(TRUE, BOX), df, seed=0)
+    dt = time.perf_counter() - t0
+    return {
+        "time_s": dt,
+        "nfev": f.result.nfev,
+        "chi2": f.result.chisqr,
+        "d_nm": f.result.params["film.thickness_nm"].value,
+    }
+
+
+def bench_pyelli(df: pd.DataFrame) -> dict | None:
+    try:
+        import elli
+    except ImportError:
+        return None
+    from scipy import optimize
+
+    si = TRUE.substrate
+    psi_rows = df[df.quantity == "psi"]
+    del_rows = df[df.quantity == "delta"]
+    wl = np.unique(psi_rows.wavelength_nm.to_numpy())
+    angles = [55.0, 65.0, 75.0]
+    n_si = si.nk(wl)
+    sub = elli.IsotropicMaterial(elli.Table(lbda=wl, n=n_si))
+    nfev = 0
+
+    def resid(x: np.ndarray) -> np.ndarray:
+        nonlocal nfev
+        nfev += 1
+        d, a, b = x
+        film = elli.IsotropicMaterial(elli.Cauchy(n0=a, n1=b * 1e4, n2=0.0, k0=0.0))
+        out = []
+        structure = elli.Structure(elli.AIR, [elli.Layer(film, d)], sub)
+        for th in angles:
+            r = structure.evaluate(wl, th, solver=elli.Solver2x2)
+            pm = psi_rows[np.isclose(psi_rows.theta_i_deg, th)].value.to_numpy()
+            dm = del_rows[np.isclose(del_rows.theta_i_deg, th)].value.to_numpy()
+            dd = (np.asarray(r.delta) - dm + 180.0) % 360.0 - 180.0
+            out += [(np.asarray(r.psi) - pm) / SIG_PSI, dd / SIG_DELTA]
+        return np.concatenate(out)
+
+    lo = np.array([BOX[k][0] for k in BOX])
+    hi = np.array([BOX[k][1] for k in BOX])
+    t0 = time.perf_counter()
+    res = optimize.least_squares(resid, (lo + hi) / 2, bounds=(lo, hi), x_scale="jac")
+    dt = time.perf_counter() - t0
+    return {"time_s": dt, "nfev": nfev, "chi2": float(res.fun @ res.fun), "d_nm": float(res.x[0])}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    args = ap.parse_args()
+    df = synthetic()
+    print(f"{len(df) // 2} (psi, Delta) pairs: 700 wavelengths x 3 angles; true d = 105 nm")
+    for name, fn in (("labbrdf", bench_labbrdf), ("pyElli", bench_pyelli)):
+        runs = [fn(df) for _ in range(args.repeat)]
+        if runs[0] is None:
+            print(f"{name:8s} not installed")
+            continue
+        t = statistics.median(r["time_s"] for r in runs)
+        r = runs[0]
+        print(
+            f"{name:8s} {t:7.2f} s  nfev {r['nfev']:5d}  chi2 {r['chi2']:10.1f}  "
+            f"d {r['d_nm']:.3f} nm"
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,157 @@
+"""`labbrdf film`: model file or --layer, table and JSON output, n,k CSV, errors (exit 2)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from labbrdf.cli import main
+from labbrdf.dataset import Measurement, write
+from labbrdf.dispersion import Cauchy
+from labbrdf.films import Layer, Stack
+
+TRUE = Stack([Layer(Cauchy(A=1.46, B=0.004), 105.0, "film")], "si")
+
+
+@pytest.fixture(scope="module")
+def film_file(tmp_path_factory):
+    wl = np.linspace(300, 1000, 40)
+    W, T = np.meshgrid(wl, [60.0, 70.0], indexing="ij")
+    w, t = W.ravel(), T.ravel()
+    psi, delta = TRUE.psi_delta(w, t)
+    rng = np.random.default_rng(0)
+    parts = []
+    for q, v, s in (("psi", psi, 0.02), ("delta", delta, 0.05)):
+        parts.append(
+            pd.DataFrame(
+                {
+                    "sample": "wafer",
+                    "instrument": "sim",
+                    "source": "film.parquet",
+                    "quantity": q,
+                    "value": np.mod(v + rng.normal(0, s, v.size), 360.0) if q == "delta" else v,
+                    "sigma": s,
+                    "unit": "deg",
+                    "wavelength_nm": w,
+                    "theta_i_deg": t,
+                    "theta_r_deg": t,
+                    "phi_r_deg": 180.0,
+                }
+            )
+        )
+    df = pd.concat(parts, ignore_index=True)
+    df["quantity"] = df["quantity"].astype("category")
+    p = tmp_path_factory.mktemp("film") / "film.parquet"
+    write(Measurement(df, {}), p)
+    return p
+
+
+def test_film_with_layers_prints_the_table(film_file, capsys):
+    code = main(
+        ["film", str(film_file), "--layer", "film:cauchy:0..300:A=1.3..1.8:B=0..0.02",
+         "--ci", "wald"]
+    )  # fmt: skip
+    out = capsys.readouterr().out
+    assert code == 0
+    assert "layer film (cauchy)" in out and "thickness_nm" in out
+    assert "MSE =" in out and "chi2/nu =" in out
+    line = next(x for x in out.splitlines() if "thickness_nm" in x)
+    assert float(line.split()[1]) == pytest.approx(105.0, abs=0.5)
+
+
+def test_film_with_a_model_file_writes_json_nk_csv_and_fit_json(film_file, tmp_path, capsys):
+    model = tmp_path / "m.toml"
+    model.write_text(
+        '[substrate]\nmaterial = "si"\n\n[[layer]]\nname = "film"\nmaterial = "cauchy"\n'
+        "thickness_nm = [50, 200]\nA = [1.3, 1.8]\nB = 0.004\n"
+    )
+    nk, fj = tmp_path / "nk.csv", tmp_path / "fit.json"
+    argv = ["film", str(film_file), "--model", str(model), "--json", "-o", str(nk)]
+    code = main([*argv, "--fit-json", str(fj), "--ci", "wald"])
+    assert code == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["layers"][0]["parameters"]["thickness_nm"]["ci95"][0] < 105.0
+    table = pd.read_csv(nk)
+    assert list(table.columns) == [
+        "wavelength_nm",
+        "film_n",
+        "film_k",
+        "substrate_n",
+        "substrate_k",
+    ]
+    assert len(table) == 40
+    assert Stack.from_fit_json(fj).layers[0].thickness_nm == pytest.approx(105.0, abs=0.5)
+    # outputs are never overwritten silently
+    assert main([*argv, "--fit-json", str(fj)]) == 2
+    assert "exists; pass --overwrite" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("extra", "match"),
+    [
+        (["--layer", "film:cauchy"], "expected NAME:MATERIAL:THICKNESS"),
+        (["--layer", "film:cauchy:10:Q=1"], "PARAM one of"),
+        (["--layer", "film:cauchy:300..0"], "impossible bounds"),
+        (["--layer", "film:unobtainium:10"], "unknown material"),
+        (["--layer", "film:cauchy:1..20", "--wavelength-range", "900", "100"], "MIN MAX"),
+        (["--model", "absent.toml"], "cannot read the model file"),
+    ],
+)
+def test_film_bad_input_exits_2_with_a_message(film_file, capsys, extra, match):
+    assert main(["film", str(film_file), *extra]) == 2
+    err = capsys.readouterr().err
+    assert match in err and "Traceback" not in err
+
+
+def test_film_model_file_error_names_file_and_line(film_file, tmp_path, capsys):
+    model = tmp_path / "bad.toml"
+    model.write_text(
+        '[substrate]\nmaterial = "si"\n\n[[layer]]\nmaterial = "cauchy"\nthickness_nm = 5\nZ = 1\n'
+    )
+    assert main(["film", str(film_file), "--model", str(model)]) == 2
+    err = capsys.readouterr().err
+    assert "bad.toml, line 7: unknown parameter 'Z'" in err
+
+
+def test_default_model_is_a_cauchy_layer_on_silicon(film_file, capsys):
+    assert main(["film", str(film_file), "--json", "--ci", "wald"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["layers"][0]["material"]["model"] == "cauchy"
+    assert doc["substrate"]["material"] == {"model": "tabulated", "reference": "si"}
+    assert doc["layers"][0]["parameters"]["thickness_nm"]["value"] == pytest.approx(105, abs=1)
+
+
+@pytest.mark.shared
+def test_native_oxide_on_silicon_from_the_completeease_file(real_exports, capsys):
+    f = real_exports / "woollam-completeease-ascii" / "complete_ease_example.dat"
+    code = main(
+        ["film", str(f), "--substrate", "si", "--layer", "oxide:sio2:0..20",
+         "--wavelength-range", "250", "1450", "--json"]
+    )  # fmt: skip
+    assert code == 0
+    doc = json.loads(capsys.readouterr().out)
+    d = doc["layers"][0]["parameters"]["thickness_nm"]
+    # the file's sample is "2 nm SiO2 on Si"; Green's Si table and Malitson's SiO2
+    assert 1.5 < d["value"] < 3.0
+    assert d["ci95_scaled"][0] <= d["value"] <= d["ci95_scaled"][1]
+    assert doc["mse"] < 20
+
+
+def test_film_without_a_substrate_table_covering_the_data_exits_2(tmp_path, capsys):
+    wl = np.array([200.0, 300.0, 400.0])
+    df = pd.DataFrame(
+        {"sample": "w", "instrument": "sim", "source": "x",
+         "quantity": ["psi"] * 3 + ["delta"] * 3,
+         "value": [20.0] * 3 + [100.0] * 3, "sigma": 0.01, "unit": "deg",
+         "wavelength_nm": np.r_[wl, wl], "theta_i_deg": 70.0, "theta_r_deg": 70.0,
+         "phi_r_deg": 180.0}
+    )  # fmt: skip
+    df["quantity"] = df["quantity"].astype("category")
+    p = tmp_path / "uv.parquet"
+    write(Measurement(df, {}), p)
+    assert main(["film", str(p), "--layer", "ox:sio2:0..10"]) == 2
+    err = capsys.readouterr().err
+    assert "covers 250-1450 nm but the data span 200-400 nm" in err
