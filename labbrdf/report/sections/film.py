@@ -54,17 +54,13 @@ def _describe(m: Any) -> str:
 
 
 def default_film_model() -> films.FilmModel:
-    """The stated default: one transparent Cauchy layer on crystalline silicon.
+    """The stated default: :meth:`labbrdf.films.FilmModel.cauchy_on_silicon`.
 
-    Layer ``film``: Cauchy ``n = A + B/lambda^2 + C/lambda^4`` (k = 0) with ``A, B, C`` in
-    the default boxes of :class:`labbrdf.dispersion.Cauchy` and the thickness free in
-    [0, 1000] nm; substrate: c-Si (Green 2008, shipped table), so the fit window is the
-    table's 250-1450 nm. Used only when asked for (``--film-model default``).
+    One transparent Cauchy layer (thickness free in [0, 1000] nm) on crystalline silicon,
+    fitted over the silicon table's 250-1450 nm; used only when asked for
+    (``--film-model default``).
     """
-    stack = films.Stack([films.Layer("cauchy", 100.0, "film")], "si")
-    fm = films.FilmModel.default(stack, thickness_max_nm=1000.0)
-    lo, hi = stack.substrate.range_nm  # type: ignore[attr-defined]
-    return films.FilmModel(fm.stack, fm.free, (float(lo), float(hi)), "default model")
+    return films.FilmModel.cauchy_on_silicon()
 
 
 def _propagated(
@@ -97,26 +93,33 @@ def _propagated(
     return base, np.sqrt(np.maximum(var, 0.0))
 
 
-def _param_rows(fit: films.FilmFit) -> list[dict[str, Any]]:
-    res = fit.result
+def _param_rows(summary: dict[str, Any]) -> list[dict[str, Any]]:
+    """The varying parameters of a :meth:`labbrdf.films.FilmFit.summary`, one row each."""
+    groups = [(lay["name"], lay["parameters"]) for lay in summary["layers"]]
+    groups.append(("substrate", summary["substrate"]["parameters"]))
     rows = []
-    for key, q in res.params.items():
-        if not q.vary:
-            continue
-        ci = q.ci95
-        rows.append(
-            {
-                "parameter": key,
-                "value": q.value,
-                "stderr": q.stderr,
-                "ci_lo": None if ci is None else ci[0],
-                "ci_hi": None if ci is None else ci[1],
-                "units": q.units,
-                "min": q.min,
-                "max": q.max,
-                "flags": ", ".join(res.flags.get(key, [])),
-            }
-        )
+    for owner, params in groups:
+        for name, d in params.items():
+            if not d.get("vary"):
+                continue
+            ci = d.get("ci95") or [None, None]
+            cis = d.get("ci95_scaled") or [None, None]
+            lo, hi = d.get("bounds") or [None, None]
+            rows.append(
+                {
+                    "parameter": f"{owner}.{name}",
+                    "value": d["value"],
+                    "stderr": d.get("stderr"),
+                    "ci_lo": ci[0],
+                    "ci_hi": ci[1],
+                    "ci_lo_scaled": cis[0],
+                    "ci_hi_scaled": cis[1],
+                    "units": d.get("units", ""),
+                    "min": lo,
+                    "max": hi,
+                    "flags": ", ".join(d.get("flags", [])),
+                }
+            )
     return rows
 
 
@@ -181,6 +184,7 @@ def _nk_figure(fit: films.FilmFit) -> str:
                 return np.asarray(v.real if part == "n" else v.imag, float)
 
             y, sig = _propagated(fit, curve)
+            sig = sig * (fit.misfit_scale or 1.0)
             series.append({"label": name, "x": wl, "y": y, "band": sig})
         panels.append(
             {
@@ -205,25 +209,18 @@ def _reflectance(
     if r.empty:
         b.skip(f"film.reflectance.{tag}", name, f"no reflectance row in {lo:g}-{hi:g} nm")
         return None
-    wl = r["wavelength_nm"].to_numpy(float)
-    theta = r["theta_i_deg"].to_numpy(float)
-    theta = np.where(np.isfinite(theta), theta, 0.0)  # spectrophotometer: normal incidence
-    if "channel" in r.columns:
-        ch = r["channel"].astype(object).where(r["channel"].notna(), "").astype(str).to_numpy()
-    else:
-        ch = np.full(len(r), "", dtype=object)
-
-    def curve(s: films.Stack) -> np.ndarray:
-        rs, rp = s.reflectance(wl, theta)
-        return np.where(ch == "s", rs, np.where(ch == "p", rp, 0.5 * (rs + rp)))
-
-    pred, pred_sigma = _propagated(fit, curve)
-    meas = r["value"].to_numpy(float)
-    msig = r["sigma"].to_numpy(float)
-    diff = meas - pred
-    dsig = np.where(np.isfinite(msig), np.hypot(msig, np.nan_to_num(pred_sigma)), pred_sigma)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        z = diff / dsig
+    try:
+        cmp = fit.compare_reflectance(r)
+    except ValueError as exc:
+        b.skip(f"film.reflectance.{tag}", name, str(exc))
+        return None
+    wl = cmp["wavelength_nm"].to_numpy(float)
+    theta = np.nan_to_num(cmp["theta_i_deg"].to_numpy(float), nan=0.0)
+    ch = cmp["channel"].astype(object).where(cmp["channel"].notna(), "").astype(str).to_numpy()
+    meas, msig = cmp["measured"].to_numpy(float), cmp["measured_sigma"].to_numpy(float)
+    pred, pred_sigma = cmp["predicted"].to_numpy(float), cmp["predicted_sigma"].to_numpy(float)
+    diff, dsig = cmp["difference"].to_numpy(float), cmp["difference_sigma"].to_numpy(float)
+    z = cmp["z"].to_numpy(float)
     ok = np.isfinite(z)
     nz = int(ok.sum())
     chi2 = float(np.sum(z[ok] ** 2))
@@ -254,10 +251,11 @@ def _reflectance(
     b.figure(
         f"film_{tag}_refl",
         f"Reflectance of {rsrc} against the stack fitted to {src}",
-        f"Measured: {kind} [1] of {rsrc} ({len(r)} points, not used by the fit; coloured, "
+        f"Measured: {kind} [1] of {rsrc} ({len(cmp)} points, not used by the fit; coloured, "
         f"at most {_MAX_ANGLES} channel-angle pairs drawn). Modelled (black lines): the "
         f"stack fitted to the psi/Delta of {src}, coherent transfer matrices, band = "
-        "1-sigma propagated from the fit's covariance. Right: measured - predicted "
+        "1-sigma propagated from the fit's covariance (times sqrt(chi2/nu) where chi-square "
+        "rejects the film model). Right: measured - predicted "
         "with the measurement's and the prediction's 1-sigma in quadrature.",
         figures.panels_figure(
             [
@@ -298,7 +296,7 @@ def _reflectance(
         "ellipsometer_file": src,
         "refl_file": rsrc,
         "quantity": kind,
-        "points": len(r),
+        "points": len(cmp),
         "mean_diff": float(np.mean(diff)),
         "rms_diff": float(np.sqrt(np.mean(diff**2))),
         "ratio": float(np.median(meas / pred)),
@@ -396,14 +394,6 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
             f"{s['nvarys']} parameters: chi2/nu {s['redchi']:.4g}, Woollam MSE "
             f"{s['mse']:.4g}; {s['message']}."
             + (" Notes: " + "; ".join(s["notes"]) + "." if s["notes"] else "")
-            + (
-                f" chi2 = {s['chisqr']:.4g} on {s['nfree']} degrees of freedom (p < "
-                f"{P_AGREE:g}): the model misses structure of the data beyond the file's "
-                "sigmas (which are usually repeatability only), so the intervals below are "
-                "statistical and understate the model error."
-                if s["nfree"] and stats.chi2.sf(s["chisqr"], s["nfree"]) < P_AGREE
-                else ""
-            )
         )
         b.table(
             f"film_{tag}_params",
@@ -414,13 +404,17 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
                 ("stderr", "\u03c3", ".2g"),
                 ("ci_lo", "95 % low", ".6g"),
                 ("ci_hi", "95 % high", ".6g"),
+                ("ci_lo_scaled", "95 % low, scaled", ".6g"),
+                ("ci_hi_scaled", "95 % high, scaled", ".6g"),
                 ("units", "units", ""),
                 ("min", "box min", ".4g"),
                 ("max", "box max", ".4g"),
                 ("flags", "flags", ""),
             ],
-            _param_rows(fit),
-            caption=f"{s['ci_method']} intervals; units [1] where none is given.",
+            _param_rows(s),
+            caption=f"{s['ci_method']} intervals from the files' sigmas; 'scaled': times "
+            "sqrt(chi2/nu), given where chi-square rejects the film model (p < 0.01), which "
+            "then misses the data by more than the sigmas; units [1] where none is given.",
         )
         b.figure(
             f"film_{tag}_psi_delta",
@@ -435,8 +429,8 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
             f"film_{tag}_nk",
             f"{src}: n and k of each layer of the fitted stack",
             "Modelled: n [1] and k [1] of each layer and of the substrate against wavelength "
-            "[nm], band = 1-sigma propagated from the fit's covariance (zero for fixed "
-            "parameters and tables).",
+            "[nm], band = 1-sigma propagated from the fit's covariance, times sqrt(chi2/nu) "
+            "where chi-square rejects the film model (zero for fixed parameters and tables).",
             _nk_figure(fit),
         )
         summary_rows.append(
