@@ -544,8 +544,8 @@ def cmd_nk(args: argparse.Namespace) -> int:
             f"{flagged} of {len(comb)} wavelengths: the angles of incidence disagree "
             f"(p < {P_ANGLE_DEPENDENT:g}), so the values there are pseudo-constants of a stack "
             "(a film or roughness), not a material's n, k. They are not combined (n, k empty "
-            "above; per angle with -o FILE or --json) and predict no reflectance; fit a stack "
-            "model for the layers' constants."
+            "above; per angle with -o FILE or --json) and predict no reflectance; `labbrdf film` "
+            "fits a stack model for the layers' constants."
         )
     return 0
 

@@ -771,8 +771,8 @@ def coating_from_fit(path: str | os.PathLike[str], wavelength_nm: float) -> tupl
     ----------
     path : path-like
         A film fit's JSON (:meth:`labbrdf.films.FilmFit.save_json`, ``labbrdf film
-        --json``) whose stack has exactly one layer over the substrate (the tracer's one
-        coating).
+        --fit-json FIT.json``) whose stack has exactly one layer over the substrate
+        (the tracer's one coating).
     wavelength_nm : float
         Vacuum wavelength [nm], inside the fitted wavelength range.
 

@@ -325,8 +325,8 @@ def nk_section(ctx: Context) -> None:
         "gives the same n, k at every angle, while a film or roughness makes the pseudo "
         "constants depend on the angle. Where the angles disagree the values are "
         "pseudo-constants of a stack, not a material's n, k: they are not combined into one "
-        "value, and no reflectance is predicted from them (a fitted stack model does that, "
-        "section film)."
+        "value, and no reflectance is predicted from them (a fitted stack model does that: "
+        "section film, with --film-model)."
     )
     summary: list[dict[str, Any]] = []
     cmp_rows: list[dict[str, Any]] = []
