@@ -9,7 +9,8 @@ measured reflectance rows.
 The two-phase inversion treats the sample as a bare, clean, isotropic half-space. Where the
 angles of incidence disagree, the sample is a stack (a film or roughness), its
 pseudo-constants depend on the angle, and they are reported as what they are: per-angle
-values, never combined into one "n, k" and never used to predict a reflectance
+values, never combined into one "n, k" and never used to predict a reflectance; where the
+angles disagree at some wavelengths only, the combined sigmas carry the scatter
 (:func:`combined_table`, Notes).
 
 Grouping
@@ -296,23 +297,28 @@ def combined_table(
         ``wavelength_nm, n, k, n_sigma, k_sigma, nk_cov, chi2, dof, p_value,
         angle_dependent, method, n_points, n_angles`` after the group keys; see
         :func:`labbrdf.ellipsometry.combine_angles` for the sigma and scatter rules. A
-        wavelength mixing points with and without sigma uses the scatter rule. A last
-        column ``combined`` is false where ``n, k, n_sigma, k_sigma, nk_cov`` are NaN:
-        where ``angle_dependent`` is true, and everywhere in a group whose
-        :func:`angle_verdict` is ``stack`` (Notes).
+        wavelength mixing points with and without sigma uses the scatter rule. Two last
+        columns: ``sigma_scale``, the factor the sigmas were multiplied by (the Birge ratio
+        ``sqrt(chi2/dof)`` where the angles disagree under the sigma rule, else 1), and
+        ``combined``, false where ``n, k, n_sigma, k_sigma, nk_cov`` are NaN: everywhere in
+        a group whose :func:`angle_verdict` is ``stack`` (Notes).
 
     Notes
     -----
-    Where the angles of incidence disagree (``p_value < alpha``), the two-phase
-    pseudo-constants are those of a stack (a film or roughness on the substrate), which
-    depend on the angle; they are no material's constants. Their inverse-covariance mean
-    would be one more angle-dependent number, with a sigma that only measures how well
-    each angle is measured, not how far apart the angles are (on an oxide-coated wafer:
-    n = -0.705 with sigma 3e-4 at 500 nm, chi2/dof 1.5e4). It is therefore not given: the
-    per-angle pseudo-constants stay in :func:`nk_table`, and a stack model
-    (:mod:`labbrdf.films`) gives the layers' constants. In a group where the angles
-    disagree at most wavelengths (verdict ``stack``), the few where they agree do so by
-    chance and are not given either.
+    Where the angles of incidence disagree at most wavelengths of a group (verdict
+    ``stack``), the two-phase pseudo-constants are those of a stack (a film or roughness on
+    the substrate), which depend on the angle; they are no material's constants. Their
+    inverse-covariance mean would be one more angle-dependent number, with a sigma that
+    only measures how well each angle is measured, not how far apart the angles are (on an
+    oxide-coated wafer: n = -0.705 with sigma 3e-4 at 500 nm, chi2/dof 1.5e4). It is
+    therefore not given, at any wavelength of the group (the few where the angles agree do
+    so by chance): the per-angle pseudo-constants stay in :func:`nk_table`, and a stack
+    model (:mod:`labbrdf.films`) gives the layers' constants. In other groups, a
+    wavelength whose angles disagree keeps its mean, with the sigmas multiplied by the
+    Birge ratio ``sqrt(chi2/dof)`` (R. T. Birge, Phys. Rev. 40, 207 (1932)) so that they
+    cover the angle-to-angle scatter (sigmas that leave out systematic errors, or a film
+    that matters at some wavelengths only); the scatter rule's sigma is the scatter
+    already.
     """
     table = data if "n" in _frame(data).columns else nk_table(data, **nk_options)
     table = _spot_labels(_frame(table))
@@ -340,12 +346,24 @@ def combined_table(
         rows.append(row)
     out = pd.DataFrame(rows, columns=keys + _COMBINED_COLUMNS)
     out = out.astype({"dof": "int64", "angle_dependent": bool, "n_points": "int64"})
-    # no one n, k where the angles disagree, nor anywhere in a stack-like group (Notes)
-    given = ~out["angle_dependent"].to_numpy(bool)
+    # no n, k anywhere in a stack-like group; elsewhere the sigmas of a wavelength whose
+    # angles disagree carry their scatter (Birge ratio) (Notes)
+    given = np.ones(len(out), dtype=bool)
     for _, idx in out.groupby(keys, sort=False, dropna=False).groups.items():
         if angle_verdict(out.loc[idx], alpha=alpha).kind == "stack":
             given[out.index.get_indexer(idx)] = False
+    flagged = out["angle_dependent"].to_numpy(bool)
+    chi2 = out["chi2"].to_numpy(float)
+    dof = out["dof"].to_numpy(float)
+    scale = np.ones(len(out))
+    birge = given & flagged & np.isfinite(chi2) & (dof > 0)  # the sigma rule's chi2
+    scale[birge] = np.sqrt(chi2[birge] / dof[birge])
+    for c in ("n_sigma", "k_sigma"):
+        out[c] = out[c].to_numpy(float) * scale
+    out["nk_cov"] = out["nk_cov"].to_numpy(float) * scale**2
+    scale[~given] = np.nan
     out.loc[~given, list(_NOT_COMBINED)] = np.nan
+    out["sigma_scale"] = scale
     out["combined"] = given
     return out
 
@@ -536,8 +554,8 @@ def nk_at(
     sample, source : str, optional
         Select one (sample, source) when the table holds several.
     on_angle_dependent : {"raise", "nan"}, optional
-        What to do at a wavelength that needs a node where the angles disagree (no
-        combined n, k there, :func:`combined_table`): raise (default) or return NaN.
+        What to do at a wavelength that needs a node without combined n, k (a sample whose
+        angles disagree, :func:`combined_table`): raise (default) or return NaN.
 
     Returns
     -------
@@ -550,7 +568,7 @@ def nk_at(
     ------
     ValueError
         A wavelength outside the measured range (no extrapolation), an ambiguous table,
-        or (``on_angle_dependent="raise"``) a wavelength where the angles disagree.
+        or (``on_angle_dependent="raise"``) a wavelength without combined n, k.
 
     Notes
     -----
@@ -583,8 +601,8 @@ def nk_at(
 def _angle_dependent_message(wavelength_nm: np.ndarray) -> str:
     w = ", ".join(f"{v:g}" for v in np.unique(wavelength_nm)[:5])
     return (
-        f"at {w} nm the angles of incidence disagree (at that wavelength or at most of the "
-        "sample's): the two-phase values are pseudo-constants of a stack (a film or "
+        f"at {w} nm no n, k: the angles of incidence disagree at most of the sample's "
+        "wavelengths, so its two-phase values are pseudo-constants of a stack (a film or "
         "roughness), not a material's n, k; fit a stack model to get the layers' constants"
     )
 
@@ -627,14 +645,14 @@ def compare_reflectance(
         quadrature, and is the predicted sigma alone (a lower bound) where the measurement
         has none. ``attrs["outside_range"]`` counts the rows outside the ``nk`` range
         (dropped: no extrapolation), ``attrs["angle_dependent"]`` the rows at wavelengths
-        where the angles of incidence disagree (dropped: pseudo-constants of a stack
-        predict no reflectance, :func:`combined_table`).
+        without combined n, k (dropped: pseudo-constants of a stack predict no
+        reflectance, :func:`combined_table`).
 
     Raises
     ------
     ValueError
-        No reflectance rows, none inside the ``nk`` range, or none at a wavelength where
-        the angles of incidence agree.
+        No reflectance rows, none inside the ``nk`` range, or none at a wavelength with
+        combined n, k (a sample whose angles of incidence disagree).
     """
     df = _frame(reflectance)
     rows = df[df["quantity"] == "reflectance"]
@@ -652,10 +670,11 @@ def compare_reflectance(
     usable = np.isfinite(at["n"]) & np.isfinite(at["k"])
     if not usable.any():
         raise ValueError(
-            "the angles of incidence of the n, k disagree at every wavelength compared: "
-            "they are pseudo-constants of a stack (a film or roughness), not a material's "
-            "n, k, and the Fresnel reflectance of a bare half-space does not apply; a fitted "
-            "stack model predicts the reflectance"
+            "no combined n, k at the wavelengths compared: the angles of incidence disagree "
+            "at most of the sample's wavelengths, so its values are pseudo-constants of a "
+            "stack (a film or roughness), not a material's n, k, and the Fresnel "
+            "reflectance of a bare half-space does not apply; a fitted stack model "
+            "predicts the reflectance"
         )
     rows = rows[usable]
     at = {c: v[usable] for c, v in at.items()}

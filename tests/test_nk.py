@@ -196,22 +196,35 @@ def test_chance_agreement_in_a_stack_is_not_given():
     assert not at800["angle_dependent"] and not at800["combined"] and np.isnan(at800["n"])
 
 
-def test_partly_angle_dependent_sample_keeps_the_consistent_wavelengths():
-    rows = pd.concat(
+def _partly():
+    """A film's psi/Delta at 400 nm, a bulk material's at 500-700 nm, in one file."""
+    return pd.concat(
         [_film_rows(wl=(400.0,)), _synthetic(wl=(500.0, 600.0, 700.0)).assign(
             sample="film", source="film.dat")],
         ignore_index=True,
     )  # fmt: skip
-    c = nk.combined_table(rows)
+
+
+def test_partly_angle_dependent_sample_carries_the_scatter_in_its_sigmas():
+    plain = nk.combined_table(_synthetic(wl=(500.0, 600.0, 700.0)))  # the bulk part alone
+    c = nk.combined_table(_partly())
     v = nk.angle_verdict(c)
     assert v.kind == "partly" and v.fraction == pytest.approx(0.25)
-    assert c["combined"].tolist() == [False, True, True, True]
+    assert c["combined"].all()
+    birge = float(np.sqrt(c["chi2"].iloc[0] / c["dof"].iloc[0]))
+    assert birge > 10 and c["sigma_scale"].tolist() == pytest.approx([birge, 1, 1, 1])
+    # the film's wavelength: the same mean, sigmas times the Birge ratio
+    t = nk.nk_table(_partly())
+    g = t[t["wavelength_nm"] == 400.0]
+    cov = np.stack([np.stack([g["n_sigma"] ** 2, g["nk_cov"]], -1),
+                    np.stack([g["nk_cov"], g["k_sigma"] ** 2], -1)], -2)  # fmt: skip
+    raw = ell.combine_angles(g["n"], g["k"], g["theta_i_deg"], cov)
+    assert c["n"].iloc[0] == pytest.approx(raw.n, rel=1e-12)
+    assert c["n_sigma"].iloc[0] == pytest.approx(raw.n_sigma * birge, rel=1e-12)
+    assert c["nk_cov"].iloc[0] == pytest.approx(raw.nk_cov * birge**2, rel=1e-12)
+    np.testing.assert_allclose(c["n_sigma"].iloc[1:], plain["n_sigma"], rtol=1e-12)
     at = nk.nk_at(c, [550.0, 650.0])
     np.testing.assert_allclose(at["n"], 2.0, rtol=1e-12)
-    with pytest.raises(ValueError, match="pseudo-constants of a stack"):
-        nk.nk_at(c, 450.0)  # between a flagged and a combined wavelength
-    nan = nk.nk_at(c, [400.0, 450.0, 500.0], on_angle_dependent="nan")
-    assert np.isnan(nan["n"][:2]).all() and nan["n"][2] == pytest.approx(2.0)
 
 
 def test_angle_verdict_untested_with_one_angle():
@@ -238,15 +251,11 @@ def test_compare_reflectance_refuses_a_stack():
         nk.compare_reflectance(c, _refl_rows([450.0, 550.0]))
 
 
-def test_compare_reflectance_skips_the_angle_dependent_wavelengths():
-    rows = pd.concat(
-        [_film_rows(wl=(400.0,)), _synthetic(wl=(500.0, 600.0, 700.0)).assign(
-            sample="film", source="film.dat")],
-        ignore_index=True,
-    )  # fmt: skip
-    cmp = nk.compare_reflectance(nk.combined_table(rows), _refl_rows([450.0, 550.0, 650.0]))
-    assert cmp.attrs["angle_dependent"] == 2 and len(cmp) == 4
-    np.testing.assert_allclose(cmp["difference"], 0.0, atol=1e-12)
+def test_nk_at_refuses_a_stack_and_can_return_nan():
+    c = nk.combined_table(_film_rows())
+    with pytest.raises(ValueError, match=r"at 450 nm no n, k.*pseudo-constants of a stack"):
+        nk.nk_at(c, 450.0)
+    assert np.isnan(nk.nk_at(c, [450.0, 500.0], on_angle_dependent="nan")["n"]).all()
 
 
 def test_oxide_coated_wafer_gives_no_constants(real_exports):

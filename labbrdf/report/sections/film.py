@@ -8,11 +8,13 @@ this section fits it to the file's psi/Delta at every angle (:func:`labbrdf.film
 and shows the model, the parameters with their intervals, psi and Delta against wavelength
 per angle with the fit and the residuals, each layer's n, k with its uncertainty band, and
 the reflectance comparison redone with the fitted stack: the measured reflectance of the
-same sample (not used by the fit) against the stack's R_s, R_p.
+same sample (not used by the fit) against the stack's R_s, R_p
+(:meth:`labbrdf.films.FilmFit.compare_reflectance`), inside the fitted wavelength range.
 
 Uncertainties of derived curves (n, k of a layer, predicted R) are first-order: central
 differences of the curve in each varying parameter, combined with the fit's covariance
-``J C J^T``.
+``J C J^T``, times ``sqrt(chi2/nu)`` where chi-square rejects the film model
+(:attr:`labbrdf.films.FilmFit.misfit_scale`).
 """
 
 from __future__ import annotations

@@ -162,7 +162,6 @@ def _compare(
             "chi2_dof": chi2 / nz if nz else None,
             "p_value": p if nz else None,
             "outside": int(cmp.attrs.get("outside_range", 0)),
-            "angle_dep": int(cmp.attrs.get("angle_dependent", 0)),
         }
     )
     x = cmp["wavelength_nm"].to_numpy(float)
@@ -270,8 +269,7 @@ def _r0_figure(ctx: Context, i: int, src: str, comb: pd.DataFrame) -> None:
         f"{src}: predicted normal-incidence reflectance",
         "Modelled from the combined n, k (two-phase Fresnel, bare half-space): R_s, R_p and "
         "their mean (R_s = R_p at normal incidence) [1] against wavelength [nm], band = "
-        "propagated 1-sigma. Meaningful for a bulk material only (see the verdict); gaps "
-        "where the angles disagree (no prediction there).",
+        "propagated 1-sigma. Meaningful for a bulk material only (see the verdict).",
         figures.panels_figure(
             [
                 {
@@ -384,7 +382,7 @@ def nk_section(ctx: Context) -> None:
                 "Derived from measured psi/Delta: n [1] and k [1] against wavelength [nm], "
                 "combined over the angles of incidence; band = 1-sigma (propagated from the "
                 "file's sigmas, or the angle-to-angle scatter where that is larger or sigmas "
-                "are missing); gaps where the angles disagree (not combined).",
+                "are missing), times sqrt(chi2/dof) where the angles disagree.",
                 _nk_figure(src, comb),
                 details=stack_like,
             )
@@ -407,8 +405,9 @@ def nk_section(ctx: Context) -> None:
             ],
             comb.to_dict("records"),
             caption="n, k combined over the angles of incidence; chi2/dof and p test their "
-            f"agreement; angle-dependent = p < {ell.P_ANGLE_DEPENDENT:g} (no combined n, k "
-            "there: pseudo-constants of a stack).",
+            f"agreement; angle-dependent = p < {ell.P_ANGLE_DEPENDENT:g} (sigmas times "
+            "sqrt(chi2/dof) there; no n, k at all for a sample whose angles disagree at most "
+            "wavelengths: pseudo-constants of a stack).",
             details=True,
         )
         b.figure(
@@ -420,7 +419,8 @@ def nk_section(ctx: Context) -> None:
             _pseudo_figure(pts),
             details=not stack_like,
         )
-        nk_ok = comb["combined"].to_numpy(bool) & tested
+        nk_ok = comb["combined"].to_numpy(bool) & ~comb["angle_dependent"].to_numpy(bool)
+        nk_ok &= tested
         if nk_ok.any():
             c_ok = comb[nk_ok]
             neg = c_ok["k"].to_numpy(float) < -3 * np.nan_to_num(c_ok["k_sigma"].to_numpy(float))
@@ -531,14 +531,12 @@ def nk_section(ctx: Context) -> None:
                 ("chi2_dof", "\u03c7\u00b2/dof", ".3g"),
                 ("p_value", "p", ".2g"),
                 ("outside", "rows outside n, k range", "d"),
-                ("angle_dep", "rows where the angles disagree", "d"),
             ],
             cmp_rows,
             caption="diff = measured - predicted; sigma diff adds the measurement's and the "
             "prediction's 1-sigma in quadrature (the prediction's alone where the file has "
             "none: a lower bound). Spectrophotometer rows without an angle are taken at "
-            "normal incidence. Rows at wavelengths where the ellipsometer's angles disagree "
-            "are not compared (no n, k there: pseudo-constants of a stack).",
+            "normal incidence.",
         )
 
 
