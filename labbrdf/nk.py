@@ -358,8 +358,8 @@ def combined_table(
     scale = np.ones(len(out))
     birge = given & flagged & np.isfinite(chi2) & (dof > 0)  # the sigma rule's chi2
     scale[birge] = np.sqrt(chi2[birge] / dof[birge])
-    for c in ("n_sigma", "k_sigma"):
-        out[c] = out[c].to_numpy(float) * scale
+    for col in ("n_sigma", "k_sigma"):
+        out[col] = out[col].to_numpy(float) * scale
     out["nk_cov"] = out["nk_cov"].to_numpy(float) * scale**2
     scale[~given] = np.nan
     out.loc[~given, list(_NOT_COMBINED)] = np.nan
