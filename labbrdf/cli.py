@@ -515,7 +515,7 @@ def _model_from_args(args: argparse.Namespace) -> tuple[Any, dict[str, float]]:
 def cmd_nk(args: argparse.Namespace) -> int:
     from . import adapters
     from .ellipsometry import P_ANGLE_DEPENDENT
-    from .nk import combined_table, nk_json, nk_table
+    from .nk import angle_verdict, combined_table, nk_json, nk_table
     from .outputs import atomic_output, check_file_output, check_input_files, csv_safe_frame
 
     check_input_files(args.files)
@@ -538,15 +538,20 @@ def cmd_nk(args: argparse.Namespace) -> int:
                         "dof", "p_value", "angle_dependent") if c in comb.columns]  # fmt: skip
     with pd.option_context("display.width", 200, "display.max_rows", 40):
         print(comb[cols].to_string(index=False))
-    flagged = int(comb["angle_dependent"].fillna(False).astype(bool).sum())
-    if flagged:
-        print(
-            f"{flagged} of {len(comb)} wavelengths: the angles of incidence disagree "
-            f"(p < {P_ANGLE_DEPENDENT:g}), so the values there are pseudo-constants of a stack "
-            "(a film or roughness), not a material's n, k. They are not combined (n, k empty "
-            "above; per angle with -o FILE or --json) and predict no reflectance; `labbrdf film` "
-            "fits a stack model for the layers' constants."
-        )
+    for (sample, source), g in comb.groupby(["sample", "source"], sort=False):
+        v = angle_verdict(g)
+        if v.kind == "stack":
+            print(
+                f"{sample} ({source}): {v.text}, not a material's n, k. They are not combined "
+                "(n, k empty above; per angle with -o FILE or --json) and predict no "
+                "reflectance; `labbrdf film` fits a stack model for the layers' constants."
+            )
+        elif g["angle_dependent"].astype(bool).any():
+            print(
+                f"{sample} ({source}): {v.text}. Where the angles disagree "
+                f"(p < {P_ANGLE_DEPENDENT:g}) the sigmas are multiplied by sqrt(chi2/dof) to "
+                "cover their scatter."
+            )
     return 0
 
 
