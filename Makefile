@@ -10,7 +10,7 @@ LOCK := requirements.lock
 UV_COMPILE = $(BIN)/uv pip compile pyproject.toml --all-extras --generate-hashes \
 	--universal --python-version 3.11 --quiet -o $(LOCK)
 
-.PHONY: test report install lint typecheck bench lock upgrade test-lowest clean
+.PHONY: test report docs install lint typecheck bench lock upgrade test-lowest clean
 
 $(STAMP): $(LOCK) pyproject.toml
 	rm -rf $(VENV)
@@ -26,7 +26,13 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -q
 
 report: $(STAMP)
-	$(BIN)/labbrdf validate --out reports/validation
+	$(BIN)/labbrdf validate --out reports/validation --overwrite
+
+# The documentation site, warnings as errors (every cross-reference to labbrdf must resolve);
+# open build/docs/index.html.
+docs: $(STAMP)
+	rm -rf docs/generated build/docs
+	$(BIN)/sphinx-build -E -W --keep-going -q -b html docs build/docs
 
 lint: $(STAMP)
 	$(BIN)/ruff check labbrdf tests benchmarks
@@ -62,4 +68,4 @@ test-lowest: $(STAMP)
 		-W "ignore::DeprecationWarning" -W "ignore::FutureWarning"
 
 clean:
-	rm -rf $(VENV) .venv-lowest .venv-lowest.txt build *.egg-info
+	rm -rf $(VENV) .venv-lowest .venv-lowest.txt build docs/generated *.egg-info

@@ -7,18 +7,24 @@ or output error (unreadable file, unknown name, an output path that is refused o
 written, ...), 3 ``fit``: some groups could not be fitted or did not converge (listed with
 ``success`` false and the reason), 141 the reader of our output went away; the error is on
 stderr. Every output path goes through :mod:`labbrdf.outputs`.
+
+Arguments that name files are declared as :class:`InputPath` or :class:`OutputPath`; before
+a command runs, :func:`_checked_outputs` checks all its outputs against all its inputs and
+runs it under one rule (:func:`labbrdf.outputs.write_policy`): an existing output is
+replaced only with ``--overwrite``, an input never, and every write is atomic.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import json
 import math
 import os
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any, Literal
 
@@ -29,6 +35,117 @@ __all__ = ["main"]
 
 class UsageError(Exception):
     """A command-line input error: printed, exit code 2."""
+
+
+# ------------------------------------------------------------------------- input/output paths
+
+
+class InputPath(argparse.Action):
+    """An option or positional argument that names files the command reads.
+
+    Every output of the command refuses all of them (see :func:`_checked_outputs`), so
+    an option declared with ``action=InputPath`` cannot be forgotten by a writer.
+    """
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        setattr(namespace, self.dest, values)
+
+
+class OutputPath(argparse.Action):
+    """An option that names an output the command writes; checked before it runs.
+
+    ``kind`` is ``"file"`` (with the accepted ``suffixes``) or ``"dir"`` (a report folder).
+    """
+
+    def __init__(
+        self,
+        option_strings: Sequence[str],
+        dest: str,
+        *,
+        suffixes: Sequence[str] = (),
+        kind: Literal["file", "dir"] = "file",
+        **kw: Any,
+    ) -> None:
+        super().__init__(option_strings, dest, **kw)
+        self.suffixes = tuple(suffixes)
+        self.kind = kind
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        setattr(namespace, self.dest, values)
+
+
+def path_actions(parser: argparse.ArgumentParser) -> list[argparse.Action]:
+    """The :class:`InputPath` and :class:`OutputPath` arguments of a (sub)parser."""
+    return [a for a in parser._actions if isinstance(a, InputPath | OutputPath)]
+
+
+def _option_name(a: argparse.Action) -> str:
+    return a.option_strings[0] if a.option_strings else str(a.metavar or a.dest)
+
+
+def _named_paths(args: argparse.Namespace, kind: type) -> list[tuple[argparse.Action, str]]:
+    out: list[tuple[argparse.Action, str]] = []
+    actions: Sequence[argparse.Action] = getattr(args, "path_actions", ())
+    for a in actions:
+        v = getattr(args, a.dest, None)
+        if isinstance(a, kind) and v is not None:
+            out.extend((a, str(p)) for p in (v if isinstance(v, list) else [v]))
+    return out
+
+
+def _inputs(args: argparse.Namespace) -> list[str]:
+    """Every file the command reads, whichever option names it."""
+    return [p for _, p in _named_paths(args, InputPath)]
+
+
+@contextlib.contextmanager
+def _checked_outputs(args: argparse.Namespace) -> Iterator[None]:
+    """Check every input and output of the command, then run it under the output rule.
+
+    The rule (:func:`labbrdf.outputs.write_policy`): an existing output is replaced only
+    with ``--overwrite``, an input never; every file written inside, sidecars included,
+    follows it.
+    """
+    from .outputs import check_file_output, check_input_files, check_report_dir, write_policy
+
+    inputs = _inputs(args)
+    with write_policy(overwrite=bool(getattr(args, "overwrite", False)), inputs=inputs):
+        check_input_files(inputs)
+        seen: dict[Path, str] = {}
+        for a, path in _named_paths(args, OutputPath):
+            if not isinstance(a, OutputPath):  # pragma: no cover - _named_paths filtered
+                continue
+            name = _option_name(a)
+            if a.kind == "dir":
+                out = check_report_dir(path, option=name)
+            else:
+                out = check_file_output(path, suffixes=a.suffixes, option=name)
+            key = Path(os.path.abspath(out))
+            if key in seen:
+                raise UsageError(f"{name} {path}: also given to {seen[key]}; expected two names")
+            seen[key] = name
+        yield
+
+
+def _add_overwrite(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace existing outputs (never an input); without it an existing file is "
+        "refused before any work",
+    )
 
 
 def _emit_json(obj: Any) -> None:
@@ -136,11 +253,33 @@ def _add_scheduler(p: argparse.ArgumentParser) -> None:
         "a trusted network only)",
     )
     p.add_argument("--workers", type=int, default=None, help="worker processes (default: cores)")
-    p.add_argument("--tls-ca", default=None, metavar="PEM", help="CA certificate (tls://)")
-    p.add_argument("--tls-cert", default=None, metavar="PEM", help="this client's certificate")
-    p.add_argument("--tls-key", default=None, metavar="PEM", help="this client's private key")
+    p.add_argument(
+        "--tls-ca", action=InputPath, default=None, metavar="PEM", help="CA certificate (tls://)"
+    )
+    p.add_argument(
+        "--tls-cert",
+        action=InputPath,
+        default=None,
+        metavar="PEM",
+        help="this client's certificate",
+    )
+    p.add_argument(
+        "--tls-key",
+        action=InputPath,
+        default=None,
+        metavar="PEM",
+        help="this client's private key",
+    )
     p.add_argument(
         "--dashboard", action="store_true", help="start the local cluster's dashboard (127.0.0.1)"
+    )
+    p.add_argument(
+        "--worker-timeout",
+        type=float,
+        default=None,
+        metavar="SECONDS",
+        help="how long to wait for a worker on a tcp:// or tls:// scheduler that has none "
+        "(default 60)",
     )
 
 
@@ -148,19 +287,20 @@ def _check_executor(args: argparse.Namespace) -> None:
     """Reject a bad ``--scheduler`` / ``--workers`` before any work is done."""
     from .parallel import check_scheduler, configure
 
-    try:
-        check_scheduler(args.scheduler)
-    except ValueError as exc:
-        raise UsageError(f"--scheduler: {exc}") from None
-    try:
+    try:  # first: certificates given here decide what --scheduler local needs
         configure(
             dashboard=True if args.dashboard else None,
             tls_ca=args.tls_ca,
             tls_cert=args.tls_cert,
             tls_key=args.tls_key,
+            worker_timeout=args.worker_timeout,
         )
     except ValueError as exc:
         raise UsageError(str(exc)) from None
+    try:
+        check_scheduler(args.scheduler)
+    except ValueError as exc:
+        raise UsageError(f"--scheduler: {exc}") from None
     if args.workers is not None and args.workers < 1:
         raise UsageError(f"--workers must be >= 1, got {args.workers}")
 
@@ -190,16 +330,17 @@ def _executor_errors(cmd: Any) -> Any:
 def cmd_ingest(args: argparse.Namespace) -> int:
     from . import adapters
     from .dataset import concat, write
-    from .outputs import check_file_output, check_input_files
+    from .outputs import check_file_output
 
-    check_input_files(args.files)
     out = None
-    if args.output:
-        out = check_file_output(args.output, inputs=args.files, suffixes=(".parquet", ".csv"))
+    if args.output:  # checked with the inputs by _checked_outputs
+        out = Path(args.output)
         if out.suffix.lower() == ".csv":  # its metadata goes to a sidecar beside it
             from .dataset import sidecar_path
 
-            check_file_output(sidecar_path(out), inputs=args.files, suffixes=(".json",))
+            check_file_output(
+                sidecar_path(out), suffixes=(".json",), option=f"-o {out}: its metadata file"
+            )
     from .selection import SelectionError
 
     rows: list[dict[str, Any]] = []
@@ -208,7 +349,7 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     unselected: list[str] = []
     for f in args.files:
         try:
-            m = adapters.read(f, args.format)
+            m = adapters.read(f, args.format, columns=args.columns)
         except (ValueError, NotImplementedError) as exc:
             if not args.keep_going:
                 print(f"labbrdf ingest: {exc}", file=sys.stderr)
@@ -229,7 +370,10 @@ def cmd_ingest(args: argparse.Namespace) -> int:
                 "sample": s["sample"][0] if len(s["sample"]) == 1 else s["sample"],
                 "rows": s["rows"],
                 "quantities": s["quantities"],
+                "channels": _channels(m.data),
                 "wavelength_nm": s["wavelength_nm"],
+                # False: the file states none and wavelength_nm is a label (.bsdf)
+                "wavelength_stated": m.meta.get("wavelength_stated") is not False,
                 "theta_i_deg": s["theta_i_deg"],
             }
         )
@@ -253,6 +397,31 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     return 2 if failures else 0
 
 
+def _channels(d: Any) -> dict[str, list[str]]:
+    """The channels of each quantity that has any, in file order.
+
+    ``p``/``s`` reflectance, generalised ellipsometry ``pp``/``ps``/``sp``, tristimulus
+    ``X``/``Y``/``Z``; quantities without a channel are left out.
+    """
+    if "channel" not in d.columns:
+        return {}
+    out: dict[str, list[str]] = {}
+    for q, c in d[["quantity", "channel"]].drop_duplicates().itertuples(index=False):
+        if c:
+            out.setdefault(str(q), []).append(str(c))
+    return out
+
+
+def _channels_cell(channels: dict[str, list[str]]) -> str:
+    """``"p"``; ``"pp,ps,sp"`` when every quantity has the same; else per quantity."""
+    if not channels:
+        return "-"
+    lists = {tuple(v) for v in channels.values()}
+    if len(lists) == 1:
+        return ",".join(next(iter(lists)))
+    return " ".join(f"{q}:{','.join(v)}" for q, v in channels.items())
+
+
 def _short(text: str, width: int = 36) -> str:
     return text if len(text) <= width else text[: width - 3] + "..."
 
@@ -268,7 +437,16 @@ def _quantities_cell(qs: list[str]) -> str:
 
 
 def _print_ingest_table(rows: list[dict[str, Any]]) -> None:
-    head = ["file", "format", "sample", "quantities", "wavelength_nm", "theta_i_deg", "rows"]
+    head = [
+        "file",
+        "format",
+        "sample",
+        "quantities",
+        "channel",
+        "wavelength_nm",
+        "theta_i_deg",
+        "rows",
+    ]
     table = []
     for r in rows:
         wl = r["wavelength_nm"]
@@ -283,7 +461,8 @@ def _print_ingest_table(rows: list[dict[str, Any]]) -> None:
                     else f"{len(r['sample'])} samples: {r['sample'][0]}, ..."
                 ),
                 _quantities_cell(r["quantities"]),
-                f"{wl[0]:.6g}-{wl[1]:.6g}",
+                _channels_cell(r["channels"]),
+                f"{wl[0]:.6g}-{wl[1]:.6g}" if r["wavelength_stated"] else "not stated",
                 ",".join(f"{t:g}" for t in th[:8]) + (",..." if len(th) > 8 else "") or "-",
                 str(r["rows"]),
             ]
@@ -317,12 +496,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
     from . import adapters, models
     from .fitting import fit_many
-    from .outputs import check_file_output, check_input_files
 
     _check_executor(args)
-    check_input_files(args.files)
-    if args.output:
-        check_file_output(args.output, inputs=args.files, suffixes=(".csv",))
     data = _selected(args, adapters.read_many(args.files))
     fix = _parse_assignments(args.fix, "--fix")
     options, start = _split_params(args.model, args.param)
@@ -516,11 +691,8 @@ def cmd_nk(args: argparse.Namespace) -> int:
     from . import adapters
     from .ellipsometry import P_ANGLE_DEPENDENT
     from .nk import angle_verdict, combined_table, nk_json, nk_table
-    from .outputs import atomic_output, check_file_output, check_input_files, csv_safe_frame
+    from .outputs import atomic_output, csv_safe_frame
 
-    check_input_files(args.files)
-    if args.output:
-        check_file_output(args.output, inputs=args.files, suffixes=(".csv",))
     data = _selected(args, adapters.read_many(args.files))
     on_ill: Literal["warn", "raise"] = "warn" if args.allow_ill_conditioned else "raise"
     table = nk_table(data, on_ill_conditioned=on_ill, theta_sigma_deg=args.theta_sigma)
@@ -724,7 +896,6 @@ def cmd_export(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .adapters.zemax_bsdf import model_to_bsdf
-    from .outputs import check_file_output
 
     if args.format != "zemax-bsdf":
         raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
@@ -738,11 +909,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     unknown = [k for k in values if k not in model.params]
     if unknown:
         raise UsageError(f"--param {unknown}: {args.model} parameters are {list(model.params)}")
-    out = check_file_output(
-        args.output, inputs=[args.nk_from] if args.nk_from else [], suffixes=(".bsdf",)
-    )
-    if out.exists() and not args.overwrite:
-        raise UsageError(f"-o {out}: exists; pass --overwrite to replace it")
+    out = Path(args.output)  # checked with the inputs by _checked_outputs
     model_to_bsdf(
         model,
         values,
@@ -759,13 +926,9 @@ def cmd_export(args: argparse.Namespace) -> int:
 def _export_trace(args: argparse.Namespace) -> int:
     """``export --trace RUN.npz``: the tracer's unpolarized S0 on the scatter grid."""
     from .adapters.zemax_bsdf import binned_to_bsdf
-    from .outputs import check_file_output, check_input_files
     from .tracer import TraceResult
 
-    check_input_files([args.trace])
-    out = check_file_output(args.output, inputs=[args.trace], suffixes=(".bsdf",))
-    if out.exists() and not args.overwrite:
-        raise UsageError(f"-o {out}: exists; pass --overwrite to replace it")
+    out = Path(args.output)  # checked with the inputs by _checked_outputs
     if args.theta_i is not None or args.param or args.nk_from:
         raise UsageError(
             "--trace takes its angle and material from the run; drop --theta-i/--param"
@@ -910,14 +1073,9 @@ def _complex(text: str, what: str) -> complex:
 def cmd_trace(args: argparse.Namespace) -> int:
 
     from . import tracer
-    from .outputs import check_file_output
     from .parallel import imap
 
-    _check_executor(args)
-    if args.output:
-        check_file_output(args.output, suffixes=(".npz",))
-    if args.png:
-        check_file_output(args.png, suffixes=(".png",), option="--png")
+    _check_executor(args)  # the outputs were checked with the inputs by _checked_outputs
     if (args.substrate is None) == (args.nk_from is None):
         raise UsageError("give the substrate index with --substrate N+Kj or --nk-from FILE")
     if args.nk_from is not None:
@@ -995,11 +1153,9 @@ def cmd_trace(args: argparse.Namespace) -> int:
     if args.output:
         result.save(args.output)
     if args.png:
-        from .outputs import atomic_output
         from .report.figures import save_trace_maps_png
 
-        with atomic_output(args.png) as tmp:
-            save_trace_maps_png(result, tmp)
+        save_trace_maps_png(result, args.png)  # atomically
     summary = tracer.trace_summary(result)
     summary["seconds"] = seconds
     if args.json:
@@ -1024,7 +1180,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from .report.validate import default_fixtures_dir
 
     _check_executor(args)
-    check_report_dir(args.out, inputs=[default_fixtures_dir()], option="--out")
+    check_report_dir(args.out, inputs=[default_fixtures_dir()], option="--out")  # the fixtures
     return int(
         validate(
             out=args.out,
@@ -1037,11 +1193,9 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    from .outputs import check_input_files, check_report_dir
     from .report import user_report
+    from .report.sections.film import default_film_model
 
-    check_input_files(args.files)
-    check_report_dir(args.output, inputs=args.files)
     options, start = _split_params(args.model, args.param)
     selection = {k: getattr(args, k) for k in SELECTION_KEYS if getattr(args, k) is not None}
     return int(
@@ -1053,7 +1207,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             start=start,
             selection=selection,
             progress=not args.quiet,
-            film_model=args.film_model,
+            film_model=default_film_model() if args.film_default else args.film_model,
         )
     )
 
@@ -1073,9 +1227,24 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     s = sub.add_parser("ingest", help="read instrument exports into one dataset")
-    s.add_argument("files", nargs="+", metavar="FILE")
+    s.add_argument("files", nargs="+", action=InputPath, metavar="FILE")
     s.add_argument("--format", default=None, help="force an adapter (see `labbrdf formats`)")
-    s.add_argument("-o", "--output", default=None, help="write OUT.parquet or OUT.csv")
+    s.add_argument(
+        "--columns",
+        default=None,
+        metavar="NAMES",
+        help="declare the columns of a headerless numeric file (implies --format columns), "
+        "e.g. wavelength_nm,absorbance; see docs/formats.md",
+    )
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".parquet", ".csv"),
+        default=None,
+        help="write OUT.parquet, or OUT.csv and its metadata OUT.meta.json",
+    )
+    _add_overwrite(s)
     s.add_argument("--json", action="store_true", help="print a JSON list, one object per file")
     s.add_argument("--keep-going", action="store_true", help="read the rest after a failure")
     _add_selection(s)
@@ -1086,7 +1255,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_formats)
 
     s = sub.add_parser("fit", help="fit a model per group (sample, wavelength)")
-    s.add_argument("files", nargs="+", metavar="FILE_OR_DATASET")
+    s.add_argument("files", nargs="+", action=InputPath, metavar="FILE_OR_DATASET")
     s.add_argument("--model", required=True)
     s.add_argument("--by", default="sample,wavelength_nm", help="comma-separated group columns")
     s.add_argument("--method", default="GN_CRS2_LM+LN_BOBYQA", help="nlopt GLOBAL[+LOCAL]")
@@ -1103,7 +1272,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--free", action="append", metavar="NAME", help="vary a parameter fixed by default"
     )
     s.add_argument(
-        "--nk-from", default=None, metavar="FILE", help="n, k from psi/Delta (microfacet)"
+        "--nk-from",
+        action=InputPath,
+        default=None,
+        metavar="FILE",
+        help="n, k from psi/Delta (microfacet)",
     )
     s.add_argument(
         "--nk-wavelength",
@@ -1118,17 +1291,38 @@ def build_parser() -> argparse.ArgumentParser:
         default="auto",
         help="auto: 1/sigma^2 where every point has sigma, else relative",
     )
-    s.add_argument("--relative-floor", type=float, default=1e-3, help="of max |y| (relative)")
+    s.add_argument(
+        "--relative-floor",
+        type=float,
+        default=1e-3,
+        help="floor of --weighting relative, a fraction of the largest absolute value",
+    )
     s.add_argument("--keep-zeros", action="store_true", help="fit points with value 0 too")
-    s.add_argument("-o", "--output", default=None, help="write the parameter table (CSV)")
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".csv",),
+        default=None,
+        help="write the parameter table (CSV)",
+    )
+    _add_overwrite(s)
     s.add_argument("--json", action="store_true")
     _add_selection(s)
     _add_scheduler(s)
     s.set_defaults(func=cmd_fit)
 
     s = sub.add_parser("nk", help="optical constants n, k from ellipsometer psi/Delta")
-    s.add_argument("files", nargs="+", metavar="FILE")
-    s.add_argument("-o", "--output", default=None, help="write the table (CSV)")
+    s.add_argument("files", nargs="+", action=InputPath, metavar="FILE")
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".csv",),
+        default=None,
+        help="write the table (CSV)",
+    )
+    _add_overwrite(s)
     s.add_argument("--combined", action="store_true", help="-o writes the per-wavelength table")
     s.add_argument("--theta-sigma", type=float, default=0.0, help="angle uncertainty [deg]")
     s.add_argument(
@@ -1185,49 +1379,71 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_film)
 
     s = sub.add_parser("surface", help="roughness statistics of a height map or profile")
-    s.add_argument("file", metavar="FILE")
+    s.add_argument("file", action=InputPath, metavar="FILE")
     s.add_argument("--channel", default=None, help="channel name or index (default: height)")
     s.add_argument("--degree", type=int, default=1, help="levelling polynomial (1 = plane)")
     s.add_argument("--blocks", type=int, default=None, help="tiles per axis for uncertainties")
-    s.add_argument("--png", default=None, help="write map, ACF and slope histogram (.png)")
+    s.add_argument(
+        "--png",
+        action=OutputPath,
+        suffixes=(".png",),
+        default=None,
+        help="write map, ACF and slope histogram (.png)",
+    )
+    _add_overwrite(s)
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_surface)
 
     s = sub.add_parser("export", help="write a model BRDF in an exchange format")
     s.add_argument("--format", default="zemax-bsdf", help="zemax-bsdf")
     s.add_argument("--model", default=None, help="a model (with --param) ...")
-    s.add_argument("--trace", default=None, metavar="RUN.npz", help="... or a trace's S0")
+    s.add_argument(
+        "--trace", action=InputPath, default=None, metavar="RUN.npz", help="... or a trace's S0"
+    )
     s.add_argument("--param", action="append", metavar="NAME=VALUE")
-    s.add_argument("--nk-from", default=None, metavar="FILE")
+    s.add_argument("--nk-from", action=InputPath, default=None, metavar="FILE")
     s.add_argument("--wavelength", type=float, default=None, help="[nm] for --nk-from")
     s.add_argument("--theta-i", type=float, nargs="+", default=None, metavar="DEG")
     s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")
     s.add_argument("--azimuth", default="0:180:5", help="START:STOP:STEP [deg]")
-    s.add_argument("-o", "--output", required=True)
-    s.add_argument("--overwrite", action="store_true")
+    s.add_argument("-o", "--output", action=OutputPath, suffixes=(".bsdf",), required=True)
+    _add_overwrite(s)
     s.set_defaults(func=cmd_export)
 
     s = sub.add_parser("hemispherical", help="directional-hemispherical reflectance of a model")
     s.add_argument("--model", required=True)
     s.add_argument("--param", action="append", metavar="NAME=VALUE")
     s.add_argument("--theta-i", type=float, nargs="+", required=True, metavar="DEG")
-    s.add_argument("--nk-from", default=None, metavar="FILE", help="n, k from psi/Delta")
+    s.add_argument(
+        "--nk-from", action=InputPath, default=None, metavar="FILE", help="n, k from psi/Delta"
+    )
     s.add_argument("--wavelength", type=float, default=None, help="[nm] for --nk-from")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_hemispherical)
 
     s = sub.add_parser("trace", help="Monte Carlo polarization ray tracing (pBRDF)")
     s.add_argument("--substrate", default=None, help="complex index, e.g. 1.55+7.71j")
-    s.add_argument("--nk-from", default=None, metavar="FILE", help="substrate n, k from psi/Delta")
+    s.add_argument(
+        "--nk-from",
+        action=InputPath,
+        default=None,
+        metavar="FILE",
+        help="substrate n, k from psi/Delta",
+    )
     s.add_argument("--alpha", type=float, default=None, help="GGX roughness of the substrate")
     s.add_argument(
-        "--surface", default=None, metavar="FILE", help="measured height map: its slope table"
+        "--surface",
+        action=InputPath,
+        default=None,
+        metavar="FILE",
+        help="measured height map: its slope table",
     )
     s.add_argument("--channel", default=None, help="height channel of --surface")
     s.add_argument("--coating", default=None, help="coating index, e.g. 1.5")
     s.add_argument(
         "--coating-from",
         default=None,
+        action=InputPath,
         metavar="FIT.json",
         help="coating index at --wavelength and thickness from a one-layer film fit",
     )
@@ -1235,6 +1451,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--coating-alpha", type=float, default=None)
     s.add_argument(
         "--coating-surface",
+        action=InputPath,
         default=None,
         metavar="FILE",
         help="measured height map of the coating's top: its ML GGX alpha",
@@ -1245,14 +1462,29 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=int, default=1)
     s.add_argument("--single-scattering", action="store_true")
     s.add_argument("--coherent", action="store_true")
-    s.add_argument("-o", "--output", default=None, help="write the pBRDF (.npz)")
-    s.add_argument("--png", default=None, help="write S0/DOP hemisphere maps (.png)")
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".npz",),
+        default=None,
+        help="write the pBRDF (.npz)",
+    )
+    s.add_argument(
+        "--png",
+        action=OutputPath,
+        suffixes=(".png",),
+        default=None,
+        help="write S0/DOP hemisphere maps (.png)",
+    )
+    _add_overwrite(s)
     s.add_argument("--json", action="store_true")
     _add_scheduler(s)
     s.set_defaults(func=cmd_trace)
 
     s = sub.add_parser("validate", help="run the whole validation and write the HTML report")
-    s.add_argument("--out", default="reports/validation")
+    s.add_argument("--out", action=OutputPath, kind="dir", default="reports/validation")
+    _add_overwrite(s)
     s.add_argument("--quick", action="store_true", help="small scale (tests, previews)")
     _add_scheduler(s)
     s.set_defaults(func=cmd_validate)
@@ -1261,6 +1493,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument(
         "files",
         nargs="+",
+        action=InputPath,
         metavar="DATA",
         help="instrument exports, .bsdf files, datasets and height maps (.di, .opdx, ...)",
     )
@@ -1271,17 +1504,26 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="NAME=VALUE",
         help="a model option (microfacet n=, k=, diffuse=true) or a parameter's start value",
     )
-    s.add_argument("-o", "--output", required=True, metavar="DIR")
-    s.add_argument(
+    s.add_argument("-o", "--output", action=OutputPath, kind="dir", required=True, metavar="DIR")
+    _add_overwrite(s)
+    film = s.add_mutually_exclusive_group()
+    film.add_argument(
         "--film-model",
         default=None,
+        action=InputPath,
         metavar="FILE.toml",
-        help="fit this film stack to psi/Delta files whose angles disagree; 'default': "
-        "one transparent Cauchy layer on c-Si, thickness free",
+        help="fit this film stack to psi/Delta files whose angles disagree",
+    )
+    film.add_argument(
+        "--film-default",
+        action="store_true",
+        help="... or the stated default: one transparent Cauchy layer on c-Si, thickness free",
     )
     s.add_argument("--quiet", action="store_true", help="no progress lines")
     _add_selection(s)
     s.set_defaults(func=cmd_report)
+    for sp in sub.choices.values():  # what _checked_outputs checks, per command
+        sp.set_defaults(path_actions=tuple(path_actions(sp)))
     return p
 
 
@@ -1290,7 +1532,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        return int(args.func(args))
+        with _checked_outputs(args):
+            return int(args.func(args))
     except UsageError as exc:
         print(f"labbrdf {args.command}: {exc}", file=sys.stderr)
         return 2

@@ -439,6 +439,23 @@ class Measurement:
         }
 
 
+#: Longest name [characters] kept in a string column built from one header field: a
+#: sample name is a line of a header, and a crafted or corrupt file with a title of
+#: megabytes would otherwise put it in every output row (CSV, Parquet, reports).
+MAX_NAME_CHARS = 512
+
+
+def capped_name(name: str) -> str:
+    """``name`` itself, or its first characters and a mark saying how long it was.
+
+    The reader's ``meta`` keeps the whole header field; only the table's copy is cut.
+    """
+    if len(name) <= MAX_NAME_CHARS:
+        return name
+    mark = f"... [{len(name)} characters, cut]"
+    return name[: MAX_NAME_CHARS - len(mark)] + mark
+
+
 def make_frame(
     *,
     sample: str,
@@ -455,6 +472,11 @@ def make_frame(
     **optional: Any,
 ) -> pd.DataFrame:
     """Build a schema table from arrays and scalars (broadcast to one length).
+
+    A scalar string becomes an object column of references to that one string (never n
+    copies), and a ``sample`` longer than
+    :data:`MAX_NAME_CHARS` is cut by :func:`capped_name`: memory stays a small multiple of
+    the data whatever a header holds.
 
     Optional columns (``time_s``, ``channel``, ``x_mm``, ``y_mm``, ``sample_rotation_deg``,
     ``zone``) go in ``optional``.
@@ -479,9 +501,17 @@ def make_frame(
         "phi_r_deg": phi_r_deg,
         **optional,
     }
+    if isinstance(sample, str) and len(sample) > MAX_NAME_CHARS:
+        cols["sample"] = capped_name(sample)
     out: dict[str, Any] = {}
     for k, v in cols.items():
-        if isinstance(v, str) or np.ndim(v) == 0:
+        if isinstance(v, str):
+            # n references to one str object: a list of n strings would become a string
+            # array of n copies under pandas >= 3 (a 5 MB title times the rows)
+            fill = np.empty(n, dtype=object)
+            fill[:] = v
+            out[k] = pd.Series(fill, dtype=object, copy=False)
+        elif np.ndim(v) == 0:
             out[k] = [v] * n
         else:
             arr = list(v) if not isinstance(v, np.ndarray) else v

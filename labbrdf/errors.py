@@ -7,10 +7,10 @@ catches those keeps working:
 ===============================================  =================
 error                                            also a
 ===============================================  =================
-:class:`labbrdf.adapters.AdapterError`           ``ValueError``
-:class:`labbrdf.dataset.DatasetError`            ``ValueError``
-:class:`labbrdf.models.ModelError`               ``ValueError``
-:class:`labbrdf.fitting.FitError`                ``ValueError``
+:class:`labbrdf.AdapterError`                    ``ValueError``
+:class:`labbrdf.DatasetError`                    ``ValueError``
+:class:`labbrdf.ModelError`                      ``ValueError``
+:class:`labbrdf.FitError`                        ``ValueError``
 :class:`labbrdf.parallel.ParallelError`          ``RuntimeError``
 ===============================================  =================
 """

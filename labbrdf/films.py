@@ -27,7 +27,7 @@ import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -35,6 +35,9 @@ from numpy.typing import ArrayLike, NDArray
 from . import dispersion as disp
 from . import stack as stk
 from .errors import LabbrdfError
+
+if TYPE_CHECKING:  # at run time through __getattr__ below (the fit imports this module)
+    from .fitting.film import FilmFit, fit_film, woollam_mse
 
 __all__ = [
     "FILM_QUANTITIES",
@@ -656,6 +659,14 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
     return FilmModel(st, free, wl_range, where)
 
 
-# the fit lives with the fitting core (it imports this module's objects, so this import
-# comes last); re-exported here so that ``labbrdf.films`` is the one place to look
-from .fitting.film import FilmFit, fit_film, woollam_mse  # noqa: E402
+# the fit lives with the fitting core (labbrdf.fitting.film), which imports this module's
+# objects; it is re-exported here lazily (PEP 562), so either module may be imported first
+_FIT_NAMES = ("FilmFit", "fit_film", "woollam_mse")
+
+
+def __getattr__(name: str) -> Any:
+    if name in _FIT_NAMES:
+        from .fitting import film as _fit
+
+        return getattr(_fit, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

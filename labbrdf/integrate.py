@@ -17,9 +17,9 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq, minimize_scalar
-from scipy.special import erf
 
 from .models.base import Model, Parameters
+from .models.smooth3 import smooth3_hemispherical, smooth3_lobe_integral
 
 __all__ = [
     "EnergyCheck",
@@ -41,66 +41,6 @@ _MAX_KINKS = 2
 
 
 # ----------------------------------------------------------------------------- smooth3
-def smooth3_lobe_integral(theta_i: ArrayLike, k2: float, k3: float) -> NDArray[np.float64]:
-    """``I(theta_i) = int_0^{pi/2} exp(-(theta_i - k2 - t)^2 / k3^2) sin t dt`` in closed form.
-
-    ``I = Im{k3 e^{ic} e^{-k3^2/4} (sqrt(pi)/2) [erf(u1 - i k3/2) - erf(u0 - i k3/2)]}`` with
-    ``c = theta_i - k2``, ``u0 = -c/k3``, ``u1 = (pi/2 - c)/k3`` (docs/models.md 1.2).
-
-    Parameters
-    ----------
-    theta_i : array_like
-        Incidence angle [rad].
-    k2 : float
-        Lobe shift [rad].
-    k3 : float
-        Lobe 1/e half-width [rad], > 0.
-
-    Returns
-    -------
-    ndarray
-        I [1], in (0, 1).
-    """
-    if not k3 > 0:
-        raise ValueError(f"k3 must be > 0 [rad]; got {k3!r}")
-    c = np.asarray(theta_i, dtype=float) - k2
-    w = 0.5j * k3
-    diff = erf((math.pi / 2 - c) / k3 - w) - erf(-c / k3 - w)
-    return np.imag(k3 * np.exp(1j * c - k3**2 / 4) * (math.sqrt(math.pi) / 2) * diff)
-
-
-def smooth3_hemispherical(
-    theta_i_deg: ArrayLike, k1: float, k2: float, k3: float
-) -> NDArray[np.float64]:
-    """Closed-form directional-hemispherical reflectance of the smooth3 model.
-
-    ``rho(ti) = 2 pi int_0^{pi/2} R cos(tr) sin(tr) d tr = pi k1 I(ti) / (4 cos ti)``
-    with R of eq. (7) of [1]_ taken as an azimuth-independent BRDF and ``I`` from
-    :func:`smooth3_lobe_integral`.
-
-    Parameters
-    ----------
-    theta_i_deg : array_like
-        Incidence angle [deg], in [0, 90).
-    k1 : float
-        Amplitude [1].
-    k2, k3 : float
-        Lobe shift and 1/e half-width [rad].
-
-    Returns
-    -------
-    ndarray
-        rho [1] (a fraction).
-
-    Notes
-    -----
-    The paper's eq. (8) bounds this by ``2 pi k1 / 8`` and concludes that ``k1 <= 4/pi``
-    conserves energy; that holds at normal incidence only (docs/models.md 1.4).
-    """
-    ti = np.radians(_check_theta_i(theta_i_deg))
-    return math.pi * k1 * smooth3_lobe_integral(ti, k2, k3) / (4.0 * np.cos(ti))
-
-
 def k1_max_energy(k2: float, k3: float, theta_max_deg: float) -> float:
     """Largest k1 for which smooth3 keeps ``rho(theta) <= 1`` for all ``theta <= theta_max``.
 
@@ -255,7 +195,8 @@ def hemispherical_reflectance(
     theta_i_deg : array_like
         Incidence angle(s) [deg], in [0, 90).
     method : {"auto", "closed", "quadrature"}
-        ``auto`` uses the closed form for smooth3 and quadrature otherwise.
+        ``auto`` uses the model's closed form (:meth:`labbrdf.models.Model.hemispherical`)
+        where it has one (smooth3) and quadrature otherwise.
     rtol : float
         Relative accuracy target of the quadrature: the Gauss-Legendre nodes per panel are
         doubled (8 to 128) until two successive results agree to ``rtol``; otherwise a
@@ -285,10 +226,12 @@ def hemispherical_reflectance(
         raise ValueError(f"rtol must be in (0, 1); got {rtol!r}")
     t = _check_theta_i(theta_i_deg)
     p = model.values(params)
-    if method == "closed" or (method == "auto" and model.name == "smooth3"):
-        if model.name != "smooth3":
+    if method != "quadrature":
+        closed = model.hemispherical(t, p)
+        if closed is not None:
+            return np.asarray(closed, dtype=float)
+        if method == "closed":
             raise ValueError(f"no closed form for model {model.name!r}; use method='quadrature'")
-        return smooth3_hemispherical(t, p["k1"], p["k2"], p["k3"])
     flat = [_hemi_adaptive(model, p, math.radians(x), rtol) for x in t.ravel()]
     return np.asarray(flat, dtype=float).reshape(t.shape)
 

@@ -5,7 +5,7 @@ vectorised with NumPy broadcasting; angles are in degrees at the public API (rad
 Outputs are ndarrays (0-d for scalar inputs).
 
 Conventions (the ONE labbrdf convention, "LB"; also in ``docs/conventions.md``)
------------------------------------------------------------------------------
+-------------------------------------------------------------------------------
 * Time dependence ``exp(-i omega t)``; complex index ``N = n + ik`` with ``k >= 0`` for an
   absorbing medium. A plane wave travels as ``exp(+i k0 (kx x + kz z))``, so the physical
   root of ``kz = N cos(theta)`` has ``Im(kz) >= 0`` (it decays away from the interface) and,

@@ -1,20 +1,33 @@
 """Output-path safety: every file or folder labbrdf writes goes through this module.
 
-Nothing a user owns is lost by our outputs:
+Nothing a user owns is lost by our outputs. The command line follows one rule for every
+output it writes, sidecar files included: **an existing file (or earlier report folder) is
+never replaced unless ``--overwrite`` is given; an input is never replaced, even with
+``--overwrite``; every write is atomic.** The CLI states the rule once per command with
+:func:`write_policy` (whether to overwrite, and all the command's inputs); every check and
+every write below consults it, so a writer added later follows it without being told.
+Outside a :func:`write_policy` block (the library used from Python) an existing output is
+replaced, as :func:`open` with ``"w"`` would, and only the inputs passed explicitly are
+refused.
 
 * :func:`check_file_output` refuses a file output that is one of the inputs, an existing
-  folder or anything but a regular file, a name ending in a path separator (a folder),
-  or a name without the expected suffix.
+  file (unless overwriting), an existing folder or anything but a regular file, a name
+  ending in a path separator (a folder), or a name without the expected suffix.
 * :func:`check_report_dir` refuses a report folder that is (or contains, or lies inside)
   an input, an existing file, the current working folder, or an existing folder that is
   neither empty nor a previous labbrdf report; a previous report in which the user put
-  a file of their own is refused too, naming that file. A report folder is recognised by
+  a file of their own is refused too, naming that file, and a previous report is
+  replaced only when overwriting. A report folder is recognised by
   its marker file :data:`REPORT_MARKER` (a small JSON that lists the files we wrote), or,
   for reports written before the marker existed, by its exact layout (``index.html``,
   ``results.json`` with the report keys, ``tables/*.csv`` and nothing else).
 * :func:`atomic_output` (files) and :func:`replace_dir` (report folders) build the output
   under a temporary hidden name beside it and rename it into place; outputs get the
-  permissions of the umask (``0o666 & ~umask``; a replaced file keeps its mode).
+  permissions of the umask (``0o666 & ~umask``; a replaced file keeps its mode). When
+  not overwriting, the file is put in place with a hard link, which fails rather than
+  replace a file that appeared while we worked. Any OS error while writing (a full
+  disk, a read-only folder, ...) becomes an :class:`OutputError` that names the output
+  path and the cause.
 * Temporary names carry our pattern, a host tag and the process id
   (``.NAME.labbrdf-tmp-HOST-PID-XXXX.tmp``, ``.NAME.labbrdf-new-HOST-PID-XXXX``,
   ``.NAME.labbrdf-old-HOST-PID-XXXX``). A run killed with SIGKILL leaves them behind; the
@@ -41,6 +54,8 @@ import stat
 import tempfile
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from contextvars import ContextVar
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +63,7 @@ __all__ = [
     "CSV_FORMULA_PREFIXES",
     "REPORT_MARKER",
     "OutputError",
+    "WritePolicy",
     "atomic_output",
     "check_file_output",
     "check_input_files",
@@ -56,6 +72,7 @@ __all__ = [
     "csv_safe_cell",
     "csv_safe_frame",
     "replace_dir",
+    "write_policy",
 ]
 
 #: the marker file written into every report folder
@@ -73,6 +90,71 @@ class OutputError(ValueError, OSError):
 
     Also an OSError, so that code which caught the OS error of a failed write still does.
     """
+
+
+@dataclass(frozen=True)
+class WritePolicy:
+    """What a writer may replace: see :func:`write_policy`.
+
+    Attributes
+    ----------
+    overwrite : bool
+        Whether an existing output may be replaced.
+    inputs : tuple of Path
+        Files the running command reads; never replaced.
+    """
+
+    overwrite: bool = True
+    inputs: tuple[Path, ...] = ()
+
+
+_LIBRARY_POLICY = WritePolicy()
+_POLICY: ContextVar[WritePolicy | None] = ContextVar("labbrdf_write_policy", default=None)
+
+
+#: temporary files of this process's open :func:`atomic_output` blocks and their targets:
+#: a nested block writing onto one of them (a writer given the temporary name) replaces
+#: it, and names the real target in its messages
+_OWN_TMPS: dict[str, Path] = {}
+
+
+def _current() -> WritePolicy:
+    return _POLICY.get() or _LIBRARY_POLICY
+
+
+@contextlib.contextmanager
+def write_policy(
+    *, overwrite: bool, inputs: Iterable[str | os.PathLike[str]] = ()
+) -> Iterator[WritePolicy]:
+    """Apply the output rule to every check and write inside the ``with`` block.
+
+    Parameters
+    ----------
+    overwrite : bool
+        False: an existing output file, or a non-empty earlier report folder, is refused
+        (checked before any work and again at the final rename, atomically).
+    inputs : iterable of path-like
+        Every input of the command, refused as an output even when ``overwrite``.
+
+    Yields
+    ------
+    WritePolicy
+        The policy in force.
+    """
+    policy = WritePolicy(bool(overwrite), tuple(Path(p) for p in inputs))
+    token = _POLICY.set(policy)
+    try:
+        yield policy
+    finally:
+        _POLICY.reset(token)
+
+
+def _policy_inputs(inputs: Iterable[str | os.PathLike[str]]) -> list[Path]:
+    return [Path(p) for p in inputs] + list(_current().inputs)
+
+
+def _overwrite(overwrite: bool | None) -> bool:
+    return _current().overwrite if overwrite is None else overwrite
 
 
 # --------------------------------------------------------------------------- helpers
@@ -113,11 +195,11 @@ def _pid_alive(pid: int) -> bool:
 
 
 def _display(path: Path | str) -> str:
-    return str(path)
+    return str(_OWN_TMPS.get(os.path.abspath(path), path))
 
 
 def _wraps_oserror(path: Path | str, what: str, exc: OSError) -> OutputError:
-    reason = exc.strerror or str(exc)
+    reason = exc.strerror or (os.strerror(exc.errno) if exc.errno else "") or str(exc)
     if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
         hint = "; expected a folder you can write to"
     elif exc.errno == errno.ENOSPC:
@@ -199,6 +281,7 @@ def check_file_output(
     inputs: Iterable[str | os.PathLike[str]] = (),
     suffixes: Sequence[str] = (),
     option: str = "-o",
+    overwrite: bool | None = None,
 ) -> Path:
     """Validate a file output before any work is done; return it as a Path.
 
@@ -212,12 +295,16 @@ def check_file_output(
         Accepted suffixes (lower case, with the dot); empty accepts any.
     option : str
         The option name, for the messages.
+    overwrite : bool, optional
+        Whether an existing file may be replaced; default: the :func:`write_policy` in
+        force (whose inputs are refused too).
 
     Raises
     ------
     OutputError
         The name ends with a separator (a folder), has the wrong suffix, is an existing
-        folder or a non-regular file, or is one of the inputs.
+        folder or a non-regular file, is one of the inputs, or is an existing file and
+        not ``overwrite``.
     """
     if not os.fspath(path):
         raise OutputError(f"{option}: empty file name")
@@ -239,15 +326,53 @@ def check_file_output(
             raise OutputError(f"{option} {p}: not a regular file; expected a file name")
     if suffixes and p.suffix.lower() not in suffixes:
         raise OutputError(f"{option} {p}: expected a file name ending in {want}")
-    for f in inputs:
-        fp = Path(f)
-        if (p.exists() and fp.exists() and _same(p, fp)) or _resolved(p) == _resolved(fp):
-            raise OutputError(f"{option} {p} is one of the input files; refusing to overwrite it")
+    _refuse_inputs(p, _policy_inputs(inputs), option)
+    if os.path.lexists(p) and not _overwrite(overwrite):
+        raise OutputError(
+            f"{option} {p}: exists; pass --overwrite to replace it (nothing was changed)"
+        )
     parent = p.parent if str(p.parent) else Path(".")
     if parent.exists() and not parent.is_dir():
         raise OutputError(f"{option} {p}: {parent} is not a folder")
     _check_writable(p, option)
     return p
+
+
+def _refuse_inputs(p: Path, inputs: Iterable[Path], option: str) -> None:
+    for fp in inputs:
+        if (p.exists() and fp.exists() and _same(p, fp)) or _resolved(p) == _resolved(fp):
+            raise OutputError(
+                f"{option} {p} is one of the input files ({fp}); refusing to overwrite it, "
+                "even with --overwrite"
+            )
+
+
+def _put_in_place(tmp: str, target: Path, overwrite: bool) -> None:
+    """Rename ``tmp`` onto ``target``; without ``overwrite``, never replace a file.
+
+    A hard link creates ``target`` only if no file of that name exists (atomically); on
+    a file system without hard links, the existence check and the rename are separate.
+    """
+    if overwrite:
+        os.replace(tmp, target)
+        return
+    exists = OutputError(
+        f"cannot write {target}: a file of that name appeared while labbrdf worked; pass "
+        "--overwrite to replace it (it was left as it was)"
+    )
+    try:
+        os.link(tmp, target)
+    except FileExistsError:
+        raise exists from None
+    except OSError as exc:
+        if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV,
+                             errno.EMLINK, errno.ENOSYS, errno.EACCES):  # fmt: skip
+            raise
+        if os.path.lexists(target):
+            raise exists from None
+        os.replace(tmp, target)
+        return
+    os.unlink(tmp)
 
 
 def clean_leftovers(target: str | os.PathLike[str]) -> list[Path]:
@@ -326,7 +451,9 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
 
     On any exception the temporary file is removed and ``path`` is left as it was. The
     file gets ``0o666 & ~umask`` (a file it replaces: that file's mode). An OS error
-    (read-only folder, full disk, ...) becomes :class:`OutputError` naming the path.
+    while writing or renaming (read-only folder, full disk, ...) becomes
+    :class:`OutputError` naming ``path`` and the cause. Under a :func:`write_policy`,
+    ``path`` may not be an input, nor an existing file unless it allows overwriting.
     """
     target = Path(path)
     parent = target.parent if str(target.parent) else Path(".")
@@ -342,8 +469,16 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
     except OSError as exc:
         raise _wraps_oserror(target, "cannot write", exc) from None
     os.close(fd)
+    _OWN_TMPS[os.path.abspath(tmp)] = _OWN_TMPS.get(os.path.abspath(target), target)
     try:
-        yield tmp
+        try:
+            yield tmp
+        except OutputError:
+            raise
+        except OSError as exc:  # the writer's own error: say which output and why
+            raise _wraps_oserror(target, "cannot write", exc) from exc
+        policy = _current()
+        _refuse_inputs(target, policy.inputs, "cannot write")
         try:
             mode = stat.S_IMODE(os.stat(target).st_mode) if target.is_file() else None
         except OSError:
@@ -352,10 +487,13 @@ def atomic_output(path: str | os.PathLike[str]) -> Iterator[str]:
             os.chmod(tmp, mode if mode is not None else 0o666 & ~_umask())
             if target.is_dir():
                 raise OutputError(f"cannot write {target}: is an existing folder")
-            os.replace(tmp, target)
+            _put_in_place(tmp, target, policy.overwrite or os.path.abspath(target) in _OWN_TMPS)
+        except OutputError:
+            raise
         except OSError as exc:
             raise _wraps_oserror(target, "cannot write", exc) from None
     finally:
+        _OWN_TMPS.pop(os.path.abspath(tmp), None)
         if os.path.lexists(tmp):
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
@@ -420,8 +558,12 @@ def check_report_dir(
     *,
     inputs: Iterable[str | os.PathLike[str]] = (),
     option: str = "-o",
+    overwrite: bool | None = None,
 ) -> Path:
     """Validate a report folder before any work is done; return it resolved.
+
+    ``overwrite`` (default: the :func:`write_policy` in force, whose inputs are refused
+    too) allows an earlier report to be replaced.
 
     Raises
     ------
@@ -429,7 +571,8 @@ def check_report_dir(
         ``path`` is an existing file, equals or contains an input (or lies inside an
         input folder), is the current working folder, or is an existing folder that is
         neither empty nor a previous labbrdf report, or a previous report that holds a
-        file we did not write (named in the message).
+        file we did not write (named in the message), or a previous report and not
+        ``overwrite``.
     """
     if not os.fspath(path):
         raise OutputError(f"{option}: empty folder name")
@@ -440,7 +583,7 @@ def check_report_dir(
             "(a new name, an empty folder or an earlier report)"
         )
     out = _resolved(path)
-    for f in inputs:
+    for f in _policy_inputs(inputs):
         fp = _resolved(f)
         if _is_within(fp, out):
             raise OutputError(
@@ -479,6 +622,11 @@ def check_report_dir(
                     f"files labbrdf did not write ({names}); move them out or choose "
                     "another folder (nothing was changed)"
                 )
+            if not _overwrite(overwrite):
+                raise OutputError(
+                    f"{option} {shown}: is an earlier labbrdf report; pass --overwrite to "
+                    "replace it (nothing was changed)"
+                )
     if out.parent.exists() and not out.parent.is_dir():
         raise OutputError(f"{option} {shown}: {out.parent} is not a folder")
     _check_writable(out, option, shown)
@@ -512,7 +660,9 @@ def replace_dir(
 ) -> Path:
     """Build a report folder with ``write(tmp)`` and move it into place at ``out``.
 
-    ``out`` is checked with :func:`check_report_dir` before and again after building.
+    ``out`` is checked with :func:`check_report_dir` before and again after building
+    (so an earlier report is replaced only when the :func:`write_policy` allows it). An
+    OS error of ``write`` becomes :class:`OutputError` naming the report and the cause.
     The folder is built in a hidden temporary sibling (marked as ours from the start),
     then an existing ``out`` (an earlier report) is renamed aside, the new folder renamed
     in, and the old one deleted. If ``write`` raises, the temporary folder is removed and
@@ -537,7 +687,16 @@ def replace_dir(
             os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700; a report is shared
         except OSError as exc:
             raise _wraps_oserror(target, "cannot write the report folder", exc) from None
-        write(tmp)  # its own errors propagate unchanged
+        try:
+            write(tmp)
+        except OutputError:
+            raise
+        except OSError as exc:  # a full disk, ...: name the report and the file
+            inner = Path(exc.filename) if isinstance(exc.filename, str) else None
+            shown = target
+            if inner is not None and _is_within(_resolved(inner), _resolved(tmp)):
+                shown = target / _resolved(inner).relative_to(_resolved(tmp))
+            raise _wraps_oserror(shown, "cannot write the report", exc) from exc
         _write_marker(tmp, _listing(tmp), "complete")
         check_report_dir(out, inputs=inputs, option=option)  # changed while we worked?
     except BaseException:

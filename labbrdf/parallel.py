@@ -15,7 +15,11 @@ Schedulers
     A ``dask.distributed.LocalCluster`` with ``workers`` single-threaded worker processes.
 ``tcp://host:port`` (or ``tls://``)
     A running ``dask scheduler``; the workers are whatever ``dask worker tcp://host:port``
-    processes are attached to it (they need labbrdf installed).
+    processes are attached to it (they need labbrdf installed). A scheduler with no worker
+    is waited for at most ``worker_timeout`` seconds (:func:`configure`, ``labbrdf
+    --worker-timeout``, default :data:`DEFAULT_WORKER_TIMEOUT`), then the run fails with
+    :class:`ParallelError` naming the address: tasks sent to a scheduler without workers
+    would wait forever.
 
 Security
 --------
@@ -23,10 +27,15 @@ Whoever can connect to a dask scheduler can run any code on every worker. ``loca
 the scheduler, the workers, their nannies and every HTTP service to ``127.0.0.1`` and starts
 no dashboard unless asked (:func:`configure` ``dashboard=True``, ``labbrdf --dashboard`` or
 ``LABBRDF_DASK_DASHBOARD=1``; it then listens on ``127.0.0.1:8787`` or a free port).
-A ``tcp://`` address is neither authenticated nor encrypted: a remote one prints a warning.
-``tls://`` uses dask's mutual TLS: the CA, certificate and key come from
-:func:`configure` (``labbrdf --tls-ca/--tls-cert/--tls-key``) or from the dask config
-``distributed.comm.tls.*``; with certificates configured, ``local`` runs on TLS too.
+Loopback alone does not keep out the other users of a shared machine, so ``local`` always
+runs on mutual TLS: with the certificates configured below, or else with temporary
+credentials that dask makes in memory for this cluster
+(``distributed.security.Security.temporary()``, which needs the ``cryptography`` package):
+a self-signed CA and key that exist only in this process and its workers, so no other
+process can connect. A ``tcp://`` address is neither authenticated nor encrypted: a remote
+one prints a warning. ``tls://`` uses dask's mutual TLS: the CA, certificate and key come
+from :func:`configure` (``labbrdf --tls-ca/--tls-cert/--tls-key``) or from the dask config
+``distributed.comm.tls.*``.
 
 Results always come back in the order of the items, so a computation whose tasks carry
 their own seeds gives the same numbers whatever the scheduler and the worker count.
@@ -75,6 +84,7 @@ from typing import Any, TypeVar
 from .errors import LabbrdfError
 
 __all__ = [
+    "DEFAULT_WORKER_TIMEOUT",
     "SCHEDULERS",
     "ParallelError",
     "Progress",
@@ -91,9 +101,19 @@ R = TypeVar("R")
 #: the scheduler names besides ``tcp://`` / ``tls://`` addresses
 SCHEDULERS = ("serial", "processes", "local")
 
+#: how long a run waits for a worker on a ``tcp://`` / ``tls://`` scheduler that has none [s]
+DEFAULT_WORKER_TIMEOUT = 60.0
+
 _DASK_HINT = (
     "the dask schedulers need dask.distributed: install it with "
     "`pip install labbrdf[dask]` (or `pip install 'dask[distributed]'`)"
+)
+
+
+_CRYPTOGRAPHY_HINT = (
+    "the local dask cluster runs on TLS and needs the cryptography package to make its "
+    "temporary credentials: `pip install cryptography` (or `pip install labbrdf[dask]`), "
+    "or configure certificates (--tls-ca, --tls-cert, --tls-key)"
 )
 
 
@@ -122,7 +142,9 @@ def check_scheduler(scheduler: str) -> str:
         address.
     ImportError
         For a dask scheduler (``local``, an address) when dask.distributed is not
-        installed; the message says how to install it.
+        installed, or for ``local`` without certificates when the ``cryptography``
+        package (its temporary TLS credentials) is missing; the message says how to
+        install it.
     """
     if not isinstance(scheduler, str):
         raise ValueError(f"scheduler must be a string, got {type(scheduler).__name__}")
@@ -130,6 +152,11 @@ def check_scheduler(scheduler: str) -> str:
         return scheduler
     if scheduler == "local" or scheduler.startswith(("tcp://", "tls://")):
         _import_dask()
+        if scheduler == "local" and _tls_files() is None:
+            try:
+                import cryptography  # noqa: F401 - the temporary TLS credentials need it
+            except ImportError as exc:
+                raise ImportError(_CRYPTOGRAPHY_HINT) from exc
         return scheduler
     raise ValueError(
         f"unknown scheduler {scheduler!r}; use one of {list(SCHEDULERS)} "
@@ -138,7 +165,7 @@ def check_scheduler(scheduler: str) -> str:
 
 
 #: options of the dask schedulers, set by :func:`configure`
-_OPTIONS: dict[str, Any] = {"dashboard": None, "tls": None}
+_OPTIONS: dict[str, Any] = {"dashboard": None, "tls": None, "worker_timeout": None}
 
 _LOOPBACK = ("127.0.0.1", "localhost", "[::1]", "::1")
 
@@ -149,6 +176,7 @@ def configure(
     tls_ca: str | os.PathLike[str] | None = None,
     tls_cert: str | os.PathLike[str] | None = None,
     tls_key: str | os.PathLike[str] | None = None,
+    worker_timeout: float | None = None,
 ) -> None:
     """Set the dask options of this process (the CLI calls it from its flags).
 
@@ -160,14 +188,25 @@ def configure(
     tls_ca, tls_cert, tls_key : path-like, optional
         PEM files for mutual TLS: the CA that signed every cluster certificate, and this
         process's certificate and key (the key may be inside the certificate file). Used
-        for ``tls://`` addresses and, when given, for the ``local`` cluster as well.
+        for ``tls://`` addresses and, when given, for the ``local`` cluster as well
+        (otherwise ``local`` makes temporary credentials of its own).
+    worker_timeout : float, optional
+        How long to wait for a worker on a ``tcp://`` / ``tls://`` scheduler that has none
+        [s] (default :data:`DEFAULT_WORKER_TIMEOUT`).
 
     Raises
     ------
     ValueError
-        A certificate option without ``tls_ca`` and ``tls_cert``, or a file that does not
-        exist.
+        A certificate option without ``tls_ca`` and ``tls_cert``, a file that does not
+        exist, or a ``worker_timeout`` that is not a finite number > 0.
     """
+    if worker_timeout is not None:
+        t = float(worker_timeout)
+        if not (t > 0 and t < float("inf")):
+            raise ValueError(
+                f"--worker-timeout: expected a finite number of seconds > 0, got {t:g}"
+            )
+        _OPTIONS["worker_timeout"] = t
     if dashboard is not None:
         _OPTIONS["dashboard"] = bool(dashboard)
     if tls_ca is None and tls_cert is None and tls_key is None:
@@ -209,6 +248,25 @@ def _security() -> Any | None:
         tls_worker_key=key,
         require_encryption=True,
     )
+
+
+def _temporary_security() -> Any:
+    """Mutual-TLS credentials made in memory for one ``local`` cluster.
+
+    A self-signed certificate and key that only this process holds (dask passes them to
+    the workers it starts); nothing is written to disk.
+
+    Raises
+    ------
+    ImportError
+        The ``cryptography`` package is missing (the message says how to install it).
+    """
+    from distributed.security import Security
+
+    try:
+        return Security.temporary()
+    except ImportError as exc:
+        raise ImportError(_CRYPTOGRAPHY_HINT) from exc
 
 
 def _tls_files() -> tuple[str, str, str | None] | None:
@@ -331,12 +389,14 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
                 "tls:// with certificates, or a scheduler on a trusted network only."
             )
         try:
-            return Client(scheduler, set_as_default=False, **kw), True
+            client = Client(scheduler, set_as_default=False, **kw)
         except OSError as exc:  # refused, timed out, unknown host
             raise ParallelError(
                 f"cannot reach the dask scheduler {scheduler} ({exc}); start one with "
                 "`dask scheduler` and attach workers with `dask worker <address>`"
             ) from exc
+        _wait_for_a_worker(client, scheduler)
+        return client, True
     sec = _security()
     dash = _dashboard_wanted()
     key = (_workers(workers), int(retries), _tls_files(), dash)
@@ -345,6 +405,8 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
         if client is not None and _LOCAL.get("key") == key and client.status == "running":
             return client, False
     shutdown()
+    if sec is None:
+        sec = _temporary_security()
     import dask
 
     # dask's nannies start workers with MALLOC_TRIM_THRESHOLD_=65536, which makes glibc
@@ -357,10 +419,8 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
         del os.environ["MALLOC_TRIM_THRESHOLD_"]
     # everything on the loopback interface: the scheduler's HTTP server (which dask binds
     # to all interfaces when given ":0"), the workers and their nannies; no dashboard
-    # unless asked; TLS when certificates are configured
-    extra: dict[str, Any] = {}
-    if sec is not None:
-        extra = {"security": sec, "protocol": "tls://"}
+    # unless asked; always TLS (configured certificates or temporary ones)
+    extra: dict[str, Any] = {"security": sec, "protocol": "tls://"}
     with dask.config.set({"distributed.nanny.pre-spawn-environ": env}):
         cluster = LocalCluster(
             n_workers=key[0],
@@ -378,7 +438,7 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
             },
             **extra,
         )
-    client = Client(cluster, set_as_default=False, **({"security": sec} if sec else {}))
+    client = Client(cluster, set_as_default=False, security=sec)
     if dash:
         _warn(f"dask dashboard (no authentication, this machine only): {client.dashboard_link}")
     with _LOCAL_LOCK:
@@ -388,6 +448,26 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
             atexit.register(shutdown)
             _ATEXIT.append(True)
     return client, False
+
+
+def _wait_for_a_worker(client: Any, scheduler: str) -> None:
+    """Wait up to the configured worker timeout for one worker; else close and fail.
+
+    Raises
+    ------
+    ParallelError
+        No worker attached to ``scheduler`` within the timeout (the client is closed).
+    """
+    timeout = _OPTIONS["worker_timeout"] or DEFAULT_WORKER_TIMEOUT
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except TimeoutError:  # asyncio.TimeoutError is TimeoutError since Python 3.11
+        client.close()
+        raise ParallelError(
+            f"the dask scheduler {scheduler} has no worker: none attached within "
+            f"{timeout:g} s. Start workers with `dask worker {scheduler}` (they need labbrdf "
+            "installed), or wait longer with --worker-timeout SECONDS"
+        ) from None
 
 
 def imap(

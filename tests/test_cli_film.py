@@ -155,3 +155,19 @@ def test_film_without_a_substrate_table_covering_the_data_exits_2(tmp_path, caps
     assert main(["film", str(p), "--layer", "ox:sio2:0..10"]) == 2
     err = capsys.readouterr().err
     assert "covers 250-1450 nm but the data span 200-400 nm" in err
+
+
+def test_substrate_from_an_nk_file_and_a_bad_one(film_file, tmp_path, capsys):
+    good = tmp_path / "si_copy.csv"
+    lam = np.arange(250.0, 1451.0, 10.0)
+    n_si = Stack([], "si").nk(lam)["substrate"]
+    good.write_text("".join(f"{w},{n.real},{n.imag}\n" for w, n in zip(lam, n_si, strict=True)))
+    argv = ["film", str(film_file), "--layer", "film:cauchy:50..200:A=1.3..1.8:B=0.004"]
+    assert main([*argv, "--substrate", str(good), "--json", "--ci", "wald"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["layers"][0]["parameters"]["thickness_nm"]["value"] == pytest.approx(105, abs=0.5)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("250,3.0,0.1\n300,oops,0.1\n")
+    assert main([*argv, "--substrate", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "bad.csv, line 2: expected numbers" in err and "Traceback" not in err

@@ -115,7 +115,9 @@ def test_report_refuses_the_current_folder(tmp_path, capsys, monkeypatch):
     assert snapshot(tmp_path) == before
 
 
-def test_report_refuses_a_non_empty_folder_and_replaces_an_earlier_report(tmp_path, capsys):
+def test_report_refuses_a_non_empty_folder_and_replaces_an_earlier_report_on_request(
+    tmp_path, capsys
+):
     bad = tmp_path / "bad.xyz"  # unreadable: a failed check, but a quick report
     bad.write_text("x\n")
     out = tmp_path / "rep"
@@ -125,10 +127,14 @@ def test_report_refuses_a_non_empty_folder_and_replaces_an_earlier_report(tmp_pa
     assert (out / "mine.txt").read_text() == "mine"
     (out / "mine.txt").unlink()
     assert main(["report", str(bad), "-o", str(out)]) == 1
-    assert main(["report", str(bad), "-o", str(out)]) == 1  # an earlier report: replaced
+    first = snapshot(out)
+    expect_refused(capsys, ["report", str(bad), "-o", str(out)], "earlier", "--overwrite")
+    assert snapshot(out) == first
+    assert main(["report", str(bad), "-o", str(out), "--overwrite"]) == 1  # replaced
     assert (out / ".labbrdf-report").is_file()
     (out / "tables" / "extra.xlsx").write_text("mine")
-    expect_refused(capsys, ["report", str(bad), "-o", str(out)], "tables/extra.xlsx")
+    argv = ["report", str(bad), "-o", str(out), "--overwrite"]
+    expect_refused(capsys, argv, "tables/extra.xlsx")
     assert (out / "tables" / "extra.xlsx").read_text() == "mine"
 
 
@@ -302,3 +308,186 @@ def test_fit_lists_failed_groups_and_exits_3(tmp_path, capsys):
     assert groups[0]["group"] == {"sample": "S", "wavelength_nm": 500.0}
     assert "not fitted" in groups[0]["message"]
     assert "FAILED" in cap.err
+
+
+# ------------------------------------------------------------------ one rule, every writer
+
+ELLIPSOMETRY = SCAN.parents[1] / "ellipsometry" / "al_bare_wvase.dat"
+
+
+def _fake_height_map(path, channel):
+    from labbrdf.adapters.topography import HeightMap
+
+    rng = np.random.default_rng(3)
+    z = rng.normal(size=(64, 64))
+    z = (z + np.roll(z, 1, 0) + np.roll(z, 1, 1) + np.roll(z, 1, (0, 1))) * 1e-9
+    return HeightMap(heights=z, pixel_size=(1e-7, 1e-7), path=str(path), channel="height")
+
+
+def _fake_validate(out="reports/validation", **kw):
+    from labbrdf.report.builder import write_report
+
+    write_report(out, {"title": "v", "tables": {}, "checks": []}, "<html/>")
+    return 0
+
+
+@pytest.fixture
+def writers(tmp_path, monkeypatch):
+    """Each writer command: its argv without the output, its output option and suffix.
+
+    ``surface`` reads a synthetic height map (the readers are tested elsewhere) and
+    ``validate`` is a stand-in that goes through the real report writer.
+    """
+    import labbrdf.cli
+    import labbrdf.report
+
+    monkeypatch.setattr(labbrdf.cli, "_height_map", _fake_height_map)
+    monkeypatch.setattr(labbrdf.report, "validate", _fake_validate)
+    data = small_dataset(tmp_path / "in" / "scan.csv")
+    hm = tmp_path / "in" / "afm.di"
+    hm.write_bytes(b"height map")
+    bad = tmp_path / "in" / "bad.xyz"
+    bad.write_text("x\n")
+    return {
+        "ingest-parquet": (["ingest", str(data)], "-o", ".parquet"),
+        "ingest-csv": (["ingest", str(data)], "-o", ".csv"),
+        "fit": (["fit", str(data), "--model", "smooth3", "--scheduler", "serial"], "-o", ".csv"),
+        "nk": (["nk", str(ELLIPSOMETRY)], "-o", ".csv"),
+        "trace-o": (TRACE, "-o", ".npz"),
+        "trace-png": (TRACE, "--png", ".png"),
+        "surface": (["surface", str(hm), "--blocks", "0"], "--png", ".png"),
+        "export": (["export", "--model", "smooth3", "--theta-i", "30"], "-o", ".bsdf"),
+        "report": (["report", str(bad)], "-o", ""),
+        "validate": (["validate", "--scheduler", "serial"], "--out", ""),
+    }
+
+
+WRITERS = [
+    "ingest-parquet",
+    "ingest-csv",
+    "fit",
+    "nk",
+    "trace-o",
+    "trace-png",
+    "surface",
+    "export",
+    "report",
+    "validate",
+]
+
+
+def _existing_output(path: Path, suffix: str) -> None:
+    if suffix:
+        path.write_text("the user's file\n")
+    else:
+        from labbrdf.outputs import replace_dir
+
+        replace_dir(path, lambda d: (d / "index.html").write_text("an earlier report"))
+
+
+@pytest.mark.parametrize("writer", WRITERS)
+def test_every_writer_replaces_an_existing_output_only_with_overwrite(
+    writer, writers, tmp_path, capsys
+):
+    argv, option, suffix = writers[writer]
+    out = tmp_path / "out" / f"result{suffix}"
+    out.parent.mkdir()
+    _existing_output(out, suffix)
+    before = snapshot(tmp_path)
+    err = expect_refused(capsys, [*argv, option, str(out)], option, str(out), "--overwrite")
+    assert "exists" in err or "earlier labbrdf report" in err
+    assert snapshot(tmp_path) == before  # nothing written, not even a temporary file
+    assert main([*argv, option, str(out), "--overwrite"]) in (0, 1)
+    after = snapshot(tmp_path)
+    changed = {k for k in after if before.get(k) != after[k]} | (before.keys() - after.keys())
+    assert changed, "--overwrite wrote nothing"
+    assert all(k.startswith("out") for k in changed), changed  # only the output changed
+
+
+def test_ingest_csv_never_replaces_a_metadata_file_it_was_not_named(tmp_path, capsys):
+    data = small_dataset(tmp_path / "scan.parquet")
+    (tmp_path / "data.meta.json").write_text('{"mine": true}\n')
+    before = snapshot(tmp_path)
+    out = tmp_path / "data.csv"
+    expect_refused(capsys, ["ingest", str(data), "-o", str(out)], "data.meta.json", "--overwrite")
+    assert snapshot(tmp_path) == before
+    assert main(["ingest", str(data), "-o", str(out), "--overwrite"]) == 0
+    assert json.loads((tmp_path / "data.meta.json").read_text()) != {"mine": True}
+
+
+def test_ingest_csv_refuses_an_input_as_its_metadata_file(tmp_path, capsys):
+    data = small_dataset(tmp_path / "scan.csv")  # writes scan.meta.json, read back with it
+    meta = tmp_path / "scan.meta.json"
+    other = small_dataset(tmp_path / "other.parquet")
+    shutil.copy(meta, tmp_path / "x.meta.json")
+    before = snapshot(tmp_path)
+    argv = ["ingest", str(other), str(tmp_path / "x.meta.json"), "-o", str(tmp_path / "x.csv")]
+    expect_refused(capsys, [*argv, "--overwrite"], "x.meta.json", "input")
+    assert snapshot(tmp_path) == before
+    assert data.exists()
+
+
+def _full_disk_files(monkeypatch):
+    """Every temporary file labbrdf writes goes to /dev/full (ENOSPC on write)."""
+    import tempfile
+
+    real = tempfile.mkstemp
+
+    def mkstemp(*a, **kw):
+        fd, name = real(*a, **kw)
+        if ".labbrdf-tmp-" in os.path.basename(name):
+            os.unlink(name)
+            os.symlink("/dev/full", name)
+        return fd, name
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+
+
+def _full_disk_reports(monkeypatch):
+    """Every report folder labbrdf builds has its index.html on /dev/full."""
+    import tempfile
+
+    real = tempfile.mkdtemp
+
+    def mkdtemp(*a, **kw):
+        name = real(*a, **kw)
+        if ".labbrdf-new-" in os.path.basename(name):
+            os.symlink("/dev/full", os.path.join(name, "index.html"))
+        return name
+
+    monkeypatch.setattr(tempfile, "mkdtemp", mkdtemp)
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full (ENOSPC)")
+@pytest.mark.parametrize("writer", WRITERS)
+def test_a_full_disk_names_the_output_and_the_cause(
+    writer, writers, tmp_path, capsys, monkeypatch
+):
+    argv, option, suffix = writers[writer]
+    out = tmp_path / "out" / f"result{suffix}"
+    if suffix:
+        _full_disk_files(monkeypatch)
+    else:
+        _full_disk_reports(monkeypatch)
+    before = snapshot(tmp_path)
+    err = expect_refused(capsys, [*argv, option, str(out)], "No space left on device")
+    shown = out.with_name("result.meta.json") if writer == "ingest-csv" else out
+    assert f"{shown}:" in err or f"{shown}/index.html:" in err, err  # the path, then the cause
+    assert snapshot(tmp_path) == before
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == []  # no leftovers
+
+
+def test_two_outputs_of_one_command_may_not_be_the_same_file(tmp_path):
+    # today every command's outputs differ in suffix; the check is for a later command
+    import argparse
+
+    from labbrdf import cli
+
+    p = str(tmp_path / "x.png")
+    png = cli.OutputPath(["--png"], "png", suffixes=(".png",))
+    maps = cli.OutputPath(["--maps"], "maps", suffixes=(".png",))
+    args = argparse.Namespace(path_actions=(png, maps), png=p, maps=p)
+    with pytest.raises(cli.UsageError, match=r"--maps .*x.png: also given to --png"):
+        with cli._checked_outputs(args):
+            pass  # pragma: no cover
+    assert not os.path.exists(p)

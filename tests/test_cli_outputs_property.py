@@ -2,20 +2,29 @@
 touches anything outside its output path.
 
 For random choices of writer (ingest -o, fit -o, trace -o, trace --png, report -o,
-validate --out) and of output (an input, the folder of the inputs, a non-empty folder, an
+validate --out), of output (an input, the folder of the inputs, a non-empty folder, an
 earlier report, a new path, a new nested path, an existing file, the working folder, a
-name ending in '/'), run the real CLI in a fresh temporary tree and check: every input
-file keeps its bytes and mtime; no file outside the output path appears, disappears or
-changes; the exit code is one of 0-3 and never a traceback. The report builders are
-replaced by a fast stand-in that goes through the real writer (write_report), since the
-property is about where the writers write, not about the report's content.
+name ending in '/') and of --overwrite, run the real CLI in a fresh temporary tree and
+check: every input file keeps its bytes and mtime; no file outside the output path
+appears, disappears or changes; an existing output is replaced only with --overwrite; the
+exit code is one of 0-3 and never a traceback. The report builders are replaced by a fast
+stand-in that goes through the real writer (write_report), since the property is about
+where the writers write, not about the report's content.
+
+Then, enumerated from the parser itself (so that an option added later is covered without
+editing this file): for every command, every argument that names an input and every
+output option, the output naming that input (or a link to it, or for a report folder the
+folder holding it) is refused with exit 2, with and without --overwrite, and the input
+keeps its bytes.
 """
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import io
 import os
+import re
 import tempfile
 from pathlib import Path
 
@@ -25,7 +34,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import labbrdf.report
-from labbrdf.cli import main
+from labbrdf.cli import InputPath, OutputPath, build_parser, main, path_actions
 from labbrdf.dataset import Measurement, make_frame, write
 from labbrdf.outputs import replace_dir
 from labbrdf.report.builder import write_report
@@ -127,17 +136,21 @@ def _output(kind: str, writer: str, root: Path, d: dict[str, Path]) -> str:
     }[kind]
 
 
-def _argv(writer: str, out: str, inputs: list[str]) -> list[str]:
+def _argv(writer: str, out: str, inputs: list[str], overwrite: bool = False) -> list[str]:
     trace = ["trace", "--substrate", "1.5+7j", "--alpha", "0.3", "--theta-i", "30"]
     trace += ["--wavelength", "600", "--rays", "500", "--scheduler", "serial", "--json"]
-    return {
-        "ingest": ["ingest", *inputs, "-o", out, "--json"],
-        "fit": ["fit", *inputs, "--model", "smooth3", "--scheduler", "serial", "--json"],
-        "trace-o": [*trace, "-o", out],
-        "trace-png": [*trace, "--png", out],
-        "report": ["report", *inputs, "-o", out],
-        "validate": ["validate", "--out", out, "--scheduler", "serial"],
-    }[writer] + (["-o", out] if writer == "fit" else [])
+    return (
+        {
+            "ingest": ["ingest", *inputs, "-o", out, "--json"],
+            "fit": ["fit", *inputs, "--model", "smooth3", "--scheduler", "serial", "--json"],
+            "trace-o": [*trace, "-o", out],
+            "trace-png": [*trace, "--png", out],
+            "report": ["report", *inputs, "-o", out],
+            "validate": ["validate", "--out", out, "--scheduler", "serial"],
+        }[writer]
+        + (["-o", out] if writer == "fit" else [])
+        + (["--overwrite"] if overwrite else [])
+    )
 
 
 def _under(rel: str, out: Path, root: Path) -> bool:
@@ -162,9 +175,10 @@ def fast_reports(monkeypatch):
     writer=st.sampled_from(WRITERS),
     kind=st.sampled_from(OUTPUTS),
     n_inputs=st.integers(1, 2),
+    overwrite=st.booleans(),
 )
 def test_no_writer_touches_inputs_or_anything_outside_its_output(
-    fast_reports, writer, kind, n_inputs
+    fast_reports, writer, kind, n_inputs, overwrite
 ):
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp).resolve()
@@ -178,7 +192,7 @@ def test_no_writer_touches_inputs_or_anything_outside_its_output(
         os.chdir(cwd)
         try:
             with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-                code = main(_argv(writer, out, inputs))
+                code = main(_argv(writer, out, inputs, overwrite))
         finally:
             os.chdir(old)
         after = _snapshot(root)
@@ -192,12 +206,142 @@ def test_no_writer_touches_inputs_or_anything_outside_its_output(
         outside_after = {k: v for k, v in after.items() if not _under(k, target, root)}
         assert outside_after == outside_before, (writer, kind, code, err.getvalue())
         refused = {"input", "inputs_folder", "nonempty_dir", "cwd", "link_to_folder"}
-        if writer not in ("trace-o", "trace-png"):
-            refused.add("link_to_input")  # trace has no inputs: the link is just replaced
+        if writer not in ("trace-o", "trace-png") or not overwrite:
+            refused.add("link_to_input")  # trace has no inputs: with --overwrite, replaced
         if writer in SUFFIX:
             refused.add("trailing_slash")  # a folder name for a file output
+            if not overwrite:
+                refused.add("existing_file")
         else:
             refused.add("existing_file")  # a file where a report folder should go
+            if not overwrite:
+                refused.add("prev_report")
         if kind in refused:
             assert code == 2, (writer, kind, err.getvalue())
             assert after == before
+
+
+# --------------------------------------------------------------------------- every input option
+
+
+#: values for the required options that are neither inputs nor outputs, by destination;
+#: a command that gains a required option fails here until it is given a value
+FILLER = {"model": "smooth3", "theta_i": "30", "wavelength": "600"}
+
+
+def _subparsers() -> dict[str, argparse.ArgumentParser]:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return dict(sub.choices)
+
+
+def _input_output_pairs() -> list[tuple[str, str, str]]:
+    pairs = []
+    for name, sp in _subparsers().items():
+        acts = path_actions(sp)
+        for i in (a for a in acts if isinstance(a, InputPath)):
+            for o in (a for a in acts if isinstance(a, OutputPath)):
+                pairs.append((name, i.dest, o.dest))
+    return pairs
+
+
+PAIRS = _input_output_pairs()
+
+
+def test_the_parser_declares_every_input_option_of_every_writer():
+    # the options through which the tester destroyed inputs, and their neighbours
+    for pair in [
+        ("trace", "surface", "output"),
+        ("trace", "nk_from", "png"),
+        ("trace", "coating_surface", "output"),
+        ("trace", "tls_key", "png"),
+        ("fit", "nk_from", "output"),
+        ("export", "trace", "output"),
+        ("export", "nk_from", "output"),
+        ("ingest", "files", "output"),
+        ("surface", "file", "png"),
+        ("report", "files", "output"),
+        ("validate", "tls_ca", "out"),
+    ]:
+        assert pair in PAIRS
+
+
+PATHLIKE_METAVAR = re.compile(r"FILE|PEM|DATA|DIR|PATH|\.[A-Za-z0-9]+$")
+PATHLIKE_HELP = re.compile(r"^write |\bfile\b|\(\.[a-z0-9]+\)|height map|folder")
+PATHLIKE_DEST = re.compile(r"^(output|out|png|file|files|path)$|_(file|path|from|surface|dir)$")
+
+
+def test_no_option_that_names_a_file_is_left_undeclared():
+    """An argument that looks like a path must be an InputPath or an OutputPath."""
+    loose = []
+    for name, sp in _subparsers().items():
+        for a in sp._actions:
+            if isinstance(a, InputPath | OutputPath) or a.nargs == 0:
+                continue
+            if (
+                PATHLIKE_METAVAR.search(str(a.metavar or ""))
+                or PATHLIKE_HELP.search(a.help or "")
+                or PATHLIKE_DEST.search(a.dest)
+            ):
+                loose.append(f"{name} {a.option_strings or a.dest}")
+    assert loose == []
+
+
+def _argv_naming(
+    command: str, input_dest: str, input_path: str, output_dest: str, output: str, filler: str
+) -> list[str]:
+    sp = _subparsers()[command]
+    argv = [command]
+    for a in sp._actions:
+        if a.dest in ("help",):
+            continue
+        if a.dest == input_dest:
+            value = [input_path]
+        elif a.dest == output_dest:
+            value = [output]
+        elif not a.required:
+            continue
+        elif isinstance(a, InputPath):
+            value = [filler]
+        else:
+            assert a.dest in FILLER, f"{command}: give the required {a.dest} a value in FILLER"
+            value = [FILLER[a.dest]]
+        argv += [*a.option_strings[:1], *value]
+    return argv
+
+
+@pytest.mark.parametrize("overwrite", [False, True], ids=["plain", "overwrite"])
+@pytest.mark.parametrize("link", [False, True], ids=["same", "link"])
+@pytest.mark.parametrize(("command", "input_dest", "output_dest"), PAIRS, ids=str)
+def test_no_output_may_name_an_input_whichever_option_names_it(
+    tmp_path, capsys, command, input_dest, output_dest, link, overwrite
+):
+    sp = _subparsers()[command]
+    out_action = next(a for a in path_actions(sp) if a.dest == output_dest)
+    assert isinstance(out_action, OutputPath)
+    filler = tmp_path / "other.dat"
+    filler.write_bytes(b"another input")
+    if out_action.kind == "dir":
+        folder = tmp_path / "rep"
+        folder.mkdir()
+        src = folder / "input.dat"
+        out = tmp_path / "link" if link else folder
+        if link:
+            out.symlink_to(folder, target_is_directory=True)
+    else:
+        suffix = out_action.suffixes[0] if out_action.suffixes else ".dat"
+        src = tmp_path / f"input{suffix}"
+        out = tmp_path / f"link{suffix}" if link else src
+        if link:
+            out.symlink_to(src)
+    src.write_bytes(b"the user's only copy\x00" * 1000)
+    before = (src.read_bytes(), src.stat().st_mtime_ns)
+    argv = _argv_naming(command, input_dest, str(src), output_dest, str(out), str(filler))
+    if overwrite:
+        argv.append("--overwrite")
+    assert main(argv) == 2, argv
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert "input" in err and str(out) in err, err
+    assert (src.read_bytes(), src.stat().st_mtime_ns) == before
+    assert sorted(p.name for p in src.parent.iterdir() if p.name.startswith(".")) == []

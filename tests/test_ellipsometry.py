@@ -33,9 +33,16 @@ def _rho_of_w(w: np.ndarray, theta_deg: np.ndarray) -> np.ndarray:
 
 
 def _independent_nk(psi_deg, delta_deg, theta_deg) -> tuple[np.ndarray, np.ndarray]:
-    """Solve rho(w) = tan(psi) exp(-i Delta) for w (grid start, secant), then N."""
+    """Solve rho(w) = tan(psi) exp(-i Delta) for w (grid start, secant), then N.
+
+    A bare substrate has ``|r_p| <= |r_s|`` (psi <= 45 deg). A film can give psi > 45 deg;
+    no passive substrate has that rho, and the two-phase pseudo-index is defined by the
+    closed form, which depends on rho through ((1 - rho)/(1 + rho))^2 only, so it is the
+    same for rho and 1/rho. There the solver is given 1/rho, which a substrate does have.
+    """
     psi, delta, theta = (np.asarray(a, dtype=float) for a in (psi_deg, delta_deg, theta_deg))
     target = np.tan(np.radians(psi)) * np.exp(-1j * np.radians(delta))
+    target = np.where(np.abs(target) > 1.0, 1.0 / target, target)
     radius, phase = np.meshgrid(np.geomspace(0.01, 50.0, 160), np.linspace(0, 2 * np.pi, 120))
     grid = (radius * np.exp(1j * phase)).ravel()  # polar grid: |w| from 0.01 to 50
     start = np.empty(psi.shape, dtype=complex)

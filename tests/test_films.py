@@ -155,3 +155,13 @@ def test_model_file_with_a_table_file_substrate_relative_to_the_model(tmp_path):
 def test_missing_model_file_is_a_film_error(tmp_path):
     with pytest.raises(FilmError, match="cannot read the model file"):
         load_model(tmp_path / "absent.toml")
+
+
+def test_the_fit_module_and_the_objects_module_import_in_either_order():
+    import subprocess
+    import sys
+
+    for first in ("labbrdf.fitting.film", "labbrdf.films"):
+        code = f"import {first}\nfrom labbrdf.films import FilmFit, fit_film\nprint('ok')"
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+        assert done.stdout.strip() == "ok", done.stderr

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import errno
 import io
 import json
 import os
@@ -27,6 +28,7 @@ from labbrdf.outputs import (
     clean_leftovers,
     csv_safe_cell,
     replace_dir,
+    write_policy,
 )
 from labbrdf.report import builder
 
@@ -201,6 +203,137 @@ def test_os_error_at_rename_is_an_output_error_naming_the_path(tmp_path, monkeyp
         with atomic_output(tmp_path / "a.csv") as tmp:
             Path(tmp).write_text("x")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_os_error_while_writing_names_the_output_and_the_cause(tmp_path):
+    with pytest.raises(OutputError, match=r"cannot write .*a\.csv: No space left on device"):
+        with atomic_output(tmp_path / "a.csv"):
+            raise OSError(errno.ENOSPC, None)  # no strerror, as some libraries raise it
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_write_error_in_a_report_names_the_report_file(tmp_path):
+    def write(d: Path) -> None:
+        (d / "tables").mkdir()
+        name = str(d / "tables" / "fits.csv")
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), name)
+
+    out = tmp_path / "rep"
+    with pytest.raises(OutputError, match=r"rep/tables/fits\.csv: No space left on device"):
+        replace_dir(out, write)
+    assert list(tmp_path.iterdir()) == []
+
+
+# --------------------------------------------------------------------------- the write policy
+
+
+def test_the_library_replaces_an_existing_file_outside_a_write_policy(tmp_path):
+    p = tmp_path / "a.csv"
+    p.write_text("old")
+    assert check_file_output(p) == p
+    with atomic_output(p) as tmp:
+        Path(tmp).write_text("new")
+    assert p.read_text() == "new"
+
+
+def test_write_policy_refuses_an_existing_file_before_any_work(tmp_path):
+    p = tmp_path / "a.csv"
+    p.write_text("old")
+    with write_policy(overwrite=False):
+        with pytest.raises(OutputError, match=r"-o .*a\.csv: exists; pass --overwrite"):
+            check_file_output(p)
+        assert check_file_output(tmp_path / "b.csv") == tmp_path / "b.csv"
+        assert check_file_output(p, overwrite=True) == p  # an explicit argument wins
+    with write_policy(overwrite=True):
+        assert check_file_output(p) == p
+    assert p.read_text() == "old"
+
+
+def test_write_policy_refuses_a_file_that_appears_while_writing(tmp_path):
+    p = tmp_path / "a.csv"
+    with write_policy(overwrite=False):
+        with pytest.raises(OutputError, match=r"a\.csv: a file of that name appeared"):
+            with atomic_output(p) as tmp:
+                Path(tmp).write_text("ours")
+                p.write_text("theirs")  # e.g. another program, during a long run
+    assert p.read_text() == "theirs"
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["a.csv"]
+
+
+def test_write_policy_refuses_its_inputs_even_when_overwriting(tmp_path):
+    src = tmp_path / "scan.csv"
+    src.write_text("the only copy")
+    link = tmp_path / "link.csv"
+    link.symlink_to(src)
+    with write_policy(overwrite=True, inputs=[src]):
+        for out in (src, link):
+            with pytest.raises(OutputError, match="one of the input files"):
+                check_file_output(out)
+            with pytest.raises(OutputError, match="one of the input files"):
+                with atomic_output(out) as tmp:  # a writer that skipped the check
+                    Path(tmp).write_text("x")
+        with pytest.raises(OutputError, match="contains the input"):
+            check_report_dir(tmp_path)
+    assert src.read_text() == "the only copy" and link.is_symlink()
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["link.csv", "scan.csv"]
+
+
+@pytest.mark.parametrize("code", [errno.EPERM, errno.EXDEV])
+def test_without_hard_links_an_existing_file_is_still_refused(tmp_path, monkeypatch, code):
+    def no_link(*a, **k):
+        raise OSError(code, os.strerror(code))
+
+    monkeypatch.setattr(outputs.os, "link", no_link)
+    with write_policy(overwrite=False):
+        with atomic_output(tmp_path / "new.csv") as tmp:
+            Path(tmp).write_text("new")
+        with pytest.raises(OutputError, match="appeared"):
+            with atomic_output(tmp_path / "new.csv") as tmp:
+                Path(tmp).write_text("again")
+    assert (tmp_path / "new.csv").read_text() == "new"
+    assert [x.name for x in tmp_path.iterdir()] == ["new.csv"]
+
+
+def test_an_os_error_of_the_hard_link_names_the_output(tmp_path, monkeypatch):
+    def broken(*a, **k):
+        raise OSError(errno.EIO, os.strerror(errno.EIO))
+
+    monkeypatch.setattr(outputs.os, "link", broken)
+    with write_policy(overwrite=False):
+        with pytest.raises(OutputError, match=r"cannot write .*new\.csv: Input/output error"):
+            with atomic_output(tmp_path / "new.csv") as tmp:
+                Path(tmp).write_text("new")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_writer_given_a_temporary_name_writes_under_a_no_overwrite_policy(tmp_path):
+    p = tmp_path / "m.png"
+    with write_policy(overwrite=False):
+        with atomic_output(p) as outer:
+            with atomic_output(outer) as inner:  # a writer that is itself atomic
+                Path(inner).write_bytes(b"png")
+        assert p.read_bytes() == b"png"
+        with pytest.raises(OutputError, match=r"cannot write .*/m2\.png: No space left"):
+            with atomic_output(tmp_path / "m2.png") as outer:
+                with atomic_output(outer):
+                    raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    assert [x.name for x in tmp_path.iterdir()] == ["m.png"]
+
+
+def test_write_policy_replaces_an_earlier_report_only_when_overwriting(tmp_path):
+    out = tmp_path / "rep"
+    replace_dir(out, _report)
+    first = (out / "index.html").read_text()
+    with write_policy(overwrite=False):
+        with pytest.raises(OutputError, match="earlier labbrdf report; pass --overwrite"):
+            replace_dir(out, lambda d: (d / "index.html").write_text("new"))
+        assert (out / "index.html").read_text() == first
+        empty = tmp_path / "empty"
+        empty.mkdir()
+        replace_dir(empty, _report)  # an empty folder holds nothing to lose
+    with write_policy(overwrite=True):
+        replace_dir(out, lambda d: (d / "index.html").write_text("new"))
+    assert (out / "index.html").read_text() == "new"
 
 
 # --------------------------------------------------------------------------- leftovers

@@ -78,3 +78,23 @@ def test_importlib_resources_finds_the_fixtures_of_the_installed_wheel(
     where, counts = done.stdout.splitlines()
     assert Path(where).is_relative_to(site)
     assert counts == "7 True"
+
+
+@pytest.mark.slow
+def test_the_installed_wheel_ships_the_reference_nk_tables(wheel: Path, tmp_path: Path) -> None:
+    names = set(zipfile.ZipFile(wheel).namelist())
+    for f in ("README.md", "si_green2008.csv", "sio2_malitson1965.csv"):
+        assert f"labbrdf/data/nk/{f}" in names
+    site = tmp_path / "site"
+    zipfile.ZipFile(wheel).extractall(site)
+    code = (
+        "from labbrdf.dispersion import Tabulated\n"
+        "print(Tabulated.reference('si').nk(630.0), Tabulated.reference('sio2').range_nm)\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(site)
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, env=env
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["(3.879+0.016444j)", "(210.0,", "2500.0)"]

@@ -12,6 +12,7 @@ serial numbers, and exhausted retries a :class:`ParallelError` with nothing retu
 
 from __future__ import annotations
 
+import asyncio
 import builtins
 import functools
 import importlib
@@ -758,7 +759,7 @@ def test_local_cluster_listens_on_loopback_only_and_has_no_dashboard():
     for pid, ip, port in info["listen"]:
         assert ip == "127.0.0.1", f"pid {pid} listens on {ip}:{port}"
     for a in info["addresses"]:
-        assert a.startswith("tcp://127.0.0.1:"), a
+        assert a.startswith("tls://127.0.0.1:"), a  # TLS even without certificates
     # dask always runs the scheduler's HTTP server (/health, /metrics; listed as
     # "dashboard"): checked above to be on 127.0.0.1 like every other socket
 
@@ -911,3 +912,138 @@ def test_tcp_to_another_host_warns_that_it_is_unauthenticated(monkeypatch, capsy
     with pytest.raises(parallel.ParallelError):
         parallel.run(abs, [1], scheduler="tcp://127.0.0.1:8786")
     assert "unauthenticated" not in capsys.readouterr().err  # this machine: no warning
+
+
+# --------------------------------------------------------------------------- local on TLS
+#
+# ``local`` runs on mutual TLS with credentials made in memory for the cluster
+# (Security.temporary): another user of the machine who finds the port can connect
+# neither without credentials, nor over plain TCP, nor with credentials of their own.
+
+
+def _identity(addr: str, connection_args: dict[str, Any]) -> dict[str, Any]:
+    """Connect to a dask scheduler as a client would and ask who it is."""
+    from distributed.comm import connect
+
+    async def ask() -> dict[str, Any]:
+        comm = await connect(addr, timeout="10s", **connection_args)
+        try:
+            await comm.write({"op": "identity"})
+            return await comm.read()
+        finally:
+            await comm.close()
+
+    return asyncio.run(ask())
+
+
+@pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
+def test_local_cluster_is_tls_and_refuses_clients_without_its_credentials():
+    import ssl
+
+    from distributed.comm.core import CommClosedError
+    from distributed.security import Security
+
+    assert parallel.run(abs, [-1, 2], scheduler="local", workers=1) == [1, 2]
+    cluster = parallel._LOCAL["cluster"]
+    addr = cluster.scheduler_address
+    assert addr.startswith("tls://127.0.0.1:"), addr
+    info = parallel._LOCAL["client"].scheduler_info()
+    assert info["workers"] and all(w.startswith("tls://127.0.0.1:") for w in info["workers"])
+    own = cluster.security
+    # the cluster's own credentials are answered (so the refusals below are about them)
+    assert _identity(addr, own.get_connection_args("client"))["type"] == "Scheduler"
+    # TLS that trusts the cluster's CA but shows no client certificate: refused
+    ctx = ssl.create_default_context(cadata=own.tls_ca_file)
+    ctx.check_hostname = False
+    with pytest.raises(CommClosedError):
+        _identity(addr, {"ssl_context": ctx, "require_encryption": True})
+    # credentials of one's own (another user's temporary ones): refused
+    with pytest.raises(CommClosedError):
+        _identity(addr, Security.temporary().get_connection_args("client"))
+    # plain TCP to the TLS port: refused
+    with pytest.raises(CommClosedError):
+        _identity(addr.replace("tls://", "tcp://"), {})
+
+
+@pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
+def test_local_cluster_without_cryptography_says_how_to_install_it(monkeypatch):
+    from distributed.security import Security
+
+    def no_cryptography(cls: Any, **kw: Any) -> Any:
+        raise ImportError("Using `Security.temporary` requires `cryptography`")
+
+    parallel.shutdown()
+    monkeypatch.setattr(Security, "temporary", classmethod(no_cryptography))
+    with pytest.raises(ImportError, match=r"cryptography.*pip install cryptography"):
+        parallel.run(abs, [1], scheduler="local", workers=1)
+    assert "client" not in parallel._LOCAL
+    # checked up front too (the CLI and validate call check_scheduler before any work)
+    monkeypatch.setitem(sys.modules, "cryptography", None)
+    with pytest.raises(ImportError, match=r"pip install cryptography"):
+        parallel.check_scheduler("local")
+    assert parallel.check_scheduler("serial") == "serial"
+
+
+# --------------------------------------------------------------------------- no workers
+
+
+@pytest.fixture
+def workerless_scheduler() -> Any:
+    """A dask scheduler on 127.0.0.1 (in this process) with no worker attached."""
+    pytest.importorskip("dask.distributed")
+    from distributed import LocalCluster
+
+    with LocalCluster(
+        n_workers=0,
+        processes=False,
+        host="127.0.0.1",
+        protocol="tcp://",
+        dashboard_address=None,
+        scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
+    ) as cluster:
+        yield cluster.scheduler_address
+
+
+@pytest.mark.usefixtures("reset_parallel_options")
+def test_scheduler_without_workers_fails_after_the_timeout_naming_the_address(
+    workerless_scheduler,
+):
+    addr = workerless_scheduler
+    parallel.configure(worker_timeout=1.0)
+    t0 = time.perf_counter()
+    with pytest.raises(ParallelError) as exc:
+        parallel.run(abs, [1, 2], scheduler=addr)
+    assert time.perf_counter() - t0 < 30
+    msg = str(exc.value)
+    assert addr in msg and "no worker" in msg and "within 1 s" in msg
+    assert f"dask worker {addr}" in msg and "--worker-timeout" in msg
+
+
+@pytest.mark.usefixtures("reset_parallel_options")
+def test_cli_scheduler_without_workers_exits_2_with_the_address(
+    workerless_scheduler, frame, tmp_path, capsys
+):
+    addr = workerless_scheduler
+    data = _write_dataset(frame, tmp_path)
+    out = tmp_path / "t.csv"
+    argv = ["fit", data, "--model", "smooth3", "-o", str(out), "--scheduler", addr]
+    assert main([*argv, "--worker-timeout", "1"]) == 2
+    err = capsys.readouterr().err
+    assert f"labbrdf fit: the dask scheduler {addr} has no worker" in err
+    assert "Traceback" not in err and not out.exists()
+
+
+def test_default_worker_timeout_is_a_minute():
+    assert parallel.DEFAULT_WORKER_TIMEOUT == 60.0
+    assert parallel._OPTIONS.get("worker_timeout") is None  # the default applies
+
+
+@pytest.mark.parametrize("bad", ["0", "-1", "nan", "inf"])
+@pytest.mark.usefixtures("reset_parallel_options")
+def test_bad_worker_timeout_is_refused(bad, capsys):
+    scan = ROOT / "labbrdf" / "data" / "fixtures" / "specular" / "osr_specular.csv"
+    argv = ["fit", str(scan), "--model", "smooth3", "--scheduler", "serial"]
+    assert main([*argv, "--worker-timeout", bad]) == 2
+    assert "--worker-timeout: expected a finite number of seconds > 0" in capsys.readouterr().err
+    with pytest.raises(ValueError, match="worker-timeout"):
+        parallel.configure(worker_timeout=float(bad))

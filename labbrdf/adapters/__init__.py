@@ -17,7 +17,8 @@ other under ``except``: a parse error is reported as is.
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable
+import re
+from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -25,18 +26,24 @@ from ..dataset import Measurement, concat
 from . import (
     accurion,
     cary,
+    columns,
     filmsense,
     jasco,
     jcamp,
     labbrdf_csv,
     native,
+    oceanoptics,
     perkinelmer,
+    refused,
     sentech,
+    shimadzu,
     spc,
     woollam,
     zemax_bsdf,
 )
 from ._base import AdapterError, Format, check_regular_file
+from ._ole2 import is_ole2
+from .columns import read_columns as _read_columns
 
 __all__ = ["AdapterError", "Format", "READERS", "formats", "read", "read_many", "sniff"]
 
@@ -52,9 +59,13 @@ _VENDOR_MODULES = (
     cary,
     jcamp,
     spc,
+    shimadzu,
+    oceanoptics,
     labbrdf_csv,
     native,
     zemax_bsdf,
+    refused,
+    columns,
 )
 
 
@@ -70,8 +81,15 @@ def _registry() -> dict[str, Format]:
 
 #: name -> Format
 READERS: dict[str, Format] = _registry()
+#: formats whose files are OLE2 compound documents (the container decides among an
+#: extension's formats when no sniffer claims the file)
+_OLE2_FORMATS = ("shimadzu-uvprobe-spc", "jasco-jws")
 
 _SNIFF_BYTES = 8192
+#: how to force a format, in the words of both interfaces
+_FORCE = "pass --format NAME on the command line or format=NAME in Python"
+#: a head of only numbers, separators and line breaks (a headerless column file)
+_NUMBERS_ONLY = re.compile(rb"\A(?:[ \t]*[-+0-9.,;eE \t]+[ \t]*\r?\n){2,}")
 
 
 def formats() -> list[dict[str, Any]]:
@@ -117,27 +135,63 @@ def _no_match_message(path: Path, by_ext: list[str], head: bytes) -> str:
         parts.append(f"formats of the extension {path.suffix.lower()!r}: {by_ext}")
     if near:
         parts.append(f"formats whose keywords occur in the header: {near}")
+    hint = ""
+    if is_ole2(head):
+        hint = (
+            "; it is an OLE2 compound document (Microsoft structured storage, magic "
+            "D0 CF 11 E0 A1 B1 1A E1), the container of Shimadzu UVProbe .spc "
+            "('shimadzu-uvprobe-spc'), legacy JASCO .jws ('jasco-jws') and Office files"
+        )
+    elif _NUMBERS_ONLY.match(head):
+        hint = (
+            "; its first lines are bare numbers: declare the columns with --columns on the "
+            "command line or columns= in Python (format 'columns'), e.g. "
+            "--columns wavelength_nm,absorbance"
+        )
     if not parts:
         return (
             "no adapter recognises this file: neither its extension nor its first lines "
-            "belong to a supported format; labbrdf.adapters.formats() lists them"
+            "belong to a supported format; `labbrdf formats` (labbrdf.adapters.formats() in "
+            "Python) lists them" + hint
         )
     return (
         "no adapter recognises this file (no header sniffer claims it); closest candidates: "
         + "; ".join(parts)
-        + "; pass format= to read it with one of them and see what does not match"
+        + f"; {_FORCE} to read it with one of them and see what does not match"
+        + hint
     )
 
 
 def _read_with(name: str, path: Path) -> Measurement:
-    m = READERS[name].read(path)
+    try:
+        m = READERS[name].read(path)
+    except MemoryError:
+        # a file whose content asks for more memory than there is: name the file, and free
+        # what the reader held before anything else allocates
+        raise AdapterError(
+            path,
+            f"ran out of memory reading it as {name!r} (file of "
+            f"{_size(path)} bytes): corrupt counts or an absurd header?",
+        ) from None
     if not isinstance(m, Measurement):  # a reader bug, not a user error
         raise TypeError(f"adapter {name!r} returned {type(m).__name__}, not a Measurement")
     m.meta.setdefault("format", name)
     return m
 
 
-def read(path: str | os.PathLike[str], format: str | None = None) -> Measurement:
+def _size(path: Path) -> int | str:
+    try:
+        return path.stat().st_size
+    except OSError:
+        return "unknown"
+
+
+def read(
+    path: str | os.PathLike[str],
+    format: str | None = None,
+    *,
+    columns: str | Sequence[str] | None = None,
+) -> Measurement:
     """Read one instrument export into a validated :class:`~labbrdf.dataset.Measurement`.
 
     Parameters
@@ -147,6 +201,9 @@ def read(path: str | os.PathLike[str], format: str | None = None) -> Measurement
     format : str, optional
         A registry name (see :func:`formats`); by default chosen from the extension and
         the header.
+    columns : str or sequence of str, optional
+        The declared columns of a headerless numeric file (format ``"columns"``, implied),
+        e.g. ``"wavelength_nm,absorbance"``; see :mod:`labbrdf.adapters.columns`.
 
     Raises
     ------
@@ -158,8 +215,22 @@ def read(path: str | os.PathLike[str], format: str | None = None) -> Measurement
         raise AdapterError(
             path, f"unknown format {format!r}; supported formats are {sorted(READERS)}"
         )
+    if columns is not None and format not in (None, "columns"):
+        raise AdapterError(
+            path,
+            f"--columns / columns= declare the columns of format 'columns', not of {format!r}",
+        )
     # before any reader opens it: /dev/zero never ends, a FIFO blocks open()
     check_regular_file(p)
+    if columns is not None:
+        try:
+            m = _read_columns(p, columns)
+        except MemoryError:
+            raise AdapterError(
+                path, f"ran out of memory reading it as 'columns' (file of {_size(p)} bytes)"
+            ) from None
+        m.meta.setdefault("format", "columns")
+        return m
     if format is not None:
         return _read_with(format, p)
     by_ext = _by_extension(p)
@@ -170,12 +241,19 @@ def read(path: str | os.PathLike[str], format: str | None = None) -> Measurement
     if len(pool) == 1:
         return _read_with(pool[0], p)
     if pool:
-        raise AdapterError(path, f"several adapters claim this file: {pool}; pass format=")
+        raise AdapterError(path, f"several adapters claim this file: {pool}; {_FORCE}")
+    if is_ole2(head):  # an OLE2 container goes to the extension's OLE2 format, if any
+        by_ext = [n for n in by_ext if n in _OLE2_FORMATS] or by_ext
     if len(by_ext) == 1:  # its reader says what is wrong, and where
         return _read_with(by_ext[0], p)
     raise AdapterError(path, _no_match_message(p, by_ext, head))
 
 
-def read_many(paths: Iterable[str | os.PathLike[str]], format: str | None = None) -> Measurement:
+def read_many(
+    paths: Iterable[str | os.PathLike[str]],
+    format: str | None = None,
+    *,
+    columns: str | Sequence[str] | None = None,
+) -> Measurement:
     """Read several files and concatenate them (each row keeps its ``source``)."""
-    return concat(read(p, format) for p in paths)
+    return concat(read(p, format, columns=columns) for p in paths)

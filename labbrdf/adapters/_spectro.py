@@ -4,7 +4,7 @@ One spectrum is an ordinate ``y`` against a wavelength axis ``x`` [nm] in the fi
 (percent, absorbance). :func:`spectrum_frame` converts it to the canonical schema (percent to
 fraction), drops missing points and counts them, and :func:`finish` wraps the frames in a
 validated :class:`~labbrdf.dataset.Measurement`, turning a schema violation into an
-:class:`~labbrdf.adapters.AdapterError` that names the file.
+:class:`~labbrdf.AdapterError` that names the file.
 """
 
 from __future__ import annotations

@@ -11,7 +11,7 @@ Text export (``jasco-spectramanager-text``)
     the keys we know are also given in English in ``meta["footer_en"]``. ``NPOINTS`` must
     match the data rows and every X must lie on ``FIRSTX + i * DELTAX``.
 
-Binary ``.jws``/``.jrs`` (``jasco-jws``), Spectra Manager 2 ("``L~S ``" magic)
+Binary ``.jws``/``.jrs`` (``jasco-jws``), Spectra Manager 2 (magic bytes ``"L~S "``)
     Little-endian fixed offsets (docs/formats.md section 7, confirmed on three V-730 files):
     NPOINTS int32 at 0x84; FIRSTX, LASTX, DELTAX float64 at 0x88/0x90/0x98; x-unit code
     (byte) at 0xA0 (3 = nm); y-mode code (byte) at 0xA4 (0 = %T, 2 = %R, 3 = Abs, 8-10 =
@@ -20,8 +20,20 @@ Binary ``.jws``/``.jrs`` (``jasco-jws``), Spectra Manager 2 ("``L~S ``" magic)
     0x484; float32 ordinates from 0x740 to the end of the file. The file size must be exactly
     0x740 + 4 * NPOINTS and the block length 4 * NPOINTS, otherwise the file is truncated or
     not understood and AdapterError gives the byte offset. Legacy Spectra Manager 1.x files
-    (OLE2 compound documents, magic ``D0 CF 11 E0``) are recognised and refused with a clear
-    message.
+    (OLE2 compound documents, magic ``D0 CF 11 E0``) are read as below.
+
+Legacy ``.jws`` (Spectra Manager 1.x, the same format name ``jasco-jws``)
+    An OLE2 compound document (``labbrdf.adapters._ole2``). Stream ``DataInfo`` (96 bytes,
+    little-endian, the layout used by the public jwsProcessor/pyjws readers): six uint32
+    (the fourth is the number of channels, the sixth NPOINTS), FIRSTX, LASTX, DELTAX as
+    float64 at 24/32/40, then one uint32 data-type code per axis from byte 48: the X code
+    then one code per channel. X codes: ``0x10000103`` wavelength [nm], ``0x10000100``
+    wavenumber [1/cm] (FTIR; converted by lambda [nm] = 1e7 / nu). Channel codes: 0 = %T,
+    2 = %R, 3 = absorbance (as the version-2 y-mode byte). Stream ``Y-Data``: NPOINTS
+    float32 per channel (channel after channel); only the first channel is read, and its
+    code must be one of these. The stream size must be a multiple of 4 * NPOINTS that holds
+    the channels, FIRSTX + (NPOINTS - 1) * DELTAX must equal LASTX (to 1e-6 relative), and
+    the invalid-point marker -FLT_MIN is dropped as below. The sample is the file stem.
 
 Quantities: ``ABSORBANCE``/Abs -> ``absorbance``; ``%T``/``TRANSMITTANCE`` (JASCO writes
 percent) -> ``transmittance``; ``%R``/``REFLECTANCE`` -> ``reflectance``, or
@@ -50,6 +62,7 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import AdapterError, Format, check_count, decode, read_bytes, split_lines
+from ._ole2 import ole_names, open_ole2, read_stream
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_jasco_jws", "read_jasco_text"]
@@ -297,7 +310,7 @@ def _read_footer(
 
 
 def _sniff_jws(head: bytes) -> bool:
-    return head[:4] == _JWS_MAGIC
+    return head[:4] == _JWS_MAGIC or ole_names(head, "DataInfo", "Y-Data")
 
 
 def _cstr(raw: bytes, offset: int, width: int) -> str:
@@ -335,11 +348,7 @@ def read_jasco_jws(path: str | os.PathLike[str]) -> Measurement:
         return AdapterError(path, message, offset, unit="byte")
 
     if raw[:8] == _OLE_MAGIC:
-        raise fail(
-            "legacy Spectra Manager 1.x .jws (OLE2 compound document) is not supported; "
-            "export the spectrum as text from Spectra Manager or re-save it with version 2",
-            0,
-        )
+        return _read_legacy(path)
     if raw[:4] != _JWS_MAGIC:
         raise fail(f"expected the JASCO magic 'L~S ', found {raw[:4]!r}", 0)
     if len(raw) < _JWS_DATA_OFFSET:
@@ -435,6 +444,104 @@ def read_jasco_jws(path: str | os.PathLike[str]) -> Measurement:
     return finish(path, [frame], meta)
 
 
+#: legacy DataInfo X codes -> (name, function to wavelength [nm])
+_LEGACY_X: dict[int, tuple[str, Any]] = {
+    0x10000103: ("nm", lambda v: v),
+    0x10000100: ("1/cm", lambda v: 1.0e7 / v),
+}
+_LEGACY_WHAT = "JASCO Spectra Manager 1.x .jws"
+
+
+def _read_legacy(path: str | os.PathLike[str]) -> Measurement:
+    """Read a legacy (Spectra Manager 1.x, OLE2) ``.jws``; see the module docstring."""
+    with open_ole2(path, _LEGACY_WHAT) as ole:
+        info = read_stream(ole, path, "DataInfo", _LEGACY_WHAT)
+        if len(info) < 56:
+            raise AdapterError(
+                path, f"{_LEGACY_WHAT}: stream 'DataInfo' is {len(info)} bytes, expected >= 56"
+            )
+        head = struct.unpack_from("<6I3d", info, 0)
+        channels, npoints = head[3], head[5]
+        firstx, lastx, deltax = head[6:9]
+        if not 1 <= channels <= 16:
+            raise AdapterError(
+                path, f"{_LEGACY_WHAT}: DataInfo says {channels} channels, expected 1 to 16"
+            )
+        if len(info) < 48 + 4 * (channels + 1):
+            raise AdapterError(
+                path, f"{_LEGACY_WHAT}: stream 'DataInfo' ends before the channel codes"
+            )
+        codes = struct.unpack_from(f"<{channels + 1}I", info, 48)
+        if npoints <= 0:
+            raise AdapterError(path, f"{_LEGACY_WHAT}: NPOINTS {npoints}: expected > 0")
+        check_count(path, "NPOINTS (DataInfo)", npoints)
+        ydata = read_stream(ole, path, "Y-Data", _LEGACY_WHAT)
+    if len(ydata) < 4 * npoints * channels:
+        raise AdapterError(
+            path,
+            f"{_LEGACY_WHAT}: stream 'Y-Data' is {len(ydata)} bytes but {channels} channel(s) "
+            f"of NPOINTS {npoints} need {4 * npoints * channels} (truncated or NPOINTS wrong)",
+        )
+    xcode, ycode = codes[0], codes[1]
+    if xcode not in _LEGACY_X:
+        raise AdapterError(
+            path,
+            f"{_LEGACY_WHAT}: x-axis code 0x{xcode:08X} in DataInfo: expected 0x10000103 "
+            "(wavelength, nm) or 0x10000100 (wavenumber, 1/cm)",
+        )
+    if ycode not in _JWS_YMODES:
+        raise AdapterError(
+            path,
+            f"{_LEGACY_WHAT}: channel code {ycode} in DataInfo has no labbrdf quantity; "
+            f"expected one of {sorted(_JWS_YMODES)} (%T, %R, absorbance)",
+        )
+    if not (np.isfinite(firstx) and np.isfinite(deltax) and deltax != 0 and firstx > 0):
+        raise AdapterError(
+            path, f"{_LEGACY_WHAT}: FIRSTX {firstx}, DELTAX {deltax}: expected finite, > 0, != 0"
+        )
+    with np.errstate(over="ignore", invalid="ignore"):
+        x_file = firstx + deltax * np.arange(npoints)
+    if not abs(x_file[-1] - lastx) <= 1e-6 * max(abs(lastx), 1.0):
+        raise AdapterError(
+            path,
+            f"{_LEGACY_WHAT}: FIRSTX {firstx:g} + (NPOINTS - 1) * DELTAX = {x_file[-1]:g} "
+            f"disagrees with LASTX {lastx:g} (corrupt DataInfo)",
+        )
+    if x_file.min() <= 0:
+        raise AdapterError(path, f"{_LEGACY_WHAT}: the X axis reaches {x_file.min():g} <= 0")
+    xunit, to_nm = _LEGACY_X[xcode]
+    x = to_nm(x_file)
+    with np.errstate(invalid="ignore"):
+        y = np.frombuffer(ydata, "<f4", npoints, 0).astype(float)
+    invalid = (y <= -1.17e-38) & (y >= -1.19e-38)
+    y[invalid] = np.nan
+    quantity, scale = _JWS_YMODES[ycode]
+    frame, dropped = spectrum_frame(
+        path=path,
+        sample=Path(path).stem,
+        instrument=JWS_INSTRUMENT,
+        quantity=quantity,
+        scale=scale,
+        x_nm=x,
+        y=y,
+    )
+    meta: dict[str, Any] = {
+        "format": "jasco-jws",
+        "layout": "Spectra Manager 1.x (OLE2)",
+        "npoints": int(npoints),
+        "channels": int(channels),
+        "x_unit_in_file": xunit,
+        "firstx_in_file": float(firstx),
+        "lastx_in_file": float(lastx),
+        "deltax_in_file": float(deltax),
+        "x_code": f"0x{xcode:08X}",
+        "ymode_code": int(ycode),
+        "dropped_points": dropped,
+        "invalid_marker_points": int(np.count_nonzero(invalid)),
+    }
+    return finish(path, [frame], meta)
+
+
 FORMATS = (
     Format(
         "jasco-spectramanager-text",
@@ -447,7 +554,7 @@ FORMATS = (
     ),
     Format(
         "jasco-jws",
-        "JASCO Spectra Manager 2 binary .jws/.jrs",
+        "JASCO Spectra Manager binary .jws/.jrs (version 2, and 1.x OLE2)",
         (".jws", ".jrs"),
         _sniff_jws,
         read_jasco_jws,

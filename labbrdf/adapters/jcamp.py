@@ -35,8 +35,11 @@ Checks (each raises AdapterError with the line)
 Quantities: YUNITS ``ABSORBANCE``/``A`` -> ``absorbance``; ``TRANSMITTANCE`` (a fraction in
 JCAMP-DX) or ``%T``/``PERCENT TRANSMITTANCE`` (percent) -> ``transmittance``;
 ``REFLECTANCE``/``%R`` likewise -> ``reflectance``, or ``hemispherical_reflectance`` when a
-record of the block mentions an integrating sphere. XUNITS must be NANOMETERS/NM (or
-MICROMETERS, converted). The sample of each block is its ``TITLE``.
+record of the block mentions an integrating sphere. XUNITS must be NANOMETERS/NM, MICROMETERS
+(converted) or 1/CM (wavenumbers, lambda [nm] = 1e7 / nu), also spelled out (``Wavelength
+(nm)``, ``Wavenumber (cm-1)``); YUNITS may be spelled out too (``Transmittance (%)``). A DOS
+end-of-file byte (0x1A) after the last ``##END=`` is ignored. The sample of each block is its
+``TITLE``.
 
 Notes
 -----
@@ -79,6 +82,74 @@ _YUNITS: dict[str, tuple[str, float]] = {
     "PERCENTREFLECTANCE": ("reflectance", PERCENT),
 }
 _XUNITS = {"NANOMETERS": 1.0, "NM": 1.0, "MICROMETERS": 1000.0, "UM": 1000.0}
+#: spelled-out X units (lower case, after removing the axis name, brackets and blanks)
+_X_SPELLED: dict[str, str] = {
+    **dict.fromkeys(("nm", "nanometers", "nanometer", "nanometres", "nanometre"), "nm"),
+    **dict.fromkeys(
+        (
+            "um",
+            "µm",
+            "μm",
+            "micrometers",
+            "micrometer",
+            "micrometres",
+            "micrometre",
+            "microns",
+            "micron",
+        ),
+        "um",
+    ),
+    **dict.fromkeys(("1/cm", "cm-1", "cm^-1", "cm⁻¹", "/cm", "wavenumbers", "wavenumber"), "1/cm"),
+}
+#: file X unit -> (name in meta, function to wavelength [nm])
+_X_TO_NM: dict[str, Any] = {
+    "nm": lambda v: v,
+    "um": lambda v: v * 1000.0,
+    "1/cm": lambda v: 1.0e7 / v,  # lambda [nm] = 1e7 / wavenumber [1/cm]
+}
+
+
+def _xunit(text: str) -> str | None:
+    """``nm``, ``um`` or ``1/cm`` for an XUNITS value, spelled out or not, else None.
+
+    ``NANOMETERS`` (the standard's spelling), ``nm``, ``Wavelength (nm)``,
+    ``wavelength [nm]``, ``MICROMETERS``, ``1/CM`` (the IR spelling), ``Wavenumber (cm-1)``.
+    """
+    t = text.strip().lower()
+    if t.upper() in _XUNITS:
+        return "nm" if _XUNITS[t.upper()] == 1.0 else "um"
+    t = re.sub(r"^(wavelengths?|wavenumbers?|lambda)\b", "", t)
+    t = re.sub(r"[\s()\[\]]", "", t)
+    if not t and re.match(r"\s*wavenumbers?\s*$", text, re.IGNORECASE):
+        return "1/cm"
+    return _X_SPELLED.get(t)
+
+
+def _yunit(text: str) -> tuple[str, float] | None:
+    """Quantity and scale for a YUNITS value, spelled out or not, else None.
+
+    Beyond the standard's names: ``Transmittance (%)``, ``% Reflectance``,
+    ``Absorbance (A)``, ``Abs.``; ``%`` or ``percent`` means percent.
+    """
+    key = _norm(text)
+    if key in _YUNITS:
+        return _YUNITS[key]
+    t = text.strip().lower()
+    percent = "%" in t or "percent" in t
+    for word, quantity in (
+        ("absorbance", "absorbance"),
+        ("abs", "absorbance"),
+        ("transmittance", "transmittance"),
+        ("transmission", "transmittance"),
+        ("reflectance", "reflectance"),
+        ("reflection", "reflectance"),
+    ):
+        if re.search(rf"\b{word}\b", t):
+            if quantity == "absorbance":
+                return None if percent else (quantity, 1.0)
+            return quantity, PERCENT if percent else 1.0
+    return None
+
 
 _SQZ = {c: i for i, c in enumerate("@ABCDEFGHI")} | {c: -i for i, c in enumerate("@abcdefghi")}
 _DIF = {c: i for i, c in enumerate("%JKLMNOPQR")} | {c: -i for i, c in enumerate("%jklmnopqr")}
@@ -361,15 +432,21 @@ def _spectrum(
     for key in needed:
         if key not in rec:
             raise AdapterError(path, f"block has no ##{key}= record", where)
-    xunits = rec.get("XUNITS", "").strip().upper()
-    if xunits not in _XUNITS:
+    xunit = _xunit(rec.get("XUNITS", ""))
+    if xunit is None:
         raise AdapterError(
-            path, f"XUNITS {rec.get('XUNITS', '')!r}: expected one of {sorted(_XUNITS)}", where
+            path,
+            f"XUNITS {rec.get('XUNITS', '')[:40]!r}: expected a wavelength in NANOMETERS or "
+            "MICROMETERS, or a wavenumber in 1/CM (spelled out as 'Wavelength (nm)' too)",
+            block.lines.get("XUNITS", where),
         )
-    yunits = _norm(rec.get("YUNITS", ""))
-    if yunits not in _YUNITS:
+    yunit = _yunit(rec.get("YUNITS", ""))
+    if yunit is None:
         raise AdapterError(
-            path, f"YUNITS {rec.get('YUNITS', '')!r}: expected one of {sorted(_YUNITS)}", where
+            path,
+            f"YUNITS {rec.get('YUNITS', '')[:40]!r}: expected one of {sorted(_YUNITS)} "
+            "(or spelled out, e.g. 'Transmittance (%)')",
+            block.lines.get("YUNITS", where),
         )
     xfactor = number(rec.get("XFACTOR", "1"), path, where, "XFACTOR")
     yfactor = number(rec.get("YFACTOR", "1"), path, where, "YFACTOR")
@@ -377,13 +454,17 @@ def _spectrum(
         x, ys = _xydata(path, block, xfactor)
     else:
         x, ys = _xypoints(path, block, xfactor)
-    quantity, scale = _YUNITS[yunits]
+    quantity, scale = yunit
     if quantity == "reflectance" and any(
         re.search(r"sphere", v, re.IGNORECASE) for v in rec.values()
     ):
         quantity = "hemispherical_reflectance"
-    with np.errstate(over="ignore", invalid="ignore"):
-        x_nm = x * _XUNITS[xunits]
+    if xunit == "1/cm" and not np.all(x > 0):
+        raise AdapterError(
+            path, "a wavenumber [1/cm] <= 0 cannot be converted to a wavelength", block.data_line
+        )
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        x_nm = _X_TO_NM[xunit](x)
     title = rec.get("TITLE", "").strip() or f"{Path(path).stem} block {index + 1}"
     frame, dropped = spectrum_frame(
         path=path,
@@ -501,6 +582,10 @@ def read_jcamp(path: str | os.PathLike[str]) -> Measurement:
     """
     raw = read_bytes(path)
     text, encoding = decode(raw, path, ("utf-8", "cp1252"))
+    # a DOS end-of-file byte (Ctrl-Z) after the last ##END= is no text after it
+    body = text.rstrip()
+    if body.endswith("\x1a"):
+        text = body[:-1]
     root = _parse_blocks(path, split_lines(text))
     if root.records.get("DATATYPE", "").strip().upper() == "LINK":
         spectra = root.children

@@ -22,7 +22,7 @@ Common rules
    ``meta["dropped_points"]``. An empty ``sigma`` means "no uncertainty" (NaN). Every other
    cell must be a finite decimal number. ``#`` lines between data rows are comments.
 5. ``sample`` defaults to the file stem, ``instrument`` to ``labbrdf-csv``.
-6. A bad row raises :class:`~labbrdf.adapters.AdapterError` with its line number: wrong
+6. A bad row raises :class:`~labbrdf.AdapterError` with its line number: wrong
    cell count, a non-number, wavelength <= 0, an angle outside its range, sigma < 0.
 
 (a) Specular scan: ``# labbrdf specular-scan v1``

@@ -7,7 +7,9 @@ Layout (Galactic Industries, "SPC file format", 1996; docs/formats.md section 11
 ``fdate`` packed int32 at 32, ``fres`` char[9] at 36, ``fsource`` char[9] at 45, ``fcmnt``
 char[130] at 88, ``flogoff`` int32 at 248, ``fmethod`` char[48] at 264. Then, if flag
 TXVALS (0x80) is set, ``fnpts`` float32 X values; then per subfile a 32-byte sub-header
-(``subexp`` signed byte 1, ``subnpts`` int32 at 16) and ``fnpts`` Y values: float32 when the
+(``subexp`` signed byte 1, ``subnpts`` int32 at 16: the subfile's own point count, which
+the specification uses only with TXYXYS; with a shared X axis it is kept in meta and not
+checked, as writers leave 0 or other values there) and ``fnpts`` Y values: float32 when the
 exponent is -128, else int32 (int16 with flag TSPREC 0x01) scaled by 2**(exp - 32)
 (2**(exp - 16)). X is evenly spaced from ``ffirst`` to ``flast`` unless TXVALS; it must be strictly
 monotonic (ascending or descending) and within 1 nm to 1 mm, else the header is corrupt.
@@ -45,6 +47,7 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import AdapterError, Format, check_count, read_bytes
+from ._ole2 import is_ole2
 from ._spectro import finish, spectrum_frame
 
 __all__ = ["FORMATS", "read_spc"]
@@ -174,6 +177,14 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
 
     if len(raw) < _HEADER:
         raise fail(f"file is {len(raw)} bytes, shorter than the 512-byte SPC header", len(raw))
+    if is_ole2(raw):
+        raise fail(
+            "this is an OLE2 compound document (magic D0 CF 11 E0 A1 B1 1A E1), not a "
+            "Galactic SPC: a Shimadzu UVProbe .spc? Read it with --format "
+            "shimadzu-uvprobe-spc on the command line or format='shimadzu-uvprobe-spc' in "
+            "Python",
+            0,
+        )
     flags, version = raw[0], raw[1]
     if version in (0x4D, 0x4C):
         kind = "old-format (0x4D)" if version == 0x4D else "big-endian (0x4C)"
@@ -271,12 +282,14 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
     comment = _text(raw, 88, 130)
     base = comment or Path(path).stem
     ys: list[tuple[np.ndarray, int]] = []
+    subnpts_all: list[int] = []
     offset = _HEADER + xbytes
-    for k in range(nsub):
+    for _k in range(nsub):
         subexp = struct.unpack_from("<b", raw, offset + 1)[0]
-        (subnpts,) = struct.unpack_from("<i", raw, offset + 16)
-        if subnpts not in (0, npts):
-            raise fail(f"subfile {k}: subnpts {subnpts} disagrees with fnpts {npts}", offset + 16)
+        # subnpts counts the subfile's own X/Y pairs and matters only with TXYXYS (refused
+        # above); with one shared X axis the specification leaves it unused, and writers
+        # leave 0 or anything there: kept in meta, never checked
+        (sub_n,) = struct.unpack_from("<i", raw, offset + 16)
         exp = subexp if nsub > 1 or fexp == 0 else fexp
         start = offset + _SUBHEADER
         if exp == -128:
@@ -287,6 +300,7 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
         else:
             y = np.frombuffer(raw, "<i2", npts, start).astype(float) * 2.0 ** (exp - 16)
         ys.append((y, int(exp)))
+        subnpts_all.append(int(sub_n))
         offset = start + width * npts
     scale, in_file, basis = 1.0, None, None
     if quantity != "absorbance":
@@ -304,7 +318,9 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
         )
         frames.append(frame)
         dropped += d
-        subs.append({"exponent": exp, "points": int(npts), "dropped": d})
+        subs.append(
+            {"exponent": exp, "points": int(npts), "subnpts": subnpts_all[k], "dropped": d}
+        )
     meta: dict[str, Any] = {
         "format": "galactic-spc",
         "flags": int(flags),

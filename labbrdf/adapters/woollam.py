@@ -16,15 +16,15 @@ then one record per line, TAB separated. An untagged row is ``x AOI Psi Delta sP
 (CompleteEASE 3.x adds a trailing TAB; the dynamic variant adds an empty column and the time
 in minutes). A tagged row starts with its data type:
 
-==============================  =================================================  ==========
-tag                             fields after the tag                               quantity
-==============================  =================================================  ==========
-``E``                           x AOI Psi Delta sPsi sDelta                         psi, delta
-``AnE`` / ``Aps`` / ``Asp``     x AOI Psi Delta sPsi sDelta (channel pp / ps / sp)  psi, delta
-``dpolE`` / ``dPolE``           x AOI depolarisation[%] sigma[%]                    depolarization
-``uR`` / ``pR`` / ``sR``        x AOI R sigma (channel u / p / s)                   see below
-``mm11`` .. ``mm44``            x AOI M M sM sM (value written twice)               mueller_ij
-==============================  =================================================  ==========
+===========================  ==================================================  ==============
+tag                          fields after the tag                                quantity
+===========================  ==================================================  ==============
+``E``                        x AOI Psi Delta sPsi sDelta                         psi, delta
+``AnE`` / ``Aps`` / ``Asp``  x AOI Psi Delta sPsi sDelta (channel pp / ps / sp)  psi, delta
+``dpolE`` / ``dPolE``        x AOI depolarisation[%] sigma[%]                    depolarization
+``uR`` / ``pR`` / ``sR``     x AOI R sigma (channel u / p / s)                   see below
+``mm11`` .. ``mm44``         x AOI M M sM sM (value written twice)               mueller_ij
+===========================  ==================================================  ==============
 
 Reflectance: in an ``RTmethod`` file the ``uR``/``pR``/``sR`` rows are calibrated specular
 reflectances (fractions, as in ``ta2o5_02262007_rp.dat``) and become ``reflectance`` with

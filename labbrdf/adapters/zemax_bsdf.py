@@ -58,6 +58,7 @@ __all__ = [
     "read_zemax_bsdf",
     "scatter_to_angles",
     "scatter_to_direction",
+    "stated_wavelength",
     "binned_to_bsdf",
     "write_bsdf",
 ]
@@ -242,6 +243,8 @@ class BsdfTable:
         Comment lines (without ``#``).
     source : str
         The ``Source`` keyword.
+    wavelength_nm : float or None
+        The wavelength a comment states [nm] (see :func:`stated_wavelength`), else None.
     """
 
     symmetry: str
@@ -255,6 +258,7 @@ class BsdfTable:
     tis: NDArray[np.float64]
     comments: list[str] = field(default_factory=list)
     source: str = "Measured"
+    wavelength_nm: float | None = None
 
     @property
     def channels(self) -> tuple[str, ...]:
@@ -267,7 +271,8 @@ class _Lines:
 
     def __init__(self, lines: list[str]) -> None:
         self.items = [(n, s) for n, s in ((i + 1, ln.strip()) for i, ln in enumerate(lines)) if s]
-        self.comments = [s[1:].strip() for _, s in self.items if s.startswith("#")]
+        self.comment_lines = [(n, s[1:].strip()) for n, s in self.items if s.startswith("#")]
+        self.comments = [c for _, c in self.comment_lines]
         self.items = [(n, s) for n, s in self.items if not s.startswith("#")]
         self.pos = 0
 
@@ -534,6 +539,7 @@ def read_table(path: str | os.PathLike[str]) -> BsdfTable:
         tis=np.empty(shape[:3]),
         comments=cur.comments,
         source=head["Source"][0] if "Source" in head else "",
+        wavelength_nm=stated_wavelength(path, cur.comment_lines),
     )
     _parse_data(path, cur, t)
     return t
@@ -542,19 +548,47 @@ def read_table(path: str | os.PathLike[str]) -> BsdfTable:
 # ------------------------------------------------------------------------------ reader
 
 
+def _pole_repeats(shape: tuple[int, ...], radial_deg: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """The grid points that repeat the pole: radial 0 at every azimuth but the first.
+
+    At radial angle 0 every azimuth names the same direction (the specular one, or that of
+    direct transmission), so the file writes that one point once per azimuth.
+    """
+    rep = np.zeros(shape, dtype=bool)
+    if radial_deg.size and radial_deg[0] == 0.0:
+        rep[..., 1:, 0] = True
+    return rep
+
+
 def _table_frame(
     t: BsdfTable, path: str | os.PathLike[str], wavelength_nm: float
-) -> tuple[pd.DataFrame, int]:
-    """Rows above the horizon in the dataset schema, and the number dropped below it."""
+) -> tuple[pd.DataFrame, int, int]:
+    """Rows above the horizon in the dataset schema, and the counts left out.
+
+    Returns the frame, the number of points below the horizon, and the number of repeated
+    pole points (the pole is one row per block).
+    """
     nrot, nch, naoi, naz, nrad = t.values.shape
     full = t.values.shape
-    theta_r, phi_r, above = (
+    theta_r, phi_r, above_f = (
         np.broadcast_to(x, full).reshape(-1)
         for x in scatter_to_angles(
             t.theta_i_deg[:, None, None], t.radial_deg[None, None, :], t.azimuth_deg[None, :, None]
         )
     )
-    keep = np.flatnonzero(above)
+    above = np.asarray(above_f, dtype=bool)
+    repeat = _pole_repeats(full, t.radial_deg).reshape(-1)
+    keep = np.flatnonzero(above & ~repeat)
+    values = t.values.copy()
+    if repeat.any():
+        # one value for the one direction: the file's, or, where the azimuths of a block
+        # disagree, their mean weighted by the azimuth cells (the average over the polar
+        # cap, so grid_integral is unchanged; meta["pole"] reports the largest spread)
+        pole = values[..., 0]
+        w = _azimuth_weights(t.azimuth_deg, t.symmetry)
+        values[..., 0, 0] = np.where(
+            np.all(pole == pole[..., :1], axis=-1), pole[..., 0], (pole @ w) / w.sum()
+        )
     ti = np.broadcast_to(t.theta_i_deg[:, None, None], full).reshape(-1)
     optional: dict[str, Any] = {}
     if nrot > 1 or t.rotation_deg[0] != 0:
@@ -567,7 +601,7 @@ def _table_frame(
         instrument=INSTRUMENT,
         source=os.path.basename(os.fspath(path)),
         quantity=SCATTER_TYPES[t.scatter_type],
-        value=t.values.reshape(-1)[keep],
+        value=values.reshape(-1)[keep],
         unit="sr-1",
         wavelength_nm=wavelength_nm,
         theta_i_deg=ti[keep],
@@ -575,7 +609,22 @@ def _table_frame(
         phi_r_deg=phi_r[keep],
         **optional,
     )
-    return frame, int(above.size - keep.size)
+    return frame, int((~above).sum()), int((above & repeat).sum())
+
+
+def _pole_meta(t: BsdfTable, repeats: int) -> dict[str, Any]:
+    """What became of the pole (radial 0) points: one row kept per block."""
+    if not repeats:
+        return {"repeats_left_out": 0}
+    pole = t.values[..., 0]
+    spread = np.max(np.abs(pole - pole[..., :1]))
+    return {
+        "repeats_left_out": repeats,
+        "rule": "radial 0 is one direction at every azimuth: one row per incidence (and "
+        "rotation, channel), with the file's value, or, where the azimuths' values differ, "
+        "their mean weighted by the azimuth cell widths",
+        "max_spread_sr-1": float(spread),
+    }
 
 
 def _tis_meta(t: BsdfTable) -> list[dict[str, Any]]:
@@ -604,21 +653,25 @@ def read_zemax_bsdf(
     path : str or path-like
         The file.
     wavelength_nm : float, optional
-        Wavelength to record [nm]; the format has no wavelength field, so by default
-        :data:`DEFAULT_WAVELENGTH_NM` (555 nm, a photopic label) is written and
-        ``meta["wavelength_stated"]`` is False.
+        Wavelength to record [nm]. The format has no wavelength field: by default the one a
+        comment states (:func:`stated_wavelength`), else :data:`DEFAULT_WAVELENGTH_NM`
+        (555 nm, a photopic label) with ``meta["wavelength_stated"]`` False.
 
     Returns
     -------
     Measurement
-        One row per grid point above the horizon: quantity ``brdf`` or ``btdf`` [sr-1],
+        One row per grid point above the horizon, the pole (radial 0, the same direction
+        at every azimuth) once per incidence: quantity ``brdf`` or ``btdf`` [sr-1],
         ``theta_i_deg``, ``theta_r_deg``, ``phi_r_deg`` from the exact conversion of the
         scatter angles; ``channel`` ``X``/``Y``/``Z`` for tristimulus files;
         ``sample_rotation_deg`` when the file has a rotation other than 0. PlaneSymmetrical
         files keep the measured half only (azimuths 0..180, i.e. phi_r in [0, 180] or 180..,
         see :func:`mirror_plane_symmetric`). ``meta`` holds the header, ``tis`` (one entry
         per block), ``grid`` (the file's lists), ``dropped_below_horizon`` and
-        ``zero_values_kept`` (zeros above the horizon, kept as data).
+        ``zero_values_kept`` (zeros above the horizon, kept as data), ``pole`` (the
+        repeated pole points left out) and ``wavelength_stated`` (False when no comment
+        states the wavelength: then the 555 nm label is written, see
+        :data:`DEFAULT_WAVELENGTH_NM`).
 
     Raises
     ------
@@ -627,12 +680,12 @@ def read_zemax_bsdf(
     """
     t = read_table(path)
     if wavelength_nm is None:
-        wavelength_nm = _own_wavelength(t.comments)
+        wavelength_nm = t.wavelength_nm
     stated = wavelength_nm is not None
     wl = float(wavelength_nm) if wavelength_nm is not None else DEFAULT_WAVELENGTH_NM
     if not (math.isfinite(wl) and wl > 0):
         raise AdapterError(path, f"wavelength_nm={wavelength_nm!r}: expected a finite number > 0")
-    frame, dropped = _table_frame(t, path, wl)
+    frame, dropped, repeats = _table_frame(t, path, wl)
     meta: dict[str, Any] = {
         "format": "zemax-bsdf",
         "source_keyword": t.source,
@@ -650,6 +703,7 @@ def read_zemax_bsdf(
         },
         "tis": _tis_meta(t),
         "dropped_below_horizon": dropped,
+        "pole": _pole_meta(t, repeats),
         "zero_values_kept": int((frame["value"].to_numpy() == 0).sum()),
         "comments": t.comments,
     }
@@ -667,17 +721,55 @@ def read_zemax_bsdf(
 #: comment labbrdf writes for the wavelength of a model it exports (the format has no field)
 _WAVELENGTH_COMMENT = "labbrdf wavelength_nm "
 
+#: wavelength comments read, ``#labbrdf wavelength_nm 550`` (ours) and ``#Wavelength (nm) =
+#: 550.0`` (the Speos-to-Zemax converter's); the value is checked by :func:`_num`
+_WAVELENGTH_COMMENTS = re.compile(
+    r"(?:labbrdf\s+wavelength_nm|wavelength\s*\(nm\)\s*[=:])\s*(?P<v>\S+)\s*",
+    re.IGNORECASE | re.ASCII,
+)
 
-def _own_wavelength(comments: list[str]) -> float | None:
-    """The wavelength [nm] of a ``#labbrdf wavelength_nm W`` comment (our exports), if any."""
-    for c in comments:
-        if c.startswith(_WAVELENGTH_COMMENT):
-            try:
-                w = float(c[len(_WAVELENGTH_COMMENT) :].strip())
-            except ValueError:
-                return None
-            return w if math.isfinite(w) and w > 0 and c.isascii() else None
-    return None
+
+def stated_wavelength(
+    path: str | os.PathLike[str], comment_lines: Sequence[tuple[int, str]]
+) -> float | None:
+    """The wavelength [nm] a file's comments state, or None when none does.
+
+    The format has no wavelength field; two comments carry one: ``#labbrdf wavelength_nm W``
+    (written by :func:`write_bsdf`) and ``#Wavelength (nm) = W`` (written by the
+    Speos-to-Zemax converter).
+
+    Parameters
+    ----------
+    path : path-like
+        The file (for error messages).
+    comment_lines : sequence of (int, str)
+        ``(line number, comment without '#')``.
+
+    Raises
+    ------
+    AdapterError
+        A wavelength comment whose value is not a number > 0 [nm], or two comments that
+        state different wavelengths (the line of the offending comment is named).
+    """
+    found: float | None = None
+    for line, c in comment_lines:
+        m = _WAVELENGTH_COMMENTS.fullmatch(c)
+        if m is None:
+            continue
+        w = _num(path, m["v"], line, "wavelength comment")
+        if w <= 0:
+            raise AdapterError(
+                path, f"wavelength comment: expected a wavelength > 0 [nm], found {w:g}", line
+            )
+        if found is not None and w != found:
+            raise AdapterError(
+                path,
+                f"wavelength comment states {w:g} nm, an earlier one {found:g} nm: "
+                "expected one wavelength per file",
+                line,
+            )
+        found = w
+    return found
 
 
 def mirror_plane_symmetric(m: Measurement) -> Measurement:
@@ -776,7 +868,8 @@ def _table_from_measurement(m: Measurement) -> BsdfTable:
     """Put the rows of a reader's Measurement back on the file's grid (0 below the horizon).
 
     The reader writes the rows in the file's order (rotation, channel, incidence, azimuth,
-    radial), skipping the points below the horizon; this checks that the rows are still
+    radial), skipping the points below the horizon and the pole's repeats (its one row is
+    copied back to every azimuth); this checks that the rows are still
     those (same count, same angles to 1e-9 deg) and refuses a filtered or mirrored table.
     """
     g = m.meta.get("grid")
@@ -788,14 +881,18 @@ def _table_from_measurement(m: Measurement) -> BsdfTable:
     shape = (rot.size, nch, aoi.size, az.size, rad.size)
     _, _, ai, zi, qi = np.indices(shape).reshape(5, -1)
     theta_r, phi_r, above = scatter_to_angles(aoi[ai], rad[qi], az[zi])
+    repeat = _pole_repeats(shape, rad).reshape(-1)
+    if not (m.meta.get("pole") or {}).get("repeats_left_out"):
+        repeat[:] = False  # read before the pole was kept once
+    kept = above & ~repeat
     d = m.data
-    same = len(d) == int(above.sum()) and "mirrored" not in m.meta
+    same = len(d) == int(kept.sum()) and "mirrored" not in m.meta
     if same:
-        dphi = np.abs(d["phi_r_deg"].to_numpy() - phi_r[above])
+        dphi = np.abs(d["phi_r_deg"].to_numpy() - phi_r[kept])
         same = bool(
-            np.all(np.abs(d["theta_r_deg"].to_numpy() - theta_r[above]) < 1e-9)
+            np.all(np.abs(d["theta_r_deg"].to_numpy() - theta_r[kept]) < 1e-9)
             and np.all(np.minimum(dphi, 360.0 - dphi) < 1e-9)
-            and np.all(d["theta_i_deg"].to_numpy() == aoi[ai[above]])
+            and np.all(d["theta_i_deg"].to_numpy() == aoi[ai[kept]])
         )
     if not same:
         raise ValueError(
@@ -803,7 +900,9 @@ def _table_from_measurement(m: Measurement) -> BsdfTable:
             "pass the BsdfTable of read_table() instead"
         )
     v = np.zeros(shape)
-    v.reshape(-1)[above] = d["value"].to_numpy()
+    v.reshape(-1)[kept] = d["value"].to_numpy()
+    if repeat.any():
+        v[..., 1:, 0] = v[..., :1, 0]  # the pole, at every azimuth of the grid
     return BsdfTable(
         symmetry=m.meta.get("symmetry", "Asymmetrical"),
         spectral=m.meta.get("spectral_content", "Monochrome"),
@@ -1117,7 +1216,7 @@ def binned_to_bsdf(
     theta_i_deg : float
         Angle of incidence of the binned data [deg].
     values : array_like, shape (n_theta, n_phi)
-        Bin-averaged BRDF [sr^-1], e.g. :meth:`labbrdf.tracer.TraceResult.s0`.
+        Bin-averaged BRDF [sr^-1], e.g. :meth:`labbrdf.TraceResult.s0`.
     theta_edges_deg, phi_edges_deg : array_like
         Bin edges [deg], ``n_theta + 1`` in [0, 90] and ``n_phi + 1`` in [0, 360]
         (outward azimuth, source at 0).

@@ -34,9 +34,9 @@ among them in its own ``__all__``. They may change without notice.
 from __future__ import annotations
 
 from .batch import fit_many
-from .core import ALGORITHMS, CONSTRAINED, SPECULAR_LINE_SHAPE, fit, parse_method
+from .core import ALGORITHMS, CONSTRAINED, fit, parse_method
 from .data import FITTABLE_QUANTITIES, FitData, FitError
-from .objective import GUESSES, Objective
+from .objective import Objective
 from .result import FitResult
 from .uncertainty import AT_BOUND_FRAC, COND_MAX, CORREL_MAX, REL_STDERR_MAX, REL_STDERR_POOR
 
@@ -47,10 +47,8 @@ __all__ = [
     "CONSTRAINED",
     "CORREL_MAX",
     "FITTABLE_QUANTITIES",
-    "GUESSES",
     "REL_STDERR_MAX",
     "REL_STDERR_POOR",
-    "SPECULAR_LINE_SHAPE",
     "FitData",
     "FitError",
     "FitResult",

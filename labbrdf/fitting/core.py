@@ -18,7 +18,7 @@ from ..dataset import Measurement
 from ..models import Model, Parameters
 from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
-from .objective import GUESSES, Objective
+from .objective import Objective
 from .result import FitResult
 from .uncertainty import AT_BOUND_FRAC, jacobian, uncertainties
 
@@ -29,7 +29,6 @@ __all__ = [
     "CONSTRAINED",
     "LOCAL_ROUNDS",
     "RELATIVE_FLOOR",
-    "SPECULAR_LINE_SHAPE",
     "fit",
     "parse_method",
     "setup_params",
@@ -62,11 +61,6 @@ CONSTRAINED = frozenset(
         "LD_AUGLAG_EQ",
     }
 )
-
-
-#: models whose shape parameters cannot be identified from specular-line data alone
-#: (docs/models.md 1.1: on theta_r == theta_i smooth3 gives only k1 exp(-k2^2/k3^2))
-SPECULAR_LINE_SHAPE = {"smooth3": ("k2", "k3")}
 
 
 # default stage settings (tuned with benchmarks/bench_fit.py)
@@ -378,7 +372,8 @@ def fit(
         take constraints (:data:`CONSTRAINED`, e.g. ``"GN_ISRES+LN_COBYLA"``).
     maxeval : int or sequence, optional
         Total evaluation budget per stage (one number for all stages, or one per stage).
-        Default: ``30 (n + 1)`` for a global stage that starts from a :data:`GUESSES` point,
+        Default: ``30 (n + 1)`` for a global stage that starts from the model's guess
+        (:meth:`~labbrdf.models.Model.guess`),
         ``100 (n + 1)`` without one, and ``LOCAL_ROUNDS x 400 n`` (2000 n) for a local
         stage, where ``n`` is the number of searched (non-profiled) parameters (tuned with
         benchmarks/bench_fit.py). A local stage runs in rounds of at most ``400 n``
@@ -396,7 +391,7 @@ def fit(
         Points with NaN/inf values or angles raise, or are dropped and counted in
         ``FitResult.ndropped``.
     guess : bool
-        Start from the data-driven guess of :data:`GUESSES` (smooth3: a parabola through
+        Start from the model's data-driven guess (smooth3: a parabola through
         log R) for the varying parameters not given in ``params``; the global stage keeps
         that point in its population, so it can only improve on it.
     ci : {"wald", "profile"}
@@ -686,15 +681,15 @@ def _profile_interval(
 
 
 def _apply_guess(model: Model, fd: FitData, p: Parameters, given: set[str]) -> bool:
-    """Start varying parameters not set by the caller at the :data:`GUESSES` point."""
-    if model.name not in GUESSES:
-        return False
+    """Start varying parameters not set by the caller at the model's own guess."""
     with np.errstate(all="ignore"):
-        g = GUESSES[model.name](
-            np.radians(np.asarray(fd.theta_i_deg)),
-            np.radians(np.asarray(fd.theta_r_deg)),
-            np.asarray(fd.value),
+        g = model.guess(
+            np.radians(np.asarray(fd.theta_i_deg, dtype=float)),
+            np.radians(np.asarray(fd.theta_r_deg, dtype=float)),
+            np.asarray(fd.value, dtype=float),
         )
+    if not g:
+        return False
     used = False
     for k, v in g.items():
         q = p[k]
@@ -753,13 +748,13 @@ def _check_design(model: Model, fd: FitData, varying: list[str]) -> None:
             f"data: {n_pts} point(s) for {nvarys} free parameter(s) {varying}; "
             f"need at least {nvarys + 1} to fit and estimate uncertainties"
         )
-    shape = [k for k in SPECULAR_LINE_SHAPE.get(model.name, ()) if k in varying]
+    shape = [k for k in model.specular_line_shape if k in varying]
     on_line = np.abs(np.asarray(fd.theta_r_deg) - np.asarray(fd.theta_i_deg)) < 1e-9
     if shape and on_line.all():
         raise FitError(
             f"data: all {n_pts} points lie on the specular line theta_r == theta_i, where "
             f"{model.name} identifies only k1 exp(-k2^2/k3^2) (docs/models.md 1.1); "
-            f"add off-specular points or fix {list(SPECULAR_LINE_SHAPE[model.name])}, "
+            f"add off-specular points or fix {list(model.specular_line_shape)}, "
             "e.g. fix={'k2': 0.0, 'k3': 0.4}"
         )
 

@@ -56,6 +56,7 @@ class _FilmFitModel(Model):
         self.fm = fm
         self.channels = np.asarray(channels, int)
         self.y = np.asarray(y, float)
+        self._pairs: tuple[NDArray, ...] | None = None
         super().__init__()
 
     def default_params(self) -> Parameters:
@@ -72,9 +73,15 @@ class _FilmFitModel(Model):
 
     def rows(self, p: Mapping[str, float], ti_deg: NDArray, wl: NDArray) -> NDArray:
         s = self.fm.stack.with_values({k: p[k] for k in self.fm.free})
-        idx = s.indices(wl)
         th = np.clip(ti_deg, 0.0, 90.0)
-        rs, rp, ts, tp, kz0, kzs = stk._stack(idx, s._thicknesses(), wl, th)
+        # psi, Delta, R_s, R_p of one (wavelength, angle) share one stack evaluation
+        key = self._pairs
+        if key is None or not (np.array_equal(key[0], wl) and np.array_equal(key[1], th)):
+            pairs, inv = np.unique(np.stack([wl, th]), axis=1, return_inverse=True)
+            key = self._pairs = (wl.copy(), th.copy(), pairs[0], pairs[1], inv.ravel())
+        u_wl, u_th, inv = key[2], key[3], key[4]
+        rs_u, rp_u, _, _, _, _ = stk._stack(s.indices(u_wl), s._thicknesses(), u_wl, u_th)
+        rs, rp = rs_u[inv], rp_u[inv]
         ch = self.channels
         out = np.full(ch.shape, np.nan)
         psi = np.degrees(np.arctan2(np.abs(rp), np.abs(rs)))
@@ -87,7 +94,7 @@ class _FilmFitModel(Model):
         out = np.where(ch == 3, Rp, out)
         out = np.where(ch == 4, 0.5 * (Rs + Rp), out)
         if np.any(ch >= 5):
-            Ts, Tp = stk.transmittance(idx, s._thicknesses(), wl, th)
+            Ts, Tp = stk.transmittance(s.indices(wl), s._thicknesses(), wl, th)
             out = np.where(ch == 5, Ts, out)
             out = np.where(ch == 6, Tp, out)
             out = np.where(ch == 7, 0.5 * (Ts + Tp), out)
@@ -219,7 +226,7 @@ def woollam_mse(chisqr: float, n_values: int, n_params: int) -> float:
 
 @dataclass
 class FilmFit:
-    """A film fit: the core's :class:`~labbrdf.fitting.FitResult` and the best-fit stack."""
+    """A film fit: the core's :class:`~labbrdf.FitResult` and the best-fit stack."""
 
     result: FitResult
     model: FilmModel
@@ -362,6 +369,11 @@ class FilmFit:
                 d["stderr"] = q.stderr
                 d["ci95"] = list(q.ci95) if q.ci95 is not None else None
                 d["ci_method"] = res.ci_method
+                if q.stderr is not None:
+                    d["ci95_wald"] = [
+                        max(q.value - tq * q.stderr, q.min),
+                        min(q.value + tq * q.stderr, q.max),
+                    ]
                 if scale is not None and q.stderr is not None:
                     se = q.stderr * scale
                     d["stderr_scaled"] = se

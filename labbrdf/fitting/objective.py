@@ -1,7 +1,7 @@
 """Weighted least squares as a function of a flat, bounded search vector.
 
-Linear amplitudes are profiled out by exact bounded linear least squares; smooth3 gets a
-data-driven starting point (:data:`GUESSES`).
+Linear amplitudes are profiled out by exact bounded linear least squares; a model's
+data-driven starting point is its own (:meth:`labbrdf.models.Model.guess`).
 """
 
 from __future__ import annotations
@@ -15,40 +15,9 @@ from numpy.typing import ArrayLike, NDArray
 from ..models import Model, Parameters
 from .data import FitData, FitError
 
-__all__ = ["GUESSES", "Objective"]
+__all__ = ["Objective"]
 
 _PENALTY = 1e100  # objective value for non-finite model output (inf breaks local methods)
-
-
-def _guess_smooth3(ti: NDArray, tr: NDArray, y: NDArray) -> dict[str, float]:
-    """Starting values for smooth3 from a quadratic fit of log(8 y cos ti cos tr) in ti - tr.
-
-    Eq. (7) of Zou et al. (2013) is log-quadratic in d = ti - tr [rad]:
-    ``log(8 R cos ti cos tr) = (log k1 - k2^2/k3^2) + (2 k2/k3^2) d - d^2/k3^2``, so an
-    ordinary least-squares parabola gives (k1, k2, k3) when its curvature is negative.
-    Returns {} when it is not (noise-dominated scans).
-    """
-    ok = y > 0
-    if ok.sum() < 4:
-        return {}
-    d = (ti - tr)[ok]
-    if np.ptp(d) == 0:
-        return {}
-    z = np.log(8 * y[ok] * np.cos(ti[ok]) * np.cos(tr[ok]))
-    a2, a1, a0 = np.polyfit(d, z, 2)
-    if not a2 < 0:
-        return {}
-    k3 = 1.0 / math.sqrt(-a2)
-    k2 = a1 * k3**2 / 2
-    k1 = math.exp(a0 + (k2 / k3) ** 2)
-    return {"k1": k1, "k2": k2, "k3": k3} if math.isfinite(k1) else {}
-
-
-#: starting-value heuristics by model name, ``guess(theta_i, theta_r, value) -> dict``
-#: (radians); the global stage starts its population from this point
-GUESSES: dict[str, Callable[[NDArray, NDArray, NDArray], dict[str, float]]] = {
-    "smooth3": _guess_smooth3,
-}
 
 
 def _bounded_lsq(G: NDArray, g: NDArray, lo: NDArray, hi: NDArray) -> NDArray:

@@ -157,6 +157,11 @@ class Model(ABC):
     doi: str = ""
     #: names of parameters that enter linearly (may be profiled out by least squares)
     linear: tuple[str, ...] = ()
+    #: parameters that only shape the lobe away from the specular line: a fit to points on
+    #: theta_r == theta_i alone cannot identify them (the fitting core refuses to vary them)
+    specular_line_shape: tuple[str, ...] = ()
+    #: what the model's form says about reciprocity, a sentence for reports
+    reciprocity_note: str = ""
 
     def __init__(self, **options: Any) -> None:
         self.options: dict[str, Any] = dict(options)
@@ -192,6 +197,25 @@ class Model(ABC):
     def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:
         """Whether f(i, r) == f(r, i) for these parameter values."""
         return False
+
+    def guess(self, theta_i: NDArray, theta_r: NDArray, value: NDArray) -> dict[str, float]:
+        """Data-driven starting values (name -> value) from measured points, or ``{}``.
+
+        ``theta_i``, ``theta_r`` [rad] and ``value`` (the measured BRDF [sr^-1]) are flat
+        arrays of the points to be fitted. The fitting core's global stage keeps this point
+        in its population, so a guess can only help. The default has none.
+        """
+        return {}
+
+    def hemispherical(
+        self, theta_i_deg: ArrayLike, params: Mapping[str, float] | None = None
+    ) -> NDArray[np.float64] | None:
+        """Closed-form directional-hemispherical reflectance [1], or None where there is none.
+
+        :func:`labbrdf.integrate.hemispherical_reflectance` uses it when it exists and
+        integrates the BRDF by quadrature otherwise.
+        """
+        return None
 
     # ---------------------------------------------------------------- public
     def values(self, params: Mapping[str, float] | Parameters | None = None) -> dict[str, float]:

@@ -74,8 +74,8 @@ class FiveParam(Model):
     + diffuse`` [sr^-1], where ``a`` is the facet tilt, ``g`` the local incidence angle and
     ``a_`` the parameter ``a``.
 
-    Options
-    -------
+    Other Parameters
+    ----------------
     shadowing : {"ts", "none", "mb"} or callable, default "ts"
         G: Torrance-Sparrow V-groove in Blinn's form, 1, or Maxwell-Beard (adds the fixed
         parameters ``Omega`` and ``tau`` [rad]); a callable
@@ -104,6 +104,10 @@ class FiveParam(Model):
         "eq. (3) of Zou, Bai, Wu, Acta Optica Sinica 33(6) 0612008 (2013)"
     )
     doi = "10.3788/AOS201333.0612008"
+    reciprocity_note = (
+        "five_param is not reciprocal in general: its diffuse term k_d / cos\u03b8i "
+        "depends on the incidence direction alone; it is reciprocal only for k_d = 0."
+    )
     linear = ("kb", "kd")
 
     def __init__(

@@ -94,7 +94,8 @@ def smith_g1_ggx(cos_v: ArrayLike, alpha: float) -> NDArray[np.float64]:
 def stokes_from_jones(jones: NDArray) -> NDArray[np.float64]:
     """Mueller matrix (..., 4, 4) of Jones matrices (..., 2, 2) in the LB Stokes convention.
 
-    S0 = |Es|^2 + |Ep|^2, S1 = |Es|^2 - |Ep|^2, S2 = 2 Re(Es Ep*), S3 = 2 Im(Es* Ep)
+    ``S0 = |Es|^2 + |Ep|^2``, ``S1 = |Es|^2 - |Ep|^2``, ``S2 = 2 Re(Es Ep*)``,
+    ``S3 = 2 Im(Es* Ep)``
     (oracles README section 2: S3 = +1 when E turns from s towards p, time factor exp(-iwt)).
 
     Parameters
@@ -117,10 +118,11 @@ def stokes_from_jones(jones: NDArray) -> NDArray[np.float64]:
 class Microfacet(Model):
     """GGX microfacet BRDF with Smith G1 G1 and the exact Fresnel factor of a substrate.
 
-    Options (exactly one of the first three)
-    ----------------------------------------
+    Other Parameters
+    ----------------
     n, k : float
-        Complex index N = n + ik of the substrate (k >= 0), ambient index 1.
+        Complex index N = n + ik of the substrate (k >= 0), ambient index 1. Give exactly
+        one of ``n, k``, ``psi_delta`` and ``ideal_mirror``.
     psi_delta : tuple of float
         ``(psi_deg, delta_deg, theta_deg)`` measured by an ellipsometer on the same sample;
         N comes from the two-phase inversion :func:`labbrdf.optics.nk_from_psi_delta`.
@@ -151,6 +153,11 @@ class Microfacet(Model):
         "EGSR 2007 (GGX D, Smith G1); Fresnel amplitudes of the substrate"
     )
     doi = "10.2312/EGWR/EGSR07/195-206"
+    reciprocity_note = (
+        "microfacet is reciprocal by construction (the GGX term "
+        "F D G1 G1 / (4 cos\u03b8i cos\u03b8r) and the Lambertian kd / pi are symmetric in the "
+        "two directions)."
+    )
     linear: tuple[str, ...] = ("scale",)
 
     def __init__(

@@ -15,7 +15,8 @@ from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
+from scipy.special import erf
 
 from .base import Model, ModelError, Parameters
 
@@ -52,6 +53,94 @@ def smooth3_brdf(
         return k1 / (8.0 * np.cos(ti) * np.cos(tr)) * np.exp(-(((ti - tr - k2) / k3) ** 2))
 
 
+def smooth3_lobe_integral(theta_i: ArrayLike, k2: float, k3: float) -> NDArray[np.float64]:
+    """``I(theta_i) = int_0^{pi/2} exp(-(theta_i - k2 - t)^2 / k3^2) sin t dt`` in closed form.
+
+    ``I = Im{k3 e^{ic} e^{-k3^2/4} (sqrt(pi)/2) [erf(u1 - i k3/2) - erf(u0 - i k3/2)]}`` with
+    ``c = theta_i - k2``, ``u0 = -c/k3``, ``u1 = (pi/2 - c)/k3`` (docs/models.md 1.2).
+
+    Parameters
+    ----------
+    theta_i : array_like
+        Incidence angle [rad].
+    k2 : float
+        Lobe shift [rad].
+    k3 : float
+        Lobe 1/e half-width [rad], > 0.
+
+    Returns
+    -------
+    ndarray
+        I [1], in (0, 1).
+    """
+    if not k3 > 0:
+        raise ValueError(f"k3 must be > 0 [rad]; got {k3!r}")
+    c = np.asarray(theta_i, dtype=float) - k2
+    w = 0.5j * k3
+    diff = erf((math.pi / 2 - c) / k3 - w) - erf(-c / k3 - w)
+    return np.imag(k3 * np.exp(1j * c - k3**2 / 4) * (math.sqrt(math.pi) / 2) * diff)
+
+
+def smooth3_hemispherical(
+    theta_i_deg: ArrayLike, k1: float, k2: float, k3: float
+) -> NDArray[np.float64]:
+    """Closed-form directional-hemispherical reflectance of the smooth3 model.
+
+    ``rho(ti) = 2 pi int_0^{pi/2} R cos(tr) sin(tr) d tr = pi k1 I(ti) / (4 cos ti)``
+    with R of eq. (7) of Zou et al. (2013) taken as an azimuth-independent BRDF and ``I`` from
+    :func:`smooth3_lobe_integral`.
+
+    Parameters
+    ----------
+    theta_i_deg : array_like
+        Incidence angle [deg], in [0, 90).
+    k1 : float
+        Amplitude [1].
+    k2, k3 : float
+        Lobe shift and 1/e half-width [rad].
+
+    Returns
+    -------
+    ndarray
+        rho [1] (a fraction).
+
+    Notes
+    -----
+    The paper's eq. (8) bounds this by ``2 pi k1 / 8`` and concludes that ``k1 <= 4/pi``
+    conserves energy; that holds at normal incidence only (docs/models.md 1.4; see
+    :func:`labbrdf.integrate.k1_max_energy`).
+    """
+    t = np.asarray(theta_i_deg, dtype=float)
+    if not np.all(np.isfinite(t)) or np.any(t < 0) or np.any(t >= 90):
+        raise ValueError(f"theta_i_deg must be finite and in [0, 90) degrees; got {theta_i_deg!r}")
+    ti = np.radians(t)
+    return math.pi * k1 * smooth3_lobe_integral(ti, k2, k3) / (4.0 * np.cos(ti))
+
+
+def guess_smooth3(ti: NDArray, tr: NDArray, y: NDArray) -> dict[str, float]:
+    """Starting values for smooth3 from a quadratic fit of log(8 y cos ti cos tr) in ti - tr.
+
+    Eq. (7) of Zou et al. (2013) is log-quadratic in d = ti - tr [rad]:
+    ``log(8 R cos ti cos tr) = (log k1 - k2^2/k3^2) + (2 k2/k3^2) d - d^2/k3^2``, so an
+    ordinary least-squares parabola gives (k1, k2, k3) when its curvature is negative.
+    Returns {} when it is not (noise-dominated scans).
+    """
+    ok = y > 0
+    if ok.sum() < 4:
+        return {}
+    d = (ti - tr)[ok]
+    if np.ptp(d) == 0:
+        return {}
+    z = np.log(8 * y[ok] * np.cos(ti[ok]) * np.cos(tr[ok]))
+    a2, a1, a0 = np.polyfit(d, z, 2)
+    if not a2 < 0:
+        return {}
+    k3 = 1.0 / math.sqrt(-a2)
+    k2 = a1 * k3**2 / 2
+    k1 = math.exp(a0 + (k2 / k3) ** 2)
+    return {"k1": k1, "k2": k2, "k3": k3} if math.isfinite(k1) else {}
+
+
 class Smooth3(Model):
     """3-parameter smooth-sample model, eq. (7) of Zou, Bai, Wu 2013.
 
@@ -78,6 +167,9 @@ class Smooth3(Model):
     )
     doi = "10.3788/AOS201333.0612008"
     linear = ("k1",)
+    # on theta_r == theta_i only k1 exp(-k2^2/k3^2) is identifiable (docs/models.md 1.1)
+    specular_line_shape = ("k2", "k3")
+    reciprocity_note = "smooth3 is reciprocal only for k2 = 0."
 
     def __init__(self, **options: Any) -> None:
         if options:
@@ -134,6 +226,17 @@ class Smooth3(Model):
     def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:
         """True iff ``k2 == 0`` (docs/models.md 1.3)."""
         return self.values(params)["k2"] == 0.0
+
+    def guess(self, theta_i: NDArray, theta_r: NDArray, value: NDArray) -> dict[str, float]:
+        """A parabola through log R in ``theta_i - theta_r`` (:func:`guess_smooth3`)."""
+        return guess_smooth3(theta_i, theta_r, value)
+
+    def hemispherical(
+        self, theta_i_deg: ArrayLike, params: Mapping[str, float] | None = None
+    ) -> NDArray[np.float64]:
+        """The closed form :func:`smooth3_hemispherical` (docs/models.md 1.2)."""
+        p = self.values(params)
+        return smooth3_hemispherical(theta_i_deg, p["k1"], p["k2"], p["k3"])
 
 
 def _check_k3(k3: float) -> None:

@@ -39,10 +39,12 @@ __all__ = [
     "fmt",
     "headline",
     "jsonable",
+    "not_applicable",
     "num",
     "resolve",
     "slug",
     "tables_csv",
+    "tally",
     "wl_label",
     "write_report",
 ]
@@ -121,9 +123,13 @@ def slug(s: str) -> str:
     return "".join(c if c.isalnum() else "_" for c in s)[:40] or "sample"
 
 
-def wl_label(x: float) -> str:
-    """A wavelength for text: ``"550 nm"``."""
-    return f"{x:g} nm"
+def wl_label(x: float, *, stated: bool = True) -> str:
+    """A wavelength for text: ``"550 nm"``, or "wavelength not stated".
+
+    ``stated=False``: ``x`` is only a label (a file that states no wavelength,
+    ``meta["wavelength_stated"]`` False).
+    """
+    return f"{x:g} nm" if stated else "wavelength not stated"
 
 
 # --------------------------------------------------------------------------- builder
@@ -340,23 +346,26 @@ class Builder:
 
     # ---- finish
     def finish(self) -> int:
-        """Fill the summary; return the exit code (1 if any check failed)."""
-        counts = {s: 0 for s in STATUSES}
-        for c in self.results["checks"]:
-            counts[c["status"]] += 1
+        """Fill the summary; return the exit code (1 if any check failed).
+
+        ``summary`` is :func:`tally` of the checks plus ``exit_code`` and ``headline``
+        (made from that same tally); ``not_applicable`` lists the sections that did not
+        apply (:func:`not_applicable`), which the page shows once, together.
+        """
+        counts = tally(self.results["checks"])
         code = 1 if counts["fail"] else 0
         self.results["summary"] = {
             **counts,
-            "total": sum(counts.values()),
             "exit_code": code,
-            "headline": headline(self.results["checks"]),
+            "headline": headline(counts),
         }
+        self.results["not_applicable"] = not_applicable(self.results)
         self.results["meta"]["elapsed_s"] = round(time.perf_counter() - self._t0, 3)
         return code
 
 
-def headline(checks: Sequence[Mapping[str, Any]]) -> str:
-    """The page's one-line verdict: what was checked, never "pass" when nothing was.
+def tally(checks: Sequence[Mapping[str, Any]]) -> dict[str, int]:
+    """The one count of a report's checks, used by its summary, headline and page.
 
     Parameters
     ----------
@@ -365,17 +374,75 @@ def headline(checks: Sequence[Mapping[str, Any]]) -> str:
 
     Returns
     -------
-    str
-        ``"3 checks passed, 0 failed, 5 not applicable"``; ``"nothing checked (...)"`` when
-        no substantive check passed or failed.
+    dict
+        ``pass``, ``fail``, ``skipped`` (one per check), ``total``, and ``bookkeeping``:
+        the passes that are bookkeeping (``substantive=False``, e.g. "every file was
+        read"), included in ``pass``.
     """
-    sub = [c for c in checks if c.get("substantive", True)]
-    passed = sum(c["status"] == "pass" for c in sub)
-    failed = sum(c["status"] == "fail" for c in checks)
-    na = sum(c["status"] == "skipped" for c in checks)
-    if passed + failed == 0:
-        return f"nothing checked ({na} not applicable)"
-    return f"{passed} checks passed, {failed} failed, {na} not applicable"
+    counts = {s: 0 for s in STATUSES}
+    for c in checks:
+        counts[c["status"]] += 1
+    return {
+        **counts,
+        "total": len(checks),
+        "bookkeeping": sum(
+            c["status"] == "pass" and not c.get("substantive", True) for c in checks
+        ),
+    }
+
+
+def headline(counts: Mapping[str, int] | Sequence[Mapping[str, Any]]) -> str:
+    """The page's one-line verdict: what was checked, never "pass" when nothing was.
+
+    Parameters
+    ----------
+    counts : mapping or sequence of mappings
+        A :func:`tally`, or the checks to tally.
+
+    Returns
+    -------
+    str
+        ``"4 checks passed (2 of them bookkeeping), 1 failed, 6 not applicable"``, every
+        number that of the tally; ``"nothing checked beyond bookkeeping (...)"`` when only
+        bookkeeping checks passed and none failed.
+    """
+    t = counts if isinstance(counts, Mapping) else tally(counts)
+    passed, book, failed, na = t["pass"], t["bookkeeping"], t["fail"], t["skipped"]
+    plural = "check" if passed == 1 else "checks"
+    book_text = f" ({book} of them bookkeeping)" if book else ""
+    if passed - book + failed == 0:
+        return (
+            f"nothing checked beyond bookkeeping ({passed} bookkeeping {plural}, "
+            f"{na} not applicable)"
+        )
+    return f"{passed} {plural} passed{book_text}, {failed} failed, {na} not applicable"
+
+
+def not_applicable(results: Mapping[str, Any]) -> list[dict[str, Any]]:
+    """The sections that did not apply.
+
+    A section did not apply when it is not available and holds nothing but text and
+    skipped checks.
+
+    Returns
+    -------
+    list of dict
+        ``{"section", "title", "reason", "checks"}`` per such section (``checks``: indices
+        into ``results["checks"]``), in page order. The page lists them once, with their
+        reasons, instead of a section and a check table each.
+    """
+    out = []
+    for sec in results["sections"]:
+        if sec["status"] != "not available":
+            continue
+        idx = [it["index"] for it in sec["items"] if it["kind"] == "check"]
+        shown = [it for it in sec["items"] if it["kind"] not in ("check", "text", "heading")]
+        if shown or any(results["checks"][i]["status"] != "skipped" for i in idx):
+            continue
+        out.append(
+            {"section": sec["id"], "title": sec["title"], "reason": sec["reason"], "checks": idx}
+        )
+    return out
 
 
 # --------------------------------------------------------------------------- output

@@ -3,7 +3,7 @@
 Each section function (:mod:`labbrdf.report.sections`) takes the :class:`Context` and adds
 text, tables, figures and checks to its :class:`~labbrdf.report.builder.Builder`. Fits run
 through :func:`labbrdf.fitting.fit` and are kept as :class:`FitRecord` s built from
-:meth:`labbrdf.fitting.FitResult.summary` (a plain dict, so that it travels between
+:meth:`labbrdf.FitResult.summary` (a plain dict, so that it travels between
 processes). The published tables of Zou, Bai, Wu (2013) are read here
 (:func:`load_published`).
 """
@@ -75,7 +75,7 @@ class FitRecord:
     sample: str
     wavelength_nm: float
     data: pd.DataFrame
-    #: :meth:`labbrdf.fitting.FitResult.summary` of the fit
+    #: :meth:`labbrdf.FitResult.summary` of the fit
     summary: dict[str, Any]
     values: dict[str, float]
     params: dict[str, ParamRecord]

@@ -1,4 +1,4 @@
-"""``labbrdf report DATA... --model NAME -o DIR``: the report for a user's own files.
+"""The report for a user's own files (``labbrdf report DATA --model NAME -o DIR``).
 
 The same kind of page as the validation report: what was ingested, a figure of every
 measured quantity per file, optical constants from psi/Delta with the Fresnel reflectance
@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import __version__, models
+from ..films import FilmModel
 from ..provenance import versions
 from . import html
 from .builder import Builder, Unavailable, write_report
@@ -57,6 +58,11 @@ def _brdf_scans(ctx: Context) -> bool:
     return True
 
 
+def _fitted(results: Mapping[str, Any]) -> bool:
+    """Whether a fit section ran: the specular fits or the BRDF fits."""
+    return any(s["id"] in ("fits", "brdf") and s["status"] == "ok" for s in results["sections"])
+
+
 def user_report(
     paths: Sequence[str | os.PathLike[str]],
     model: str,
@@ -71,7 +77,7 @@ def user_report(
     title: str | None = None,
     start: Mapping[str, float] | None = None,
     selection: Mapping[str, Any] | None = None,
-    film_model: str | os.PathLike[str] | None = None,
+    film_model: str | os.PathLike[str] | FilmModel | None = None,
     **kw: Any,
 ) -> int:
     """Build a report for the given files and write it (atomically) to ``out``.
@@ -94,17 +100,19 @@ def user_report(
     scheduler, workers :
         Executor for the fits (:mod:`labbrdf.parallel`); None runs in this process.
     title : str, optional
-        Page title.
+        Page title (default: "labbrdf report: <model> fits", or "... nothing fitted"
+        when no section could fit the model).
     start : mapping, optional
         Starting values of model parameters (name -> value) for every fit.
     selection : mapping, optional
         Rows to keep, as :func:`labbrdf.selection.select` takes them (``wavelength``,
         ``theta_i``, ``quantity``, ``sample``); applied to every file after reading.
-    film_model : path-like or "default", optional
-        A film model (TOML, :func:`labbrdf.films.load_model`) fitted to every psi/Delta
-        file whose angles of incidence disagree (section ``film``), or ``"default"``
-        for one transparent Cauchy layer on c-Si with the thickness free
-        (:func:`labbrdf.report.sections.film.default_film_model`). None: no film fit.
+    film_model : path-like or FilmModel, optional
+        A film model (a TOML file, :func:`labbrdf.films.load_model`, or a
+        :class:`~labbrdf.films.FilmModel`, e.g. the stated default of one transparent
+        Cauchy layer on c-Si with the thickness free,
+        :func:`labbrdf.report.sections.film.default_film_model`) fitted to every psi/Delta
+        file whose angles of incidence disagree (section ``film``). None: no film fit.
     **kw :
         ``quick`` is accepted for symmetry with :func:`~labbrdf.report.validate` (no effect).
 
@@ -129,13 +137,17 @@ def user_report(
         raise ValueError("paths: expected at least one data file")
     from ..outputs import check_report_dir
 
-    check_report_dir(out, inputs=paths)  # refused before the fits, not after
+    # the model file is an input too: never inside the replaced folder
+    model_file: list[str | os.PathLike[str]] = (
+        [Path(film_model)] if isinstance(film_model, (str, os.PathLike)) else []
+    )
+    check_report_dir(out, inputs=paths + model_file)  # refused before the fits, not after
     opts = dict(options or {})
     try:
         models.get(model, **opts)
     except Exception as exc:
         raise ValueError(f"model: {exc}") from None
-    film, film_how = film_model_of(None if film_model is None else str(film_model))
+    film, film_how = film_model_of(film_model)
     b = Builder(
         title or f"labbrdf report: {model} fits",
         progress=progress,
@@ -147,7 +159,7 @@ def user_report(
             "method": method,
             "seed": seed,
             "files": [str(p) for p in paths],
-            "film_model": None if film_model is None else str(film_model),
+            "film_model": film_how or None,
             "environment": versions(),
         },
     )
@@ -218,8 +230,10 @@ def user_report(
         ("surface", "Measured surface topography", surface_section),
     ]
     run(ctx, sections)
+    if title is None and not _fitted(b.results):
+        b.results["title"] = f"labbrdf report: {len(paths)} file(s), nothing fitted"
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
-    write_report(out, b.results, page, inputs=paths)
+    write_report(out, b.results, page, inputs=paths + model_file)
     b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
     return code

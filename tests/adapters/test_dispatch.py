@@ -160,3 +160,90 @@ def test_adapter_error_survives_pickling():
     assert (back.path, back.reason, back.line, back.unit, str(back)) == (
         "x.dat", "expected a number", 7, "byte", "x.dat, byte 7: expected a number",
     )  # fmt: skip
+
+
+# ------------------------------------------------------------ messages and refusals
+
+
+def test_messages_name_the_option_of_both_interfaces(tmp_path: Path) -> None:
+    """The CLI has --format, Python has format=: a message that tells to force a format
+    names both."""
+    p = tmp_path / "notes.csv"
+    p.write_text("hello,world\n1,2\n")
+    with pytest.raises(AdapterError) as exc:
+        labbrdf.read(p)
+    msg = str(exc.value)
+    assert "--format NAME on the command line" in msg and "format=NAME in Python" in msg
+    assert "pass format= to" not in msg
+
+
+def test_no_adapter_message_names_the_cli_listing(tmp_path: Path) -> None:
+    p = tmp_path / "data.xyz"
+    p.write_text("hello\n")
+    with pytest.raises(AdapterError, match=r"`labbrdf formats` \(labbrdf.adapters.formats\(\)"):
+        labbrdf.read(p)
+
+
+def test_unclaimed_ole2_container_is_named_as_such(tmp_path: Path, make_ole2) -> None:
+    p = tmp_path / "book.xls"
+    p.write_bytes(make_ole2({"Workbook": b"x" * 100}))
+    with pytest.raises(AdapterError, match=r"OLE2 compound document .* Shimadzu UVProbe .spc"):
+        labbrdf.read(p)
+
+
+def test_headerless_numbers_get_the_columns_hint(tmp_path: Path) -> None:
+    p = tmp_path / "spectrum.dat"
+    p.write_text("400\t0.1\n401\t0.2\n402\t0.3\n")
+    with pytest.raises(AdapterError, match=r"bare numbers: declare the columns with --columns"):
+        labbrdf.read(p)
+
+
+def test_binary_completeease_se_is_refused_with_what_to_do(tmp_path: Path) -> None:
+    p = tmp_path / "wafer.SE"
+    p.write_bytes(b"\x01\x00\x00\x00CompleteEASE\x00" + bytes(range(256)) * 4)
+    with pytest.raises(AdapterError, match=r"CompleteEASE binary .SE.*export it as text") as exc:
+        labbrdf.read(p)
+    assert str(p) in str(exc.value)
+
+
+def test_text_saved_as_se_is_read_by_its_content(real_exports: Path, tmp_path: Path) -> None:
+    src = real_exports / "woollam-completeease-ascii" / "complete_ease_example.dat"
+    p = tmp_path / "complete_ease_example.se"
+    p.write_bytes(src.read_bytes())
+    assert labbrdf.read(p).meta["format"] == labbrdf.read(src).meta["format"]
+
+
+def test_text_forced_as_completeease_se_says_to_read_it_by_content(tmp_path: Path) -> None:
+    p = tmp_path / "x.se"
+    p.write_text("just text\n")
+    with pytest.raises(AdapterError, match=r"is text, not a CompleteEASE binary .SE.*--format"):
+        labbrdf.read(p, format="woollam-completeease-se")
+
+
+def test_empty_se_is_refused_as_empty(tmp_path: Path) -> None:
+    p = tmp_path / "x.se"
+    p.write_bytes(b"")
+    with pytest.raises(AdapterError, match=r"the file is empty"):
+        labbrdf.read(p)
+
+
+def test_every_registered_format_is_listed_with_its_extensions() -> None:
+    names = {f["name"]: f for f in labbrdf.adapters.formats()}
+    for name, ext in [
+        ("shimadzu-uvprobe-text", ".txt"),
+        ("shimadzu-uvprobe-spc", ".spc"),
+        ("oceanoptics-text", ".txt"),
+        ("jasco-jws", ".jws"),
+        ("woollam-completeease-se", ".se"),
+    ]:
+        assert ext in names[name]["extensions"], name
+    assert names["columns"]["extensions"] == []
+
+
+def test_cli_formats_lists_the_new_formats(capsys) -> None:
+    from labbrdf.cli import main
+
+    assert main(["formats"]) == 0
+    out = capsys.readouterr().out
+    for name in ("shimadzu-uvprobe-text", "shimadzu-uvprobe-spc", "oceanoptics-text", "columns"):
+        assert name in out

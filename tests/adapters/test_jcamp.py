@@ -115,3 +115,101 @@ def test_unsupported_peak_table_is_refused_at_its_line(tmp_path: Path) -> None:
     p.write_bytes(_points("400, 10\n").replace(b"##XYPOINTS= (XY..XY)", b"##PEAK TABLE= (XY..XY)"))
     with pytest.raises(AdapterError, match=r"line 11: .*##PEAK TABLE= is not supported"):
         read_jcamp(p)
+
+
+# ----------------------------------------------------------------- units and end of file
+
+
+def _xypoints(xunits: str, yunits: str, pairs: str = "10,1\n20,2\n", tail: str = "") -> bytes:
+    return (
+        f"##TITLE= t\n##JCAMP-DX= 5.01\n##XUNITS= {xunits}\n##YUNITS= {yunits}\n"
+        f"##NPOINTS= 2\n##XYPOINTS= (XY..XY)\n{pairs}##END=\n{tail}"
+    ).encode()
+
+
+@pytest.mark.parametrize(
+    ("xunits", "factor"),
+    [
+        ("Wavelength (nm)", 1.0),
+        ("wavelength [nm]", 1.0),
+        ("Nanometers", 1.0),
+        ("Wavelength (µm)", 1000.0),
+        ("MICRONS", 1000.0),
+    ],
+)
+def test_spelled_out_wavelength_units_are_recognised(
+    tmp_path: Path, xunits: str, factor: float
+) -> None:
+    p = tmp_path / "u.jdx"
+    p.write_bytes(_xypoints(xunits, "ABSORBANCE"))
+    m = read_jcamp(p)
+    assert list(m.data["wavelength_nm"]) == [10 * factor, 20 * factor]
+
+
+@pytest.mark.parametrize("xunits", ["1/CM", "Wavenumber (cm-1)", "cm-1"])
+def test_wavenumbers_are_converted_to_wavelength(tmp_path: Path, xunits: str) -> None:
+    """lambda [nm] = 1e7 / nu [1/cm]: 4000 1/cm is 2500 nm, 10000 1/cm is 1000 nm."""
+    p = tmp_path / "ir.jdx"
+    p.write_bytes(_xypoints(xunits, "TRANSMITTANCE", "4000,0.5\n10000,0.25\n"))
+    m = read_jcamp(p)
+    assert list(m.data["wavelength_nm"]) == pytest.approx([2500.0, 1000.0], rel=1e-15)
+    assert list(m.data["value"]) == [0.5, 0.25]
+
+
+def test_spelled_out_percent_transmittance_is_divided_by_100(tmp_path: Path) -> None:
+    p = tmp_path / "t.jdx"
+    p.write_bytes(_xypoints("NANOMETERS", "Transmittance (%)", "10,50\n20,25\n"))
+    m = read_jcamp(p)
+    assert m.quantities == ["transmittance"]
+    assert list(m.data["value"]) == [0.5, 0.25]
+
+
+@pytest.mark.parametrize(
+    ("xunits", "yunits", "match"),
+    [
+        ("Time (s)", "ABSORBANCE", r"line 3: XUNITS 'Time \(s\)': expected a wavelength"),
+        ("NANOMETERS", "Absorbance (%)", r"line 4: YUNITS 'Absorbance \(%\)': expected one of"),
+        ("NANOMETERS", "COUNTS", r"line 4: YUNITS 'COUNTS'"),
+    ],
+)
+def test_unknown_units_are_refused_at_their_line(
+    tmp_path: Path, xunits: str, yunits: str, match: str
+) -> None:
+    p = tmp_path / "bad.jdx"
+    p.write_bytes(_xypoints(xunits, yunits))
+    with pytest.raises(AdapterError, match=match) as exc:
+        read_jcamp(p)
+    assert str(p) in str(exc.value)
+
+
+def test_zero_wavenumber_is_refused(tmp_path: Path) -> None:
+    p = tmp_path / "zero.jdx"
+    p.write_bytes(_xypoints("1/CM", "ABSORBANCE", "0,1\n10,2\n"))
+    with pytest.raises(AdapterError, match=r"line 6: a wavenumber \[1/cm\] <= 0"):
+        read_jcamp(p)
+
+
+@pytest.mark.parametrize("tail", ["\x1a", "\x1a\r\n", "\r\n\x1a"])
+def test_dos_end_of_file_byte_after_end_is_accepted(tmp_path: Path, tail: str) -> None:
+    p = tmp_path / "eof.jdx"
+    p.write_bytes(_xypoints("NANOMETERS", "ABSORBANCE", tail=tail))
+    assert len(read_jcamp(p)) == 2
+
+
+def test_dos_end_of_file_byte_on_the_real_file(real_exports: Path, tmp_path: Path) -> None:
+    p = tmp_path / "dupinc1.jdx"
+    p.write_bytes(_dupinc(real_exports) + b"\x1a")
+    assert read_jcamp(p).data.equals(read_jcamp(real_exports / JDX / "dupinc1.jdx").data)
+
+
+@pytest.mark.parametrize(
+    ("tail", "match"),
+    [("\x1ajunk\n", r"line 10: text after the last ##END="), ("\x1a\x1a", r"line 10: text after")],
+)
+def test_text_or_two_eof_bytes_after_end_are_still_refused(
+    tmp_path: Path, tail: str, match: str
+) -> None:
+    p = tmp_path / "tail.jdx"
+    p.write_bytes(_xypoints("NANOMETERS", "ABSORBANCE", tail=tail))
+    with pytest.raises(AdapterError, match=match):
+        read_jcamp(p)

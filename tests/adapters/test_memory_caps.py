@@ -120,3 +120,88 @@ def test_crafted_huge_count_raises_adaptererror_within_512_mb(
     out = _read_limited(fmt, path)
     assert out.startswith(f"AdapterError: {path}"), out
     assert expected in out, out
+
+
+# ------------------------------------------------------------ header strings
+
+
+_CHILD_TIMED = """
+import resource, sys, time
+resource.setrlimit(resource.RLIMIT_AS, ({limit}, {limit}))
+import labbrdf
+from labbrdf.adapters import AdapterError
+t = time.perf_counter()
+try:
+    m = labbrdf.read(sys.argv[1])
+except AdapterError as exc:
+    print("AdapterError:", str(exc)[:300])
+else:
+    print("rows", len(m), "sample", len(m.data["sample"].iloc[0]),
+          "meta_title", len(m.meta["blocks"][0]["title"]))
+print("seconds", time.perf_counter() - t)
+print("peak_mb", resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+"""
+
+#: 1 GiB of address space: the 5 MB title once per row (440 rows) needed 2.3 GB
+GIB = 1 << 30
+
+
+def test_five_megabyte_jcamp_title_reads_within_one_gib(tmp_path: Path) -> None:
+    """The title is the sample name: kept once (cut in the table), never once per row."""
+    title = "T" * 5_000_000
+    rows = "".join(f"{400 + 10 * i} {i % 7 + 1}\n" for i in range(440))
+    p = tmp_path / "title.jdx"
+    p.write_text(
+        f"##TITLE= {title}\n##JCAMP-DX= 4.24\n##XUNITS= NANOMETERS\n##YUNITS= ABSORBANCE\n"
+        f"##NPOINTS= 440\n##XYPOINTS= (XY..XY)\n{rows}##END=\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1"}
+    out = subprocess.run(
+        [sys.executable, "-c", _CHILD_TIMED.format(limit=GIB), str(p)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+    )
+    assert out.returncode == 0, out.stderr[-2000:]
+    lines = dict(line.split(" ", 1) for line in out.stdout.strip().splitlines())
+    assert lines["rows"].startswith("440 sample 512 meta_title 5000000"), out.stdout
+    # the table, one copy of the title in meta and the interpreter: far below the limit
+    assert float(lines["peak_mb"]) < 400, out.stdout
+
+
+def test_memory_error_in_a_reader_names_the_file(tmp_path: Path, monkeypatch) -> None:
+    from labbrdf import adapters
+
+    def exhausted(path):
+        raise MemoryError
+
+    fmt = adapters.READERS["jcamp-dx"]
+    monkeypatch.setitem(
+        adapters.READERS,
+        "jcamp-dx",
+        adapters.Format(fmt.name, fmt.description, fmt.extensions, fmt.sniff, exhausted),
+    )
+    p = tmp_path / "x.jdx"
+    p.write_text("##TITLE= t\n##JCAMP-DX= 4.24\n")
+    with pytest.raises(adapters.AdapterError, match=r"x.jdx: ran out of memory reading it as"):
+        adapters.read(p)
+
+
+def test_long_sample_names_are_cut_with_a_mark() -> None:
+    from labbrdf.dataset import MAX_NAME_CHARS, capped_name, make_frame
+
+    assert capped_name("short") == "short"
+    long = "x" * 10_000
+    cut = capped_name(long)
+    assert len(cut) == MAX_NAME_CHARS and cut.endswith("... [10000 characters, cut]")
+    f = make_frame(
+        sample=long,
+        instrument="i",
+        source="s",
+        quantity="absorbance",
+        value=[1.0, 2.0],
+        unit="1",
+        wavelength_nm=[400.0, 401.0],
+    )
+    assert set(f["sample"]) == {cut}

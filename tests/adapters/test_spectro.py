@@ -282,7 +282,8 @@ def test_dispatch_without_format_picks_our_adapter(real_exports: Path) -> None:
             assert via_read.meta["format"] == fmt, path.name
             n += 1
     # 13 of the first collection + "F4-P3HT 1-10 0,5 mgml.Probe.Raw.asc" (added later)
-    assert n == 14
+    # + the legacy (OLE2) "legacy_trans_512.jws"
+    assert n == 15
 
 
 def test_our_sniffers_claim_exactly_our_own_real_files(real_exports: Path) -> None:

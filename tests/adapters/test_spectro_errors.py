@@ -146,7 +146,10 @@ def test_jws_modes_and_invalid_marker(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("data", "match"),
     [
-        (b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1" + b"\x00" * 600, r"byte 0: legacy Spectra Manager"),
+        (
+            b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1" + b"\x00" * 600,
+            r"Spectra Manager 1.x .jws: the OLE2 container is corrupt or truncated",
+        ),
         (b"MZ" + b"\x00" * 2000, r"byte 0: expected the JASCO magic"),
         (jws()[:0x500], r"byte 1280: file is 1280 bytes, shorter than the 1856-byte header"),
         (jws()[:-1], r"byte 132: file is 1867 bytes but NPOINTS 3 needs 1868"),
@@ -358,7 +361,7 @@ LINK = "##TITLE= outer\n##JCAMP-DX= 4.24\n##DATA TYPE= LINK\n##BLOCKS= 2\n"
         (jdx(extra="##XUNITS= NM\n"), r"line 11: label ##XUNITS= repeated in one block"),
         (jdx(extra="##DELTAX= 2\n"), r"DELTAX 2 disagrees with \(LASTX - FIRSTX\)"),
         (jdx(yunits="COUNTS"), r"YUNITS 'COUNTS': expected one of"),
-        (jdx().replace(b"NANOMETERS", b"1/CM"), r"XUNITS '1/CM': expected one of"),
+        (jdx().replace(b"NANOMETERS", b"SECONDS"), r"line 4: XUNITS 'SECONDS': expected a wave"),
         (jdx().replace(b"(X++(Y..Y))", b"(XY..XY)"), r"only \(X\+\+\(Y..Y\)\) is supported"),
         (jdx().replace(b"##XYDATA", b"##PEAK TABLE"), r"block has no ##XYDATA= table"),
         (jdx().replace(b"##NPOINTS= 6\n", b""), r"block has no ##NPOINTS= record"),
@@ -468,11 +471,22 @@ def test_spc_errors(tmp_path: Path, data: bytes, match: str) -> None:
     assert str(p) in str(exc.value)
 
 
-def test_spc_subheader_point_count_must_match(tmp_path: Path) -> None:
+def test_spc_subheader_point_count_is_not_checked_with_a_shared_x_axis(tmp_path: Path) -> None:
+    """Galactic's specification uses subnpts only for TXYXYS files (each subfile its own X).
+
+    With one shared X axis a writer may leave any value there; the file size, checked
+    against fnpts, is what says the data are whole.
+    """
+    good = read_spc(write(tmp_path, "good.spc", spc()))
     data = bytearray(spc())
     struct.pack_into("<i", data, 512 + 16, 7)
-    with pytest.raises(AdapterError, match=r"byte 528: subfile 0: subnpts 7 disagrees"):
-        read_spc(write(tmp_path, "bad.spc", bytes(data)))
+    odd = read_spc(write(tmp_path, "odd.spc", bytes(data)))
+    cols = ["value", "wavelength_nm", "quantity", "sample"]
+    assert odd.data[cols].equals(good.data[cols])
+    assert odd.meta["subfiles"][0]["subnpts"] == 7
+    # the size still decides: one byte less is refused
+    with pytest.raises(AdapterError, match=r"bad.spc, byte \d+: file is"):
+        read_spc(write(tmp_path, "bad.spc", bytes(data[:-1])))
 
 
 @pytest.mark.parametrize(

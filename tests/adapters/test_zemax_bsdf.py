@@ -53,10 +53,13 @@ def test_real_counts_and_ranges(real):
     assert m.meta["symmetry"] == "PlaneSymmetrical" and "phi_r -> 360 - phi_r" in m.meta["mirror"]
     below = {t: sum(cos_theta_r(t, r, a) <= 1e-12 for a in AZ for r in RAD) for t in AOI}
     per = m.data.groupby("theta_i_deg").size().to_dict()
-    assert per == {float(t): 19 * 11 - below[t] for t in AOI}
-    assert per[15.0] == 204 and per[75.0] == 153
+    # the pole (radial 0) is one direction: one row per incidence, not one per azimuth
+    assert per == {float(t): 19 * 11 - below[t] - 18 for t in AOI}
+    assert per[15.0] == 186 and per[75.0] == 135
     assert m.meta["dropped_below_horizon"] == sum(below.values()) == 352
-    assert len(m) == 13 * 19 * 11 - 352 == 2365
+    assert m.meta["pole"]["repeats_left_out"] == 13 * 18
+    assert m.meta["pole"]["max_spread_sr-1"] == 0.0  # the file repeats one value
+    assert len(m) == 13 * 19 * 11 - 352 - 13 * 18 == 2131
     assert m.data.theta_r_deg.min() == 0.0 and 89.8 < m.data.theta_r_deg.max() < 90.0
     assert set(m.data.quantity.astype(str)) == {"brdf"} and set(m.data.unit) == {"sr-1"}
     assert m.meta["wavelength_stated"] is False and (m.data.wavelength_nm == 555.0).all()
@@ -68,7 +71,7 @@ def test_real_spot_values(real):
     m = labbrdf.read(real)
     # line 19 (AOI 15, azimuth 0): "6.375E-02	6.180E-02	5.879E-02	5.529E-02	5.190E-02 ...
     #   ... 3.304E-02	3.219E-02"
-    assert row(m, 15, 15, 180).value.tolist() == [0.06375] * 19  # specular, every azimuth
+    assert row(m, 15, 15, 180).value.tolist() == [0.06375]  # specular, written per azimuth
     assert row(m, 15, 5, 180).value.tolist() == [0.05879]  # radial 10: theta_s - r
     (v,) = row(m, 15, 5, 0).value  # radial 20 crosses the normal: |15 - 20|, phi 0
     assert v == 0.05190
@@ -216,14 +219,20 @@ def test_round_trip(tmp_path, var, seed):
     _, _, above = zb.scatter_to_angles(
         ti[:, None, None], rad[None, None, :], v["az"][None, :, None]
     )
-    assert len(m) == above.sum() * shape[0] * shape[1]
+    # the pole (radial 0) once per block, not once per azimuth
+    pole_repeats = (v["az"].size - 1) * ti.size
+    assert len(m) == (above.sum() - pole_repeats) * shape[0] * shape[1]
     q = "btdf" if v.get("t") == "BTDF" else "brdf"
     assert set(m.data.quantity.astype(str)) == {q}
     if v["nch"] == 3:
         assert sorted(set(m.data.channel)) == ["X", "Y", "Z"]
     if len(v["rot"]) > 1:
         assert sorted(set(m.data.sample_rotation_deg)) == sorted(map(float, v["rot"]))
-    assert np.array_equal(zb.grid_integral(m)["integral"], zb.grid_integral(t)["integral"] * 1)
+    # the pole's random per-azimuth values become their cell-weighted mean: same integral
+    # up to the rounding of that mean
+    assert np.allclose(
+        zb.grid_integral(m)["integral"], zb.grid_integral(t)["integral"], rtol=1e-13, atol=0
+    )
 
 
 def test_writer_refuses_overwrite_and_leaves_no_temp(tmp_path):
@@ -307,6 +316,55 @@ def test_good_minimal_file(tmp_path):
     alt = GOOD.replace(" ", "\t").replace("\n", "\r\n").replace("DataEnd\r\n", "")
     t2 = zb.read_table(_write(tmp_path, alt, "f.bsdf"))
     assert np.array_equal(t.values, t2.values)
+
+
+def test_pole_is_one_row_per_incidence_with_the_cap_average(tmp_path):
+    # GOOD's pole values are equal per block (1 and 4): kept once, unchanged
+    m = labbrdf.read(_write(tmp_path, GOOD))
+    pole = m.data[m.data.theta_r_deg == m.data.theta_i_deg]
+    assert pole.value.tolist() == [1.0, 4.0] and len(m) == 2 * (2 * 3 - 1)
+    assert m.meta["pole"]["repeats_left_out"] == 2
+    # azimuths 0 and 180 of a PlaneSymmetrical file: cells of 90 deg each, so the mean
+    m = labbrdf.read(_write(tmp_path, GOOD.replace("4 5 6\n4 5 6", "4 5 6\n8 5 6"), "b.bsdf"))
+    pole = m.data[m.data.theta_r_deg == m.data.theta_i_deg]
+    assert pole.value.tolist() == [1.0, 6.0]
+    assert m.meta["pole"]["max_spread_sr-1"] == 4.0
+    # unequal cells (azimuths 0, 30, 180: widths 15, 90, 75 deg) weight the values
+    text = GOOD.replace("ScatterAzimuth 2\n0 180", "ScatterAzimuth 3\n0 30 180")
+    text = text.replace("1 2 3\n1 2 3", "1 2 3\n1 2 3\n7 2 3")
+    text = text.replace("4 5 6\n4 5 6", "4 5 6\n4 5 6\n4 5 6")
+    m = labbrdf.read(_write(tmp_path, text, "c.bsdf"))
+    pole = m.data[m.data.theta_r_deg == m.data.theta_i_deg]
+    assert np.allclose(pole.value, [(1 * 15 + 1 * 90 + 7 * 75) / 180, 4.0], rtol=1e-15)
+    # back on the grid: the pole value at every azimuth
+    t = zb._table_from_measurement(m)
+    assert np.allclose(t.values[0, 0, 0, :, 0], (15 + 90 + 7 * 75) / 180, rtol=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("comment", "wl"),
+    [("#Wavelength (nm) = 550.0", 550.0), ("#labbrdf wavelength_nm 632.8", 632.8)],
+)
+def test_wavelength_comment_is_read(tmp_path, comment, wl):
+    m = labbrdf.read(_write(tmp_path, f"{comment}\n{GOOD}"))
+    assert (m.data.wavelength_nm == wl).all() and m.meta["wavelength_stated"] is True
+    m = labbrdf.read(_write(tmp_path, GOOD, "none.bsdf"))
+    assert m.meta["wavelength_stated"] is False
+
+
+@pytest.mark.parametrize(
+    ("comments", "msg", "line"),
+    [
+        ("#Wavelength (nm) = green", "wavelength comment: expected an ASCII decimal", 1),
+        ("#Wavelength (nm) = -550", "expected a wavelength > 0", 1),
+        ("#Wavelength (nm) = 550\n#Wavelength (nm) = 600", "earlier one 550 nm", 2),
+    ],
+)
+def test_bad_wavelength_comment_names_the_line(tmp_path, comments, msg, line):
+    p = _write(tmp_path, f"{comments}\n{GOOD}")
+    with pytest.raises(AdapterError, match=msg) as exc:
+        labbrdf.read(p)
+    assert exc.value.line == line and exc.value.path == str(p)
 
 
 HUGE = (

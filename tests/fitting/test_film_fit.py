@@ -210,3 +210,18 @@ def test_bad_fit_requests_raise_film_errors(kw, match):
     data = _psi_delta(TRUE, np.random.default_rng(0))
     with pytest.raises(FilmError, match=match):
         fit_film(TRUE, data, **kw)
+
+
+def test_cross_polarisation_rows_are_left_out_and_odd_channels_refused():
+    rng = np.random.default_rng(2)
+    data = _psi_delta(TRUE, rng, wl=np.linspace(400, 900, 10))
+    data["channel"] = None
+    cross = data.copy()
+    cross["channel"] = "ps"  # generalised ellipsometry: not a two-phase psi/Delta
+    cross["value"] = 0.0
+    box = {"film.thickness_nm": (50.0, 150.0)}
+    f = fit_film(FilmModel(TRUE, box), pd.concat([data, cross], ignore_index=True))
+    assert f.result.ndata == len(data)
+    odd = _rows("reflectance", np.array([500.0]), 60.0, np.array([0.3]), 0.01, "x")
+    with pytest.raises(FilmError, match="channel \\['x'\\]; expected s, p or none"):
+        fit_film(FilmModel(TRUE, box), [data, odd])

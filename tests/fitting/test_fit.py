@@ -20,9 +20,10 @@ from scipy import integrate, optimize, special, stats
 
 from labbrdf.dataset import Measurement, make_frame
 from labbrdf.fitting import FitData, FitError, fit, fit_many, parse_method
-from labbrdf.fitting.objective import _bounded_lsq, _guess_smooth3
+from labbrdf.fitting.objective import _bounded_lsq
 from labbrdf.fitting.result import _fmt_ci, _fmt_unc
 from labbrdf.models import Model, ModelError, Parameters, get
+from labbrdf.models.smooth3 import guess_smooth3
 
 #: Zou 2013 Table 1 (OSR) and Table 2 (mirror): wavelength [nm] -> (k1, k2 [rad], k3 [rad])
 ZOU2013 = {
@@ -160,7 +161,7 @@ def test_smooth3_guess_is_exact_on_noise_free_data(sample: str, wl: int) -> None
     # round-off (float64 log of values ~0.1-1: ~1e-15, amplified by the polyfit conditioning)
     k = ZOU2013[sample][wl]
     ti, tr, y = smooth3_truth(k)
-    g = _guess_smooth3(np.radians(ti), np.radians(tr), y)
+    g = guess_smooth3(np.radians(ti), np.radians(tr), y)
     assert [g[n] for n in NAMES] == pytest.approx(k, rel=1e-6)
 
 

@@ -11,7 +11,7 @@ import pytest
 
 from labbrdf.cli import main
 from labbrdf.dataset import Measurement, make_frame, write_csv
-from labbrdf.report.sections.film import DEFAULT_MODEL, default_film_model, film_model_of
+from labbrdf.report.sections.film import default_film_model, film_model_of
 from labbrdf.report.user import user_report
 
 # the synthetic sample: 120 nm of Cauchy n = 1.46 + 0.004/lambda^2 [um] on n = 3.9 + 0.02i
@@ -137,7 +137,7 @@ def test_no_model_says_how_to_give_one(tmp_path: Path) -> None:
     res = json.loads((tmp_path / "rep" / "results.json").read_text())
     film = next(s for s in res["sections"] if s["id"] == "film")
     assert film["status"] == "not available"
-    assert "--film-model FILE.toml" in film["reason"] and DEFAULT_MODEL in film["reason"]
+    assert "--film-model FILE.toml" in film["reason"] and "--film-default" in film["reason"]
     assert res["summary"]["exit_code"] == 0
 
 
@@ -149,7 +149,7 @@ def test_default_model_is_cauchy_on_silicon_with_thickness_free() -> None:
     assert {"film.A", "film.B"} <= set(fm.free) and "film.C" not in fm.free
     assert fm.wavelength_range_nm == (250.0, 1450.0)
     assert film_model_of(None) == (None, "")
-    assert film_model_of(DEFAULT_MODEL)[1].startswith("the default model")
+    assert film_model_of(fm) == (fm, fm.source)
 
 
 @pytest.mark.parametrize(

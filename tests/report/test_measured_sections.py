@@ -121,7 +121,7 @@ def test_headline_of_only_skipped_checks_does_not_say_pass(
     assert "pass" not in top.lower().replace('class="', "")
     assert "nothing checked" in top
     assert headline([{"status": "pass"}, {"status": "skipped"}]) == (
-        "1 checks passed, 0 failed, 1 not applicable"
+        "1 check passed, 0 failed, 1 not applicable"
     )
 
 

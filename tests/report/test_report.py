@@ -530,3 +530,106 @@ def test_save_trace_maps_png_writes_a_png(tmp_path):
     res = SimpleNamespace(mueller=m, theta_r_edges_deg=th[:32], phi_r_edges_deg=ph)
     p = save_trace_maps_png(res, tmp_path / "maps.png")
     assert p.read_bytes().startswith(PNG_MAGIC)
+
+
+# --------------------------------------------------------------------------- one count
+
+
+def _page_tally(page: Path) -> dict[str, int]:
+    """Statuses of the checks as the page shows them (one element per check)."""
+    p = _parse(page)
+    shown = [a for _, a in p.tags if str(a.get("id") or "").startswith("check-")]
+    ids = [a["id"] for a in shown]
+    assert len(ids) == len(set(ids)), "a check is shown twice"
+    return {s: sum(a.get("data-status") == s for a in shown) for s in _common.STATUSES}
+
+
+def _headline_numbers(text: str) -> dict[str, int]:
+    m = re.fullmatch(
+        r"(\d+) checks? passed(?: \((\d+) of them bookkeeping\))?, (\d+) failed, "
+        r"(\d+) not applicable",
+        text,
+    ) or re.fullmatch(
+        r"nothing checked beyond bookkeeping \((\d+) bookkeeping checks?, (\d+) not applicable\)",
+        text,
+    )
+    assert m is not None, text
+    g = [int(x) if x is not None else 0 for x in m.groups()]
+    if len(g) == 2:
+        return {"pass": g[0], "bookkeeping": g[0], "fail": 0, "skipped": g[1]}
+    return {"pass": g[0], "bookkeeping": g[1], "fail": g[2], "skipped": g[3]}
+
+
+def _assert_one_count(out: Path, res: dict) -> None:
+    summary = res["summary"]
+    t = _common.tally(res["checks"])
+    assert {k: summary[k] for k in t} == t
+    assert summary["total"] == len(res["checks"]) == t["pass"] + t["fail"] + t["skipped"]
+    assert _headline_numbers(summary["headline"]) == {
+        k: t[k] for k in ("pass", "bookkeeping", "fail", "skipped")
+    }
+    assert _page_tally(out / "index.html") == {s: t[s] for s in _common.STATUSES}
+    rows = (out / "tables" / "checks.csv").read_text().splitlines()[1:]
+    assert len(rows) == t["total"]
+
+
+def test_validation_report_headline_page_and_results_json_count_alike(quick_report):
+    _, out, res = quick_report
+    assert res["summary"]["bookkeeping"] >= 1  # the case that made the counts differ
+    _assert_one_count(out, res)
+
+
+def test_user_report_that_fits_nothing_counts_alike_and_lists_what_did_not_apply(
+    tmp_path, fixtures_dir
+):
+    f = fixtures_dir / "spectrophotometer" / "osr_sphere_cary.csv"  # no BRDF rows
+    out = tmp_path / "r"
+    report.user_report([f], "smooth3", out, progress=False)
+    res = json.loads((out / "results.json").read_text())
+    _assert_one_count(out, res)
+    assert res["summary"]["bookkeeping"] >= 1
+    # nothing was fitted: the title does not promise smooth3 fits
+    assert res["title"] == "labbrdf report: 1 file(s), nothing fitted"
+    page = (out / "index.html").read_text()
+    assert "<title>labbrdf report: 1 file(s), nothing fitted</title>" in page
+    # the sections that did not apply are listed once, with their reasons, not one
+    # section and one check table each
+    na = {n["section"]: n for n in res["not_applicable"]}
+    assert {"fits", "scans", "spectra", "physics", "brdf", "surface"} <= set(na)
+    assert page.count('id="not-applicable"') == 1
+    for sid, n in na.items():
+        assert f'id="sec-{sid}"' not in page
+        assert n["reason"] and n["reason"] in page.replace("&#39;", "'")
+    assert page.count("<h3>Checks</h3>") == sum(
+        1
+        for s in res["sections"]
+        if s["id"] not in na and any(it["kind"] == "check" for it in s["items"])
+    )
+
+
+def test_user_report_with_fits_keeps_its_model_title(tmp_path):
+    f = _scan_file(tmp_path / "scan.csv", "tile 7", "plain")
+    out = tmp_path / "r"
+    assert report.user_report([f], "smooth3", out, progress=False) == 0
+    res = json.loads((out / "results.json").read_text())
+    assert res["title"] == "labbrdf report: smooth3 fits"
+    _assert_one_count(out, res)
+
+
+def test_headline_counts_bookkeeping_passes_and_says_nothing_checked_without_others():
+    checks = [
+        {"status": "pass", "substantive": False},
+        {"status": "pass"},
+        {"status": "fail"},
+        {"status": "skipped"},
+    ]
+    t = _common.tally(checks)
+    assert t == {"pass": 2, "fail": 1, "skipped": 1, "total": 4, "bookkeeping": 1}
+    assert _common.headline(t) == _common.headline(checks)
+    assert _common.headline(t) == "2 checks passed (1 of them bookkeeping), 1 failed, " + (
+        "1 not applicable"
+    )
+    only = [checks[0], checks[3]]
+    assert _common.headline(only) == (
+        "nothing checked beyond bookkeeping (1 bookkeeping check, 1 not applicable)"
+    )

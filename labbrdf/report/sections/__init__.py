@@ -30,13 +30,14 @@ module                    section id(s)
 from __future__ import annotations
 
 from collections.abc import Callable, Container, Sequence
+from typing import TypeAlias
 
 from ..context import Context
 
 __all__ = ["Section", "run"]
 
 #: one section of a workflow: id (the module's name), title, function of the Context
-Section = tuple[str, str, Callable[[Context], object]]
+Section: TypeAlias = tuple[str, str, Callable[[Context], object]]
 
 
 def run(ctx: Context, sections: Sequence[Section], only: Container[str] | None = None) -> None:

@@ -22,15 +22,6 @@ __all__ = ["brdf_section", "brdf_fit_options", "energy_rows"]
 
 #: rows closer than this to the plane of incidence count as in-plane [deg]
 IN_PLANE_TOL_DEG = 1e-6
-#: what each model's form says about reciprocity (Helmholtz: f(i, o) = f(o, i))
-RECIPROCITY_NOTE = {
-    "microfacet": "microfacet is reciprocal by construction (the GGX term "
-    "F D G1 G1 / (4 cos\u03b8i cos\u03b8r) and the Lambertian kd / pi are symmetric in the "
-    "two directions).",
-    "five_param": "five_param is not reciprocal in general: its diffuse term k_d / cos\u03b8i "
-    "depends on the incidence direction alone; it is reciprocal only for k_d = 0.",
-    "smooth3": "smooth3 is reciprocal only for k2 = 0.",
-}
 #: direction pairs (theta_a, theta_b, phi) [deg] of the reciprocity table
 RECIP_PAIRS = ((15.0, 45.0, 180.0), (30.0, 60.0, 180.0), (20.0, 70.0, 90.0), (45.0, 10.0, 135.0))
 
@@ -302,7 +293,7 @@ def _fits_table(
     opts = ", ".join(f"{k}={v}" for k, v in options.items()) or "defaults"
     b.table(
         "brdf_fits",
-        f"{model} ({opts}) fitted per angle of incidence and jointly{_one_group(fits)}",
+        f"{model} ({opts}) fitted per angle of incidence and jointly{_one_group(ctx, fits)}",
         cols,
         out,
         caption=f"Measured: the BRDF rows of each incidence angle \u03b8i ('joint': all angles "
@@ -336,13 +327,31 @@ def _group_cols(fits: Sequence[tuple[float | None, FitRecord]]) -> list[tuple[st
     return [("sample", "sample", ""), ("wavelength_nm", "\u03bb [nm]", "g")]
 
 
-def _one_group(fits: Sequence[tuple[float | None, FitRecord]]) -> str:
+def _one_group(ctx: Context, fits: Sequence[tuple[float | None, FitRecord]]) -> str:
     """Title suffix "(sample, wavelength)" when all fits share them, else empty."""
     keys = {(r.sample, r.wavelength_nm) for _, r in fits}
     if len(keys) != 1:
         return ""
     s, w = next(iter(keys))
-    return f" ({s}, {wl_label(w)})"
+    return f" ({s}, {_wl_text(ctx, s, w)})"
+
+
+def _wl_text(ctx: Context, sample: str, wl: float) -> str:
+    """``"550 nm"``, or "wavelength not stated" for a label.
+
+    The label case: every file of the sample at ``wl`` states no wavelength (a .bsdf file
+    without a wavelength comment).
+    """
+    unstated = {
+        Path(str(f.get("path", ""))).name
+        for f in ctx.files
+        if (f.get("meta") or {}).get("wavelength_stated") is False
+    }
+    d = ctx.data
+    if not unstated or d is None:
+        return wl_label(wl)
+    g = d[(d["sample"] == sample) & (d["wavelength_nm"] == wl)]
+    return wl_label(wl, stated=not (len(g) and g["source"].isin(unstated).all()))
 
 
 def _select(n: int) -> list[int]:
@@ -386,8 +395,8 @@ def _maps(
     if not any(off_plane):
         ctx.b.note(
             "hemisphere maps",
-            f"{sample}, {wl_label(wl)}: every row lies in the plane of incidence, so there is "
-            "no hemisphere to map; see the in-plane cuts",
+            f"{sample}, {_wl_text(ctx, sample, wl)}: every row lies in the plane of incidence, "
+            "so there is no hemisphere to map; see the in-plane cuts",
         )
         return
     panels = [p for p, ok in zip(panels, off_plane, strict=True) if ok]
@@ -404,7 +413,7 @@ def _maps(
         "direction at (-\u03b8i, 0); circles at \u03b8r = 30, 60, 90 deg. "
     )
     sel = _select(len(panels))
-    tag = f"{sample}, {wl_label(wl)}"
+    tag = f"{sample}, {_wl_text(ctx, sample, wl)}"
     ctx.b.figure(
         f"brdf_maps_{_slug(sample, wl)}",
         f"Measured BRDF, per-incidence fit and relative residual ({tag})",
@@ -469,7 +478,7 @@ def _cuts(
     if not panels:
         ctx.b.note("in-plane cuts", "no rows in the plane of incidence (\u03c6r = 0 or 180 deg)")
         return
-    tag = f"{sample}, {wl_label(wl)}"
+    tag = f"{sample}, {_wl_text(ctx, sample, wl)}"
     ctx.b.figure(
         f"brdf_cuts_{_slug(sample, wl)}",
         f"In-plane cuts with the fitted models ({tag})",
@@ -506,7 +515,7 @@ def _energy(ctx: Context, fits: Sequence[tuple[float | None, FitRecord]]) -> Non
     b.table(
         "brdf_energy",
         "Energy per angle of incidence: file TIS, grid integral of the data, model integral"
-        + _one_group(fits),
+        + _one_group(ctx, fits),
         cols,
         rows,
         caption="All values are fractions of the incident power. 'file TIS': the value the "
@@ -655,7 +664,7 @@ def _reciprocity(ctx: Context, fits: Sequence[tuple[float | None, FitRecord]]) -
         "(labbrdf.integrate.reciprocity_defect).",
     )
     name = fits[0][1].model
-    general = RECIPROCITY_NOTE.get(name, "")
+    general = models.MODELS[name].reciprocity_note if name in models.MODELS else ""
     b.text(
         (general + " " if general else "")
         + (

@@ -19,6 +19,7 @@ differences of the curve in each varying parameter, combined with the fit's cova
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from typing import Any
 
@@ -34,10 +35,7 @@ from ..context import Context
 from .measured import file_frames
 from .nk import P_AGREE
 
-__all__ = ["DEFAULT_MODEL", "default_film_model", "film_model_of", "film_section"]
-
-#: the argument of ``--film-model`` that asks for :func:`default_film_model`
-DEFAULT_MODEL = "default"
+__all__ = ["default_film_model", "film_model_of", "film_section"]
 
 #: most wavelengths on which layer n, k and their bands are drawn
 _NK_POINTS = 120
@@ -60,7 +58,7 @@ def default_film_model() -> films.FilmModel:
 
     One transparent Cauchy layer (thickness free in [0, 1000] nm) on crystalline silicon,
     fitted over the silicon table's 250-1450 nm; used only when asked for
-    (``--film-model default``).
+    (``labbrdf report --film-default``).
     """
     return films.FilmModel.cauchy_on_silicon()
 
@@ -354,8 +352,8 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
         names = ", ".join(s for s, _g, _v in flagged)
         raise Unavailable(
             f"{names}: pseudo-constants of a stack, and no film model given: give one with "
-            f"--film-model FILE.toml, or --film-model {DEFAULT_MODEL} for one transparent "
-            "Cauchy layer on crystalline silicon (thickness free)"
+            "--film-model FILE.toml, or --film-default for one transparent Cauchy layer on "
+            "crystalline silicon (thickness free)"
         )
     free = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in model.free.items())
     b.text(
@@ -475,15 +473,17 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
         )
 
 
-def film_model_of(arg: str | None) -> tuple[films.FilmModel | None, str]:
-    """The film model of a ``--film-model`` argument, and how it was given.
+def film_model_of(
+    model: str | os.PathLike[str] | films.FilmModel | None,
+) -> tuple[films.FilmModel | None, str]:
+    """The film model of a report, and how it was given.
 
-    ``None``: no model; :data:`DEFAULT_MODEL`: :func:`default_film_model`; anything else:
-    a TOML model file (:func:`labbrdf.films.load_model`; its errors name the file and the
-    line).
+    ``None``: no model; a :class:`~labbrdf.films.FilmModel` (e.g.
+    :func:`default_film_model`): itself; a path: a TOML model file
+    (:func:`labbrdf.films.load_model`; its errors name the file and the line).
     """
-    if arg is None:
+    if model is None:
         return None, ""
-    if arg == DEFAULT_MODEL:
-        return default_film_model(), "the default model: Cauchy on c-Si, thickness free"
-    return films.load_model(arg), f"model file {arg}"
+    if isinstance(model, films.FilmModel):
+        return model, model.source
+    return films.load_model(model), f"model file {model}"

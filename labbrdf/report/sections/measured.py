@@ -190,10 +190,14 @@ def _spectral_panels(
     return panels, xlabel
 
 
-def _ranges(g: pd.DataFrame) -> str:
+def _ranges(g: pd.DataFrame, wl_stated: bool = True) -> str:
     wl = g["wavelength_nm"]
     th = sorted({round(float(t), 2) for t in g["theta_i_deg"].dropna()})
-    parts = [f"\u03bb {wl.min():.4g}-{wl.max():.4g} nm ({wl.round(6).nunique()} wavelengths)"]
+    parts = [
+        f"\u03bb {wl.min():.4g}-{wl.max():.4g} nm ({wl.round(6).nunique()} wavelengths)"
+        if wl_stated
+        else f"wavelength not stated (labelled {wl.min():.4g} nm)"
+    ]
     if th:
         parts.append(
             "\u03b8i "
@@ -286,7 +290,7 @@ def _mueller_panels(g: pd.DataFrame) -> list[dict[str, Any]]:
     return panels
 
 
-def _brdf_panels(g: pd.DataFrame, q: str) -> list[dict[str, Any]]:
+def _brdf_panels(g: pd.DataFrame, q: str, wl_stated: bool = True) -> list[dict[str, Any]]:
     gq = g[g["quantity"] == q].assign(theta_i_deg=g["theta_i_deg"].round(2))
     panels = []
     for wl in _pick(sorted(gq["wavelength_nm"].unique()), 3):
@@ -296,7 +300,9 @@ def _brdf_panels(g: pd.DataFrame, q: str) -> list[dict[str, Any]]:
             x["style"] = "points"
         panels.append(
             {
-                "title": f"{QUANTITY_LABELS.get(q, q)} at {wl:g} nm",
+                "title": f"{QUANTITY_LABELS.get(q, q)} at {wl:g} nm"
+                if wl_stated
+                else f"{QUANTITY_LABELS.get(q, q)}, wavelength not stated",
                 "xlabel": "detector angle \u03b8r [deg] (all azimuths)",
                 "ylabel": _label(q, _unit(s)),
                 "logy": bool((s["value"] > 0).all()),
@@ -325,7 +331,9 @@ def _file(ctx: Context, i: int, src: str, g: pd.DataFrame, meta: Mapping[str, An
     if meta.get("reflectance_kind"):
         extra.append(str(meta["reflectance_kind"]))
     b.text(
-        f"{instr}: {', '.join(quantities)}; {_ranges(g)}; {len(g)} rows; 1-sigma given: "
+        f"{instr}: {', '.join(quantities)}; "
+        f"{_ranges(g, meta.get('wavelength_stated') is not False)}; {len(g)} rows; "
+        "1-sigma given: "
         + ("yes" if g["sigma"].notna().any() else "no")
         + (f"; {'; '.join(extra)}" if extra else "")
         + "."
@@ -384,7 +392,9 @@ def _file(ctx: Context, i: int, src: str, g: pd.DataFrame, meta: Mapping[str, An
                 f"{src}: measured {q.upper()}",
                 f"Measured {q} [sr^-1] against the detector angle \u03b8r [deg], all azimuths "
                 "together, one colour per angle of incidence, at up to three wavelengths.",
-                figures.panels_figure(_brdf_panels(g, q)),
+                figures.panels_figure(
+                    _brdf_panels(g, q, meta.get("wavelength_stated") is not False)
+                ),
             )
         shown.update(brdf)
     if times:

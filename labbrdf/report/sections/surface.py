@@ -6,7 +6,7 @@ SurfaceTopography, :mod:`labbrdf.adapters.topography`): the levelled map, its
 autocorrelation and slope histogram with the GGX and Beckmann fits; the roughness
 statistics of :func:`labbrdf.topography.roughness_statistics` with their block-jackknife
 uncertainties; and, for an areal map, tracer S0 and DOP hemisphere maps of a substrate whose
-facets follow the *measured* slope distribution (:meth:`labbrdf.tracer.Substrate.from_surface`)
+facets follow the *measured* slope distribution (:meth:`labbrdf.Substrate.from_surface`)
 beside GGX at the fitted alpha.
 
 Validation report (:func:`gaussian_acf_section`): surfaces generated with the corrected

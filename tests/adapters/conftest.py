@@ -1,0 +1,139 @@
+"""Fixtures of the adapter tests: a minimal OLE2 compound-document writer.
+
+Shimadzu UVProbe ``.spc`` and legacy JASCO ``.jws`` files are OLE2 compound documents. The
+tests build their own from named streams (``olefile`` reads but does not create them), so
+they run without ../shared. The writer follows [MS-CFB] version 3: 512-byte sectors, a FAT,
+streams under 4096 bytes in the mini stream (64-byte mini sectors, a mini FAT), directory
+entries of 128 bytes whose siblings are chained through the right-sibling pointer (a valid
+if unbalanced tree: readers do not check the red-black colours).
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Callable
+
+import pytest
+
+MAGIC = b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1"
+_FREE, _END, _FATSECT, _NOSTREAM = 0xFFFFFFFF, 0xFFFFFFFE, 0xFFFFFFFD, 0xFFFFFFFF
+_SECTOR, _MINI, _CUTOFF = 512, 64, 4096
+
+
+def _pad(data: bytes, size: int) -> bytes:
+    return data + b"\x00" * (-len(data) % size)
+
+
+def write_ole2(streams: dict[str, bytes]) -> bytes:
+    """An OLE2 compound document holding ``streams`` ({"storage/sub/name": bytes})."""
+    # directory tree: entry 0 is the root; storages are created along the paths
+    entries: list[dict] = [{"name": "Root Entry", "type": 5, "kids": [], "data": b""}]
+    index: dict[tuple[str, ...], int] = {(): 0}
+    for path, data in streams.items():
+        parts = tuple(path.split("/"))
+        for depth in range(1, len(parts) + 1):
+            key = parts[:depth]
+            if key in index:
+                continue
+            is_stream = depth == len(parts)
+            entries.append(
+                {"name": key[-1], "type": 2 if is_stream else 1, "kids": [], "data": data}
+            )
+            index[key] = len(entries) - 1
+            entries[index[key[:-1]]]["kids"].append(index[key])
+    # the mini stream (small streams) and the big streams
+    mini = b""
+    for e in entries:
+        if e["type"] == 2 and len(e["data"]) < _CUTOFF and e["data"]:
+            e["start"] = len(mini) // _MINI
+            mini += _pad(e["data"], _MINI)
+    nmini = len(mini) // _MINI
+    minifat = []
+    for e in entries:
+        if e["type"] == 2 and 0 < len(e["data"]) < _CUTOFF:
+            n = -(-len(e["data"]) // _MINI)
+            minifat += [e["start"] + i + 1 for i in range(n - 1)] + [_END]
+    assert len(minifat) == nmini
+    ndir = -(-len(entries) * 128 // _SECTOR)
+    nminifat = -(-len(minifat) * 4 // _SECTOR)
+    nministream = -(-len(mini) // _SECTOR)
+    big = [e for e in entries if e["type"] == 2 and len(e["data"]) >= _CUTOFF]
+    nbig = sum(-(-len(e["data"]) // _SECTOR) for e in big)
+    nfat = 1
+    while nfat * 128 < nfat + ndir + nminifat + nministream + nbig:
+        nfat += 1
+    fat: list[int] = [_FATSECT] * nfat
+    nxt = nfat
+
+    def chain(n: int) -> int:
+        nonlocal nxt
+        if n == 0:
+            return _END
+        start = nxt
+        fat.extend([start + i + 1 for i in range(n - 1)] + [_END])
+        nxt += n
+        return start
+
+    dir_start = chain(ndir)
+    minifat_start = chain(nminifat)
+    ministream_start = chain(nministream)
+    for e in big:
+        e["start"] = chain(-(-len(e["data"]) // _SECTOR))
+    fat += [_FREE] * (nfat * 128 - len(fat))
+    # directory entries
+    raw_dir = b""
+    for i, e in enumerate(entries):
+        kids = e["kids"]
+        right = _NOSTREAM
+        for e2 in entries:  # the next kid of the same parent is this entry's right sibling
+            if i in e2["kids"]:
+                k = e2["kids"].index(i)
+                right = e2["kids"][k + 1] if k + 1 < len(e2["kids"]) else _NOSTREAM
+        name = e["name"].encode("utf-16-le") + b"\x00\x00"
+        if e["type"] == 5:
+            start, size = (ministream_start if mini else _END), len(mini)
+        elif e["type"] == 2:
+            start, size = (e.get("start", _END) if e["data"] else _END), len(e["data"])
+        else:
+            start, size = 0, 0
+        raw_dir += (
+            name.ljust(64, b"\x00")
+            + struct.pack(
+                "<HBB3I", len(name), e["type"], 1, _NOSTREAM, right, kids[0] if kids else _NOSTREAM
+            )
+            + b"\x00" * 36
+            + struct.pack("<IQ", start, size)
+        )
+    raw_dir = _pad(raw_dir, _SECTOR)
+    header = (
+        MAGIC
+        + b"\x00" * 16
+        + struct.pack("<HHHHH", 0x3E, 3, 0xFFFE, 9, 6)
+        + b"\x00" * 6
+        + struct.pack(
+            "<IIIIIIIII",
+            0,
+            nfat,
+            dir_start,
+            0,
+            _CUTOFF,
+            minifat_start if minifat else _END,
+            nminifat,
+            _END,
+            0,
+        )
+        + struct.pack("<109I", *(list(range(nfat)) + [_FREE] * (109 - nfat)))
+    )
+    assert len(header) == _SECTOR
+    body = struct.pack(f"<{len(fat)}I", *fat) + raw_dir
+    body += _pad(struct.pack(f"<{len(minifat)}I", *minifat), _SECTOR) if minifat else b""
+    body += _pad(mini, _SECTOR)
+    for e in big:
+        body += _pad(e["data"], _SECTOR)
+    return header + body
+
+
+@pytest.fixture(scope="session")
+def make_ole2() -> Callable[[dict[str, bytes]], bytes]:
+    """The writer: ``make_ole2({"DataInfo": b"...", "Y-Data": b"..."}) -> bytes``."""
+    return write_ole2
