@@ -180,3 +180,35 @@ def test_report_with_a_missing_model_file_is_exit_2(tmp_path: Path, capsys) -> N
     argv = ["report", str(pe), "-o", str(out), "--film-model", str(tmp_path / "none.toml")]
     assert main(argv) == 2
     assert "none.toml" in capsys.readouterr().err and not out.exists()
+
+
+def test_film_model_and_default_exclude_each_other(tmp_path: Path, capsys) -> None:
+    pe, _ = _files(tmp_path)
+    model = tmp_path / "stack.toml"
+    model.write_text(MODEL)
+    argv = ["report", str(pe), "-o", str(tmp_path / "rep"), "--film-model", str(model)]
+    with pytest.raises(SystemExit) as exc:
+        main([*argv, "--film-default"])
+    assert exc.value.code == 2 and "not allowed with" in capsys.readouterr().err
+
+
+def test_a_model_file_inside_the_report_folder_is_never_replaced(tmp_path: Path, capsys) -> None:
+    pe, _ = _files(tmp_path)
+    out = tmp_path / "rep"
+    out.mkdir()
+    model = out / "stack.toml"
+    model.write_text(MODEL)
+    argv = ["report", str(pe), "-o", str(out), "--overwrite", "--film-model", str(model)]
+    assert main(argv) == 2
+    assert "stack.toml" in capsys.readouterr().err
+    assert model.read_text() == MODEL
+
+
+def test_film_default_fits_the_stated_default(tmp_path: Path) -> None:
+    pe, _ = _files(tmp_path)
+    out = tmp_path / "rep"
+    assert main(["report", str(pe), "-o", str(out), "--quiet", "--film-default"]) in (0, 1)
+    res = json.loads((out / "results.json").read_text())
+    assert res["meta"]["film_model"] == default_film_model().source
+    rows = res["tables"]["film_0_wafer_psi_csv_params"]["rows"]
+    assert {r["parameter"] for r in rows} == {"film.thickness_nm", "film.A", "film.B"}
