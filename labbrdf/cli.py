@@ -689,7 +689,8 @@ def _model_from_args(args: argparse.Namespace) -> tuple[Any, dict[str, float]]:
 
 def cmd_nk(args: argparse.Namespace) -> int:
     from . import adapters
-    from .nk import combined_table, nk_json, nk_table
+    from .ellipsometry import P_ANGLE_DEPENDENT
+    from .nk import angle_verdict, combined_table, nk_json, nk_table
     from .outputs import atomic_output, csv_safe_frame
 
     data = _selected(args, adapters.read_many(args.files))
@@ -709,12 +710,20 @@ def cmd_nk(args: argparse.Namespace) -> int:
                         "dof", "p_value", "angle_dependent") if c in comb.columns]  # fmt: skip
     with pd.option_context("display.width", 200, "display.max_rows", 40):
         print(comb[cols].to_string(index=False))
-    flagged = int(comb["angle_dependent"].fillna(False).astype(bool).sum())
-    if flagged:
-        print(
-            f"{flagged} of {len(comb)} wavelengths have angle-dependent pseudo-constants "
-            "(p < 0.01): a film or roughness, not a bulk material"
-        )
+    for (sample, source), g in comb.groupby(["sample", "source"], sort=False):
+        v = angle_verdict(g)
+        if v.kind == "stack":
+            print(
+                f"{sample} ({source}): {v.text}, not a material's n, k. They are not combined "
+                "(n, k empty above; per angle with -o FILE or --json) and predict no "
+                "reflectance; `labbrdf film` fits a stack model for the layers' constants."
+            )
+        elif g["angle_dependent"].astype(bool).any():
+            print(
+                f"{sample} ({source}): {v.text}. Where the angles disagree "
+                f"(p < {P_ANGLE_DEPENDENT:g}) the sigmas are multiplied by sqrt(chi2/dof) to "
+                "cover their scatter."
+            )
     return 0
 
 
@@ -1108,9 +1117,23 @@ def cmd_trace(args: argparse.Namespace) -> int:
         "estimator": args.estimator,
         "scalar": args.scalar,
     }
-    if args.coating is not None:
+    coat: complex | None = None
+    thickness = args.thickness
+    if args.coating_from is not None:
+        if args.coating is not None or args.thickness is not None:
+            raise UsageError(
+                "give the coating once: --coating-from FIT.json, or --coating and --thickness"
+            )
+        from .nk import coating_from_fit
+
+        try:
+            coat, thickness = coating_from_fit(args.coating_from, args.wavelength)
+        except ValueError as exc:
+            raise UsageError(f"--coating-from {exc}") from None
+    elif args.coating is not None:
         coat = _complex(args.coating, "--coating")
-        if args.thickness is None:
+    if coat is not None:
+        if thickness is None:
             raise UsageError("--coating needs --thickness (nm)")
         if args.coating_alpha is not None and args.coating_surface is not None:
             raise UsageError(
@@ -1121,14 +1144,16 @@ def cmd_trace(args: argparse.Namespace) -> int:
         if args.coating_surface is not None:
             coat_alpha, coat_ndf = _slope_table_of(args.coating_surface, args.channel)
         kw["coating"] = tracer.Coating(
-            n=coat.real, k=coat.imag, thickness_nm=args.thickness, alpha=coat_alpha, ndf=coat_ndf
+            n=coat.real, k=coat.imag, thickness_nm=thickness, alpha=coat_alpha, ndf=coat_ndf
         )
     elif (
         args.thickness is not None
         or args.coating_alpha is not None
         or args.coating_surface is not None
     ):
-        raise UsageError("--thickness, --coating-alpha and --coating-surface need --coating")
+        raise UsageError(
+            "--thickness, --coating-alpha and --coating-surface need --coating (or --coating-from)"
+        )
     config = tracer.TraceConfig(**kw)
     mapper: Any = map
     if args.scheduler != "serial":
@@ -1186,6 +1211,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 
 def cmd_report(args: argparse.Namespace) -> int:
     from .report import user_report
+    from .report.sections.film import default_film_model
 
     options, start = _split_params(args.model, args.param)
     selection = {k: getattr(args, k) for k in SELECTION_KEYS if getattr(args, k) is not None}
@@ -1198,6 +1224,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             start=start,
             selection=selection,
             progress=not args.quiet,
+            film_model=default_film_model() if args.film_default else args.film_model,
         )
     )
 
@@ -1430,6 +1457,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s.add_argument("--channel", default=None, help="height channel of --surface")
     s.add_argument("--coating", default=None, help="coating index, e.g. 1.5")
+    s.add_argument(
+        "--coating-from",
+        default=None,
+        action=InputPath,
+        metavar="FIT.json",
+        help="coating index at --wavelength and thickness from a one-layer film fit",
+    )
     s.add_argument("--thickness", type=float, default=None, help="coating thickness [nm]")
     s.add_argument("--coating-alpha", type=float, default=None)
     s.add_argument(
@@ -1511,6 +1545,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s.add_argument("-o", "--output", action=OutputPath, kind="dir", required=True, metavar="DIR")
     _add_overwrite(s)
+    film = s.add_mutually_exclusive_group()
+    film.add_argument(
+        "--film-model",
+        default=None,
+        action=InputPath,
+        metavar="FILE.toml",
+        help="fit this film stack to psi/Delta files whose angles disagree",
+    )
+    film.add_argument(
+        "--film-default",
+        action="store_true",
+        help="... or the stated default: one transparent Cauchy layer on c-Si, thickness free",
+    )
     s.add_argument("--quiet", action="store_true", help="no progress lines")
     _add_selection(s)
     s.set_defaults(func=cmd_report)

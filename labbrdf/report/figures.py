@@ -720,8 +720,9 @@ def panels_figure(
     panels : sequence of mappings
         ``{"title": str, "xlabel": str, "ylabel": str, "logy": bool (optional),
         "series": [{"label": str, "x": array, "y": array, "yerr": array or None,
-        "band": array or None, "style": "line" | "points"}]}``. ``yerr`` draws error bars
-        (1 sigma), ``band`` a shaded y +- band.
+        "band": array or None, "style": "line" | "points", "colour": str (optional)}]}``.
+        ``yerr`` draws error bars (1 sigma), ``band`` a shaded y +- band; ``colour`` (a
+        matplotlib colour) pairs series, e.g. a measurement and its model.
     title : str
         Figure title.
     ncols : int
@@ -751,6 +752,7 @@ def panels_figure(
         series = list(p.get("series", []))
         for k, s in enumerate(series):
             c = _COLOURS[k % len(_COLOURS)] if len(series) <= len(_COLOURS) else None
+            c = s.get("colour", c)
             x = np.asarray(s["x"], float)
             y = np.asarray(s["y"], float)
             order = np.argsort(x, kind="stable")
