@@ -72,7 +72,7 @@ def test_anisotropy_ratio_and_direction():
     iso = roughness_statistics(gaussian_surface(256, 256e-6, 1e-7, 6e-6, rng=8).z, 1e-6, blocks=0)
     assert iso.anisotropy_ratio < 1.15
     assert iso.acf_model == "gaussian"
-    assert abs(iso.alpha - np.sqrt(2) * iso.sigma / iso.c) < 1e-15
+    assert abs(iso.alpha_gaussian_acf - np.sqrt(2) * iso.sigma / iso.c) < 1e-15
 
 
 def test_exponential_acf_is_recognised():
@@ -129,7 +129,12 @@ def test_levelling_removes_polynomials_of_the_given_degree():
 def test_to_dict_is_json_safe_and_frozen():
     st = roughness_statistics(gaussian_surface(64, 64e-6, 1e-7, 4e-6, rng=1).z, 1e-6)
     d = json.loads(json.dumps(st.to_dict(), allow_nan=False))
-    assert d["kind"] == "areal" and set(d["uncertainty"]) >= {"sigma", "c", "alpha"}
+    assert d["kind"] == "areal" and set(d["uncertainty"]) >= {
+        "sigma",
+        "c",
+        "alpha_gaussian_acf",
+        "alpha_ggx_ml",
+    }
     assert d["slope_fits"]["best"] in ("ggx", "beckmann")
     with pytest.raises(AttributeError):
         st.sigma = 1.0  # type: ignore[misc]
@@ -278,7 +283,7 @@ def test_matrix_ascii_needs_sizes_and_reads_in_metres(tmp_path):
     z = np.random.default_rng(0).standard_normal((20, 16))
     p = tmp_path / "m.asc"
     np.savetxt(p, z)
-    with pytest.raises(AdapterError, match="m.asc.*physical_sizes"):
+    with pytest.raises(AdapterError, match="m.asc.*no lateral size.*--pixel-size"):
         read_height_map(p)
     hm = read_height_map(p, physical_sizes=(16.0, 20.0), unit="um")
     np.testing.assert_allclose(hm.pixel_size, (1e-6, 1e-6))

@@ -217,10 +217,12 @@ def check_geometry(
         )
     ext = np.asarray(heights.shape, dtype=float) * px
     if np.any(ext > MAX_EXTENT_M):
+        size = " x ".join(f"{v:.4g}" for v in ext)
+        grid = " x ".join(map(str, heights.shape))
         raise AdapterError(
             path,
-            f"lateral size {' x '.join(f'{v:.4g}' for v in ext)} m ({' x '.join(map(str, heights.shape))}"
-            f" points) exceeds {MAX_EXTENT_M:g} m: a misread header? ({fix})",
+            f"lateral size {size} m ({grid} points) exceeds {MAX_EXTENT_M:g} m:"
+            f" a misread header? ({fix})",
         )
     if px.size == 2 and max(px) / min(px) > MAX_PIXEL_ASPECT:
         raise AdapterError(
@@ -278,7 +280,9 @@ def _open(st: Any, p: str) -> Any:
             if a.strip().startswith("tried")
         ]
         cause = "; ".join(causes[:4]) or _one_line(detect)
-    raise AdapterError(p, f"not a topography file SurfaceTopography can read ({cause})") from detect
+    raise AdapterError(
+        p, f"not a topography file SurfaceTopography can read ({cause})"
+    ) from detect
 
 
 def _one_line(exc: BaseException) -> str:
@@ -354,10 +358,14 @@ def read_height_map(
             pxm = np.broadcast_to(np.asarray(pixel_size, dtype=float), (len(grid),))
             su = unit if unit is not None else ch.unit
             scale = _UNITS_M.get(su, 1.0) if isinstance(su, str) else 1.0
-            kw["physical_sizes"] = tuple(float(n * v / scale) for n, v in zip(grid, pxm, strict=True))
+            kw["physical_sizes"] = tuple(
+                float(n * v / scale) for n, v in zip(grid, pxm, strict=True)
+            )
         else:
             raise AdapterError(
-                p, "the file has no lateral size: give it with --pixel-size (Python: pixel_size=)"
+                p,
+                "the file has no lateral size: give it with --pixel-size"
+                " (Python: pixel_size= or physical_sizes=)",
             )
     file_unit = ch.unit if isinstance(ch.unit, str) else None
     if file_unit is None:
@@ -408,7 +416,7 @@ def read_height_map(
     if not np.isfinite(z).any():
         raise AdapterError(p, "no defined height in the file")
     warnings[:0] = check_geometry(p, z, pixel)
-    meta = {"unit_in_file": str(ch.unit), "reader": type(reader).__name__}
+    meta: dict[str, Any] = {"unit_in_file": str(ch.unit), "reader": type(reader).__name__}
     if unit is not None:
         meta["unit_stated"] = unit
     if pixel_size is not None:
