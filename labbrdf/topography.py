@@ -52,7 +52,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import fft as sfft
-from scipy import ndimage, optimize, special, stats
+from scipy import ndimage, optimize, special
 
 __all__ = [
     "C_MIN_PIXELS",
@@ -347,25 +347,42 @@ def _ks_normal(x: NDArray) -> float:
     s = x.std()
     if s == 0:
         return float("nan")
-    return _ks_sorted(np.sort((x - x.mean()) / s), special.ndtr)
+    xs = x - x.mean()
+    xs /= s
+    xs.sort()
+    return _ks_sorted(xs, special.ndtr)
 
 
 def _ks_sorted(xs: NDArray, cdf: Any) -> float:
-    """Two-sided KS distance sup|F_n - F| of sorted samples to the CDF ``cdf``."""
+    """Two-sided KS distance sup|F_n - F| of sorted samples to the CDF ``cdf``.
+
+    Walked in blocks of :data:`_CHUNK` samples, so that no array of the sample's size
+    beyond ``xs`` itself is made.
+    """
     n = xs.size
-    f = cdf(xs)
-    return float(max(np.max(np.arange(1, n + 1) / n - f), np.max(f - np.arange(n) / n)))
+    d = -np.inf
+    for a in range(0, n, _CHUNK):
+        f = cdf(xs[a : a + _CHUNK])
+        i = np.arange(a, a + f.size, dtype=float)
+        d = max(d, float(np.max((i + 1) / n - f)), float(np.max(f - i / n)))
+    return float(d)
 
 
 def _shape_stats(x: NDArray) -> tuple[float, float, float]:
-    """Skewness, kurtosis (3 for a Gaussian) and KS distance to the Gaussian."""
+    """Skewness, kurtosis (3 for a Gaussian) and KS distance to the Gaussian.
+
+    The moment estimators of :func:`scipy.stats.skew` and :func:`scipy.stats.kurtosis`
+    (biased, ``m3 / m2^1.5`` and ``m4 / m2^2``), formed with two temporaries.
+    """
     if x.size < 3 or x.std() == 0:
         return float("nan"), float("nan"), float("nan")
-    return (
-        float(stats.skew(x)),
-        float(stats.kurtosis(x, fisher=False)),
-        _ks_normal(x),
-    )
+    d = x - x.mean()
+    d2 = d * d
+    m2 = float(np.mean(d2))
+    m3 = float(np.dot(d2, d)) / x.size
+    m4 = float(np.dot(d2, d2)) / x.size
+    del d, d2
+    return m3 / m2**1.5, m4 / m2**2, _ks_normal(x)
 
 
 # ------------------------------------------------------------------ slope-space fits
@@ -417,47 +434,70 @@ class SlopeFits:
 
 
 def _ggx_s(q: NDArray, frac: float) -> float:
-    """Root in s = alpha^2 of ``mean(s / (s + q)) = frac`` (GGX score equation)."""
+    """Root in s = alpha^2 of ``mean(s / (s + q)) = frac`` (GGX score equation).
+
+    The left side increases with s; the root is bracketed by stepping a factor 4 from the
+    mean of q (one temporary of q's size per evaluation), then polished by Brent's method
+    to a relative 1e-13 inside the bracket.
+    """
     qpos = q[q > 0]
     if qpos.size == 0:
         return 0.0
-    lo, hi = float(np.min(qpos)) * 1e-6, float(np.max(q)) * 1e6
+    lo_lim, hi_lim = float(np.min(qpos)) * 1e-6, float(np.max(q)) * 1e6
+    del qpos
+    t = np.empty_like(q)
 
     def g(s: float) -> float:
-        return float(np.mean(s / (s + q))) - frac
+        np.add(q, s, out=t)
+        np.divide(s, t, out=t)
+        return float(np.mean(t)) - frac
 
-    return float(optimize.brentq(g, lo, hi, xtol=1e-300, rtol=1e-13))
+    s0 = min(max(float(np.mean(q)), lo_lim), hi_lim)
+    lo = hi = s0
+    if g(s0) < 0:
+        while g(hi) < 0 and hi < hi_lim:
+            lo, hi = hi, min(hi * 4.0, hi_lim)
+    else:
+        while g(lo) > 0 and lo > lo_lim:
+            lo, hi = max(lo / 4.0, lo_lim), lo
+    root = float(optimize.brentq(g, lo, hi, xtol=1e-300, rtol=1e-13))
+    del t, q  # clear the closure cells: brentq leaves g in a reference cycle until a GC
+    return root
 
 
 def _fit_core(x: NDArray, y: NDArray | None) -> dict[str, float]:
-    """ML alphas, log-likelihoods and KS distances (no uncertainties)."""
+    """ML alphas, log-likelihoods and KS distances (no uncertainties).
+
+    Raises
+    ------
+    ValueError
+        All slopes are zero (a map without roughness at the pixel scale).
+    """
     n = x.size
     if y is not None:
-        q = x * x + y * y
+        q = x * x
+        q += y * y
         # 2-D: log P22 = ln s - 2 ln(s + q) - ln pi (GGX); -ln(pi s) - q/s (Beckmann)
         sg = _ggx_s(q, 0.5)
+        _check_slopes(sg)
         sb = float(q.mean())
-        llg = float(n * math.log(sg) - 2 * np.sum(np.log(sg + q)) - n * math.log(math.pi))
+        llg = float(n * math.log(sg) - 2 * _sum_log(q, sg) - n * math.log(math.pi))
         llb = float(-n * math.log(math.pi * sb) - np.sum(q) / sb)
-        qs = np.sort(q)
-        ecdf_hi = np.arange(1, n + 1) / n
-        ecdf_lo = np.arange(n) / n
-        fg = qs / (sg + qs)
-        fb = -np.expm1(-qs / sb)
+        q.sort()
+        ksg = _ks_sorted(q, lambda v: v / (sg + v))
+        ksb = _ks_sorted(q, lambda v: -np.expm1(-v / sb))
     else:
         q = x * x
         # 1-D marginals: P2 = 1 / (2 a (1 + x^2/a^2)^(3/2)) (GGX); exp(-x^2/s)/sqrt(pi s)
         sg = _ggx_s(q, 2.0 / 3.0)
+        _check_slopes(sg)
         sb = float(2 * q.mean())
-        llg = float(n * math.log(sg) - 1.5 * np.sum(np.log(sg + q)) - n * math.log(2.0))
+        llg = float(n * math.log(sg) - 1.5 * _sum_log(q, sg) - n * math.log(2.0))
         llb = float(-0.5 * n * math.log(math.pi * sb) - np.sum(q) / sb)
+        del q
         xs = np.sort(x)
-        ecdf_hi = np.arange(1, n + 1) / n
-        ecdf_lo = np.arange(n) / n
-        fg = 0.5 + 0.5 * xs / np.sqrt(sg + xs * xs)
-        fb = 0.5 * (1 + special.erf(xs / math.sqrt(sb)))
-    ksg = float(max(np.max(ecdf_hi - fg), np.max(fg - ecdf_lo)))
-    ksb = float(max(np.max(ecdf_hi - fb), np.max(fb - ecdf_lo)))
+        ksg = _ks_sorted(xs, lambda v: 0.5 + 0.5 * v / np.sqrt(sg + v * v))
+        ksb = _ks_sorted(xs, lambda v: 0.5 * (1 + special.erf(v / math.sqrt(sb))))
     return {
         "ggx_alpha": math.sqrt(sg),
         "beckmann_alpha": math.sqrt(sb),
@@ -468,6 +508,18 @@ def _fit_core(x: NDArray, y: NDArray | None) -> dict[str, float]:
         "ggx_s": sg,
         "beckmann_s": sb,
     }
+
+
+def _check_slopes(sg: float) -> None:
+    if not sg > 0:
+        raise ValueError("all slopes are zero: the heights do not change between pixels")
+
+
+def _sum_log(q: NDArray, s: float) -> float:
+    """``sum(ln(s + q))`` with one temporary."""
+    t = q + s
+    np.log(t, out=t)
+    return float(np.sum(t))
 
 
 def _fisher_u(x: NDArray, y: NDArray | None, core: dict[str, float]) -> tuple[float, float]:
@@ -663,6 +715,9 @@ def _core(
             "all valid heights lie on the levelling polynomial (RMS height 0): no roughness"
         )
     out["height_skewness"], out["height_kurtosis"], out["height_ks"] = _shape_stats(h)
+    if with_slopes:
+        out["_top_share"] = _top_share(h)
+    del h
     sx, sy = slopes(lz, px, valid)
     if sx.size < 2:
         raise ValueError("fewer than 2 valid slopes")
@@ -678,6 +733,15 @@ def _core(
         out["slope_rms"] = out["slope_rms_x"]
         sk = (_NAN, _NAN, _NAN)
     out["slope_skewness_y"], out["slope_kurtosis_y"], out["slope_ks_y"] = sk
+    fc = _fit_core(sx, sy)
+    out["_fit"] = fc
+    out["_n_slopes"] = sx.size
+    if with_slopes:
+        out["_fisher"] = _fisher_u(sx, sy, fc)
+    del sx, sy
+    out["alpha_ggx_ml"] = fc["ggx_alpha"]
+    out["ggx_alpha"] = fc["ggx_alpha"]
+    out["beckmann_alpha"] = fc["beckmann_alpha"]
 
     rho = autocorrelation(lz, valid)
     centre = tuple(n // 2 for n in rho.shape)
@@ -712,16 +776,6 @@ def _core(
     out["alpha_gaussian_acf"] = s2 / out["c"]
     out["alpha_gaussian_acf_x"] = s2 / out["c_x"]
     out["alpha_gaussian_acf_y"] = s2 / out["c_y"] if z.ndim == 2 else _NAN
-    fc = _fit_core(sx, sy)
-    out["_fit"] = fc
-    out["_n_slopes"] = sx.size
-    if with_slopes:
-        out["_fisher"] = _fisher_u(sx, sy, fc)
-        out["_top_share"] = _top_share(h)
-    del sx, sy, h, lz
-    out["alpha_ggx_ml"] = fc["ggx_alpha"]
-    out["ggx_alpha"] = fc["ggx_alpha"]
-    out["beckmann_alpha"] = fc["beckmann_alpha"]
     return out
 
 
