@@ -710,9 +710,11 @@ def _core(
     h = lz[valid]
     out: dict[str, Any] = {}
     out["sigma"] = float(np.sqrt(np.mean(h * h)))
-    if not out["sigma"] > 0:
+    spread = float(np.sqrt(np.var(z, where=valid)))
+    if not out["sigma"] > 1e-10 * spread:
         raise ValueError(
-            "all valid heights lie on the levelling polynomial (RMS height 0): no roughness"
+            f"all valid heights lie on the levelling polynomial (RMS height {out['sigma']:.3g}"
+            f" m of {spread:.3g} m before levelling): no roughness"
         )
     out["height_skewness"], out["height_kurtosis"], out["height_ks"] = _shape_stats(h)
     if with_slopes:
