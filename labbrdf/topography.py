@@ -445,10 +445,13 @@ def _ggx_s(q: NDArray, frac: float) -> float:
         return 0.0
     lo_lim, hi_lim = float(np.min(qpos)) * 1e-6, float(np.max(q)) * 1e6
     del qpos
-    t = np.empty_like(q)
+    # q and the scratch array live in a list emptied at the end: brentq leaves g in a
+    # reference cycle, which would otherwise keep both alive until the next GC
+    arrays = [q, np.empty_like(q)]
 
     def g(s: float) -> float:
-        np.add(q, s, out=t)
+        qq, t = arrays
+        np.add(qq, s, out=t)
         np.divide(s, t, out=t)
         return float(np.mean(t)) - frac
 
@@ -461,7 +464,7 @@ def _ggx_s(q: NDArray, frac: float) -> float:
         while g(lo) > 0 and lo > lo_lim:
             lo, hi = max(lo / 4.0, lo_lim), lo
     root = float(optimize.brentq(g, lo, hi, xtol=1e-300, rtol=1e-13))
-    del t, q  # clear the closure cells: brentq leaves g in a reference cycle until a GC
+    arrays.clear()
     return root
 
 
