@@ -721,7 +721,8 @@ def cmd_surface(args: argparse.Namespace) -> int:
         shape = " x ".join(map(str, hm.heights.shape))
         raise UsageError(
             f"{args.file}: out of memory for the statistics of a {shape} map"
-            f" ({hm.heights.nbytes / 2**20:.0f} MiB of heights; the statistics need about 14 times that)"
+            f" ({hm.heights.nbytes / 2**20:.0f} MiB of heights; the statistics need about"
+            " 14 times that)"
         ) from None
     except ValueError as exc:
         raise UsageError(f"{args.file}: {exc}") from None
