@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import os
-import resource
 import subprocess
 import sys
 import textwrap
@@ -285,7 +284,3 @@ def test_out_of_memory_names_the_file_and_exits_2(big_map):
     assert r.returncode == 2, r.stderr
     assert "big.bcrf" in r.stderr and "memory" in r.stderr.lower()
     assert "Traceback" not in r.stderr
-
-
-def test_rlimit_is_available():
-    assert resource.RLIMIT_AS is not None
