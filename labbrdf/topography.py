@@ -233,7 +233,11 @@ def slopes(
 
 
 def autocorrelation(
-    z: NDArray, valid: NDArray | None = None, max_lag: tuple[int, ...] | None = None
+    z: NDArray,
+    valid: NDArray | None = None,
+    max_lag: tuple[int, ...] | None = None,
+    *,
+    hole: tuple[slice, ...] | None = None,
 ) -> NDArray:
     """Normalised autocorrelation by a mask-normalised, zero-padded FFT.
 
@@ -245,6 +249,10 @@ def autocorrelation(
         Valid points (default: finite).
     max_lag : tuple of int, optional
         Largest lag per axis in pixels (default: half the extent).
+    hole : tuple of slice, optional
+        Declares that ``valid`` is the whole grid except this rectangle (a jackknife
+        replicate of a map without dropouts): the pair counts are then exact products of
+        interval overlaps instead of a second FFT.
 
     Returns
     -------
@@ -264,13 +272,9 @@ def autocorrelation(
     num = _correlate_window(zc, shape, max_lag)
     del zc
     if valid.all():
-        # pair counts of a full grid: (M - |i|)(N - |j|), exactly what the FFT of w gives
-        counts = [
-            n - np.abs(np.arange(-lag, lag + 1)) for n, lag in zip(z.shape, max_lag, strict=True)
-        ]
-        den = counts[0].astype(float)
-        for c in counts[1:]:
-            den = np.multiply.outer(den, c)
+        den = _rect_pair_counts(z.shape, max_lag, None)
+    elif hole is not None:
+        den = _rect_pair_counts(z.shape, max_lag, hole)
     else:
         den = _correlate_window(valid.astype(float), shape, max_lag)
     good = den > 0.5
@@ -278,6 +282,36 @@ def autocorrelation(
     cov[good] = num[good] / np.round(den[good])
     centre = tuple(max_lag)
     return cov / cov[centre]
+
+
+def _rect_pair_counts(
+    shape: tuple[int, ...], max_lag: tuple[int, ...], hole: tuple[slice, ...] | None
+) -> NDArray:
+    """Valid pairs at lags ``-max_lag..max_lag`` of a full grid F minus a rectangle T.
+
+    With ``1_V = 1_F - 1_T`` the count ``sum_p 1_V(p) 1_V(p + l)`` is
+    ``c_FF - c_FT - c_TF + c_TT``, where ``c_PQ(l) = #{p in P : p + l in Q}`` of two
+    rectangles is the product over the axes of the interval overlaps
+    ``|P_k ∩ (Q_k - l_k)|``: exactly what the FFT of the indicator gives, without it.
+    """
+
+    def overlap(i: tuple[int, int], j: tuple[int, int], lags: NDArray) -> NDArray:
+        return np.maximum(0, np.minimum(i[1], j[1] - lags) - np.maximum(i[0], j[0] - lags))
+
+    lags = [np.arange(-lag, lag + 1) for lag in max_lag]
+    full = [(0, n) for n in shape]
+    if hole is None:
+        sets = [(1.0, full, full)]
+    else:
+        tile = [sl.indices(n)[:2] for sl, n in zip(hole, shape, strict=True)]
+        sets = [(1.0, full, full), (-1.0, full, tile), (-1.0, tile, full), (1.0, tile, tile)]
+    den = np.zeros(tuple(lg.size for lg in lags))
+    for sign, a, b in sets:
+        term = overlap(a[0], b[0], lags[0]).astype(float)
+        for k in range(1, len(shape)):
+            term = np.multiply.outer(term, overlap(a[k], b[k], lags[k]))
+        den += sign * term
+    return den
 
 
 def _correlate_window(a: NDArray, shape: list[int], max_lag: tuple[int, ...]) -> NDArray:
@@ -704,7 +738,12 @@ def _principal(rho: NDArray, px: tuple[float, float]) -> tuple[float, float, flo
 
 
 def _core(
-    z: NDArray, valid: NDArray, px: tuple[float, ...], degree: int, with_slopes: bool = False
+    z: NDArray,
+    valid: NDArray,
+    px: tuple[float, ...],
+    degree: int,
+    with_slopes: bool = False,
+    hole: tuple[slice, ...] | None = None,
 ) -> dict[str, Any]:
     """All statistics of one (replicate) valid set; scalars only, plus the slope fits."""
     if np.count_nonzero(valid) < 8:
@@ -748,7 +787,7 @@ def _core(
     out["ggx_alpha"] = fc["ggx_alpha"]
     out["beckmann_alpha"] = fc["beckmann_alpha"]
 
-    rho = autocorrelation(lz, valid)
+    rho = autocorrelation(lz, valid, hole=hole)
     centre = tuple(n // 2 for n in rho.shape)
     if z.ndim == 1:
         rx = rho[centre[0] :]
@@ -980,11 +1019,12 @@ def roughness_statistics(
         if not k.startswith("_") and isinstance(v, float) and math.isfinite(v)
     ]
     if len(tiles) > 1:
+        no_dropouts = bool(valid.all())
         reps: dict[str, list[float]] = {k: [] for k in scal}
         for i, t in enumerate(tiles):
             sub = valid.copy()
             sub[t] = False
-            rep = _core(z, sub, px, degree)
+            rep = _core(z, sub, px, degree, hole=t if no_dropouts else None)
             del sub
             for k in scal:
                 reps[k].append(rep[k])

@@ -427,3 +427,31 @@ def test_height_map_is_drawn_x_horizontal_y_down_as_gwyddion():
     assert surface_figure(
         np.random.default_rng(0).normal(size=(32, 16)) * 1e-7, (1e-6, 1e-6), st
     ).startswith("data:image/png")
+
+
+@pytest.mark.parametrize(
+    ("shape", "hole"),
+    [
+        ((40, 30), (slice(0, 8), slice(0, 6))),
+        ((40, 30), (slice(16, 24), slice(12, 18))),
+        ((40, 30), (slice(32, 40), slice(24, 30))),
+        ((37,), (slice(10, 17),)),
+    ],
+)
+def test_pair_counts_of_a_grid_minus_a_tile_equal_the_fft_counts(shape, hole):
+    """The jackknife replicate of a map without dropouts: the interval-overlap counts are
+    those the FFT of the indicator gives, so rho is the same to round-off."""
+    from scipy import fft as sfft
+
+    from labbrdf.topography import _correlate_window, _rect_pair_counts
+
+    v = np.ones(shape, bool)
+    v[hole] = False
+    lag = tuple(n // 2 for n in shape)
+    pad = [sfft.next_fast_len(n + m, real=True) for n, m in zip(shape, lag, strict=True)]
+    fft_counts = np.round(_correlate_window(v.astype(float), pad, lag))
+    np.testing.assert_array_equal(_rect_pair_counts(shape, lag, hole), fft_counts)
+    z = np.random.default_rng(1).standard_normal(shape)
+    np.testing.assert_allclose(
+        autocorrelation(z, v, hole=hole), autocorrelation(z, v), rtol=1e-10, atol=1e-12
+    )
