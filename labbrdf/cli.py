@@ -972,21 +972,43 @@ def _grid(text: str, option: str) -> Any:
         ) from None
 
 
-def _height_map(path: str, channel: str | None) -> Any:
-    from .adapters.topography import read_height_map
+def _height_map(path: str, channel: str | None, args: argparse.Namespace | None = None) -> Any:
+    """Read a height map; ``--pixel-size`` / ``--unit`` of ``args`` state its geometry."""
+    from .adapters.topography import length_m, read_height_map
 
     ch: int | str | None = int(channel) if channel and channel.isdigit() else channel
-    return read_height_map(path, ch)
+    unit = getattr(args, "unit", None)
+    px_text = getattr(args, "pixel_size", None)
+    pixel = None
+    if px_text is not None:
+        try:
+            pixel = tuple(length_m(v, unit) for v in px_text.split(","))
+        except ValueError as exc:
+            raise UsageError(f"--pixel-size: {exc}") from None
+        if len(pixel) not in (1, 2):
+            raise UsageError(f"--pixel-size {px_text!r}: one pitch or two (dx,dy)")
+    try:
+        hm = read_height_map(path, ch, unit=unit, pixel_size=pixel)
+    except MemoryError:
+        raise UsageError(f"{path}: out of memory while reading the height map") from None
+    for w in hm.warnings:
+        print(f"labbrdf: warning: {path}: {w}", file=sys.stderr)
+    return hm
 
 
-def _slope_table_of(path: str, channel: str | None) -> tuple[float, Any]:
+def _slope_table_of(
+    path: str, channel: str | None, args: argparse.Namespace | None = None
+) -> tuple[float, Any]:
     """(ML GGX alpha, slope table) of a measured areal map, for the coating's top."""
     from .tracer import Substrate
 
-    hm = _height_map(path, channel)
+    hm = _height_map(path, channel, args)
     if hm.heights.ndim != 2:
         raise UsageError(f"{path}: a line profile; the coating needs an areal height map")
-    s = Substrate.from_surface(hm.heights, hm.pixel_size)
+    try:
+        s = Substrate.from_surface(hm.heights, hm.pixel_size)
+    except ValueError as exc:
+        raise UsageError(f"{path}: {exc}") from None
     return float(s.alpha), s.ndf
 
 
@@ -1001,24 +1023,64 @@ def _analytic_table(args: argparse.Namespace, alpha: float) -> Any:
     return TabulatedNDF.beckmann(alpha)
 
 
+def _progress_printer(label: str, after_s: float = 2.0) -> Any:
+    """``progress(done, total)`` reporting on stderr after ``after_s`` s (a TTY: at once)."""
+    t0 = time.monotonic()
+
+    def progress(done: int, total: int) -> None:
+        if total > 1 and (sys.stderr.isatty() or time.monotonic() - t0 > after_s):
+            el = time.monotonic() - t0
+            print(f"{label}: pass {done}/{total} ({el:.0f} s)", file=sys.stderr, flush=True)
+
+    return progress
+
+
 def cmd_surface(args: argparse.Namespace) -> int:
+    from .adapters.topography import length_m
     from .outputs import check_file_output, check_input_files
     from .topography import level, roughness_statistics
 
     check_input_files([args.file])
     if args.png:
         check_file_output(args.png, inputs=[args.file], suffixes=(".png",), option="--png")
-    hm = _height_map(args.file, args.channel)
-    st = roughness_statistics(hm.heights, hm.pixel_size, degree=args.degree, blocks=args.blocks)
-    if args.png:
-        from .report.figures import save_png, surface_figure
+    cutoff = None
+    if args.short_cutoff is not None:
+        try:
+            cutoff = length_m(args.short_cutoff, args.unit)
+        except ValueError as exc:
+            raise UsageError(f"--short-cutoff: {exc}") from None
+    if args.erode_mask < 0:
+        raise UsageError(f"--erode-mask {args.erode_mask}: expected pixels >= 0")
+    hm = _height_map(args.file, args.channel, args)
+    try:
+        st = roughness_statistics(
+            hm.heights,
+            hm.pixel_size,
+            degree=args.degree,
+            blocks=args.blocks,
+            short_cutoff=cutoff,
+            erode=args.erode_mask,
+            progress=_progress_printer(f"labbrdf surface: {args.file}"),
+        )
+        if args.png:
+            from .report.figures import save_png, surface_figure
 
-        z = level(hm.heights, args.degree)
-        uri = surface_figure(z, hm.pixel_size, st, title=f"{Path(args.file).name} ({hm.channel})")
-        save_png(uri, args.png)
+            z = level(hm.heights, args.degree)
+            title = f"{Path(args.file).name} ({hm.channel})"
+            save_png(surface_figure(z, hm.pixel_size, st, title=title), args.png)
+    except MemoryError:
+        shape = " x ".join(map(str, hm.heights.shape))
+        raise UsageError(
+            f"{args.file}: out of memory for the statistics of a {shape} map"
+            f" ({hm.heights.nbytes / 2**20:.0f} MiB of heights; the statistics need about"
+            " 14 times that)"
+        ) from None
+    except ValueError as exc:
+        raise UsageError(f"{args.file}: {exc}") from None
     d = st.to_dict()
     d["file"] = str(args.file)
     d["channel"] = hm.channel
+    d["geometry_warnings"] = list(hm.warnings)
     if args.json:
         _emit_json(d)
         return 0
@@ -1027,28 +1089,31 @@ def cmd_surface(args: argparse.Namespace) -> int:
     def row(label: str, key: str, scale: float, unit: str) -> None:
         v = d.get(key)
         if v is None:
-            print(f"{label:<28} undefined")
+            print(f"{label:<38} undefined")
             return
         e = u.get(key)
         err = f" +- {e * scale:.3g}" if e is not None else ""
-        print(f"{label:<28} {v * scale:.4g}{err} {unit}")
+        print(f"{label:<38} {v * scale:.4g}{err} {unit}")
 
     print(f"{args.file} ({d['kind']}, channel {hm.channel}, {d['levelling']})")
+    print(f"bandwidth: {d['bandwidth']}")
     row("sigma (RMS height)", "sigma", 1e9, "nm")
     row("RMS slope", "slope_rms", 1.0, "")
     row("correlation length c", "c", 1e6, "um")
-    row("alpha = sqrt(2) sigma / c", "alpha", 1.0, "")
+    row("alpha_gaussian_acf = sqrt(2) sigma/c", "alpha_gaussian_acf", 1.0, "")
+    row("alpha_ggx_ml (used by trace)", "alpha_ggx_ml", 1.0, "")
     if d["kind"] == "areal":
         row("anisotropy c_major/c_minor", "anisotropy_ratio", 1.0, "")
     fits = d["slope_fits"]
     for name in ("ggx", "beckmann"):
         f = fits[name]
-        print(f"{name + ' alpha (ML)':<28} {f['alpha']:.4g}  KS {f['ks']:.3g}  AIC {f['aic']:.6g}")
+        print(f"{name + ' alpha (ML)':<38} {f['alpha']:.4g}  KS {f['ks']:.3g}  AIC {f['aic']:.6g}")
     print(f"best description of the slopes: {fits['best']}")
     if fits.get("warning"):
         print(f"warning: {fits['warning']}")
     for note in d.get("notes") or ():
-        print(f"note: {note}")
+        if note != fits.get("warning"):
+            print(f"note: {note}")
     return 0
 
 
@@ -1096,10 +1161,13 @@ def cmd_trace(args: argparse.Namespace) -> int:
     else:
         sub = _complex(args.substrate, "--substrate")
     if args.surface is not None:
-        hm = _height_map(args.surface, args.channel)
-        substrate = tracer.Substrate.from_surface(
-            hm.heights, hm.pixel_size, n=sub.real, k=sub.imag
-        )
+        hm = _height_map(args.surface, args.channel, args)
+        try:
+            substrate = tracer.Substrate.from_surface(
+                hm.heights, hm.pixel_size, n=sub.real, k=sub.imag
+            )
+        except ValueError as exc:
+            raise UsageError(f"{args.surface}: {exc}") from None
     elif args.alpha is None:
         raise UsageError("give the substrate roughness with --alpha A or --surface FILE")
     else:
@@ -1142,7 +1210,7 @@ def cmd_trace(args: argparse.Namespace) -> int:
         coat_alpha = args.coating_alpha if args.coating_alpha is not None else substrate.alpha
         coat_ndf = _analytic_table(args, coat_alpha)
         if args.coating_surface is not None:
-            coat_alpha, coat_ndf = _slope_table_of(args.coating_surface, args.channel)
+            coat_alpha, coat_ndf = _slope_table_of(args.coating_surface, args.channel, args)
         kw["coating"] = tracer.Coating(
             n=coat.real, k=coat.imag, thickness_nm=thickness, alpha=coat_alpha, ndf=coat_ndf
         )
@@ -1230,6 +1298,22 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 
 # ------------------------------------------------------------------------------- main
+
+
+def _add_geometry(s: argparse.ArgumentParser) -> None:
+    """``--pixel-size`` and ``--unit``: the geometry of a height map, stated by the user."""
+    s.add_argument(
+        "--pixel-size",
+        default=None,
+        metavar="LENGTH[,LENGTH]",
+        help="lateral pitch of the height map, e.g. 312.5nm or 1um,2um (replaces the file's)",
+    )
+    s.add_argument(
+        "--unit",
+        default=None,
+        metavar="UNIT",
+        help="length unit of the numbers in the height-map file (m, mm, um, nm, pm, A)",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -1408,6 +1492,21 @@ def build_parser() -> argparse.ArgumentParser:
         help="write map, ACF and slope histogram (.png)",
     )
     _add_overwrite(s)
+    s.add_argument(
+        "--short-cutoff",
+        default=None,
+        metavar="LENGTH",
+        help="Gaussian S-filter cut-off (ISO 16610-61), e.g. 2um: slopes and alphas then refer"
+        " to longer wavelengths (default: none, down to the pixel)",
+    )
+    s.add_argument(
+        "--erode-mask",
+        type=int,
+        default=0,
+        metavar="N",
+        help="drop the points within N pixels of a dropout (their rims often carry spikes)",
+    )
+    _add_geometry(s)
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_surface)
 
@@ -1456,6 +1555,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="measured height map: its slope table",
     )
     s.add_argument("--channel", default=None, help="height channel of --surface")
+    _add_geometry(s)
     s.add_argument("--coating", default=None, help="coating index, e.g. 1.5")
     s.add_argument(
         "--coating-from",
