@@ -852,18 +852,8 @@ def _film_table(summary: dict[str, Any]) -> str:
 
 def cmd_film(args: argparse.Namespace) -> int:
     from . import adapters, films
-    from .outputs import atomic_output, check_file_output, check_input_files, csv_safe_frame
+    from .outputs import atomic_output, csv_safe_frame
 
-    check_input_files(args.files)
-    extra_inputs = [x for x in (args.model,) if x]
-    outs = []
-    for path, suffix, opt in ((args.output, ".csv", "-o"), (args.fit_json, ".json", "--fit-json")):
-        if path:
-            out = check_file_output(path, inputs=[*args.files, *extra_inputs], suffixes=(suffix,),
-                                    option=opt)  # fmt: skip
-            if out.exists() and not args.overwrite:
-                raise UsageError(f"{opt} {out}: exists; pass --overwrite to replace it")
-            outs.append(out)
     fm = _film_model(args)
     sigma = _parse_assignments(args.sigma, "--sigma")
     wl_range = tuple(args.wavelength_range) if args.wavelength_range else None
@@ -1439,10 +1429,19 @@ def build_parser() -> argparse.ArgumentParser:
         "film",
         help="fit a thin-film stack (thicknesses, n, k) to psi/Delta, R and T of one sample",
     )
-    s.add_argument("files", nargs="+", metavar="FILE", help="files of one sample (joint fit)")
-    s.add_argument("--model", default=None, metavar="MODEL.toml", help="a film model file")
+    s.add_argument(
+        "files",
+        nargs="+",
+        action=InputPath,
+        metavar="FILE",
+        help="files of one sample (joint fit)",
+    )
+    s.add_argument(
+        "--model", action=InputPath, default=None, metavar="MODEL.toml", help="a film model file"
+    )
     s.add_argument(
         "--substrate",
+        action=InputPath,
         default=None,
         metavar="NAME|FILE",
         help="si, sio2, a dispersion model, or an n,k or ellipsometer file (default si)",
@@ -1470,11 +1469,24 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s.add_argument("--method", default="GN_CRS2_LM+LN_BOBYQA", help="nlopt stages")
     s.add_argument("--seed", type=int, default=0)
-    s.add_argument("-o", "--output", default=None, metavar="NK.csv",
-                   help="write each layer's n, k on the fitted wavelengths")  # fmt: skip
-    s.add_argument("--fit-json", default=None, metavar="FIT.json",
-                   help="write the fit (best-fit stack, intervals) as JSON")  # fmt: skip
-    s.add_argument("--overwrite", action="store_true", help="replace existing outputs")
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".csv",),
+        default=None,
+        metavar="NK.csv",
+        help="write each layer's n, k on the fitted wavelengths",
+    )
+    s.add_argument(
+        "--fit-json",
+        action=OutputPath,
+        suffixes=(".json",),
+        default=None,
+        metavar="FIT.json",
+        help="write the fit (best-fit stack, intervals) as JSON",
+    )
+    _add_overwrite(s)
     s.add_argument("--json", action="store_true")
     _add_selection(s)
     s.set_defaults(func=cmd_film)
