@@ -10,7 +10,9 @@ seen by an observer looking back at the sample along the specular direction, so 
 is the +y side when the source is at phi_i = 0. The conversions here are exact (unit
 vectors, no small-angle approximation); ``docs/bsdf.md`` has the derivation. The reader
 (:mod:`labbrdf.adapters.zemax_bsdf`), the writer (:mod:`labbrdf.bsdf_export`) and the grid
-quadrature (:func:`labbrdf.integrate.grid_integral`) share them.
+quadrature (:func:`labbrdf.integrate.grid_integral`) share them, and the cells each grid
+node owns (:func:`radial_weights`, :func:`azimuth_weights`): the quadrature's weights, and
+the reader's average over the polar cap.
 """
 
 from __future__ import annotations
@@ -18,7 +20,18 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-__all__ = ["angles_to_scatter", "scatter_to_angles", "scatter_to_direction"]
+__all__ = [
+    "SYMMETRIES",
+    "angles_to_scatter",
+    "azimuth_weights",
+    "radial_weights",
+    "scatter_to_angles",
+    "scatter_to_direction",
+]
+
+#: Symmetry keywords of a scatter grid (those of the ``.bsdf`` format): PlaneSymmetrical
+#: grids hold azimuths 0..180 of a mirror-symmetric hemisphere, the others the full circle.
+SYMMETRIES = ("PlaneSymmetrical", "Asymmetrical", "Asymmetrical4D")
 
 
 def _cosd(a: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -149,3 +162,64 @@ def angles_to_scatter(
     radial = np.degrees(np.arctan2(np.hypot(u, v), cos_r))
     az = np.mod(np.degrees(np.arctan2(v, u)), 360.0)
     return radial, np.where(az >= 360.0, 0.0, az)
+
+
+# ------------------------------------------------------------------------------ grid cells
+
+
+def _edges(a: NDArray[np.float64], lo: float, hi: float) -> NDArray[np.float64]:
+    """Cell edges around nodes ``a``: midpoints inside, ``lo``/``hi`` clipped at the ends."""
+    mid = 0.5 * (a[1:] + a[:-1])
+    return np.concatenate([[max(lo, a[0])], mid, [min(hi, a[-1])]])
+
+
+def radial_weights(radial_deg: ArrayLike) -> NDArray[np.float64]:
+    """Solid-angle weights of the radial cells of a scatter grid [sr/rad].
+
+    Each node owns the cell bounded by the midpoints to its neighbours (the end nodes half
+    cells, clipped to [0, 180] deg); its weight is ``int sin r dr = cos r_lo - cos r_hi``,
+    so a cell's solid angle about the specular direction is this times its azimuth width.
+
+    Parameters
+    ----------
+    radial_deg : array_like
+        Strictly increasing radial angles [deg].
+
+    Returns
+    -------
+    ndarray
+        One weight per radial angle [sr/rad].
+    """
+    e = np.radians(_edges(np.asarray(radial_deg, float), 0.0, 180.0))
+    return np.cos(e[:-1]) - np.cos(e[1:])
+
+
+def azimuth_weights(azimuth_deg: ArrayLike, symmetry: str) -> NDArray[np.float64]:
+    """Azimuth cell widths of a scatter grid [rad].
+
+    Each node owns the cell bounded by the midpoints to its neighbours; a full circle wraps
+    (a last node at the first + 360 deg repeats it), a PlaneSymmetrical half (azimuths
+    0..180, end nodes owning half cells) counts twice.
+
+    Parameters
+    ----------
+    azimuth_deg : array_like
+        Strictly increasing azimuths [deg].
+    symmetry : {"PlaneSymmetrical", "Asymmetrical", "Asymmetrical4D"}
+        Grid symmetry (:data:`SYMMETRIES`).
+
+    Returns
+    -------
+    ndarray
+        One width per azimuth [rad]; they sum to 2 pi.
+    """
+    a = np.asarray(azimuth_deg, float)
+    if symmetry == "PlaneSymmetrical":
+        return 2.0 * np.radians(np.diff(_edges(a, 0.0, 180.0)))
+    if a.size == 1:
+        return np.array([2.0 * np.pi])
+    if a[-1] - a[0] >= 360.0 - 1e-9:  # the first node is repeated at +360
+        return np.radians(np.diff(_edges(a, -np.inf, np.inf)))
+    ext = np.concatenate([[a[-1] - 360.0], a, [a[0] + 360.0]])
+    mid = 0.5 * (ext[1:] + ext[:-1])
+    return np.radians(np.diff(mid))

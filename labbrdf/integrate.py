@@ -21,15 +21,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq, minimize_scalar
 
-from .bsdf_geometry import scatter_to_direction
+from .bsdf_geometry import SYMMETRIES, azimuth_weights, radial_weights, scatter_to_direction
 from .models.base import Model, Parameters
 from .models.smooth3 import smooth3_hemispherical, smooth3_lobe_integral
 
 __all__ = [
-    "SYMMETRIES",
     "EnergyCheck",
     "ReciprocityDefect",
-    "azimuth_weights",
     "energy_check",
     "energy_limit_angle",
     "grid_integral",
@@ -45,10 +43,6 @@ RTOL = 1e-6
 _N_START = 8
 _N_MAX = 128
 _MAX_KINKS = 2
-
-#: Symmetry keywords of a scatter grid (those of the ``.bsdf`` format): PlaneSymmetrical
-#: grids hold azimuths 0..180 of a mirror-symmetric hemisphere, the others the full circle.
-SYMMETRIES = ("PlaneSymmetrical", "Asymmetrical", "Asymmetrical4D")
 
 
 # ----------------------------------------------------------------------------- smooth3
@@ -396,49 +390,6 @@ def reciprocity_defect(
 
 
 # ----------------------------------------------------------------------------- scatter grid
-def _edges(a: NDArray[np.float64], lo: float, hi: float) -> NDArray[np.float64]:
-    """Cell edges around nodes ``a``: midpoints inside, ``lo``/``hi`` clipped at the ends."""
-    mid = 0.5 * (a[1:] + a[:-1])
-    return np.concatenate([[max(lo, a[0])], mid, [min(hi, a[-1])]])
-
-
-def _radial_weights(radial_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Solid-angle weights of the radial cells: ``int sin r dr = cos r_lo - cos r_hi`` [sr/rad]."""
-    e = np.radians(_edges(radial_deg, 0.0, 180.0))
-    return np.cos(e[:-1]) - np.cos(e[1:])
-
-
-def azimuth_weights(azimuth_deg: ArrayLike, symmetry: str) -> NDArray[np.float64]:
-    """Azimuth cell widths of a scatter grid [rad].
-
-    Each node owns the cell bounded by the midpoints to its neighbours; a full circle wraps
-    (a last node at the first + 360 deg repeats it), a PlaneSymmetrical half (azimuths
-    0..180, end nodes owning half cells) counts twice.
-
-    Parameters
-    ----------
-    azimuth_deg : array_like
-        Strictly increasing azimuths [deg].
-    symmetry : {"PlaneSymmetrical", "Asymmetrical", "Asymmetrical4D"}
-        Grid symmetry (:data:`SYMMETRIES`).
-
-    Returns
-    -------
-    ndarray
-        One width per azimuth [rad]; they sum to 2 pi.
-    """
-    a = np.asarray(azimuth_deg, float)
-    if symmetry == "PlaneSymmetrical":
-        return 2.0 * np.radians(np.diff(_edges(a, 0.0, 180.0)))
-    if a.size == 1:
-        return np.array([2.0 * np.pi])
-    if a[-1] - a[0] >= 360.0 - 1e-9:  # the first node is repeated at +360
-        return np.radians(np.diff(_edges(a, -np.inf, np.inf)))
-    ext = np.concatenate([[a[-1] - 360.0], a, [a[0] + 360.0]])
-    mid = 0.5 * (ext[1:] + ext[:-1])
-    return np.radians(np.diff(mid))
-
-
 def _cos_weights(
     theta_i_deg: NDArray[np.float64],
     azimuth_deg: NDArray[np.float64],
@@ -450,7 +401,7 @@ def _cos_weights(
     Returns ``(w, cos_r)``: weights [sr] and cosines (0 below the horizon), each shaped
     ``(aoi, azimuth, radial)``.
     """
-    w = azimuth_weights(azimuth_deg, symmetry)[:, None] * _radial_weights(radial_deg)
+    w = azimuth_weights(azimuth_deg, symmetry)[:, None] * radial_weights(radial_deg)
     ti = theta_i_deg[:, None, None]
     d = scatter_to_direction(ti, radial_deg[None, None, :], azimuth_deg[None, :, None])
     return np.broadcast_to(w, d.shape[1:]), np.clip(d[2], 0.0, None)

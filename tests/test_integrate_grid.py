@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from labbrdf.adapters import zemax_bsdf as zb
-from labbrdf.integrate import SYMMETRIES, azimuth_weights, grid_integral
+from labbrdf.bsdf_geometry import SYMMETRIES, azimuth_weights
+from labbrdf.integrate import grid_integral
 
 LAMBERT = 1.0 / math.pi  # a BRDF whose hemispherical integral is 1 [sr^-1]
 

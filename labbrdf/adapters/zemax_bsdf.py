@@ -45,10 +45,14 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from .. import integrate
-from ..bsdf_geometry import angles_to_scatter, scatter_to_angles, scatter_to_direction
+from ..bsdf_geometry import (
+    SYMMETRIES,
+    angles_to_scatter,
+    azimuth_weights,
+    scatter_to_angles,
+    scatter_to_direction,
+)
 from ..dataset import Measurement
-from ..integrate import SYMMETRIES, azimuth_weights
 from ._base import AdapterError, Format, decode, read_bytes, split_lines
 from ._numblock import build_frame
 
@@ -782,8 +786,10 @@ def grid_integral(obj: BsdfTable | Measurement | Mapping[str, Any]) -> dict[str,
         not cover; ``tis`` (the file's values, NaN when unknown) and ``ratio`` = tis /
         integral.
     """
+    from ..integrate import grid_integral as quadrature  # scipy, only when asked for
+
     t = _table_of(obj)
-    return integrate.grid_integral(
+    return quadrature(
         t.values,
         t.theta_i_deg,
         t.azimuth_deg,

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 import random
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -268,6 +270,21 @@ def _write(tmp_path, text, name="e.bsdf"):
     p = tmp_path / name
     p.write_bytes(text.encode("utf-8"))
     return p
+
+
+def test_reading_needs_neither_scipy_nor_the_writer(tmp_path):
+    # the reader (pole average included) runs on numpy alone: scipy's libraries do not fit
+    # in the address space a memory-capped reader is given (tests/adapters/test_memory_caps)
+    p = _write(tmp_path, GOOD)
+    code = (
+        "import sys, labbrdf\n"
+        f"m = labbrdf.read({str(p)!r})\n"
+        "assert m.meta['pole']['repeats_left_out'] == 2, m.meta['pole']\n"
+        "print(sorted(k for k in ('scipy', 'labbrdf.bsdf_export') if k in sys.modules))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip() == "[]"
 
 
 def test_good_minimal_file(tmp_path):
