@@ -885,7 +885,7 @@ def cmd_film(args: argparse.Namespace) -> int:
 def cmd_export(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from .adapters.zemax_bsdf import model_to_bsdf
+    from .bsdf_export import model_to_bsdf
 
     if args.format != "zemax-bsdf":
         raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
@@ -915,7 +915,7 @@ def cmd_export(args: argparse.Namespace) -> int:
 
 def _export_trace(args: argparse.Namespace) -> int:
     """``export --trace RUN.npz``: the tracer's unpolarized S0 on the scatter grid."""
-    from .adapters.zemax_bsdf import binned_to_bsdf
+    from .bsdf_export import binned_to_bsdf
     from .tracer import TraceResult
 
     out = Path(args.output)  # checked with the inputs by _checked_outputs
