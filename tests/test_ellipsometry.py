@@ -1,4 +1,4 @@
-"""Pseudo-optical constants with uncertainties (labbrdf.ellipsometry)."""
+"""The psi/Delta inversion, its condition number and uncertainties (labbrdf.ellipsometry)."""
 
 from __future__ import annotations
 

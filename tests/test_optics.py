@@ -1,7 +1,8 @@
 """Oracle-free tests of labbrdf.optics: invariants, analytic limits, shapes, error paths.
 
 Tolerances are stated next to each assertion in units of the float64 epsilon ``EPS`` and
-follow from the number of rounding operations or from an explicit condition number.
+follow from the number of rounding operations. The inverse problem (psi, Delta to n, k) is
+tested with :mod:`labbrdf.ellipsometry` in ``tests/test_ellipsometry.py``.
 """
 
 from __future__ import annotations
