@@ -4,17 +4,17 @@ Where the angles of incidence of a psi/Delta file disagree (:func:`labbrdf.nk.an
 ``stack`` or ``partly``), its two-phase pseudo-constants are those of a stack and give
 neither a material's n, k nor a reflectance (section ``nk``). Given a film model (a TOML
 file, :func:`labbrdf.films.load_model`, or the stated default :func:`default_film_model`),
-this section fits it to the file's psi/Delta at every angle (:func:`labbrdf.films.fit_film`)
+this section fits it to the file's psi/Delta at every angle (:func:`labbrdf.fit_film`)
 and shows the model, the parameters with their intervals, psi and Delta against wavelength
 per angle with the fit and the residuals, each layer's n, k with its uncertainty band, and
 the reflectance comparison redone with the fitted stack: the measured reflectance of the
 same sample (not used by the fit) against the stack's R_s, R_p
-(:meth:`labbrdf.films.FilmFit.compare_reflectance`), inside the fitted wavelength range.
+(:meth:`labbrdf.FilmFit.compare_reflectance`), inside the fitted wavelength range.
 
 Uncertainties of derived curves (n, k of a layer, predicted R) are first-order: central
 differences of the curve in each varying parameter, combined with the fit's covariance
 ``J C J^T``, times ``sqrt(chi2/nu)`` where chi-square rejects the film model
-(:attr:`labbrdf.films.FilmFit.misfit_scale`).
+(:attr:`labbrdf.FilmFit.misfit_scale`).
 """
 
 from __future__ import annotations
@@ -94,7 +94,7 @@ def _propagated(
 
 
 def _param_rows(summary: dict[str, Any]) -> list[dict[str, Any]]:
-    """The varying parameters of a :meth:`labbrdf.films.FilmFit.summary`, one row each."""
+    """The varying parameters of a :meth:`labbrdf.FilmFit.summary`, one row each."""
     groups = [(lay["name"], lay["parameters"]) for lay in summary["layers"]]
     groups.append(("substrate", summary["substrate"]["parameters"]))
     rows = []
