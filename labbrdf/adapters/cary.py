@@ -113,6 +113,26 @@ def read_cary_csv(path: str | os.PathLike[str]) -> Measurement:
             f"do not match the {nsample} samples {names}",
             end + 1,
         )
+    frames, samples_meta, dropped_total = _samples(path, names, modes, cols, blocks, paired)
+    meta: dict[str, Any] = {
+        "format": "agilent-cary-winuv-csv",
+        "encoding": encoding,
+        "samples": samples_meta,
+        "dropped_points": dropped_total,
+    }
+    return finish(path, frames, meta)
+
+
+def _samples(
+    path: str | os.PathLike[str],
+    names: list[str],
+    modes: list[str],
+    cols: _Columns,
+    blocks: list[dict[str, Any]],
+    paired: bool,
+) -> tuple[list[pd.DataFrame], list[dict[str, Any]], int]:
+    """Each sample's frame and meta (with its metadata block), and the points dropped."""
+    nsample, end = len(names), cols.end
     x, y, present, half = cols.x, cols.y, cols.present, cols.half
     frames: list[pd.DataFrame] = []
     samples_meta: list[dict[str, Any]] = []
@@ -154,13 +174,7 @@ def read_cary_csv(path: str | os.PathLike[str]) -> Measurement:
                 **{key: val for key, val in block.items() if key != "name"},
             }
         )
-    meta: dict[str, Any] = {
-        "format": "agilent-cary-winuv-csv",
-        "encoding": encoding,
-        "samples": samples_meta,
-        "dropped_points": dropped_total,
-    }
-    return finish(path, frames, meta)
+    return frames, samples_meta, dropped_total
 
 
 def _y_modes(path: str | os.PathLike[str], line: str) -> list[str]:

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from ..dataset import Measurement, wrap_delta
@@ -189,27 +190,7 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
             int(rows.lineno[np.flatnonzero(bad)[0]]),
         )
     _footer(f, rows.footer_start, meta)
-    psi, delta = filmsense_psi_delta(rows.nn, rows.cc, rows.ss)
-    m = psi.size
-    quantity = np.tile(np.array(["psi", "delta", "depolarization"], dtype=object), m)
-    values = np.column_stack([psi, delta, 1.0 - rows.pp]).ravel()
-    units = np.tile(np.array(["deg", "deg", "1"], dtype=object), m)
-    optional: dict[str, Any] = {}
-    if rows.times is not None:
-        optional["time_s"] = np.repeat(rows.times, 3)
-    frame = build_frame(
-        sample=p.stem,
-        instrument="filmsense",
-        source=p.name,
-        quantity=quantity,
-        value=values,
-        unit=units,
-        wavelength_nm=np.repeat(rows.wl_rows, 3),
-        theta_i_deg=aoi,
-        theta_r_deg=aoi,
-        phi_r_deg=180.0,
-        **optional,
-    )
+    frame = _frame(path, rows, aoi)
     meta["delta_convention"] = (
         "Nebraska: Delta = atan2(S, C), sign checked against a Fresnel "
         "calculation (see filmsense_psi_delta)"
@@ -220,6 +201,31 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
     meta["wavelength_nm"] = [float(wl.min()), float(wl.max())]
     meta["sigma"] = "none in the file (NaN)"
     return measurement(path, frame, meta)
+
+
+def _frame(path: str | os.PathLike[str], rows: _Rows, aoi: float) -> pd.DataFrame:
+    """The tidy frame: psi and delta from N, C, S and depolarization 1 - P for each row."""
+    psi, delta = filmsense_psi_delta(rows.nn, rows.cc, rows.ss)
+    m = psi.size
+    quantity = np.tile(np.array(["psi", "delta", "depolarization"], dtype=object), m)
+    values = np.column_stack([psi, delta, 1.0 - rows.pp]).ravel()
+    units = np.tile(np.array(["deg", "deg", "1"], dtype=object), m)
+    optional: dict[str, Any] = {}
+    if rows.times is not None:
+        optional["time_s"] = np.repeat(rows.times, 3)
+    return build_frame(
+        sample=Path(path).stem,
+        instrument="filmsense",
+        source=Path(path).name,
+        quantity=quantity,
+        value=values,
+        unit=units,
+        wavelength_nm=np.repeat(rows.wl_rows, 3),
+        theta_i_deg=aoi,
+        theta_r_deg=aoi,
+        phi_r_deg=180.0,
+        **optional,
+    )
 
 
 @dataclass
