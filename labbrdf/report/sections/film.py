@@ -318,7 +318,9 @@ def _ordinary(g: pd.DataFrame) -> pd.DataFrame:
     return rows
 
 
-def _flagged(ellips: list[tuple[str, pd.DataFrame]]) -> list[tuple[str, pd.DataFrame, Any]]:
+def _flagged(
+    ellips: list[tuple[str, pd.DataFrame]],
+) -> list[tuple[str, pd.DataFrame, nkmod.AngleVerdict]]:
     """(file, rows, angle verdict) of each psi/Delta file whose angles disagree."""
     flagged = []
     for src, g in ellips:
@@ -350,7 +352,9 @@ def _model_text(ctx: Context, model: films.FilmModel, how: str) -> None:
     )
 
 
-def _fit_shown(ctx: Context, tag: str, src: str, verdict: Any, fit: films.FilmFit) -> None:
+def _fit_shown(
+    ctx: Context, tag: str, src: str, verdict: nkmod.AngleVerdict, fit: films.FilmFit
+) -> None:
     """One fit: its summary in words, the parameter table, psi/Delta and n, k figures."""
     b = ctx.b
     s = fit.summary()
@@ -406,7 +410,7 @@ def _fit_file(
     i: int,
     src: str,
     g: pd.DataFrame,
-    verdict: Any,
+    verdict: nkmod.AngleVerdict,
     model: films.FilmModel,
     ellips: list[tuple[str, pd.DataFrame]],
     refl: list[tuple[str, pd.DataFrame]],
