@@ -315,7 +315,7 @@ def test_fit_lists_failed_groups_and_exits_3(tmp_path, capsys):
 ELLIPSOMETRY = SCAN.parents[1] / "ellipsometry" / "al_bare_wvase.dat"
 
 
-def _fake_height_map(path, channel):
+def _fake_height_map(path, channel, args=None):
     from labbrdf.adapters.topography import HeightMap
 
     rng = np.random.default_rng(3)
