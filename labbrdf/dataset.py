@@ -453,6 +453,55 @@ class Measurement:
         present = set(self.data["quantity"].astype(str))
         return [q for q in QUANTITIES if q in present]
 
+    def _repr_html_(self) -> str:
+        """The summary and the first rows, for notebooks."""
+        from .richrepr import card
+
+        s = self.summary()
+        facts = [
+            ("sample", ", ".join(s["sample"][:5]) + (" ..." if len(s["sample"]) > 5 else "")),
+            ("rows", s["rows"]),
+            ("quantities", ", ".join(s["quantities"])),
+            ("wavelength [nm]", "{:g} - {:g}".format(*s["wavelength_nm"])),
+            ("theta_i [deg]", ", ".join(f"{t:g}" for t in s["theta_i_deg"][:12]) or "-"),
+            ("sources", ", ".join(sorted(set(self.data["source"].astype(str)))[:5])),
+        ]
+        return card("labbrdf Measurement", facts, extra_html=self.data.head(8).to_html())
+
+    def plot(self, quantity: str | None = None, ax: Any = None) -> Any:
+        """Values against wavelength, one line per (source, sample, angle), for notebooks.
+
+        Parameters
+        ----------
+        quantity : str, optional
+            Which quantity to draw; default the first present.
+        ax : matplotlib Axes, optional
+            Where to draw; default a new figure.
+
+        Returns
+        -------
+        matplotlib Axes
+        """
+        import matplotlib.pyplot as plt  # only here: reading data needs no plotting library
+
+        q = quantity or self.quantities[0]
+        d = self.data[self.data["quantity"].astype(str) == q]
+        if d.empty:
+            raise DatasetError(f"quantity {q!r} not in this measurement ({self.quantities})")
+        if ax is None:
+            _, ax = plt.subplots()
+        keys = ["source", "sample", "theta_i_deg", "theta_r_deg", "phi_r_deg"]
+        for key, g in d.groupby(keys, dropna=False, sort=True, observed=True):
+            g = g.sort_values("wavelength_nm")
+            label = " ".join(str(k) for k in key[1:3] if str(k) != "nan")
+            ax.plot(g["wavelength_nm"], g["value"], label=label)
+        ax.set_xlabel("wavelength [nm]")
+        unit = str(d["unit"].iloc[0])
+        ax.set_ylabel(f"{q} [{unit}]")
+        if d.groupby(keys, dropna=False, observed=True).ngroups <= 12:
+            ax.legend(fontsize="small")
+        return ax
+
     def summary(self) -> dict[str, Any]:
         """JSON-safe one-line description: sample, rows, quantities, ranges."""
         d = self.data

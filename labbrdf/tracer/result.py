@@ -122,6 +122,31 @@ class TraceResult:
         w = self._grid.cos_solid_angle_sr[:, :, None, None]
         return self.sums / (self.rays * w)
 
+    def _repr_html_(self) -> str:
+        """What was traced and the albedo, for notebooks."""
+        from ..richrepr import card
+
+        c = self.config
+        facts = [
+            ("wavelength [nm], theta_i [deg]", f"{c.wavelength_nm:g}, {c.theta_i_deg:g}"),
+            (
+                "substrate",
+                f"N = {c.substrate.n:g}+{c.substrate.k:g}i, alpha {c.substrate.alpha:g}",
+            ),
+            (
+                "coating",
+                "none"
+                if c.coating is None
+                else f"N = {c.coating.n:g}+{c.coating.k:g}i, {c.coating.thickness_nm:g} nm, "
+                f"alpha {c.coating.alpha:g}",
+            ),
+            ("estimator, scattering", f"{self.estimator}, {c.scattering}"),
+            ("rays, seconds", f"{self.rays}, {self.seconds:.3g}"),
+            ("grid", f"{self.mueller.shape[0]} x {self.mueller.shape[1]} bins of 4 x 4"),
+            ("albedo", f"{self.albedo():.6g} +- {self.albedo_stderr():.2g}"),
+        ]
+        return card("labbrdf TraceResult", facts)
+
     @property
     def estimator(self) -> str:
         """``"evaluated"`` or ``"counting"``: what produced this result.
