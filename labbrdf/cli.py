@@ -1190,6 +1190,7 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
+    from .fitting.core import METHOD
 
     p = argparse.ArgumentParser(
         prog="labbrdf",
@@ -1231,7 +1232,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("files", nargs="+", action=InputPath, metavar="FILE_OR_DATASET")
     s.add_argument("--model", required=True)
     s.add_argument("--by", default="sample,wavelength_nm", help="comma-separated group columns")
-    s.add_argument("--method", default="GN_CRS2_LM+LN_BOBYQA", help="nlopt GLOBAL[+LOCAL]")
+    s.add_argument("--method", default=METHOD, help="nlopt GLOBAL[+LOCAL]")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--fix", action="append", metavar="NAME=VALUE", help="fix a parameter")
     s.add_argument(
@@ -1340,7 +1341,7 @@ def build_parser() -> argparse.ArgumentParser:
         default="profile",
         help="95%% intervals from the profile of chi2 (default) or the covariance",
     )
-    s.add_argument("--method", default="GN_CRS2_LM+LN_BOBYQA", help="nlopt stages")
+    s.add_argument("--method", default=METHOD, help="nlopt stages")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("-o", "--output", default=None, metavar="NK.csv",
                    help="write each layer's n, k on the fitted wavelengths")  # fmt: skip

@@ -1,8 +1,15 @@
 """One way to run a list of independent tasks: serially, on local processes, or on dask.
 
 >>> from labbrdf import parallel
->>> parallel.run(abs, [-1, -2, 3], scheduler="serial")
+>>> parallel.Executor("serial").map(abs, [-1, -2, 3])
 [1, 2, 3]
+
+An :class:`Executor` names where tasks run (scheduler, worker count, the dask security and
+timeout options); batch fits, tracer runs and reports all take one, and the CLI builds one
+from its options (``--scheduler``, ``--workers``, ``--tls-*``, ``--worker-timeout``,
+``--dashboard``). :func:`as_executor` turns None or a scheduler string into one, so that a
+Python caller may still write ``scheduler="serial"``. :func:`run` and :func:`imap` are the
+same runs with the options spelt out.
 
 Schedulers
 ----------
@@ -70,6 +77,7 @@ import threading
 import time
 import uuid
 from collections import deque
+from dataclasses import dataclass, replace
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import (
     FIRST_COMPLETED,
@@ -84,10 +92,13 @@ from typing import Any, TypeVar
 from .errors import LabbrdfError
 
 __all__ = [
+    "DEFAULT_SCHEDULER",
     "DEFAULT_WORKER_TIMEOUT",
     "SCHEDULERS",
+    "Executor",
     "ParallelError",
     "Progress",
+    "as_executor",
     "check_scheduler",
     "configure",
     "imap",
@@ -100,6 +111,9 @@ R = TypeVar("R")
 
 #: the scheduler names besides ``tcp://`` / ``tls://`` addresses
 SCHEDULERS = ("serial", "processes", "local")
+
+#: the scheduler of an :class:`Executor` (and of :func:`run`, :func:`imap`) when none is named
+DEFAULT_SCHEDULER = "processes"
 
 #: how long a run waits for a worker on a ``tcp://`` / ``tls://`` scheduler that has none [s]
 DEFAULT_WORKER_TIMEOUT = 60.0
@@ -474,7 +488,7 @@ def imap(
     func: Callable[[T], R],
     items: Iterable[T],
     *,
-    scheduler: str = "processes",
+    scheduler: str = DEFAULT_SCHEDULER,
     workers: int | None = None,
     progress: bool = False,
     desc: str = "",
@@ -695,7 +709,7 @@ def run(
     func: Callable[[T], R],
     items: Iterable[T],
     *,
-    scheduler: str = "processes",
+    scheduler: str = DEFAULT_SCHEDULER,
     workers: int | None = None,
     progress: bool = False,
     desc: str = "",
@@ -717,3 +731,131 @@ def run(
             retries=retries,
         )
     )
+
+
+@dataclass(frozen=True)
+class Executor:
+    """Where a workflow's tasks run: one object passed to fits, traces and reports alike.
+
+    Parameters
+    ----------
+    scheduler : str
+        ``serial``, ``processes`` (default, :data:`DEFAULT_SCHEDULER`), ``local`` or a
+        ``tcp://`` / ``tls://`` dask scheduler address (see the module docstring).
+    workers : int, optional
+        Worker processes (``processes``, ``local``); default: the core count.
+    progress : bool
+        Show a progress bar on stderr for each run.
+    retries : int
+        Runs of a task after its worker died (``local``; see :func:`imap`).
+    dashboard : bool, optional
+        Start the ``local`` cluster's dashboard on 127.0.0.1.
+    tls_ca, tls_cert, tls_key : path-like, optional
+        PEM files for mutual TLS (see :func:`configure`).
+    worker_timeout : float, optional
+        How long to wait for a worker on a ``tcp://`` / ``tls://`` scheduler [s].
+
+    Raises
+    ------
+    ValueError
+        An unknown scheduler, ``workers`` < 1, ``retries`` < 0, or a bad security or
+        timeout option (:func:`configure`): at construction, before any work.
+    ImportError
+        A dask scheduler without dask.distributed (or ``local`` without ``cryptography``
+        and without certificates); the message says what to install.
+
+    Notes
+    -----
+    The dask options are those of this process (:func:`configure`): building an Executor
+    with any of them set configures the process, so the last Executor built decides them.
+    Results do not depend on the executor: every run returns its results in item order.
+    """
+
+    scheduler: str = DEFAULT_SCHEDULER
+    workers: int | None = None
+    progress: bool = False
+    retries: int = 2
+    dashboard: bool | None = None
+    tls_ca: str | os.PathLike[str] | None = None
+    tls_cert: str | os.PathLike[str] | None = None
+    tls_key: str | os.PathLike[str] | None = None
+    worker_timeout: float | None = None
+
+    def __post_init__(self) -> None:
+        # first the certificates: they decide what `local` needs (cryptography or not)
+        configure(
+            dashboard=self.dashboard,
+            tls_ca=self.tls_ca,
+            tls_cert=self.tls_cert,
+            tls_key=self.tls_key,
+            worker_timeout=self.worker_timeout,
+        )
+        check_scheduler(self.scheduler)
+        if self.workers is not None:
+            _workers(self.workers)
+        if int(self.retries) < 0:
+            raise ValueError(f"retries must be >= 0, got {self.retries}")
+
+    @property
+    def serial(self) -> bool:
+        """Whether tasks run in this process, in order."""
+        return self.scheduler == "serial"
+
+    @property
+    def nworkers(self) -> int:
+        """Worker processes a run is planned for (1 when serial; the core count by default)."""
+        return 1 if self.serial else _workers(self.workers)
+
+    def imap(
+        self,
+        func: Callable[[T], R],
+        items: Iterable[T],
+        *,
+        desc: str = "",
+        window: int | None = None,
+    ) -> Iterator[R]:
+        """``func`` of each item, yielded in item order (see :func:`imap`)."""
+        return imap(
+            func,
+            items,
+            scheduler=self.scheduler,
+            workers=self.workers,
+            progress=self.progress,
+            desc=desc,
+            retries=self.retries,
+            window=window,
+        )
+
+    def map(self, func: Callable[[T], R], items: Iterable[T], *, desc: str = "") -> list[R]:
+        """``[func(it) for it in items]`` on this executor, as a list in item order."""
+        return list(self.imap(func, items, desc=desc))
+
+    def __call__(self, func: Callable[[T], R], items: Iterable[T]) -> Iterator[R]:
+        """The ordered ``map(func, items)`` that :func:`labbrdf.tracer.trace` takes."""
+        return self.imap(func, items)
+
+    def with_progress(self, progress: bool) -> Executor:
+        """This executor with the progress bar switched on or off."""
+        return replace(self, progress=bool(progress))
+
+
+def as_executor(
+    executor: Executor | str | None = None, workers: int | None = None, progress: bool = False
+) -> Executor:
+    """An :class:`Executor` from an Executor, a scheduler string or None (the default).
+
+    ``workers`` and ``progress`` apply to a string or None only; an Executor is returned
+    as it is.
+
+    Raises
+    ------
+    ValueError, ImportError
+        As :class:`Executor` does, for a string.
+    """
+    if isinstance(executor, Executor):
+        return executor
+    if executor is not None and not isinstance(executor, str):
+        raise ValueError(
+            f"executor must be an Executor or a scheduler string, got {type(executor).__name__}"
+        )
+    return Executor(executor or DEFAULT_SCHEDULER, workers=workers, progress=progress)
