@@ -77,7 +77,6 @@ import threading
 import time
 import uuid
 from collections import deque
-from dataclasses import dataclass, replace
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import (
     FIRST_COMPLETED,
@@ -87,6 +86,7 @@ from concurrent.futures import (
     wait,
 )
 from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, replace
 from typing import Any, TypeVar
 
 from .errors import LabbrdfError
@@ -835,27 +835,52 @@ class Executor:
         return self.imap(func, items)
 
     def with_progress(self, progress: bool) -> Executor:
-        """This executor with the progress bar switched on or off."""
+        """The same executor with the progress bar switched on or off."""
         return replace(self, progress=bool(progress))
 
 
 def as_executor(
-    executor: Executor | str | None = None, workers: int | None = None, progress: bool = False
+    executor: Executor | str | None = None,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: bool | None = None,
 ) -> Executor:
-    """An :class:`Executor` from an Executor, a scheduler string or None (the default).
+    """The :class:`Executor` a workflow runs on, from what its caller gave.
 
-    ``workers`` and ``progress`` apply to a string or None only; an Executor is returned
-    as it is.
+    Parameters
+    ----------
+    executor : Executor or str, optional
+        An Executor (returned as it is, but for ``progress``), or a scheduler name.
+    scheduler : str, optional
+        The older keyword for a scheduler name (not together with ``executor``).
+    workers : int, optional
+        Worker processes, with a scheduler name or none (an Executor has its own).
+    progress : bool, optional
+        Progress bar on stderr (default: the Executor's setting; off for a name).
+
+    Returns
+    -------
+    Executor
+        None and no scheduler give ``Executor()``: :data:`DEFAULT_SCHEDULER`.
 
     Raises
     ------
-    ValueError, ImportError
-        As :class:`Executor` does, for a string.
+    ValueError
+        Both ``executor`` and ``scheduler``, ``workers`` with an Executor, something
+        that is neither an Executor nor a string, or what :class:`Executor` refuses.
+    ImportError
+        As :class:`Executor` raises it.
     """
+    if executor is not None and scheduler is not None:
+        raise ValueError("give either an executor or a scheduler, not both")
     if isinstance(executor, Executor):
-        return executor
-    if executor is not None and not isinstance(executor, str):
+        if workers is not None:
+            raise ValueError("workers: an Executor has its own worker count")
+        return executor if progress is None else executor.with_progress(progress)
+    spec = executor if executor is not None else scheduler
+    if spec is not None and not isinstance(spec, str):
         raise ValueError(
-            f"executor must be an Executor or a scheduler string, got {type(executor).__name__}"
+            f"executor must be an Executor or a scheduler name, got {type(spec).__name__}"
         )
-    return Executor(executor or DEFAULT_SCHEDULER, workers=workers, progress=progress)
+    return Executor(spec or DEFAULT_SCHEDULER, workers=workers, progress=bool(progress))

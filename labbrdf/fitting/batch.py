@@ -12,10 +12,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from .. import parallel  # imports only labbrdf.errors: usable from every layer
 from ..dataset import Measurement
 from ..models import Model
 from ..models import get as get_model
-from .. import parallel  # imports only labbrdf.errors: usable from every layer
 from .core import METHOD, fit, parse_method, setup_params
 from .data import FitData, FitError, select_rows, several_groups_message
 from .result import FitResult
@@ -94,7 +94,8 @@ def fit_many(
         :data:`labbrdf.parallel.DEFAULT_SCHEDULER`.
     scheduler, workers :
         The older spelling of ``executor``: a scheduler name and a worker count, turned
-        into an Executor once (not with ``executor``).
+        into an Executor once by :func:`labbrdf.parallel.as_executor` (``scheduler`` not
+        together with ``executor``, ``workers`` not with an Executor).
     progress : bool, optional
         Progress bar on stderr, counting chunks of groups (default: the Executor's
         setting; on with a scheduler name or no executor).
@@ -117,19 +118,14 @@ def fit_many(
         ``message``, ``elapsed_s``. A group that cannot be fitted (too few points, ...) gets
         ``success=False`` and the reason in ``message``.
     """
-    if executor is not None and (scheduler is not None or workers is not None):
-        raise ValueError("fit_many: give either executor or scheduler/workers, not both")
-    if isinstance(executor, parallel.Executor):
-        ex = executor if progress is None else executor.with_progress(progress)
-    else:
-        ex = parallel.as_executor(
-            executor if executor is not None else scheduler,
-            workers=workers,
-            progress=True if progress is None else progress,
-        )
+    if progress is None and not isinstance(executor, parallel.Executor):
+        progress = True  # a scheduler name or no executor: a bar, as ``labbrdf fit`` shows
+    ex = parallel.as_executor(executor, scheduler=scheduler, workers=workers, progress=progress)
     if isinstance(model, str):
         model = get_model(model)
-    model_of = model if not isinstance(model, Model) else None
+    model_of: Callable[[dict[str, Any]], Model] | None = (
+        None if isinstance(model, Model) else model
+    )
     parse_method(method)
     if isinstance(data, Measurement):
         data = data.data
@@ -169,8 +165,11 @@ def fit_many(
     todo: list[tuple[int, Model, FitData]] = []
     for i, g in enumerate(groups):
         if isinstance(g, FitData):
-            m = model if model_of is None else model_of(dict(zip(by, map(_plain, keys[i]))))
-            if model_of is not None:
+            if model_of is None:
+                assert isinstance(model, Model)
+                m = model
+            else:
+                m = model_of(dict(zip(by, map(_plain, keys[i]), strict=True)))
                 setup_params(m, fit_kw.get("params"), fit_kw.get("fix"))
             todo.append((i, m, g))
     if chunks is None:
