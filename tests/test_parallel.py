@@ -210,9 +210,9 @@ def trace_block(item: tuple[TraceConfig, tuple[int, ...]]) -> int:
     return item[1][0]
 
 
-def fit_chunk(item: tuple[Any, list[tuple[int, Any]], dict, bool]) -> int:
-    """Key of a fit_many chunk ``(model, [(group index, FitData), ...], kw, keep)``."""
-    return item[1][0][0]
+def fit_chunk(item: tuple[list[tuple[int, Any, Any]], dict, bool]) -> int:
+    """Key of a fit_many chunk ``([(group index, model, FitData), ...], kw, keep)``."""
+    return item[0][0][0]
 
 
 class KillOnce:
