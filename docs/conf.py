@@ -57,7 +57,11 @@ html_theme = "alabaster"
 html_title = "labbrdf"
 html_static_path: list[str] = []
 templates_path = ["_templates"]
-html_theme_options = {"description": "Optical metrology of surfaces: files to fits to reports"}
+html_theme_options = {
+    "description": "Optical metrology of surfaces: files to fits to reports",
+    "page_width": "1240px",  # command lines and tables need the width
+}
+smartquotes = False  # option names stay as typed (--format, not an en dash)
 
 
 def _top_level() -> dict[str, object]:

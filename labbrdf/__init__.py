@@ -63,6 +63,8 @@ _LAZY: dict[str, tuple[str, str]] = {
 #: subpackages and modules reachable as attributes of the package
 _MODULES = (
     "adapters",
+    "bsdf_export",
+    "bsdf_geometry",
     "cli",
     "dataset",
     "dispersion",
@@ -91,6 +93,8 @@ __all__ = ["__version__", *_LAZY, *_MODULES]
 if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__ imports
     from . import (
         adapters,
+        bsdf_export,
+        bsdf_geometry,
         cli,
         dataset,
         dispersion,

@@ -715,7 +715,8 @@ def _model_from_args(args: argparse.Namespace) -> tuple[Any, dict[str, float]]:
 
 def cmd_nk(args: argparse.Namespace) -> int:
     from . import adapters
-    from .nk import combined_table, nk_json, nk_table
+    from .ellipsometry import P_ANGLE_DEPENDENT
+    from .nk import angle_verdict, combined_table, nk_json, nk_table
     from .outputs import atomic_output, csv_safe_frame
 
     data = _selected(args, adapters.read_many(args.files))
@@ -735,12 +736,20 @@ def cmd_nk(args: argparse.Namespace) -> int:
                         "dof", "p_value", "angle_dependent") if c in comb.columns]  # fmt: skip
     with pd.option_context("display.width", 200, "display.max_rows", 40):
         print(comb[cols].to_string(index=False))
-    flagged = int(comb["angle_dependent"].fillna(False).astype(bool).sum())
-    if flagged:
-        print(
-            f"{flagged} of {len(comb)} wavelengths have angle-dependent pseudo-constants "
-            "(p < 0.01): a film or roughness, not a bulk material"
-        )
+    for (sample, source), g in comb.groupby(["sample", "source"], sort=False):
+        v = angle_verdict(g)
+        if v.kind == "stack":
+            print(
+                f"{sample} ({source}): {v.text}, not a material's n, k. They are not combined "
+                "(n, k empty above; per angle with -o FILE or --json) and predict no "
+                "reflectance; `labbrdf film` fits a stack model for the layers' constants."
+            )
+        elif g["angle_dependent"].astype(bool).any():
+            print(
+                f"{sample} ({source}): {v.text}. Where the angles disagree "
+                f"(p < {P_ANGLE_DEPENDENT:g}) the sigmas are multiplied by sqrt(chi2/dof) to "
+                "cover their scatter."
+            )
     return 0
 
 
@@ -869,18 +878,8 @@ def _film_table(summary: dict[str, Any]) -> str:
 
 def cmd_film(args: argparse.Namespace) -> int:
     from . import adapters, films
-    from .outputs import atomic_output, check_file_output, check_input_files, csv_safe_frame
+    from .outputs import atomic_output, csv_safe_frame
 
-    check_input_files(args.files)
-    extra_inputs = [x for x in (args.model,) if x]
-    outs = []
-    for path, suffix, opt in ((args.output, ".csv", "-o"), (args.fit_json, ".json", "--fit-json")):
-        if path:
-            out = check_file_output(path, inputs=[*args.files, *extra_inputs], suffixes=(suffix,),
-                                    option=opt)  # fmt: skip
-            if out.exists() and not args.overwrite:
-                raise UsageError(f"{opt} {out}: exists; pass --overwrite to replace it")
-            outs.append(out)
     fm = _film_model(args)
     sigma = _parse_assignments(args.sigma, "--sigma")
     wl_range = tuple(args.wavelength_range) if args.wavelength_range else None
@@ -912,7 +911,7 @@ def cmd_film(args: argparse.Namespace) -> int:
 def cmd_export(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from .adapters.zemax_bsdf import model_to_bsdf
+    from .bsdf_export import model_to_bsdf
 
     if args.format != "zemax-bsdf":
         raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
@@ -942,7 +941,7 @@ def cmd_export(args: argparse.Namespace) -> int:
 
 def _export_trace(args: argparse.Namespace) -> int:
     """``export --trace RUN.npz``: the tracer's unpolarized S0 on the scatter grid."""
-    from .adapters.zemax_bsdf import binned_to_bsdf
+    from .bsdf_export import binned_to_bsdf
     from .tracer import TraceResult
 
     out = Path(args.output)  # checked with the inputs by _checked_outputs
@@ -989,41 +988,115 @@ def _grid(text: str, option: str) -> Any:
         ) from None
 
 
-def _height_map(path: str, channel: str | None) -> Any:
-    from .adapters.topography import read_height_map
+def _height_map(path: str, channel: str | None, args: argparse.Namespace | None = None) -> Any:
+    """Read a height map; ``--pixel-size`` / ``--unit`` of ``args`` state its geometry."""
+    from .adapters.topography import length_m, read_height_map
 
     ch: int | str | None = int(channel) if channel and channel.isdigit() else channel
-    return read_height_map(path, ch)
+    unit = getattr(args, "unit", None)
+    px_text = getattr(args, "pixel_size", None)
+    pixel = None
+    if px_text is not None:
+        try:
+            pixel = tuple(length_m(v, unit) for v in px_text.split(","))
+        except ValueError as exc:
+            raise UsageError(f"--pixel-size: {exc}") from None
+        if len(pixel) not in (1, 2):
+            raise UsageError(f"--pixel-size {px_text!r}: one pitch or two (dx,dy)")
+    try:
+        hm = read_height_map(path, ch, unit=unit, pixel_size=pixel)
+    except MemoryError:
+        raise UsageError(f"{path}: out of memory while reading the height map") from None
+    for w in hm.warnings:
+        print(f"labbrdf: warning: {path}: {w}", file=sys.stderr)
+    return hm
 
 
-def _ggx_alpha_of(path: str, channel: str | None) -> float:
-    """GGX alpha fitted by maximum likelihood to the slopes of a measured areal map."""
+def _slope_table_of(
+    path: str, channel: str | None, args: argparse.Namespace | None = None
+) -> tuple[float, Any]:
+    """(ML GGX alpha, slope table) of a measured areal map, for the coating's top."""
     from .tracer import Substrate
 
-    hm = _height_map(path, channel)
+    hm = _height_map(path, channel, args)
     if hm.heights.ndim != 2:
         raise UsageError(f"{path}: a line profile; the coating needs an areal height map")
-    return float(Substrate.from_surface(hm.heights, hm.pixel_size).alpha)
+    try:
+        s = Substrate.from_surface(hm.heights, hm.pixel_size)
+    except ValueError as exc:
+        raise UsageError(f"{path}: {exc}") from None
+    return float(s.alpha), s.ndf
+
+
+def _analytic_table(args: argparse.Namespace, alpha: float) -> Any:
+    """``--distribution beckmann``: the Beckmann slope table of ``alpha``; GGX: None."""
+    if args.distribution == "ggx":
+        return None
+    from .tracer.sampling import TabulatedNDF
+
+    if not alpha > 0:
+        raise UsageError("--distribution beckmann needs a roughness alpha > 0")
+    return TabulatedNDF.beckmann(alpha)
+
+
+def _progress_printer(label: str, after_s: float = 2.0) -> Any:
+    """``progress(done, total)`` reporting on stderr after ``after_s`` s (a TTY: at once)."""
+    t0 = time.monotonic()
+
+    def progress(done: int, total: int) -> None:
+        if total > 1 and (sys.stderr.isatty() or time.monotonic() - t0 > after_s):
+            el = time.monotonic() - t0
+            print(f"{label}: pass {done}/{total} ({el:.0f} s)", file=sys.stderr, flush=True)
+
+    return progress
 
 
 def cmd_surface(args: argparse.Namespace) -> int:
+    from .adapters.topography import length_m
     from .outputs import check_file_output, check_input_files
     from .topography import level, roughness_statistics
 
     check_input_files([args.file])
     if args.png:
         check_file_output(args.png, inputs=[args.file], suffixes=(".png",), option="--png")
-    hm = _height_map(args.file, args.channel)
-    st = roughness_statistics(hm.heights, hm.pixel_size, degree=args.degree, blocks=args.blocks)
-    if args.png:
-        from .report.figures import save_png, surface_figure
+    cutoff = None
+    if args.short_cutoff is not None:
+        try:
+            cutoff = length_m(args.short_cutoff, args.unit)
+        except ValueError as exc:
+            raise UsageError(f"--short-cutoff: {exc}") from None
+    if args.erode_mask < 0:
+        raise UsageError(f"--erode-mask {args.erode_mask}: expected pixels >= 0")
+    hm = _height_map(args.file, args.channel, args)
+    try:
+        st = roughness_statistics(
+            hm.heights,
+            hm.pixel_size,
+            degree=args.degree,
+            blocks=args.blocks,
+            short_cutoff=cutoff,
+            erode=args.erode_mask,
+            progress=_progress_printer(f"labbrdf surface: {args.file}"),
+        )
+        if args.png:
+            from .report.figures import save_png, surface_figure
 
-        z = level(hm.heights, args.degree)
-        uri = surface_figure(z, hm.pixel_size, st, title=f"{Path(args.file).name} ({hm.channel})")
-        save_png(uri, args.png)
+            z = level(hm.heights, args.degree)
+            title = f"{Path(args.file).name} ({hm.channel})"
+            save_png(surface_figure(z, hm.pixel_size, st, title=title), args.png)
+    except MemoryError:
+        shape = " x ".join(map(str, hm.heights.shape))
+        raise UsageError(
+            f"{args.file}: out of memory for the statistics of a {shape} map"
+            f" ({hm.heights.nbytes / 2**20:.0f} MiB of heights; the statistics need about"
+            " 14 times that)"
+        ) from None
+    except ValueError as exc:
+        raise UsageError(f"{args.file}: {exc}") from None
     d = st.to_dict()
     d["file"] = str(args.file)
     d["channel"] = hm.channel
+    d["geometry_warnings"] = list(hm.warnings)
     if args.json:
         _emit_json(d)
         return 0
@@ -1032,28 +1105,31 @@ def cmd_surface(args: argparse.Namespace) -> int:
     def row(label: str, key: str, scale: float, unit: str) -> None:
         v = d.get(key)
         if v is None:
-            print(f"{label:<28} undefined")
+            print(f"{label:<38} undefined")
             return
         e = u.get(key)
         err = f" +- {e * scale:.3g}" if e is not None else ""
-        print(f"{label:<28} {v * scale:.4g}{err} {unit}")
+        print(f"{label:<38} {v * scale:.4g}{err} {unit}")
 
     print(f"{args.file} ({d['kind']}, channel {hm.channel}, {d['levelling']})")
+    print(f"bandwidth: {d['bandwidth']}")
     row("sigma (RMS height)", "sigma", 1e9, "nm")
     row("RMS slope", "slope_rms", 1.0, "")
     row("correlation length c", "c", 1e6, "um")
-    row("alpha = sqrt(2) sigma / c", "alpha", 1.0, "")
+    row("alpha_gaussian_acf = sqrt(2) sigma/c", "alpha_gaussian_acf", 1.0, "")
+    row("alpha_ggx_ml (used by trace)", "alpha_ggx_ml", 1.0, "")
     if d["kind"] == "areal":
         row("anisotropy c_major/c_minor", "anisotropy_ratio", 1.0, "")
     fits = d["slope_fits"]
     for name in ("ggx", "beckmann"):
         f = fits[name]
-        print(f"{name + ' alpha (ML)':<28} {f['alpha']:.4g}  KS {f['ks']:.3g}  AIC {f['aic']:.6g}")
+        print(f"{name + ' alpha (ML)':<38} {f['alpha']:.4g}  KS {f['ks']:.3g}  AIC {f['aic']:.6g}")
     print(f"best description of the slopes: {fits['best']}")
     if fits.get("warning"):
         print(f"warning: {fits['warning']}")
     for note in d.get("notes") or ():
-        print(f"note: {note}")
+        if note != fits.get("warning"):
+            print(f"note: {note}")
     return 0
 
 
@@ -1100,14 +1176,19 @@ def cmd_trace(args: argparse.Namespace) -> int:
     else:
         sub = _complex(args.substrate, "--substrate")
     if args.surface is not None:
-        hm = _height_map(args.surface, args.channel)
-        substrate = tracer.Substrate.from_surface(
-            hm.heights, hm.pixel_size, n=sub.real, k=sub.imag
-        )
+        hm = _height_map(args.surface, args.channel, args)
+        try:
+            substrate = tracer.Substrate.from_surface(
+                hm.heights, hm.pixel_size, n=sub.real, k=sub.imag
+            )
+        except ValueError as exc:
+            raise UsageError(f"{args.surface}: {exc}") from None
     elif args.alpha is None:
         raise UsageError("give the substrate roughness with --alpha A or --surface FILE")
     else:
-        substrate = tracer.Substrate(n=sub.real, k=sub.imag, alpha=args.alpha)
+        substrate = tracer.Substrate(
+            n=sub.real, k=sub.imag, alpha=args.alpha, ndf=_analytic_table(args, args.alpha)
+        )
     kw: dict[str, Any] = {
         "wavelength_nm": args.wavelength,
         "theta_i_deg": args.theta_i,
@@ -1116,27 +1197,46 @@ def cmd_trace(args: argparse.Namespace) -> int:
         "seed": args.seed,
         "scattering": "single" if args.single_scattering else "multiple",
         "coherent": args.coherent,
+        "estimator": args.estimator,
+        "scalar": args.scalar,
     }
-    if args.coating is not None:
+    coat: complex | None = None
+    thickness = args.thickness
+    if args.coating_from is not None:
+        if args.coating is not None or args.thickness is not None:
+            raise UsageError(
+                "give the coating once: --coating-from FIT.json, or --coating and --thickness"
+            )
+        from .nk import coating_from_fit
+
+        try:
+            coat, thickness = coating_from_fit(args.coating_from, args.wavelength)
+        except ValueError as exc:
+            raise UsageError(f"--coating-from {exc}") from None
+    elif args.coating is not None:
         coat = _complex(args.coating, "--coating")
-        if args.thickness is None:
+    if coat is not None:
+        if thickness is None:
             raise UsageError("--coating needs --thickness (nm)")
         if args.coating_alpha is not None and args.coating_surface is not None:
             raise UsageError(
                 "give the coating roughness once: --coating-alpha or --coating-surface"
             )
         coat_alpha = args.coating_alpha if args.coating_alpha is not None else substrate.alpha
+        coat_ndf = _analytic_table(args, coat_alpha)
         if args.coating_surface is not None:
-            coat_alpha = _ggx_alpha_of(args.coating_surface, args.channel)
+            coat_alpha, coat_ndf = _slope_table_of(args.coating_surface, args.channel, args)
         kw["coating"] = tracer.Coating(
-            n=coat.real, k=coat.imag, thickness_nm=args.thickness, alpha=coat_alpha
+            n=coat.real, k=coat.imag, thickness_nm=thickness, alpha=coat_alpha, ndf=coat_ndf
         )
     elif (
         args.thickness is not None
         or args.coating_alpha is not None
         or args.coating_surface is not None
     ):
-        raise UsageError("--thickness, --coating-alpha and --coating-surface need --coating")
+        raise UsageError(
+            "--thickness, --coating-alpha and --coating-surface need --coating (or --coating-from)"
+        )
     config = tracer.TraceConfig(**kw)
     t0 = time.perf_counter()
     result = tracer.trace(config, map=functools.partial(executor.imap, desc="trace"))
@@ -1178,6 +1278,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 @_executor_errors
 def cmd_report(args: argparse.Namespace) -> int:
     from .report import user_report
+    from .report.sections.film import default_film_model
 
     executor = _executor(args, progress=not args.quiet)
     options, start = _split_params(args.model, args.param)
@@ -1191,12 +1292,29 @@ def cmd_report(args: argparse.Namespace) -> int:
             start=start,
             selection=selection,
             progress=not args.quiet,
+            film_model=default_film_model() if args.film_default else args.film_model,
             executor=executor,
         )
     )
 
 
 # ------------------------------------------------------------------------------- main
+
+
+def _add_geometry(s: argparse.ArgumentParser) -> None:
+    """``--pixel-size`` and ``--unit``: the geometry of a height map, stated by the user."""
+    s.add_argument(
+        "--pixel-size",
+        default=None,
+        metavar="LENGTH[,LENGTH]",
+        help="lateral pitch of the height map, e.g. 312.5nm or 1um,2um (replaces the file's)",
+    )
+    s.add_argument(
+        "--unit",
+        default=None,
+        metavar="UNIT",
+        help="length unit of the numbers in the height-map file (m, mm, um, nm, pm, A)",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -1323,10 +1441,19 @@ def build_parser() -> argparse.ArgumentParser:
         "film",
         help="fit a thin-film stack (thicknesses, n, k) to psi/Delta, R and T of one sample",
     )
-    s.add_argument("files", nargs="+", metavar="FILE", help="files of one sample (joint fit)")
-    s.add_argument("--model", default=None, metavar="MODEL.toml", help="a film model file")
+    s.add_argument(
+        "files",
+        nargs="+",
+        action=InputPath,
+        metavar="FILE",
+        help="files of one sample (joint fit)",
+    )
+    s.add_argument(
+        "--model", action=InputPath, default=None, metavar="MODEL.toml", help="a film model file"
+    )
     s.add_argument(
         "--substrate",
+        action=InputPath,
         default=None,
         metavar="NAME|FILE",
         help="si, sio2, a dispersion model, or an n,k or ellipsometer file (default si)",
@@ -1354,11 +1481,24 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s.add_argument("--method", default=METHOD, help="nlopt stages")
     s.add_argument("--seed", type=int, default=0)
-    s.add_argument("-o", "--output", default=None, metavar="NK.csv",
-                   help="write each layer's n, k on the fitted wavelengths")  # fmt: skip
-    s.add_argument("--fit-json", default=None, metavar="FIT.json",
-                   help="write the fit (best-fit stack, intervals) as JSON")  # fmt: skip
-    s.add_argument("--overwrite", action="store_true", help="replace existing outputs")
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".csv",),
+        default=None,
+        metavar="NK.csv",
+        help="write each layer's n, k on the fitted wavelengths",
+    )
+    s.add_argument(
+        "--fit-json",
+        action=OutputPath,
+        suffixes=(".json",),
+        default=None,
+        metavar="FIT.json",
+        help="write the fit (best-fit stack, intervals) as JSON",
+    )
+    _add_overwrite(s)
     s.add_argument("--json", action="store_true")
     _add_selection(s)
     s.set_defaults(func=cmd_film)
@@ -1376,6 +1516,21 @@ def build_parser() -> argparse.ArgumentParser:
         help="write map, ACF and slope histogram (.png)",
     )
     _add_overwrite(s)
+    s.add_argument(
+        "--short-cutoff",
+        default=None,
+        metavar="LENGTH",
+        help="Gaussian S-filter cut-off (ISO 16610-61), e.g. 2um: slopes and alphas then refer"
+        " to longer wavelengths (default: none, down to the pixel)",
+    )
+    s.add_argument(
+        "--erode-mask",
+        type=int,
+        default=0,
+        metavar="N",
+        help="drop the points within N pixels of a dropout (their rims often carry spikes)",
+    )
+    _add_geometry(s)
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_surface)
 
@@ -1424,7 +1579,15 @@ def build_parser() -> argparse.ArgumentParser:
         help="measured height map: its slope table",
     )
     s.add_argument("--channel", default=None, help="height channel of --surface")
+    _add_geometry(s)
     s.add_argument("--coating", default=None, help="coating index, e.g. 1.5")
+    s.add_argument(
+        "--coating-from",
+        default=None,
+        action=InputPath,
+        metavar="FIT.json",
+        help="coating index at --wavelength and thickness from a one-layer film fit",
+    )
     s.add_argument("--thickness", type=float, default=None, help="coating thickness [nm]")
     s.add_argument("--coating-alpha", type=float, default=None)
     s.add_argument(
@@ -1432,7 +1595,15 @@ def build_parser() -> argparse.ArgumentParser:
         action=InputPath,
         default=None,
         metavar="FILE",
-        help="measured height map of the coating's top: its ML GGX alpha",
+        help="measured height map of the coating's top: its slope table (and, for "
+        "reference, its ML GGX alpha)",
+    )
+    s.add_argument(
+        "--distribution",
+        choices=("ggx", "beckmann"),
+        default="ggx",
+        help="microfacet distribution of the interfaces given by an alpha (measured maps "
+        "always use their own slope table)",
     )
     s.add_argument("--theta-i", type=float, required=True, help="[deg]")
     s.add_argument("--wavelength", type=float, required=True, help="[nm]")
@@ -1440,6 +1611,20 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=int, default=1)
     s.add_argument("--single-scattering", action="store_true")
     s.add_argument("--coherent", action="store_true")
+    s.add_argument(
+        "--estimator",
+        choices=("auto", "evaluated", "counting"),
+        default="auto",
+        help="evaluated: closed-form first surface + exit operator (single scattering with "
+        "a rough first interface); counting: exits counted into bins; auto (default): "
+        "evaluated where it applies",
+    )
+    s.add_argument(
+        "--scalar",
+        action="store_true",
+        help="unpolarized Fresnel reflectance at every vertex (only M00; how scalar codes "
+        "compute)",
+    )
     s.add_argument(
         "-o",
         "--output",
@@ -1484,6 +1669,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s.add_argument("-o", "--output", action=OutputPath, kind="dir", required=True, metavar="DIR")
     _add_overwrite(s)
+    film = s.add_mutually_exclusive_group()
+    film.add_argument(
+        "--film-model",
+        default=None,
+        action=InputPath,
+        metavar="FILE.toml",
+        help="fit this film stack to psi/Delta files whose angles disagree",
+    )
+    film.add_argument(
+        "--film-default",
+        action="store_true",
+        help="... or the stated default: one transparent Cauchy layer on c-Si, thickness free",
+    )
     s.add_argument("--quiet", action="store_true", help="no progress lines")
     _add_selection(s)
     _add_scheduler(s)

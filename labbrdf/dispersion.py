@@ -769,6 +769,11 @@ def _pseudo_constants(
         table = nk_mod.combined_table(df, on_ill_conditioned="ignore")
     except ValueError as exc:
         raise DispersionError(f"{path}: no pseudo-constants ({exc})") from None
+    if "combined" in table and not bool(table["combined"].all()):
+        raise DispersionError(
+            f"{path}: its angles of incidence disagree (pseudo-constants of a stack, not a "
+            "material's constants); fit the stack with `labbrdf film` and use its layers"
+        )
     table = table.sort_values("wavelength_nm").drop_duplicates("wavelength_nm")
     n = table["n"].to_numpy(float)
     k = table["k"].to_numpy(float)

@@ -6,6 +6,13 @@ two-phase pseudo-index ``<N> = n + ik`` with propagated uncertainties, combines 
 of incidence per wavelength, and predicts reflectances (Fresnel, microfacet) to compare with
 measured reflectance rows.
 
+The two-phase inversion treats the sample as a bare, clean, isotropic half-space. Where the
+angles of incidence disagree, the sample is a stack (a film or roughness), its
+pseudo-constants depend on the angle, and they are reported as what they are: per-angle
+values, never combined into one "n, k" and never used to predict a reflectance; where the
+angles disagree at some wavelengths only, the combined sigmas carry the scatter
+(:func:`combined_table`, Notes).
+
 Grouping
 --------
 Points are grouped by ``sample`` and ``source``. Within one file, a kinetic series
@@ -25,8 +32,11 @@ two-phase quantity).
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Sequence
-from typing import Any
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
@@ -36,6 +46,9 @@ from .dataset import Measurement
 
 __all__ = [
     "POSITION_TOL_MM",
+    "AngleVerdict",
+    "angle_verdict",
+    "coating_from_fit",
     "combined_table",
     "compare_reflectance",
     "microfacet_hemispherical",
@@ -77,6 +90,8 @@ _COMBINED_COLUMNS = [
     "n_points",
     "n_angles",
 ]
+#: combined columns left NaN where the angles disagree (combined_table, Notes)
+_NOT_COMBINED = ("n", "k", "n_sigma", "k_sigma", "nk_cov")
 _JSON_COMBINED = [
     "wavelength_nm",
     "n",
@@ -282,7 +297,28 @@ def combined_table(
         ``wavelength_nm, n, k, n_sigma, k_sigma, nk_cov, chi2, dof, p_value,
         angle_dependent, method, n_points, n_angles`` after the group keys; see
         :func:`labbrdf.ellipsometry.combine_angles` for the sigma and scatter rules. A
-        wavelength mixing points with and without sigma uses the scatter rule.
+        wavelength mixing points with and without sigma uses the scatter rule. Two last
+        columns: ``sigma_scale``, the factor the sigmas were multiplied by (the Birge ratio
+        ``sqrt(chi2/dof)`` where the angles disagree under the sigma rule, else 1), and
+        ``combined``, false where ``n, k, n_sigma, k_sigma, nk_cov`` are NaN: everywhere in
+        a group whose :func:`angle_verdict` is ``stack`` (Notes).
+
+    Notes
+    -----
+    Where the angles of incidence disagree at most wavelengths of a group (verdict
+    ``stack``), the two-phase pseudo-constants are those of a stack (a film or roughness on
+    the substrate), which depend on the angle; they are no material's constants. Their
+    inverse-covariance mean would be one more angle-dependent number, with a sigma that
+    only measures how well each angle is measured, not how far apart the angles are (on an
+    oxide-coated wafer: n = -0.705 with sigma 3e-4 at 500 nm, chi2/dof 1.5e4). It is
+    therefore not given, at any wavelength of the group (the few where the angles agree do
+    so by chance): the per-angle pseudo-constants stay in :func:`nk_table`, and a stack
+    model (:mod:`labbrdf.films`) gives the layers' constants. In other groups, a
+    wavelength whose angles disagree keeps its mean, with the sigmas multiplied by the
+    Birge ratio ``sqrt(chi2/dof)`` (R. T. Birge, Phys. Rev. 40, 207 (1932)) so that they
+    cover the angle-to-angle scatter (sigmas that leave out systematic errors, or a film
+    that matters at some wavelengths only); the scatter rule's sigma is the scatter
+    already.
     """
     table = data if "n" in _frame(data).columns else nk_table(data, **nk_options)
     table = _spot_labels(_frame(table))
@@ -309,7 +345,114 @@ def combined_table(
         row.update({f: getattr(c, f) for f in _COMBINED_COLUMNS[1:]})
         rows.append(row)
     out = pd.DataFrame(rows, columns=keys + _COMBINED_COLUMNS)
-    return out.astype({"dof": "int64", "angle_dependent": bool, "n_points": "int64"})
+    out = out.astype({"dof": "int64", "angle_dependent": bool, "n_points": "int64"})
+    # no n, k anywhere in a stack-like group; elsewhere the sigmas of a wavelength whose
+    # angles disagree carry their scatter (Birge ratio) (Notes)
+    given = np.ones(len(out), dtype=bool)
+    for _, idx in out.groupby(keys, sort=False, dropna=False).groups.items():
+        if angle_verdict(out.loc[idx], alpha=alpha).kind == "stack":
+            given[out.index.get_indexer(idx)] = False
+    flagged = out["angle_dependent"].to_numpy(bool)
+    chi2 = out["chi2"].to_numpy(float)
+    dof = out["dof"].to_numpy(float)
+    scale = np.ones(len(out))
+    birge = given & flagged & np.isfinite(chi2) & (dof > 0)  # the sigma rule's chi2
+    scale[birge] = np.sqrt(chi2[birge] / dof[birge])
+    for col in ("n_sigma", "k_sigma"):
+        out[col] = out[col].to_numpy(float) * scale
+    out["nk_cov"] = out["nk_cov"].to_numpy(float) * scale**2
+    scale[~given] = np.nan
+    out.loc[~given, list(_NOT_COMBINED)] = np.nan
+    out["sigma_scale"] = scale
+    out["combined"] = given
+    return out
+
+
+@dataclass(frozen=True)
+class AngleVerdict:
+    """How the angles of incidence of one sample agree, over its wavelengths.
+
+    Attributes
+    ----------
+    kind : {"untested", "bulk", "partly", "stack"}
+        ``untested``: one angle, or too few points without sigmas; ``bulk``: flagged at no
+        more wavelengths than chance explains; ``partly``: more than chance, at most half;
+        ``stack``: more than half (a film or roughness: pseudo-constants of a stack).
+    tested : int
+        Wavelengths with an angle-consistency test.
+    fraction : float or None
+        Fraction of the tested wavelengths where the angles disagree [1].
+    chance : float or None
+        Fraction expected by chance: ``alpha`` plus a binomial 3-sigma margin [1].
+    text, short : str
+        The verdict in a sentence and in a few words.
+    """
+
+    kind: Literal["untested", "bulk", "partly", "stack"]
+    tested: int
+    fraction: float | None
+    chance: float | None
+    text: str
+    short: str
+
+
+def angle_verdict(combined: pd.DataFrame, *, alpha: float = ell.P_ANGLE_DEPENDENT) -> AngleVerdict:
+    """Whether one sample's pseudo-constants depend on the angle of incidence.
+
+    Parameters
+    ----------
+    combined : pandas.DataFrame
+        The :func:`combined_table` rows of one sample (one group).
+    alpha : float, optional
+        The significance level the table was flagged with. Default 0.01.
+
+    Returns
+    -------
+    AngleVerdict
+
+    Notes
+    -----
+    Each tested wavelength is flagged with probability ``alpha`` by chance alone, so a
+    bulk material shows a flagged fraction near ``alpha``; the fraction is compared with
+    ``alpha + 3 sqrt(alpha (1 - alpha) / m)`` over ``m`` tested wavelengths (binomial
+    3-sigma). Above one half the sample is a stack: the few wavelengths where its angles
+    happen to agree are chance, not a material's constants.
+    """
+    dof = combined["dof"].to_numpy(int)
+    tested = dof > 0
+    m = int(tested.sum())
+    if not m:
+        n_max = int(combined["n_angles"].max()) if len(combined) else 0
+        text = (
+            "one angle of incidence per wavelength"
+            if n_max < 2
+            else f"{n_max} angles per wavelength and no sigmas in the file: too few for the "
+            "scatter test"
+        ) + ": the angle-to-angle consistency cannot be tested"
+        return AngleVerdict("untested", 0, None, None, text, "not testable")
+    frac = float(combined["angle_dependent"].to_numpy(bool)[tested].mean())
+    chance = alpha + 3.0 * math.sqrt(alpha * (1.0 - alpha) / m)
+    said = (
+        f"the angles disagree (p < {alpha:g}) at {100 * frac:.0f}% of the {m} wavelengths, "
+        f"{100 * alpha:g}% expected by chance"
+    )
+    if frac > 0.5:
+        return AngleVerdict(
+            "stack", m, frac, chance,
+            said + ": angle-dependent, a film or roughness, not a bulk material; the values "
+            "are pseudo-constants of a stack",
+            "angle-dependent: film or roughness",
+        )  # fmt: skip
+    if frac > chance:
+        return AngleVerdict(
+            "partly", m, frac, chance,
+            said + ": angle-dependent over part of the spectrum (a film or roughness, not a "
+            "bulk material, there); elsewhere consistent with a bulk material",
+            "partly angle-dependent",
+        )  # fmt: skip
+    return AngleVerdict(
+        "bulk", m, frac, chance, said + ": consistent with a bulk material", "consistent with bulk"
+    )
 
 
 def _json_value(v: Any) -> Any:
@@ -398,6 +541,7 @@ def nk_at(
     *,
     sample: str | None = None,
     source: str | None = None,
+    on_angle_dependent: Literal["raise", "nan"] = "raise",
 ) -> dict[str, np.ndarray]:
     """Combined ``n, k`` and uncertainties at given wavelengths, by linear interpolation.
 
@@ -409,6 +553,9 @@ def nk_at(
         Wavelength(s) [nm], within the measured range.
     sample, source : str, optional
         Select one (sample, source) when the table holds several.
+    on_angle_dependent : {"raise", "nan"}, optional
+        What to do at a wavelength that needs a node without combined n, k (a sample whose
+        angles disagree, :func:`combined_table`): raise (default) or return NaN.
 
     Returns
     -------
@@ -420,7 +567,8 @@ def nk_at(
     Raises
     ------
     ValueError
-        A wavelength outside the measured range (no extrapolation), or an ambiguous table.
+        A wavelength outside the measured range (no extrapolation), an ambiguous table,
+        or (``on_angle_dependent="raise"``) a wavelength without combined n, k.
 
     Notes
     -----
@@ -443,7 +591,20 @@ def nk_at(
     out = {"wavelength_nm": x}
     for c in ("n", "k", "n_sigma", "k_sigma", "nk_cov"):
         out[c] = np.interp(x, wl, t[c].to_numpy(float))
+    if on_angle_dependent == "raise":
+        bad = ~(np.isfinite(out["n"]) & np.isfinite(out["k"]))
+        if bad.any():
+            raise ValueError(_angle_dependent_message(x[bad]))
     return out
+
+
+def _angle_dependent_message(wavelength_nm: np.ndarray) -> str:
+    w = ", ".join(f"{v:g}" for v in np.unique(wavelength_nm)[:5])
+    return (
+        f"at {w} nm no n, k: the angles of incidence disagree at most of the sample's "
+        "wavelengths, so its two-phase values are pseudo-constants of a stack (a film or "
+        "roughness), not a material's n, k; fit a stack model to get the layers' constants"
+    )
 
 
 def compare_reflectance(
@@ -483,7 +644,15 @@ def compare_reflectance(
         ``difference = measured - predicted``; ``difference_sigma`` adds the two sigmas in
         quadrature, and is the predicted sigma alone (a lower bound) where the measurement
         has none. ``attrs["outside_range"]`` counts the rows outside the ``nk`` range
-        (dropped: no extrapolation).
+        (dropped: no extrapolation), ``attrs["angle_dependent"]`` the rows at wavelengths
+        without combined n, k (dropped: pseudo-constants of a stack predict no
+        reflectance, :func:`combined_table`).
+
+    Raises
+    ------
+    ValueError
+        No reflectance rows, none inside the ``nk`` range, or none at a wavelength with
+        combined n, k (a sample whose angles of incidence disagree).
     """
     df = _frame(reflectance)
     rows = df[df["quantity"] == "reflectance"]
@@ -497,7 +666,18 @@ def compare_reflectance(
     rows = rows[inside]
     if rows.empty:
         raise ValueError(f"no reflectance row within the n, k range [{lo:.6g}, {hi:.6g}] nm")
-    at = nk_at(nkc, rows["wavelength_nm"].to_numpy(float))
+    at = nk_at(nkc, rows["wavelength_nm"].to_numpy(float), on_angle_dependent="nan")
+    usable = np.isfinite(at["n"]) & np.isfinite(at["k"])
+    if not usable.any():
+        raise ValueError(
+            "no combined n, k at the wavelengths compared: the angles of incidence disagree "
+            "at most of the sample's wavelengths, so its values are pseudo-constants of a "
+            "stack (a film or roughness), not a material's n, k, and the Fresnel "
+            "reflectance of a bare half-space does not apply; a fitted stack model "
+            "predicts the reflectance"
+        )
+    rows = rows[usable]
+    at = {c: v[usable] for c, v in at.items()}
     theta = rows["theta_i_deg"].to_numpy(float)
     theta = np.where(np.isnan(theta), theta_if_missing_deg, theta)
     pred = ell.fresnel_reflectances(
@@ -542,6 +722,7 @@ def compare_reflectance(
         }
     )
     out.attrs["outside_range"] = int((~inside).sum())
+    out.attrs["angle_dependent"] = int((~usable).sum())
     return out
 
 
@@ -600,3 +781,58 @@ def microfacet_hemispherical(
     g_k = (albedo(n, k + h) - albedo(n, k - hk)) / (h + hk)
     var = (g_n * n_sigma) ** 2 + (g_k * k_sigma) ** 2 + 2.0 * g_n * g_k * nk_cov
     return rho, np.sqrt(np.maximum(var, 0.0))
+
+
+def coating_from_fit(path: str | os.PathLike[str], wavelength_nm: float) -> tuple[complex, float]:
+    """The coating of a one-layer film fit: its index at a wavelength and its thickness.
+
+    Parameters
+    ----------
+    path : path-like
+        A film fit's JSON (:meth:`labbrdf.films.FilmFit.save_json`, ``labbrdf film
+        --fit-json FIT.json``) whose stack has exactly one layer over the substrate
+        (the tracer's one coating).
+    wavelength_nm : float
+        Vacuum wavelength [nm], inside the fitted wavelength range.
+
+    Returns
+    -------
+    N : complex
+        The layer's fitted index ``n + ik`` at ``wavelength_nm`` [1].
+    thickness_nm : float
+        Its fitted thickness [nm].
+
+    Raises
+    ------
+    ValueError
+        The file is not a film fit (:class:`labbrdf.films.FilmError`, naming the file and
+        line), its stack has no layer, several layers or a roughness layer, or the
+        wavelength lies outside the fitted range (a dispersion model is not extrapolated
+        beyond the data that fixed it).
+    """
+    import json
+
+    from .films import Roughness, Stack  # the film objects, imported where needed
+
+    p = Path(path)
+    stack = Stack.from_fit_json(p)
+    names = [lay.name for lay in stack.layers]
+    if len(stack.layers) != 1 or isinstance(stack.layers[0].material, Roughness):
+        raise ValueError(
+            f"{p}: the tracer has one coating over the substrate; this fit's stack has "
+            f"{len(names)} layer(s) {names} (fit one layer, or give --coating and --thickness)"
+        )
+    wl = float(wavelength_nm)
+    doc = json.loads(p.read_text("utf-8"))
+    rng = doc.get("wavelength_range_nm")
+    if not (isinstance(rng, list) and len(rng) == 2):
+        raise ValueError(f"{p}: no 'wavelength_range_nm' (not a film fit of labbrdf)")
+    lo, hi = float(rng[0]), float(rng[1])
+    if not (math.isfinite(wl) and lo <= wl <= hi):
+        raise ValueError(
+            f"{p}: {wl:g} nm is outside the fitted range [{lo:g}, {hi:g}] nm; the layer's "
+            "dispersion is not extrapolated"
+        )
+    layer = stack.layers[0]
+    big_n = complex(np.asarray(stack.nk(wl)[layer.name]).ravel()[0])
+    return big_n, float(layer.thickness_nm)

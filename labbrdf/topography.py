@@ -45,16 +45,22 @@ ISO 25178-2:2012 (Sq, Ssk, Sku, Sdq); ISO 4287 (Rq, Rdq).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import fft as sfft
-from scipy import ndimage, optimize, special, stats
+from scipy import ndimage, optimize, special
 
 __all__ = [
+    "C_MIN_PIXELS",
+    "GAUSS_ALPHA",
     "KS_WARN",
+    "TOP_VARIANCE_WARN",
+    "erode_mask",
+    "s_filter",
     "RoughnessStats",
     "SlopeFit",
     "SlopeFits",
@@ -67,6 +73,15 @@ __all__ = [
 
 #: KS distance above which neither GGX nor Beckmann is said to describe the slopes.
 KS_WARN = 0.05
+#: Correlation length [pixels] below which the ACF is said to be pixel-scale noise.
+C_MIN_PIXELS = 2.0
+#: Share of the height variance the 1 % largest squared heights may carry before a note
+#: (a Gaussian surface: 8.5 %).
+TOP_VARIANCE_WARN = 0.5
+#: ISO 16610-61 Gaussian weighting constant, sqrt(ln 2 / pi): 50 % transmission at lambda_s.
+GAUSS_ALPHA = math.sqrt(math.log(2.0) / math.pi)
+
+_NAN_DEFAULT = float("nan")
 
 _INV_E = math.exp(-1.0)
 
@@ -99,19 +114,36 @@ def _pixel(pixel_size: float | ArrayLike, ndim: int) -> tuple[float, ...]:
     return tuple(float(v) for v in p)
 
 
-def _design(shape: tuple[int, ...], degree: int, valid: NDArray) -> NDArray:
-    """Monomials of total degree <= degree in normalised coordinates, at valid points."""
-    grids = np.meshgrid(*[np.arange(n) / n for n in shape], indexing="ij")
-    cols = []
+#: Elements per block of the passes that walk a map in row blocks (bounded temporaries).
+_CHUNK = 1 << 18
+
+
+def _exponents(ndim: int, degree: int) -> list[tuple[int, ...]]:
+    """Monomial exponents of total degree <= degree (x first, then mixed, then y)."""
+    if ndim == 1:
+        return [(p,) for p in range(degree + 1)]
+    return [(tot - py, py) for tot in range(degree + 1) for py in range(tot + 1)]
+
+
+def _row_blocks(shape: tuple[int, ...]) -> list[tuple[int, int]]:
+    """Row ranges of about :data:`_CHUNK` elements (whole rows of a map)."""
+    row = int(np.prod(shape[1:])) if len(shape) > 1 else 1
+    step = max(1, _CHUNK // max(row, 1))
+    return [(a, min(a + step, shape[0])) for a in range(0, shape[0], step)]
+
+
+def _block_design(
+    shape: tuple[int, ...], r0: int, r1: int, exps: list[tuple[int, ...]], v: NDArray
+) -> NDArray:
+    """Monomials in coordinates scaled to [-1, 1) at the valid points of rows r0:r1."""
+    x = 2.0 * np.arange(r0, r1) / shape[0] - 1.0
     if len(shape) == 1:
-        x = grids[0][valid]
-        cols = [x**p for p in range(degree + 1)]
-    else:
-        x, y = grids[0][valid], grids[1][valid]
-        for tot in range(degree + 1):
-            for py in range(tot + 1):
-                cols.append(x ** (tot - py) * y**py)
-    return np.column_stack(cols)
+        xs = x[v]
+        return np.column_stack([xs ** e[0] for e in exps])
+    y = 2.0 * np.arange(shape[1]) / shape[1] - 1.0
+    xs = np.broadcast_to(x[:, None], v.shape)[v]
+    ys = np.broadcast_to(y[None, :], v.shape)[v]
+    return np.column_stack([xs ** e[0] * ys ** e[1] for e in exps])
 
 
 def level(heights: ArrayLike, degree: int = 1, mask: ArrayLike | None = None) -> NDArray:
@@ -137,16 +169,35 @@ def level(heights: ArrayLike, degree: int = 1, mask: ArrayLike | None = None) ->
 
 
 def _level(z: NDArray, valid: NDArray, degree: int) -> NDArray:
+    """Levelled copy of z (NaN at invalid points); normal equations summed over row blocks.
+
+    The polynomial is fitted in coordinates scaled to [-1, 1) after removing the mean
+    height, which keeps the normal equations well conditioned for the low degrees of form
+    removal; no design matrix of the whole map is ever built.
+    """
     if not (isinstance(degree, int | np.integer) and degree >= 0):
         raise ValueError(f"degree must be an integer >= 0, got {degree!r}")
-    a = _design(z.shape, int(degree), valid)
-    if valid.sum() <= a.shape[1]:
-        raise ValueError(
-            f"{int(valid.sum())} valid points cannot fix a polynomial of degree {degree}"
-        )
-    coef = np.linalg.lstsq(a, z[valid], rcond=None)[0]
+    exps = _exponents(z.ndim, int(degree))
+    k = len(exps)
+    nvalid = int(np.count_nonzero(valid))
+    if nvalid <= k:
+        raise ValueError(f"{nvalid} valid points cannot fix a polynomial of degree {degree}")
+    zmean = float(np.mean(z, where=valid))
+    ata = np.zeros((k, k))
+    atz = np.zeros(k)
+    blocks = _row_blocks(z.shape)
+    for r0, r1 in blocks:
+        v = valid[r0:r1]
+        a = _block_design(z.shape, r0, r1, exps, v)
+        zz = z[r0:r1][v] - zmean
+        ata += a.T @ a
+        atz += a.T @ zz
+    coef = np.linalg.lstsq(ata, atz, rcond=None)[0]
     out = np.full(z.shape, np.nan)
-    out[valid] = z[valid] - a @ coef
+    for r0, r1 in blocks:
+        v = valid[r0:r1]
+        a = _block_design(z.shape, r0, r1, exps, v)
+        out[r0:r1][v] = z[r0:r1][v] - zmean - a @ coef
     return out
 
 
@@ -182,7 +233,11 @@ def slopes(
 
 
 def autocorrelation(
-    z: NDArray, valid: NDArray | None = None, max_lag: tuple[int, ...] | None = None
+    z: NDArray,
+    valid: NDArray | None = None,
+    max_lag: tuple[int, ...] | None = None,
+    *,
+    hole: tuple[slice, ...] | None = None,
 ) -> NDArray:
     """Normalised autocorrelation by a mask-normalised, zero-padded FFT.
 
@@ -194,6 +249,10 @@ def autocorrelation(
         Valid points (default: finite).
     max_lag : tuple of int, optional
         Largest lag per axis in pixels (default: half the extent).
+    hole : tuple of slice, optional
+        Declares that ``valid`` is the whole grid except this rectangle (a jackknife
+        replicate of a map without dropouts): the pair counts are then exact products of
+        interval overlaps instead of a second FFT.
 
     Returns
     -------
@@ -205,24 +264,73 @@ def autocorrelation(
         valid = np.isfinite(z)
     if max_lag is None:
         max_lag = tuple(n // 2 for n in z.shape)
-    w = valid.astype(float)
-    zc = np.where(valid, z, 0.0)
-    zc = np.where(valid, zc - zc[valid].mean(), 0.0)
     shape = [
         sfft.next_fast_len(n + lag, real=True) for n, lag in zip(z.shape, max_lag, strict=True)
     ]
-    axes = tuple(range(z.ndim))
-    fz = sfft.rfftn(zc, shape, axes=axes)
-    fw = sfft.rfftn(w, shape, axes=axes)
-    num = sfft.irfftn(fz.real**2 + fz.imag**2, shape, axes=axes)
-    den = sfft.irfftn(fw.real**2 + fw.imag**2, shape, axes=axes)
-    idx = np.ix_(*[np.r_[s - lag : s, 0 : lag + 1] for s, lag in zip(shape, max_lag, strict=True)])
-    num, den = num[idx], den[idx]
+    zc = np.zeros(z.shape)
+    np.subtract(z, np.mean(z, where=valid), out=zc, where=valid)
+    num = _correlate_window(zc, shape, max_lag)
+    del zc
+    if valid.all():
+        den = _rect_pair_counts(z.shape, max_lag, None)
+    elif hole is not None:
+        den = _rect_pair_counts(z.shape, max_lag, hole)
+    else:
+        den = _correlate_window(valid.astype(float), shape, max_lag)
     good = den > 0.5
     cov = np.full(num.shape, np.nan)
     cov[good] = num[good] / np.round(den[good])
     centre = tuple(max_lag)
     return cov / cov[centre]
+
+
+def _rect_pair_counts(
+    shape: tuple[int, ...], max_lag: tuple[int, ...], hole: tuple[slice, ...] | None
+) -> NDArray:
+    """Valid pairs at lags ``-max_lag..max_lag`` of a full grid F minus a rectangle T.
+
+    With ``1_V = 1_F - 1_T`` the count ``sum_p 1_V(p) 1_V(p + l)`` is
+    ``c_FF - c_FT - c_TF + c_TT``, where ``c_PQ(l) = #{p in P : p + l in Q}`` of two
+    rectangles is the product over the axes of the interval overlaps
+    ``|P_k ∩ (Q_k - l_k)|``: exactly what the FFT of the indicator gives, without it.
+    """
+
+    def overlap(i: tuple[int, int], j: tuple[int, int], lags: NDArray) -> NDArray:
+        return np.maximum(0, np.minimum(i[1], j[1] - lags) - np.maximum(i[0], j[0] - lags))
+
+    lags = [np.arange(-lag, lag + 1) for lag in max_lag]
+    full = [(0, n) for n in shape]
+    if hole is None:
+        sets = [(1.0, full, full)]
+    else:
+        tile = [sl.indices(n)[:2] for sl, n in zip(hole, shape, strict=True)]
+        sets = [(1.0, full, full), (-1.0, full, tile), (-1.0, tile, full), (1.0, tile, tile)]
+    den = np.zeros(tuple(lg.size for lg in lags))
+    for sign, a, b in sets:
+        term = overlap(a[0], b[0], lags[0]).astype(float)
+        for k in range(1, len(shape)):
+            term = np.multiply.outer(term, overlap(a[k], b[k], lags[k]))
+        den += sign * term
+    return den
+
+
+def _correlate_window(a: NDArray, shape: list[int], max_lag: tuple[int, ...]) -> NDArray:
+    """Zero-padded circular autocorrelation of ``a`` at lags ``-max_lag..max_lag``.
+
+    ``IFFT |FFT a|^2`` with the power formed in place in the spectrum, so that the padded
+    transform is held once (plus its inverse), not in several temporary copies.
+    """
+    axes = tuple(range(a.ndim))
+    f = sfft.rfftn(a, shape, axes=axes)
+    re, im = f.real, f.imag
+    np.square(re, out=re)
+    np.square(im, out=im)
+    re += im
+    im[...] = 0.0
+    r = sfft.irfftn(f, shape, axes=axes, overwrite_x=True)
+    del f, re, im
+    idx = np.ix_(*[np.r_[s - lag : s, 0 : lag + 1] for s, lag in zip(shape, max_lag, strict=True)])
+    return r[idx]
 
 
 def _crossing(r: NDArray, step: float) -> float:
@@ -273,25 +381,42 @@ def _ks_normal(x: NDArray) -> float:
     s = x.std()
     if s == 0:
         return float("nan")
-    return _ks_sorted(np.sort((x - x.mean()) / s), special.ndtr)
+    xs = x - x.mean()
+    xs /= s
+    xs.sort()
+    return _ks_sorted(xs, special.ndtr)
 
 
 def _ks_sorted(xs: NDArray, cdf: Any) -> float:
-    """Two-sided KS distance sup|F_n - F| of sorted samples to the CDF ``cdf``."""
+    """Two-sided KS distance sup|F_n - F| of sorted samples to the CDF ``cdf``.
+
+    Walked in blocks of :data:`_CHUNK` samples, so that no array of the sample's size
+    beyond ``xs`` itself is made.
+    """
     n = xs.size
-    f = cdf(xs)
-    return float(max(np.max(np.arange(1, n + 1) / n - f), np.max(f - np.arange(n) / n)))
+    d = -np.inf
+    for a in range(0, n, _CHUNK):
+        f = cdf(xs[a : a + _CHUNK])
+        i = np.arange(a, a + f.size, dtype=float)
+        d = max(d, float(np.max((i + 1) / n - f)), float(np.max(f - i / n)))
+    return float(d)
 
 
 def _shape_stats(x: NDArray) -> tuple[float, float, float]:
-    """Skewness, kurtosis (3 for a Gaussian) and KS distance to the Gaussian."""
+    """Skewness, kurtosis (3 for a Gaussian) and KS distance to the Gaussian.
+
+    The moment estimators of :func:`scipy.stats.skew` and :func:`scipy.stats.kurtosis`
+    (biased, ``m3 / m2^1.5`` and ``m4 / m2^2``), formed with two temporaries.
+    """
     if x.size < 3 or x.std() == 0:
         return float("nan"), float("nan"), float("nan")
-    return (
-        float(stats.skew(x)),
-        float(stats.kurtosis(x, fisher=False)),
-        _ks_normal(x),
-    )
+    d = x - x.mean()
+    d2 = d * d
+    m2 = float(np.mean(d2))
+    m3 = float(np.dot(d2, d)) / x.size
+    m4 = float(np.dot(d2, d2)) / x.size
+    del d, d2
+    return m3 / m2**1.5, m4 / m2**2, _ks_normal(x)
 
 
 # ------------------------------------------------------------------ slope-space fits
@@ -343,47 +468,73 @@ class SlopeFits:
 
 
 def _ggx_s(q: NDArray, frac: float) -> float:
-    """Root in s = alpha^2 of ``mean(s / (s + q)) = frac`` (GGX score equation)."""
+    """Root in s = alpha^2 of ``mean(s / (s + q)) = frac`` (GGX score equation).
+
+    The left side increases with s; the root is bracketed by stepping a factor 4 from the
+    mean of q (one temporary of q's size per evaluation), then polished by Brent's method
+    to a relative 1e-13 inside the bracket.
+    """
     qpos = q[q > 0]
     if qpos.size == 0:
         return 0.0
-    lo, hi = float(np.min(qpos)) * 1e-6, float(np.max(q)) * 1e6
+    lo_lim, hi_lim = float(np.min(qpos)) * 1e-6, float(np.max(q)) * 1e6
+    del qpos
+    # q and the scratch array live in a list emptied at the end: brentq leaves g in a
+    # reference cycle, which would otherwise keep both alive until the next GC
+    arrays = [q, np.empty_like(q)]
 
     def g(s: float) -> float:
-        return float(np.mean(s / (s + q))) - frac
+        qq, t = arrays
+        np.add(qq, s, out=t)
+        np.divide(s, t, out=t)
+        return float(np.mean(t)) - frac
 
-    return float(optimize.brentq(g, lo, hi, xtol=1e-300, rtol=1e-13))
+    s0 = min(max(float(np.mean(q)), lo_lim), hi_lim)
+    lo = hi = s0
+    if g(s0) < 0:
+        while g(hi) < 0 and hi < hi_lim:
+            lo, hi = hi, min(hi * 4.0, hi_lim)
+    else:
+        while g(lo) > 0 and lo > lo_lim:
+            lo, hi = max(lo / 4.0, lo_lim), lo
+    root = float(optimize.brentq(g, lo, hi, xtol=1e-300, rtol=1e-13))
+    arrays.clear()
+    return root
 
 
 def _fit_core(x: NDArray, y: NDArray | None) -> dict[str, float]:
-    """ML alphas, log-likelihoods and KS distances (no uncertainties)."""
+    """ML alphas, log-likelihoods and KS distances (no uncertainties).
+
+    Raises
+    ------
+    ValueError
+        All slopes are zero (a map without roughness at the pixel scale).
+    """
     n = x.size
     if y is not None:
-        q = x * x + y * y
+        q = x * x
+        q += y * y
         # 2-D: log P22 = ln s - 2 ln(s + q) - ln pi (GGX); -ln(pi s) - q/s (Beckmann)
         sg = _ggx_s(q, 0.5)
+        _check_slopes(sg)
         sb = float(q.mean())
-        llg = float(n * math.log(sg) - 2 * np.sum(np.log(sg + q)) - n * math.log(math.pi))
+        llg = float(n * math.log(sg) - 2 * _sum_log(q, sg) - n * math.log(math.pi))
         llb = float(-n * math.log(math.pi * sb) - np.sum(q) / sb)
-        qs = np.sort(q)
-        ecdf_hi = np.arange(1, n + 1) / n
-        ecdf_lo = np.arange(n) / n
-        fg = qs / (sg + qs)
-        fb = -np.expm1(-qs / sb)
+        q.sort()
+        ksg = _ks_sorted(q, lambda v: v / (sg + v))
+        ksb = _ks_sorted(q, lambda v: -np.expm1(-v / sb))
     else:
         q = x * x
         # 1-D marginals: P2 = 1 / (2 a (1 + x^2/a^2)^(3/2)) (GGX); exp(-x^2/s)/sqrt(pi s)
         sg = _ggx_s(q, 2.0 / 3.0)
+        _check_slopes(sg)
         sb = float(2 * q.mean())
-        llg = float(n * math.log(sg) - 1.5 * np.sum(np.log(sg + q)) - n * math.log(2.0))
+        llg = float(n * math.log(sg) - 1.5 * _sum_log(q, sg) - n * math.log(2.0))
         llb = float(-0.5 * n * math.log(math.pi * sb) - np.sum(q) / sb)
+        del q
         xs = np.sort(x)
-        ecdf_hi = np.arange(1, n + 1) / n
-        ecdf_lo = np.arange(n) / n
-        fg = 0.5 + 0.5 * xs / np.sqrt(sg + xs * xs)
-        fb = 0.5 * (1 + special.erf(xs / math.sqrt(sb)))
-    ksg = float(max(np.max(ecdf_hi - fg), np.max(fg - ecdf_lo)))
-    ksb = float(max(np.max(ecdf_hi - fb), np.max(fb - ecdf_lo)))
+        ksg = _ks_sorted(xs, lambda v: 0.5 + 0.5 * v / np.sqrt(sg + v * v))
+        ksb = _ks_sorted(xs, lambda v: 0.5 * (1 + special.erf(v / math.sqrt(sb))))
     return {
         "ggx_alpha": math.sqrt(sg),
         "beckmann_alpha": math.sqrt(sb),
@@ -394,6 +545,18 @@ def _fit_core(x: NDArray, y: NDArray | None) -> dict[str, float]:
         "ggx_s": sg,
         "beckmann_s": sb,
     }
+
+
+def _check_slopes(sg: float) -> None:
+    if not sg > 0:
+        raise ValueError("all slopes are zero: the heights do not change between pixels")
+
+
+def _sum_log(q: NDArray, s: float) -> float:
+    """``sum(ln(s + q))`` with one temporary."""
+    t = q + s
+    np.log(t, out=t)
+    return float(np.sum(t))
 
 
 def _fisher_u(x: NDArray, y: NDArray | None, core: dict[str, float]) -> tuple[float, float]:
@@ -505,13 +668,18 @@ class RoughnessStats:
     slope_skewness_y: float
     slope_kurtosis_y: float
     slope_ks_y: float
-    alpha: float  # Dong 2022: sqrt(2) sigma / c [1]
-    alpha_x: float  # sqrt(2) sigma / c_x
-    alpha_y: float
+    alpha_gaussian_acf: float  # Dong 2022: sqrt(2) sigma / c [1]
+    alpha_gaussian_acf_x: float  # sqrt(2) sigma / c_x
+    alpha_gaussian_acf_y: float
+    alpha_ggx_ml: float  # maximum-likelihood GGX alpha of the slopes (= slope_fits.ggx.alpha)
     slope_fits: SlopeFits
     uncertainty: dict[str, float] = field(default_factory=dict)
     n_blocks: int = 0
     notes: tuple[str, ...] = ()
+    short_cutoff: float = _NAN_DEFAULT  # S-filter cut-off lambda_s [m]; NaN = none
+    bandwidth: str = ""  # the wavelengths every slope and alpha refers to
+    n_eroded: int = 0  # valid points dropped by eroding the mask around dropouts
+    tracer_alpha: str = "alpha_ggx_ml"  # the alpha `trace --surface` uses
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe dict (NaN -> None, tuples -> lists)."""
@@ -569,15 +737,31 @@ def _principal(rho: NDArray, px: tuple[float, float]) -> tuple[float, float, flo
     return cmaj, cmin, cmaj / cmin if cmin > 0 else _NAN, ang
 
 
-def _core(z: NDArray, valid: NDArray, px: tuple[float, ...], degree: int) -> dict[str, Any]:
+def _core(
+    z: NDArray,
+    valid: NDArray,
+    px: tuple[float, ...],
+    degree: int,
+    with_slopes: bool = False,
+    hole: tuple[slice, ...] | None = None,
+) -> dict[str, Any]:
     """All statistics of one (replicate) valid set; scalars only, plus the slope fits."""
-    if valid.sum() < 8:
+    if np.count_nonzero(valid) < 8:
         raise ValueError("fewer than 8 valid points")
     lz = _level(z, valid, degree)
     h = lz[valid]
     out: dict[str, Any] = {}
     out["sigma"] = float(np.sqrt(np.mean(h * h)))
+    spread = float(np.sqrt(np.var(z, where=valid)))
+    if not out["sigma"] > 1e-10 * spread:
+        raise ValueError(
+            f"all valid heights lie on the levelling polynomial (RMS height {out['sigma']:.3g}"
+            f" m of {spread:.3g} m before levelling): no roughness"
+        )
     out["height_skewness"], out["height_kurtosis"], out["height_ks"] = _shape_stats(h)
+    if with_slopes:
+        out["_top_share"] = _top_share(h)
+    del h
     sx, sy = slopes(lz, px, valid)
     if sx.size < 2:
         raise ValueError("fewer than 2 valid slopes")
@@ -593,8 +777,17 @@ def _core(z: NDArray, valid: NDArray, px: tuple[float, ...], degree: int) -> dic
         out["slope_rms"] = out["slope_rms_x"]
         sk = (_NAN, _NAN, _NAN)
     out["slope_skewness_y"], out["slope_kurtosis_y"], out["slope_ks_y"] = sk
+    fc = _fit_core(sx, sy)
+    out["_fit"] = fc
+    out["_n_slopes"] = sx.size
+    if with_slopes:
+        out["_fisher"] = _fisher_u(sx, sy, fc)
+    del sx, sy
+    out["alpha_ggx_ml"] = fc["ggx_alpha"]
+    out["ggx_alpha"] = fc["ggx_alpha"]
+    out["beckmann_alpha"] = fc["beckmann_alpha"]
 
-    rho = autocorrelation(lz, valid)
+    rho = autocorrelation(lz, valid, hole=hole)
     centre = tuple(n // 2 for n in rho.shape)
     if z.ndim == 1:
         rx = rho[centre[0] :]
@@ -624,34 +817,122 @@ def _core(z: NDArray, valid: NDArray, px: tuple[float, ...], degree: int) -> dic
     out["c_fit_x"] = fx[model]
     out["c_fit_y"] = fy[model] if fy else _NAN
     s2 = math.sqrt(2.0) * out["sigma"]
-    out["alpha"] = s2 / out["c"]
-    out["alpha_x"] = s2 / out["c_x"]
-    out["alpha_y"] = s2 / out["c_y"] if z.ndim == 2 else _NAN
-    fc = _fit_core(sx, sy)
-    out["_fit"] = fc
-    out["_n_slopes"] = sx.size
-    out["_slopes"] = (sx, sy)
-    out["ggx_alpha"] = fc["ggx_alpha"]
-    out["beckmann_alpha"] = fc["beckmann_alpha"]
+    out["alpha_gaussian_acf"] = s2 / out["c"]
+    out["alpha_gaussian_acf_x"] = s2 / out["c_x"]
+    out["alpha_gaussian_acf_y"] = s2 / out["c_y"] if z.ndim == 2 else _NAN
     return out
 
 
-def _tiles(valid: NDArray, blocks: int) -> list[NDArray]:
-    """Index masks of the jackknife tiles (equal shares of the grid per axis)."""
+def _top_share(h: NDArray) -> tuple[float, NDArray]:
+    """Share of sum(h^2) carried by the 1 % largest h^2, and the threshold h^2 [m^2]."""
+    h2 = h * h
+    k = max(1, h2.size // 100)
+    part = np.partition(h2, h2.size - k)
+    top = part[h2.size - k :]
+    total = float(np.sum(h2))
+    return (float(np.sum(top)) / total if total > 0 else _NAN), np.asarray(part[h2.size - k])
+
+
+def _tiles(valid: NDArray, blocks: int) -> list[tuple[slice, ...]]:
+    """Index slices of the jackknife tiles (equal shares per axis) holding valid points."""
     edges = [np.linspace(0, n, blocks + 1).round().astype(int) for n in valid.shape]
-    tiles = []
+    cand: list[tuple[slice, ...]]
     if valid.ndim == 1:
-        for a in range(blocks):
-            t = np.zeros(valid.shape, dtype=bool)
-            t[edges[0][a] : edges[0][a + 1]] = True
-            tiles.append(t)
+        cand = [(slice(edges[0][a], edges[0][a + 1]),) for a in range(blocks)]
     else:
-        for a in range(blocks):
-            for b in range(blocks):
-                t = np.zeros(valid.shape, dtype=bool)
-                t[edges[0][a] : edges[0][a + 1], edges[1][b] : edges[1][b + 1]] = True
-                tiles.append(t)
-    return [t for t in tiles if (t & valid).any()]
+        cand = [
+            (slice(edges[0][a], edges[0][a + 1]), slice(edges[1][b], edges[1][b + 1]))
+            for a in range(blocks)
+            for b in range(blocks)
+        ]
+    return [t for t in cand if valid[t].any()]
+
+
+def s_filter(
+    heights: ArrayLike,
+    pixel_size: float | ArrayLike,
+    cutoff: float,
+    mask: ArrayLike | None = None,
+) -> NDArray:
+    """Gaussian S-filter (ISO 16610-61): remove wavelengths shorter than ``cutoff``.
+
+    Parameters
+    ----------
+    heights : array_like, 1-D or 2-D
+        Heights [m]; NaN (or masked) points are invalid.
+    pixel_size : float or (float, float)
+        Grid spacing [m].
+    cutoff : float
+        Short-wavelength cut-off lambda_s [m]: a sinusoid of this wavelength keeps 50 % of
+        its amplitude.
+    mask : array_like of bool, optional
+        True where a point is invalid.
+
+    Returns
+    -------
+    ndarray
+        Filtered heights [m], NaN at invalid points.
+
+    Notes
+    -----
+    ISO 16610-61 (areal; ISO 16610-21 for profiles) weights with
+    ``s(x) = exp(-pi (x / (a lambda_s))^2) / (a lambda_s)``, a = sqrt(ln 2 / pi), whose
+    transmission is ``exp(-pi (a lambda_s / lambda)^2)`` (0.5 at lambda = lambda_s). That
+    is a normal kernel of standard deviation ``a lambda_s / sqrt(2 pi)``, applied here per
+    axis by :func:`scipy.ndimage.gaussian_filter` to ``w z`` and to the valid-point
+    indicator ``w`` and divided (normalised convolution): dropouts and the map border get
+    no weight instead of the standard's end-effect corrections.
+    """
+    z, valid = _as_heights(heights, mask)
+    return _s_filter(z, valid, _pixel(pixel_size, z.ndim), cutoff)
+
+
+def _s_filter(z: NDArray, valid: NDArray, px: tuple[float, ...], cutoff: float) -> NDArray:
+    if not (math.isfinite(cutoff) and cutoff > 0):
+        raise ValueError(
+            f"short-wavelength cut-off must be positive and finite [m], got {cutoff!r}"
+        )
+    sig = [GAUSS_ALPHA * cutoff / (math.sqrt(2.0 * math.pi) * p) for p in px]
+    num = np.zeros(z.shape)
+    np.copyto(num, z, where=valid)
+    ndimage.gaussian_filter(num, sig, output=num, mode="constant", truncate=4.0)
+    den = ndimage.gaussian_filter(valid.astype(float), sig, mode="constant", truncate=4.0)
+    np.divide(num, den, out=num, where=valid)
+    num[~valid] = np.nan
+    return num
+
+
+def erode_mask(valid: ArrayLike, pixels: int) -> NDArray:
+    """Valid points farther than ``pixels`` (chessboard distance) from any invalid point.
+
+    Parameters
+    ----------
+    valid : array_like of bool
+        True at valid points.
+    pixels : int
+        Width of the band around each dropout to drop [pixels], >= 0.
+
+    Returns
+    -------
+    ndarray of bool
+        The eroded valid set (the map border is not a dropout).
+    """
+    v = np.asarray(valid, dtype=bool)
+    if not (isinstance(pixels, int | np.integer) and pixels >= 0):
+        raise ValueError(f"erode pixels must be an integer >= 0, got {pixels!r}")
+    if pixels == 0 or v.all():
+        return v.copy()
+    bad = ndimage.binary_dilation(
+        ~v, structure=np.ones((3,) * v.ndim, dtype=bool), iterations=int(pixels)
+    )
+    return v & ~bad
+
+
+def _fmt_len(v: float) -> str:
+    for unit, f in (("mm", 1e-3), ("um", 1e-6), ("nm", 1e-9)):
+        if abs(v) >= f:
+            return f"{v / f:.4g} {unit}"
+    return f"{v / 1e-12:.4g} pm"
 
 
 def roughness_statistics(
@@ -661,6 +942,9 @@ def roughness_statistics(
     mask: ArrayLike | None = None,
     degree: int = 1,
     blocks: int | None = None,
+    short_cutoff: float | None = None,
+    erode: int = 0,
+    progress: Callable[[int, int], None] | None = None,
 ) -> RoughnessStats:
     """Roughness statistics of an areal height map or a profile, with uncertainties.
 
@@ -677,43 +961,75 @@ def roughness_statistics(
     blocks : int, optional
         Jackknife tiles per axis (default 5 for a map, 20 for a profile); 0 or 1 = no
         uncertainties.
+    short_cutoff : float, optional
+        S-filter cut-off lambda_s [m] (:func:`s_filter`, applied after levelling); default
+        none: slopes then refer to the pixel, and pixel noise enters them in full.
+    erode : int
+        Drop the valid points within this many pixels of a dropout (:func:`erode_mask`);
+        the rims of dropouts often carry spikes.
+    progress : callable, optional
+        Called as ``progress(done, total)`` after the full pass and after each jackknife
+        replicate.
 
     Returns
     -------
     RoughnessStats
+        ``bandwidth`` states the wavelengths the slopes and alphas refer to; ``notes``
+        flag pixel-scale correlation lengths and variance carried by a few points.
 
     Raises
     ------
     ValueError
-        Bad shapes or pixel sizes, too few valid points (e.g. a map full of NaN).
+        Bad shapes or pixel sizes, too few valid points (e.g. a map full of NaN), a map
+        without roughness (all heights on the levelling polynomial).
 
     Notes
     -----
-    ``alpha = sqrt(2) sigma / c`` (Dong et al. 2022) is the RMS slope per axis of a surface
-    with the Gaussian ACF ``sigma^2 exp(-tau^2/c^2)``; for other ACFs it is only a length
-    ratio. From a profile, alpha and the slope fits describe the surface only if it is
-    isotropic (one direction is measured).
+    ``alpha_gaussian_acf = sqrt(2) sigma / c`` (Dong et al. 2022) is the RMS slope per axis
+    of a surface with the Gaussian ACF ``sigma^2 exp(-tau^2/c^2)``; for other ACFs it is
+    only a length ratio. ``alpha_ggx_ml`` is the maximum-likelihood GGX alpha of the
+    measured slopes, the one the tracer uses. From a profile, alphas and slope fits
+    describe the surface only if it is isotropic (one direction is measured).
+    Memory: a few copies of the heights (levelled copy, slopes, the zero-padded FFT of
+    the ACF at 1.5 times the size per axis); the replicates run one after the other.
     """
     z, valid = _as_heights(heights, mask)
     px = _pixel(pixel_size, z.ndim)
     if not valid.any():
         raise ValueError("heights hold no valid (finite, unmasked) point")
+    n_before = int(np.count_nonzero(valid))
+    if erode:
+        valid = erode_mask(valid, erode)
+    n_eroded = n_before - int(np.count_nonzero(valid))
+    if not valid.any():
+        raise ValueError(f"eroding the mask by {erode} pixels leaves no valid point")
+    if short_cutoff is not None:
+        z = _s_filter(_level(z, valid, degree), valid, px, float(short_cutoff))
     if blocks is None:
         blocks = 5 if z.ndim == 2 else 20
-    full = _core(z, valid, px, degree)
-    unc: dict[str, float] = {}
     tiles = _tiles(valid, blocks) if blocks and blocks > 1 else []
+    total = 1 + (len(tiles) if len(tiles) > 1 else 0)
+    full = _core(z, valid, px, degree, with_slopes=True)
+    if progress is not None:
+        progress(1, total)
+    unc: dict[str, float] = {}
     scal = [
         k
         for k, v in full.items()
         if not k.startswith("_") and isinstance(v, float) and math.isfinite(v)
     ]
     if len(tiles) > 1:
+        no_dropouts = bool(valid.all())
         reps: dict[str, list[float]] = {k: [] for k in scal}
-        for t in tiles:
-            rep = _core(z, valid & ~t, px, degree)
+        for i, t in enumerate(tiles):
+            sub = valid.copy()
+            sub[t] = False
+            rep = _core(z, sub, px, degree, hole=t if no_dropouts else None)
+            del sub
             for k in scal:
                 reps[k].append(rep[k])
+            if progress is not None:
+                progress(i + 2, total)
         nb = len(tiles)
         for k in scal:
             v = np.asarray(reps[k], dtype=float)
@@ -723,36 +1039,73 @@ def roughness_statistics(
             var = (nb - 1) / nb * float(np.sum((v - v.mean()) ** 2))
             bias = (nb - 1) * (float(v.mean()) - full[k])
             unc[k] = math.sqrt(var + bias * bias)
-    sx, sy = full["_slopes"]
     fc = full["_fit"]
-    if tiles and len(tiles) > 1:
+    if len(tiles) > 1:
         ug, ub = unc.get("ggx_alpha", _NAN), unc.get("beckmann_alpha", _NAN)
     else:
-        ug, ub = _fisher_u(sx, sy, fc)
+        ug, ub = full["_fisher"]
     fits = _make_fits(fc, ug, ub, full["_n_slopes"])
     notes = []
     if z.ndim == 1:
         notes.append(
-            "profile: alpha and the slope fits use one direction and assume an isotropic surface"
+            "profile: alphas and the slope fits use one direction and assume an isotropic surface"
         )
     if fits.warning:
         notes.append(fits.warning)
     if not math.isfinite(full["c"]):
         notes.append("the ACF does not fall below 1/e within half the map: c undefined")
+    elif full["c"] < C_MIN_PIXELS * min(px):
+        notes.append(
+            f"correlation length c = {full['c'] / min(px):.2g} pixels (< {C_MIN_PIXELS:g}):"
+            " the ACF is that of pixel-scale noise or spikes, so sqrt(2) sigma / c ="
+            f" {full['alpha_gaussian_acf']:.3g} is no slope; limit the bandwidth"
+            " (short_cutoff, --short-cutoff) or drop dropout rims (erode, --erode-mask)"
+        )
+    share, h2_thr = full["_top_share"]
+    if math.isfinite(share) and share > TOP_VARIANCE_WARN:
+        big = np.zeros(z.shape, dtype=bool)
+        lz = _level(z, valid, degree)
+        with np.errstate(invalid="ignore"):
+            np.greater_equal(lz * lz, h2_thr, out=big, where=valid)
+        del lz
+        n_big = int(np.count_nonzero(big))
+        rim = ""
+        if not valid.all():
+            near = ndimage.binary_dilation(~valid, structure=np.ones((3,) * z.ndim, dtype=bool))
+            rim = f", {int(np.count_nonzero(big & near))} of them next to a dropout"
+        notes.append(
+            f"1 % of the points ({n_big}{rim}) carry {100 * share:.3g} % of the height"
+            " variance: spikes or dropout rims dominate sigma, c and the alphas; erode the"
+            " mask around dropouts (erode, --erode-mask N) or check the data"
+        )
+    if n_eroded:
+        notes.append(f"mask eroded by {erode} pixels around dropouts: {n_eroded} points dropped")
     names = {f for f in RoughnessStats.__dataclass_fields__}
     kw = {k: v for k, v in full.items() if k in names}
     lev = {0: "mean removed", 1: "least-squares mean plane removed"}.get(
         degree, f"least-squares polynomial of total degree {degree} removed"
     )
+    extent = max(n * p for n, p in zip(z.shape, px, strict=True))
+    if short_cutoff is not None:
+        lo = (
+            f"short-wavelength cut-off {_fmt_len(float(short_cutoff))}"
+            " (Gaussian S-filter, ISO 16610-61)"
+        )
+    else:
+        lo = f"no S-filter: down to the pixel, {_fmt_len(min(px))}"
+    band = f"{lo}; up to the map size {_fmt_len(extent)} ({lev})"
     return RoughnessStats(
         kind="areal" if z.ndim == 2 else "profile",
         shape=tuple(int(n) for n in z.shape),
         pixel_size=px,
         levelling=lev,
-        n_valid=int(valid.sum()),
+        n_valid=int(np.count_nonzero(valid)),
         slope_fits=fits,
         uncertainty=unc,
         n_blocks=len(tiles) if len(tiles) > 1 else 0,
         notes=tuple(notes),
+        short_cutoff=float(short_cutoff) if short_cutoff is not None else _NAN,
+        bandwidth=band,
+        n_eroded=n_eroded,
         **kw,
     )

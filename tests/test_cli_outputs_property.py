@@ -271,12 +271,26 @@ PATHLIKE_HELP = re.compile(r"^write |\bfile\b|\(\.[a-z0-9]+\)|height map|folder"
 PATHLIKE_DEST = re.compile(r"^(output|out|png|file|files|path)$|_(file|path|from|surface|dir)$")
 
 
+#: options whose help speaks of files but whose value is not a path (a list of column
+#: names, a length, a unit, a sigma per quantity)
+NOT_PATHS = {
+    ("ingest", "columns"),
+    ("film", "sigma"),
+    ("surface", "pixel_size"),
+    ("surface", "unit"),
+    ("trace", "pixel_size"),
+    ("trace", "unit"),
+}
+
+
 def test_no_option_that_names_a_file_is_left_undeclared():
     """An argument that looks like a path must be an InputPath or an OutputPath."""
     loose = []
     for name, sp in _subparsers().items():
         for a in sp._actions:
             if isinstance(a, InputPath | OutputPath) or a.nargs == 0:
+                continue
+            if (name, a.dest) in NOT_PATHS:
                 continue
             if (
                 PATHLIKE_METAVAR.search(str(a.metavar or ""))

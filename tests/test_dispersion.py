@@ -202,3 +202,9 @@ def test_tabulated_from_a_bare_tantalum_ellipsometer_file(real_exports):
 def test_invalid_parameters_raise_clear_errors(build, match):
     with pytest.raises(DispersionError, match=match):
         build()
+
+
+def test_pseudo_constants_of_a_stack_are_refused_as_a_table(real_exports) -> None:
+    coated = real_exports / "woollam-wvase-ascii" / "w1_12082006.dat"
+    with pytest.raises(DispersionError, match="pseudo-constants of a stack"):
+        Tabulated.from_file(coated)

@@ -72,7 +72,7 @@ def test_anisotropy_ratio_and_direction():
     iso = roughness_statistics(gaussian_surface(256, 256e-6, 1e-7, 6e-6, rng=8).z, 1e-6, blocks=0)
     assert iso.anisotropy_ratio < 1.15
     assert iso.acf_model == "gaussian"
-    assert abs(iso.alpha - np.sqrt(2) * iso.sigma / iso.c) < 1e-15
+    assert abs(iso.alpha_gaussian_acf - np.sqrt(2) * iso.sigma / iso.c) < 1e-15
 
 
 def test_exponential_acf_is_recognised():
@@ -129,7 +129,12 @@ def test_levelling_removes_polynomials_of_the_given_degree():
 def test_to_dict_is_json_safe_and_frozen():
     st = roughness_statistics(gaussian_surface(64, 64e-6, 1e-7, 4e-6, rng=1).z, 1e-6)
     d = json.loads(json.dumps(st.to_dict(), allow_nan=False))
-    assert d["kind"] == "areal" and set(d["uncertainty"]) >= {"sigma", "c", "alpha"}
+    assert d["kind"] == "areal" and set(d["uncertainty"]) >= {
+        "sigma",
+        "c",
+        "alpha_gaussian_acf",
+        "alpha_ggx_ml",
+    }
     assert d["slope_fits"]["best"] in ("ggx", "beckmann")
     with pytest.raises(AttributeError):
         st.sigma = 1.0  # type: ignore[misc]
@@ -278,7 +283,7 @@ def test_matrix_ascii_needs_sizes_and_reads_in_metres(tmp_path):
     z = np.random.default_rng(0).standard_normal((20, 16))
     p = tmp_path / "m.asc"
     np.savetxt(p, z)
-    with pytest.raises(AdapterError, match="m.asc.*physical_sizes"):
+    with pytest.raises(AdapterError, match="m.asc.*no lateral size.*--pixel-size"):
         read_height_map(p)
     hm = read_height_map(p, physical_sizes=(16.0, 20.0), unit="um")
     np.testing.assert_allclose(hm.pixel_size, (1e-6, 1e-6))
@@ -291,3 +296,162 @@ def test_missing_surface_topography_names_the_extra(monkeypatch, tmp_path):
     monkeypatch.setitem(sys.modules, "SurfaceTopography", None)
     with pytest.raises(ImportError, match=r"labbrdf\[topography\]"):
         at.read_height_map(tmp_path / "x.dat")
+
+
+# ------------------------------------------------------------- bandwidth, dropouts, notes
+def test_s_filter_transmits_half_at_the_cutoff_as_iso_16610_61():
+    """ISO 16610-61 Gaussian: transmission exp(-pi (a lambda_s / lambda)^2), a = sqrt(ln2/pi):
+    0.5 at lambda = lambda_s and 2^(-1/4) = 0.841 at 2 lambda_s (interior of the map, away
+    from the border, where the truncated normal kernel is exact to 1e-4)."""
+    from labbrdf.topography import s_filter
+
+    n, d, lam_s = 512, 1e-7, 3.2e-6
+    x = np.arange(n) * d
+    for lam, want in ((lam_s, 0.5), (2 * lam_s, 2**-0.25), (lam_s / 2, 2.0**-4)):
+        z = np.sin(2 * np.pi * x / lam)[:, None] * np.ones(64)[None, :]
+        f = s_filter(z, d, lam_s)
+        inner = slice(100, n - 100)
+        xi = 2 * np.pi * x[inner] / lam
+        coef = np.linalg.lstsq(np.column_stack([np.sin(xi), np.cos(xi)]), f[inner, 32])[0]
+        assert np.hypot(*coef) == pytest.approx(want, abs=1e-3)
+
+
+def test_short_cutoff_removes_pixel_noise_and_states_the_bandwidth():
+    """AFM-like: a smooth surface (c = 40 px) plus white pixel noise. Without a bandwidth
+    the slopes are the noise's; with lambda_s = 8 px they are those of the filtered surface
+    plus the little noise left in the band."""
+    from labbrdf.topography import s_filter
+
+    d = 1e-9
+    s = gaussian_surface(256, 256 * d, 2e-9, 40 * d, rng=5)
+    noise = np.random.default_rng(6).normal(0, 0.5e-9, s.z.shape)
+    raw = roughness_statistics(s.z + noise, d, blocks=0)
+    cut = roughness_statistics(s.z + noise, d, blocks=0, short_cutoff=8 * d)
+    clean = roughness_statistics(s_filter(s.z, d, 8 * d), d, blocks=0)
+    rest = roughness_statistics(s_filter(noise, d, 8 * d), d, blocks=0)
+    assert raw.slope_rms > 5 * cut.slope_rms
+    # the filter is linear and the noise independent: slope variances add (to a few %,
+    # the sample cross term)
+    assert cut.slope_rms**2 == pytest.approx(clean.slope_rms**2 + rest.slope_rms**2, rel=0.05)
+    assert cut.short_cutoff == 8 * d
+    assert "short-wavelength cut-off 8 nm" in cut.bandwidth and "ISO 16610-61" in cut.bandwidth
+    assert "no S-filter: down to the pixel, 1 nm" in raw.bandwidth
+    assert np.isnan(raw.short_cutoff)
+    with pytest.raises(ValueError, match="cut-off must be positive"):
+        roughness_statistics(s.z, d, short_cutoff=-1.0)
+
+
+def _dropout_map():
+    """Smooth Gaussian surface (sigma 10 nm, c 8 px) with dropouts whose rims carry spikes,
+    as an optical profiler's map at edges it cannot follow."""
+    d = 1e-6
+    s = gaussian_surface(256, 256 * d, 1e-8, 8 * d, rng=9)
+    z = np.array(s.z)
+    rng = np.random.default_rng(10)
+    holes = np.zeros(z.shape, bool)
+    for i, j in rng.integers(10, 246, size=(40, 2)):
+        holes[i - 2 : i + 3, j - 2 : j + 3] = True
+    from scipy import ndimage
+
+    rim = ndimage.binary_dilation(holes) & ~holes
+    z[rim] += rng.choice([-1, 1], rim.sum()) * 3e-6  # 300 sigma spikes
+    z[holes] = np.nan
+    return z, d, s
+
+
+def test_dropout_rims_are_flagged_and_eroding_the_mask_recovers_the_surface():
+    from labbrdf.topography import C_MIN_PIXELS, erode_mask
+
+    z, d, s = _dropout_map()
+    st = roughness_statistics(z, d, blocks=0)
+    text = " ".join(st.notes)
+    assert "carry" in text and "next to a dropout" in text and "--erode-mask" in text
+    assert st.c < C_MIN_PIXELS * d and "pixels (< 2)" in text
+    er = roughness_statistics(z, d, blocks=0, erode=1)
+    assert not any("carry" in n for n in er.notes) and not any("(< 2)" in n for n in er.notes)
+    assert er.n_eroded > 0 and any("eroded by 1 pixels" in n for n in er.notes)
+    ref = roughness_statistics(s.z, d, blocks=0)
+    assert er.sigma == pytest.approx(ref.sigma, rel=0.05)
+    assert er.alpha_ggx_ml == pytest.approx(ref.alpha_ggx_ml, rel=0.05)
+    v = np.ones((5, 5), bool)
+    v[2, 2] = False
+    assert erode_mask(v, 1).sum() == 16 and erode_mask(v, 2).sum() == 0
+    assert erode_mask(v, 0).sum() == 24
+    full = np.ones((4, 4), bool)
+    assert erode_mask(full, 3).all()
+    with pytest.raises(ValueError, match="erode pixels"):
+        erode_mask(v, -1)
+
+
+def test_gaussian_map_gets_no_dropout_or_pixel_notes():
+    st = roughness_statistics(gaussian_surface(128, 128e-6, 1e-7, 6e-6, rng=2).z, 1e-6, blocks=0)
+    assert not any("carry" in n or "(< 2)" in n for n in st.notes)
+
+
+def test_progress_reports_every_pass_and_chunking_leaves_results_unchanged(monkeypatch):
+    import labbrdf.topography as T
+
+    z = gaussian_surface(96, 96e-6, 1e-7, 5e-6, rng=3).z
+    calls = []
+    a = roughness_statistics(z, 1e-6, blocks=3, progress=lambda i, n: calls.append((i, n)))
+    assert calls == [(i, 10) for i in range(1, 11)]
+    monkeypatch.setattr(T, "_CHUNK", 1000)  # many row blocks in levelling and KS
+    b = roughness_statistics(z, 1e-6, blocks=3)
+    for k in ("sigma", "c", "slope_rms", "alpha_ggx_ml", "alpha_gaussian_acf", "height_ks"):
+        assert getattr(b, k) == pytest.approx(getattr(a, k), rel=1e-9)
+        assert b.uncertainty[k] == pytest.approx(a.uncertainty[k], rel=1e-6)
+
+
+def test_cli_progress_goes_to_stderr_only_after_the_delay(capsys):
+    from labbrdf.cli import _progress_printer
+
+    _progress_printer("labbrdf surface: f.dat", after_s=3600)(2, 26)
+    assert capsys.readouterr().err == ""
+    _progress_printer("labbrdf surface: f.dat", after_s=0.0)(2, 26)
+    assert "labbrdf surface: f.dat: pass 2/26" in capsys.readouterr().err
+
+
+def test_height_map_is_drawn_x_horizontal_y_down_as_gwyddion():
+    """An asymmetric map: one raised pixel at x index 2, y index 9 of a 6 x 12 grid with
+    dx = 1 um, dy = 0.5 um. Image column = x, row = y, origin top left."""
+    from labbrdf.report.figures import height_map_image, surface_figure
+
+    z = np.zeros((6, 12))
+    z[2, 9] = 1.0
+    img, ext = height_map_image(z, (1e-6, 0.5e-6))
+    assert img.shape == (12, 6)
+    row, col = np.unravel_index(np.argmax(img), img.shape)
+    assert (row, col) == (9, 2)
+    assert ext == pytest.approx([0.0, 6.0, 6.0, 0.0])  # x 0..6 um right, y 0..6 um down
+    st = roughness_statistics(gaussian_surface(32, 32e-6, 1e-7, 3e-6, rng=1).z, 1e-6, blocks=0)
+    assert surface_figure(
+        np.random.default_rng(0).normal(size=(32, 16)) * 1e-7, (1e-6, 1e-6), st
+    ).startswith("data:image/png")
+
+
+@pytest.mark.parametrize(
+    ("shape", "hole"),
+    [
+        ((40, 30), (slice(0, 8), slice(0, 6))),
+        ((40, 30), (slice(16, 24), slice(12, 18))),
+        ((40, 30), (slice(32, 40), slice(24, 30))),
+        ((37,), (slice(10, 17),)),
+    ],
+)
+def test_pair_counts_of_a_grid_minus_a_tile_equal_the_fft_counts(shape, hole):
+    """The jackknife replicate of a map without dropouts: the interval-overlap counts are
+    those the FFT of the indicator gives, so rho is the same to round-off."""
+    from scipy import fft as sfft
+
+    from labbrdf.topography import _correlate_window, _rect_pair_counts
+
+    v = np.ones(shape, bool)
+    v[hole] = False
+    lag = tuple(n // 2 for n in shape)
+    pad = [sfft.next_fast_len(n + m, real=True) for n, m in zip(shape, lag, strict=True)]
+    fft_counts = np.round(_correlate_window(v.astype(float), pad, lag))
+    np.testing.assert_array_equal(_rect_pair_counts(shape, lag, hole), fft_counts)
+    z = np.random.default_rng(1).standard_normal(shape)
+    np.testing.assert_allclose(
+        autocorrelation(z, v, hole=hole), autocorrelation(z, v), rtol=1e-10, atol=1e-12
+    )

@@ -6,8 +6,26 @@ plain XYZ and matrix ASCII, ...); it is imported only when a file is read. Every
 converted to metres here, so :mod:`labbrdf.topography` never sees a unit.
 
 Plain XYZ (``x y z`` columns on a grid) and matrix ASCII files are also read by
-SurfaceTopography; a matrix file carries no lateral size, so ``physical_sizes`` and
-``unit`` must then be given.
+SurfaceTopography; a matrix file carries no lateral size, so ``physical_sizes`` (or
+``pixel_size``) and ``unit`` must then be given.
+
+Geometry check
+--------------
+A misread header gives a map whose numbers are wrong by orders of magnitude yet still
+produce statistics (a pitch of 4.9e-39 m from a corrupt header; a confocal map whose
+312.5 nm pitch is read as 0.3125 m, so every slope is a million times too small). Before
+anything is computed :func:`check_geometry` refuses a grid that no areal or profiling
+instrument records -- a pitch outside :data:`PITCH_RANGE_M`, a lateral size beyond
+:data:`MAX_EXTENT_M`, pixels more than :data:`MAX_PIXEL_ASPECT` times longer along one
+axis than the other -- and warns when the pitch and the height scale disagree: an RMS
+forward-difference slope above :data:`MAX_SLOPE_RMS` (steeper than any instrument
+measures) or below :data:`MIN_SLOPE_RMS` (a pitch too large for the heights). The user
+states the true geometry with ``pixel_size`` and ``unit`` (CLI ``--pixel-size``,
+``--unit``).
+
+Non-uniform line scans (stylus profilometer exports with irregular x) are interpolated
+linearly onto a uniform grid at their median spacing by SurfaceTopography's
+``to_uniform`` (every statistic here needs a uniform grid); the metadata says so.
 """
 
 from __future__ import annotations
@@ -21,7 +39,32 @@ from numpy.typing import NDArray
 
 from labbrdf.adapters._base import AdapterError
 
-__all__ = ["HeightMap", "read_height_map", "topography_statistics"]
+__all__ = [
+    "MAX_EXTENT_M",
+    "MAX_PIXEL_ASPECT",
+    "MAX_SLOPE_RMS",
+    "MIN_SLOPE_RMS",
+    "PITCH_RANGE_M",
+    "HeightMap",
+    "check_geometry",
+    "length_m",
+    "read_height_map",
+    "topography_statistics",
+]
+
+#: Plausible lateral pitch of a topography instrument [m]: 10 pm (below any AFM pixel) to
+#: 1 mm (a coarse large-aperture interferometer or a stylus trace sampled sparsely).
+PITCH_RANGE_M = (1e-11, 1e-3)
+#: Largest plausible lateral size of one map or profile [m].
+MAX_EXTENT_M = 1.0
+#: Largest plausible ratio of the pitches along the two axes of a map [1].
+MAX_PIXEL_ASPECT = 100.0
+#: RMS forward-difference slope above which the pitch is too small for the heights [1]
+#: (tan 84 deg: no optical or stylus instrument follows steeper slopes).
+MAX_SLOPE_RMS = 10.0
+#: RMS forward-difference slope below which the pitch is too large for the heights [1]
+#: (a super-polished mirror, 0.1 nm over a 100 um correlation, still has 1e-6).
+MIN_SLOPE_RMS = 1e-7
 
 _UNITS_M = {
     "m": 1.0,
@@ -64,6 +107,9 @@ class HeightMap:
         All channel names of the file.
     meta : dict
         Whatever else the reader reported (JSON-safe subset).
+    warnings : tuple of str
+        Doubts about the geometry (:func:`check_geometry`) or the reading (interpolation
+        of a non-uniform line scan).
     """
 
     heights: NDArray[np.float64]
@@ -72,6 +118,7 @@ class HeightMap:
     channel: str
     channels: tuple[str, ...] = ()
     meta: dict[str, Any] = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
 
     @property
     def mask(self) -> NDArray[np.bool_]:
@@ -97,12 +144,159 @@ def _json_meta(info: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
+def length_m(text: str | float, unit: str | None = None) -> float:
+    """A length like ``"312.5nm"``, ``"2 um"`` or ``0.5`` (in ``unit``, default m) in metres.
+
+    Parameters
+    ----------
+    text : str or float
+        Number with an optional unit suffix (m, mm, um, µm, nm, pm, A).
+    unit : str, optional
+        Unit of a bare number (default metres).
+
+    Returns
+    -------
+    float
+        The length [m], positive and finite.
+
+    Raises
+    ------
+    ValueError
+        Not a positive finite length, or an unknown unit.
+    """
+    t = str(text).strip()
+    num = t.rstrip("".join(sorted({c for u in _UNITS_M for c in u}))).strip()
+    suffix = t[len(num) :].strip() or unit or "m"
+    if suffix not in _UNITS_M:
+        raise ValueError(f"length {text!r}: unknown unit {suffix!r}; use one of {list(_UNITS_M)}")
+    try:
+        v = float(num) * _UNITS_M[suffix]
+    except ValueError:
+        raise ValueError(f"length {text!r}: expected a number with a unit, e.g. 312.5nm") from None
+    if not (np.isfinite(v) and v > 0):
+        raise ValueError(f"length {text!r}: must be positive and finite")
+    return v
+
+
+def check_geometry(
+    path: str, heights: NDArray[np.float64], pixel_size: tuple[float, ...]
+) -> tuple[str, ...]:
+    """Refuse implausible grids; return warnings when pitch and heights disagree.
+
+    Parameters
+    ----------
+    path : str
+        The file (for the messages).
+    heights : ndarray
+        Heights [m], NaN at undefined points.
+    pixel_size : tuple of float
+        Pitch per axis [m].
+
+    Returns
+    -------
+    tuple of str
+        Warnings naming the numbers (empty when the geometry is plausible).
+
+    Raises
+    ------
+    AdapterError
+        Non-finite or non-positive pitch, a pitch outside :data:`PITCH_RANGE_M`, a lateral
+        size beyond :data:`MAX_EXTENT_M` or pixels more than :data:`MAX_PIXEL_ASPECT` times
+        longer along one axis; the message says how to state the true geometry.
+    """
+    fix = "if the file is right, state the geometry with --pixel-size / --unit"
+    px = np.asarray(pixel_size, dtype=float)
+    if not np.all(np.isfinite(px)) or np.any(px <= 0):
+        raise AdapterError(path, f"pixel size {tuple(px.tolist())} m is not positive and finite")
+    lo, hi = PITCH_RANGE_M
+    if np.any(px < lo) or np.any(px > hi):
+        raise AdapterError(
+            path,
+            f"pixel size {', '.join(f'{v:.4g}' for v in px)} m is outside the {lo:g}..{hi:g} m"
+            f" of topography instruments: a misread header? ({fix})",
+        )
+    ext = np.asarray(heights.shape, dtype=float) * px
+    if np.any(ext > MAX_EXTENT_M):
+        size = " x ".join(f"{v:.4g}" for v in ext)
+        grid = " x ".join(map(str, heights.shape))
+        raise AdapterError(
+            path,
+            f"lateral size {size} m ({grid} points) exceeds {MAX_EXTENT_M:g} m:"
+            f" a misread header? ({fix})",
+        )
+    if px.size == 2 and max(px) / min(px) > MAX_PIXEL_ASPECT:
+        raise AdapterError(
+            path,
+            f"pixels {px[0]:.4g} m x {px[1]:.4g} m differ by more than {MAX_PIXEL_ASPECT:g}"
+            f" times between the axes: a misread header? ({fix})",
+        )
+    warnings = []
+    z = heights
+    if z.ndim == 1:
+        d = np.diff(z) / px[0]
+    else:
+        d = (z[1:, :] - z[:-1, :]) / px[0]
+    d = d[np.isfinite(d)]
+    if d.size:
+        srms = float(np.sqrt(np.mean(d * d)))
+        if srms > MAX_SLOPE_RMS or 0 < srms < MIN_SLOPE_RMS:
+            warnings.append(
+                f"RMS slope along x {srms:.3g} at a pixel size of {px[0]:.4g} m is outside"
+                f" {MIN_SLOPE_RMS:g}..{MAX_SLOPE_RMS:g}: pixel size or height unit is likely"
+                f" misread ({fix})"
+            )
+    return tuple(warnings)
+
+
+#: Extensions SurfaceTopography's readers do not list although the instrument writes them.
+_EXT_FORMAT = {"di": "di"}
+
+
+def _open(st: Any, p: str) -> Any:
+    """The reader of ``p``; on failure, the error of the reader its extension names."""
+    try:
+        return st.open_topography(p)
+    except Exception as exc:  # noqa: BLE001 - the reader's errors vary by format
+        detect = exc
+    ext = os.path.splitext(p)[1].lstrip(".").lower()
+    causes = []
+    for r in getattr(st.IO, "readers", ()):
+        try:
+            exts = [e.lower() for e in (r.file_extensions() or ())]
+            fmt = r.format()
+        except Exception:  # noqa: BLE001 - a reader without extensions
+            continue
+        if ext and (ext in exts or _EXT_FORMAT.get(ext) == fmt):
+            try:
+                r(p)
+            except Exception as err:  # noqa: BLE001
+                causes.append(f"as {fmt}: {_one_line(err)}")
+    cause = "; ".join(causes) if causes else None
+    if cause is None:
+        tried = [ln for ln in str(detect).splitlines() if ln.strip()]
+        causes = [
+            f"{a.strip().removeprefix('tried ').rstrip(': ')}: {b.strip()}"
+            for a, b in zip(tried[::2], tried[1::2], strict=False)
+            if a.strip().startswith("tried")
+        ]
+        cause = "; ".join(causes[:4]) or _one_line(detect)
+    raise AdapterError(
+        p, f"not a topography file SurfaceTopography can read ({cause})"
+    ) from detect
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
 def read_height_map(
     path: str | os.PathLike[str],
     channel: int | str | None = None,
     *,
     physical_sizes: tuple[float, ...] | None = None,
     unit: str | None = None,
+    pixel_size: float | tuple[float, ...] | None = None,
 ) -> HeightMap:
     """Read one height channel of a topography file, in metres.
 
@@ -115,16 +309,22 @@ def read_height_map(
     physical_sizes : tuple of float, optional
         Lateral size per axis in ``unit``, for files that do not carry it (matrix ASCII).
     unit : str, optional
-        Length unit of heights and sizes, for files that do not carry it.
+        Length unit of the numbers in the file (heights, and sizes unless ``pixel_size``
+        is given); replaces the file's own unit when it has one.
+    pixel_size : float or tuple of float, optional
+        Pitch per axis [m]; replaces the file's lateral calibration (a header that states
+        it wrongly), or gives it when the file has none.
 
     Returns
     -------
     HeightMap
+        ``warnings`` holds the doubts of :func:`check_geometry`.
 
     Raises
     ------
     AdapterError
-        Missing, unsupported or corrupt file; unknown channel; no lateral size or unit.
+        Missing, unsupported or corrupt file; unknown channel; no lateral size or unit;
+        implausible geometry (:func:`check_geometry`).
     ImportError
         SurfaceTopography is not installed (extra ``labbrdf[topography]``).
     """
@@ -132,13 +332,9 @@ def read_height_map(
     p = os.fspath(path)
     if not os.path.isfile(p):
         raise AdapterError(p, "no such file")
-    try:
-        reader = st.open_topography(p)
-    except Exception as exc:  # noqa: BLE001 - the reader's errors vary by format
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise AdapterError(
-            p, f"not a topography file SurfaceTopography can read ({first})"
-        ) from exc
+    if unit is not None and unit not in _UNITS_M:
+        raise AdapterError(p, f"unit {unit!r} unknown; use one of {list(_UNITS_M)}")
+    reader = _open(st, p)
     chans = list(reader.channels)
     names = tuple(str(c.name) for c in chans)
     if channel is None:
@@ -155,34 +351,78 @@ def read_height_map(
     kw: dict[str, Any] = {"channel_index": index}
     ch = chans[index]
     if ch.physical_sizes is None:
-        if physical_sizes is None:
-            raise AdapterError(p, "the file has no lateral size: pass physical_sizes and unit")
-        kw["physical_sizes"] = tuple(physical_sizes)
-    if ch.unit is None or not isinstance(ch.unit, str):
+        if physical_sizes is not None:
+            kw["physical_sizes"] = tuple(physical_sizes)
+        elif pixel_size is not None:
+            grid = tuple(int(n) for n in ch.nb_grid_pts)
+            pxm = np.broadcast_to(np.asarray(pixel_size, dtype=float), (len(grid),))
+            su = unit if unit is not None else ch.unit
+            scale = _UNITS_M.get(su, 1.0) if isinstance(su, str) else 1.0
+            kw["physical_sizes"] = tuple(
+                float(n * v / scale) for n, v in zip(grid, pxm, strict=True)
+            )
+        else:
+            raise AdapterError(
+                p,
+                "the file has no lateral size: give it with --pixel-size"
+                " (Python: pixel_size= or physical_sizes=)",
+            )
+    file_unit = ch.unit if isinstance(ch.unit, str) else None
+    if file_unit is None:
         if unit is None:
             raise AdapterError(
-                p, f"channel {names[index]!r} has no length unit ({ch.unit!r}): pass unit"
+                p,
+                f"channel {names[index]!r} has no length unit ({ch.unit!r}): give it with"
+                " --unit (Python: unit=)",
             )
         kw["unit"] = unit
+    warnings: list[str] = []
     try:
         topo = reader.topography(**kw)
-        topo_m = topo.to_unit("m")
-        h = topo_m.heights()
-        if not getattr(topo_m, "is_uniform", True):
-            raise AdapterError(p, "non-uniform line scans are not supported")
-        pixel = tuple(float(v) for v in np.atleast_1d(topo_m.pixel_size))
+        if not getattr(topo, "is_uniform", True):
+            x = np.asarray(topo.positions(), dtype=float)
+            step = float(np.median(np.diff(x)))
+            if not step > 0:
+                raise AdapterError(p, "the line scan's x positions do not increase")
+            n_in = x.size
+            topo = topo.to_uniform(pixel_size=step)
+            warnings.append(
+                f"non-uniform line scan ({n_in} points, spacing {np.min(np.diff(x)):.4g}"
+                f"..{np.max(np.diff(x)):.4g} {topo.unit}) interpolated linearly onto"
+                f" {topo.nb_grid_pts[0]} points at its median spacing {step:.4g} {topo.unit}"
+            )
+        tunit = unit if unit is not None else topo.unit
+        if tunit in _UNITS_M:
+            scale = _UNITS_M[tunit]
+            h = topo.heights()
+            pixel = tuple(float(v) * scale for v in np.atleast_1d(topo.pixel_size))
+        else:
+            topo_m = topo.to_unit("m")
+            scale = 1.0
+            h = topo_m.heights()
+            pixel = tuple(float(v) for v in np.atleast_1d(topo_m.pixel_size))
     except AdapterError:
         raise
     except Exception as exc:  # noqa: BLE001
-        raise AdapterError(p, f"cannot read the heights ({type(exc).__name__}: {exc})") from exc
+        raise AdapterError(p, f"cannot read the heights ({_one_line(exc)})") from exc
     z = np.array(np.ma.getdata(h), dtype=float)
+    if scale != 1.0:
+        z *= scale
     if np.ma.isMaskedArray(h):
         z[np.ma.getmaskarray(h)] = np.nan
+    del h
+    if pixel_size is not None:
+        pixel = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (z.ndim,)))
     if not np.isfinite(z).any():
         raise AdapterError(p, "no defined height in the file")
-    meta = {"unit_in_file": str(ch.unit), "reader": type(reader).__name__}
+    warnings[:0] = check_geometry(p, z, pixel)
+    meta: dict[str, Any] = {"unit_in_file": str(ch.unit), "reader": type(reader).__name__}
+    if unit is not None:
+        meta["unit_stated"] = unit
+    if pixel_size is not None:
+        meta["pixel_size_stated_m"] = list(pixel)
     meta.update(_json_meta(dict(getattr(topo, "info", {}) or {})))
-    return HeightMap(z, pixel, p, names[index], names, meta)
+    return HeightMap(z, pixel, p, names[index], names, meta, tuple(warnings))
 
 
 def topography_statistics(

@@ -1,4 +1,4 @@
-"""Zemax / Radiant "BSDF Data Interchange" tabular text files (``.bsdf``): reader and writer.
+"""Zemax / Radiant "BSDF Data Interchange" tabular text files (``.bsdf``): the reader.
 
 The format (Radiant Imaging, "BSDF Data Interchange File Format Specification", 2008; the
 "Zemax Tabular BSDF data file format" article of the Zemax knowledge base) is a header::
@@ -19,14 +19,16 @@ every angle of incidence (rotation outermost) a ``TIS <value>`` line and one row
 with one value per radial angle, and an optional ``DataEnd``. Cells are separated by tabs or
 spaces.
 
-Geometry (see ``docs/bsdf.md``): the scatter angles are given about the specular direction
-(the direction of direct transmission for BTDF): radial 0 is the specular direction, azimuth 0
-points from the specular direction towards the sample normal, azimuths increase
-counter-clockwise. The specification does not say from which side "counter-clockwise" is
-seen; labbrdf takes it as seen by an observer looking back at the sample along the specular
-direction, so azimuth 90 is the +y side when the source is at phi_i = 0. Every point is
-converted exactly (unit vectors, no small-angle approximation) to the dataset's
-``theta_i_deg``, ``theta_r_deg``, ``phi_r_deg``.
+Geometry (see ``docs/bsdf.md``; the functions are in :mod:`labbrdf.bsdf_geometry`): the
+scatter angles are given about the specular direction (the direction of direct transmission
+for BTDF): radial 0 is the specular direction, azimuth 0 points from the specular direction
+towards the sample normal, azimuths increase counter-clockwise. The specification does not
+say from which side "counter-clockwise" is seen; labbrdf takes it as seen by an observer
+looking back at the sample along the specular direction, so azimuth 90 is the +y side when
+the source is at phi_i = 0. Every point is converted exactly (unit vectors, no small-angle
+approximation) to the dataset's ``theta_i_deg``, ``theta_r_deg``, ``phi_r_deg``.
+The writer is :mod:`labbrdf.bsdf_export`; the grid quadrature is
+:func:`labbrdf.integrate.grid_integral`.
 """
 
 from __future__ import annotations
@@ -41,9 +43,16 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from ..dataset import Measurement, atomic_output
+from ..bsdf_geometry import (
+    SYMMETRIES,
+    angles_to_scatter,
+    azimuth_weights,
+    scatter_to_angles,
+    scatter_to_direction,
+)
+from ..dataset import Measurement
 from ._base import AdapterError, Format, decode, read_bytes, split_lines
 from ._numblock import build_frame
 
@@ -53,18 +62,14 @@ __all__ = [
     "angles_to_scatter",
     "grid_integral",
     "mirror_plane_symmetric",
-    "model_to_bsdf",
     "read_table",
     "read_zemax_bsdf",
     "scatter_to_angles",
     "scatter_to_direction",
     "stated_wavelength",
-    "binned_to_bsdf",
-    "write_bsdf",
 ]
 
 INSTRUMENT = "zemax-bsdf"
-SYMMETRIES = ("PlaneSymmetrical", "Asymmetrical", "Asymmetrical4D")
 SPECTRAL = {"Monochrome": ("Monochrome",), "XYZ": ("TristimulusX", "TristimulusY", "TristimulusZ")}
 #: channel column value per section name (Monochrome files have no channel column)
 _CHANNEL = {"Monochrome": "", "TristimulusX": "X", "TristimulusY": "Y", "TristimulusZ": "Z"}
@@ -80,145 +85,13 @@ DEFAULT_WAVELENGTH_NM = 555.0
 MAX_LIST = 100_000
 MAX_POINTS = 50_000_000
 
-_HEADER_LISTS = ("SampleRotation", "AngleOfIncidence", "ScatterAzimuth", "ScatterRadial")
+#: The header's list keywords, in the order the writer puts them.
+HEADER_LISTS = ("SampleRotation", "AngleOfIncidence", "ScatterAzimuth", "ScatterRadial")
 _HEADER_WORDS = ("Source", "Symmetry", "SpectralContent", "ScatterType")
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?", re.ASCII)
 _INT = re.compile(r"\+?\d+", re.ASCII)
 _NOT_NUMERIC = re.compile(r"[^0-9eE+\-. \t\n]")
 _SNIFF = re.compile(rb"^\s*(Source|Symmetry|SpectralContent|ScatterType)\s", re.MULTILINE)
-
-
-# ------------------------------------------------------------------------------ geometry
-
-
-def _cosd(a: NDArray[np.float64]) -> NDArray[np.float64]:
-    """cos of degrees, exact (0, +-1) at multiples of 90 deg."""
-    a = np.asarray(a, dtype=float)
-    r = np.mod(a, 360.0)
-    out = np.cos(np.radians(a))
-    out = np.where(r == 90.0, 0.0, out)
-    out = np.where(r == 270.0, 0.0, out)
-    out = np.where(r == 0.0, 1.0, out)
-    return np.where(r == 180.0, -1.0, out)
-
-
-def _sind(a: NDArray[np.float64]) -> NDArray[np.float64]:
-    """sin of degrees, exact (0, +-1) at multiples of 90 deg."""
-    return _cosd(np.asarray(a, dtype=float) - 90.0)
-
-
-def _frame(theta_s_deg: ArrayLike) -> tuple[NDArray[np.float64], ...]:
-    """Specular unit vector ``s`` and the azimuth-0 and azimuth-90 unit vectors ``e0``, ``e90``.
-
-    Source at phi_i = 0, so the specular direction is ``s = (-sin ts, 0, cos ts)``;
-    ``e0 = (cos ts, 0, sin ts)`` is the tangent at ``s`` pointing towards the normal (spec:
-    "azimuth 0 points from the specular direction towards the sample normal") and
-    ``e90 = s x e0 = (0, 1, 0)`` (counter-clockwise seen from the specular direction).
-    """
-    ts = np.asarray(theta_s_deg, dtype=float)
-    c, s = _cosd(ts), _sind(ts)
-    zero = np.zeros_like(c)
-    return (
-        np.stack([-s, zero, c]),
-        np.stack([c, zero, s]),
-        np.stack([zero, zero + 1.0, zero]),
-    )
-
-
-def scatter_to_direction(
-    theta_s_deg: ArrayLike, radial_deg: ArrayLike, azimuth_deg: ArrayLike
-) -> NDArray[np.float64]:
-    """Unit vector of a scatter direction given about the specular direction.
-
-    Parameters
-    ----------
-    theta_s_deg : array_like
-        Polar angle of the specular direction [deg] (the file's "AngleOfIncidence").
-    radial_deg, azimuth_deg : array_like
-        Scatter radial and azimuth angles [deg]; broadcast with ``theta_s_deg``.
-
-    Returns
-    -------
-    ndarray
-        ``(3, ...)`` Cartesian components (x, y, z), z along the sample normal.
-
-    Notes
-    -----
-    ``d = cos(r) s + sin(r) (cos(a) e0 + sin(a) e90)``: the specular vector ``s`` rotated by
-    the radial angle ``r`` about the axis ``s x (cos a e0 + sin a e90)`` (Rodrigues' formula
-    with an axis perpendicular to ``s``), exact for any ``r``.
-    """
-    # trigonometry on the inputs as given (1-D grids broadcast later), components written out
-    ts, r, a = (np.asarray(x, float) for x in (theta_s_deg, radial_deg, azimuth_deg))
-    ct, st = _cosd(ts), _sind(ts)
-    cr, sr = _cosd(r), _sind(r)
-    ca, sa = _cosd(a), _sind(a)
-    u = sr * ca  # component along e0 = (cos ts, 0, sin ts)
-    x = u * ct - cr * st
-    y = sr * sa
-    z = cr * ct + u * st
-    return np.stack(np.broadcast_arrays(x, y, z))
-
-
-def _direction_angles(d: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """(theta [deg] from +z, phi [deg] in [0, 360)) of unit vectors ``d`` (3, ...)."""
-    x, y, z = d
-    # rounded to 1e-12 deg (2e-14 rad, below the last bit of a file's angle) so that exact
-    # cases come out exact: the specular direction of 20 deg is 20.0, not 20.000000000000007
-    theta = np.round(np.degrees(np.arctan2(np.hypot(x, y), z)), 12)
-    phi = np.mod(np.round(np.degrees(np.arctan2(y, x)), 12), 360.0)
-    phi = np.where(phi >= 360.0, 0.0, phi)
-    return theta, phi
-
-
-def scatter_to_angles(
-    theta_s_deg: ArrayLike, radial_deg: ArrayLike, azimuth_deg: ArrayLike
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_]]:
-    """Dataset angles of scatter directions: ``(theta_r_deg, phi_r_deg, above)``.
-
-    Parameters
-    ----------
-    theta_s_deg, radial_deg, azimuth_deg : array_like
-        As in :func:`scatter_to_direction` [deg].
-
-    Returns
-    -------
-    theta_r_deg : ndarray
-        Polar angle from the normal [deg] (from the back normal for BTDF, whose frame is
-        the reflection frame mirrored in the sample plane).
-    phi_r_deg : ndarray
-        Azimuth of the outward direction [deg] in [0, 360), source at 0, the specular
-        direction at 180.
-    above : ndarray of bool
-        True where the direction is above the horizon (z > 0); elsewhere the point is not
-        a scatter direction of this hemisphere.
-    """
-    d = scatter_to_direction(theta_s_deg, radial_deg, azimuth_deg)
-    theta, phi = _direction_angles(d)
-    return theta, phi, d[2] > 0
-
-
-def angles_to_scatter(
-    theta_s_deg: ArrayLike, theta_r_deg: ArrayLike, phi_r_deg: ArrayLike
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Inverse of :func:`scatter_to_angles`: ``(radial_deg, azimuth_deg in [0, 360))``.
-
-    ``r = atan2(|d x s|, d . s)`` and ``a = atan2(d . e90, d . e0)`` with the frame of
-    :func:`scatter_to_direction`; ``a`` is 0 at ``r = 0`` (undefined there).
-    """
-    ts, tr, pr = np.broadcast_arrays(
-        np.asarray(theta_s_deg, float),
-        np.asarray(theta_r_deg, float),
-        np.asarray(phi_r_deg, float),
-    )
-    st = _sind(tr)
-    d = np.stack([st * _cosd(pr), st * _sind(pr), _cosd(tr)])
-    s, e0, e90 = _frame(ts)
-    cos_r = np.sum(d * s, axis=0)
-    u, v = np.sum(d * e0, axis=0), np.sum(d * e90, axis=0)
-    radial = np.degrees(np.arctan2(np.hypot(u, v), cos_r))
-    az = np.mod(np.degrees(np.arctan2(v, u)), 360.0)
-    return radial, np.where(az >= 360.0, 0.0, az)
 
 
 # ------------------------------------------------------------------------------ table
@@ -352,7 +225,7 @@ def _parse_header(path: str | os.PathLike[str], cur: _Lines) -> dict[str, Any]:
             if len(rest) != 1:
                 raise AdapterError(path, f"{key}: expected one keyword after it", n)
             head[key] = (rest[0], n)
-        elif key in _HEADER_LISTS:
+        elif key in HEADER_LISTS:
             if not rest:
                 raise AdapterError(path, f"{key}: expected a count after it", n)
             count = _count(path, rest[0], n, key)
@@ -361,7 +234,7 @@ def _parse_header(path: str | os.PathLike[str], cur: _Lines) -> dict[str, Any]:
             raise AdapterError(
                 path,
                 f"unknown header keyword {key!r}; expected one of "
-                f"{list(_HEADER_WORDS + _HEADER_LISTS)}",
+                f"{list(_HEADER_WORDS + HEADER_LISTS)}",
                 n,
             )
     return head
@@ -516,11 +389,11 @@ def read_table(path: str | os.PathLike[str]) -> BsdfTable:
     symmetry = _keyword(path, head, "Symmetry", SYMMETRIES)
     spectral = _keyword(path, head, "SpectralContent", tuple(SPECTRAL))
     scatter = _keyword(path, head, "ScatterType", tuple(SCATTER_TYPES))
-    for key in _HEADER_LISTS[1:]:
+    for key in HEADER_LISTS[1:]:
         if key not in head:
             raise AdapterError(path, f"missing header line '{key} <count>' and its values")
     rot = head.get("SampleRotation", np.zeros(1))
-    aoi, az, rad = (head[k] for k in _HEADER_LISTS[1:])
+    aoi, az, rad = (head[k] for k in HEADER_LISTS[1:])
     _check_list(path, "SampleRotation", rot, -360.0, 360.0)
     _check_list(path, "AngleOfIncidence", aoi, 0.0, 90.0)
     _check_list(path, "ScatterAzimuth", az, 0.0, 180.0 if symmetry == SYMMETRIES[0] else 360.0)
@@ -585,7 +458,7 @@ def _table_frame(
         # disagree, their mean weighted by the azimuth cells (the average over the polar
         # cap, so grid_integral is unchanged; meta["pole"] reports the largest spread)
         pole = values[..., 0]
-        w = _azimuth_weights(t.azimuth_deg, t.symmetry)
+        w = azimuth_weights(t.azimuth_deg, t.symmetry)
         values[..., 0, 0] = np.where(
             np.all(pole == pole[..., :1], axis=-1), pole[..., 0], (pole @ w) / w.sum()
         )
@@ -719,7 +592,7 @@ def read_zemax_bsdf(
 
 
 #: comment labbrdf writes for the wavelength of a model it exports (the format has no field)
-_WAVELENGTH_COMMENT = "labbrdf wavelength_nm "
+WAVELENGTH_COMMENT = "labbrdf wavelength_nm "
 
 #: wavelength comments read, ``#labbrdf wavelength_nm 550`` (ours) and ``#Wavelength (nm) =
 #: 550.0`` (the Speos-to-Zemax converter's); the value is checked by :func:`_num`
@@ -814,32 +687,6 @@ def mirror_plane_symmetric(m: Measurement) -> Measurement:
 # ------------------------------------------------------------------------------ quadrature
 
 
-def _edges(a: NDArray[np.float64], lo: float, hi: float) -> NDArray[np.float64]:
-    """Cell edges around nodes ``a``: midpoints inside, ``lo``/``hi`` clipped at the ends."""
-    mid = 0.5 * (a[1:] + a[:-1])
-    return np.concatenate([[max(lo, a[0])], mid, [min(hi, a[-1])]])
-
-
-def _radial_weights(radial_deg: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Solid-angle weights of the radial cells: ``int sin r dr = cos r_lo - cos r_hi`` [sr/rad]."""
-    e = np.radians(_edges(radial_deg, 0.0, 180.0))
-    return np.cos(e[:-1]) - np.cos(e[1:])
-
-
-def _azimuth_weights(azimuth_deg: NDArray[np.float64], symmetry: str) -> NDArray[np.float64]:
-    """Azimuth cell widths [rad]; a full circle wraps, a PlaneSymmetrical half counts twice."""
-    a = np.asarray(azimuth_deg, float)
-    if symmetry == "PlaneSymmetrical":
-        return 2.0 * np.radians(np.diff(_edges(a, 0.0, 180.0)))
-    if a.size == 1:
-        return np.array([2.0 * np.pi])
-    if a[-1] - a[0] >= 360.0 - 1e-9:  # the first node is repeated at +360
-        return np.radians(np.diff(_edges(a, -np.inf, np.inf)))
-    ext = np.concatenate([[a[-1] - 360.0], a, [a[0] + 360.0]])
-    mid = 0.5 * (ext[1:] + ext[:-1])
-    return np.radians(np.diff(mid))
-
-
 def _table_of(obj: BsdfTable | Measurement | Mapping[str, Any]) -> BsdfTable:
     if isinstance(obj, BsdfTable):
         return obj
@@ -918,20 +765,11 @@ def _table_from_measurement(m: Measurement) -> BsdfTable:
     )
 
 
-def _cos_weights(t: BsdfTable) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Solid-angle weights and projected cosines of the grid points.
-
-    Returns ``(w, cos_r)``: weights [sr] and cosines (0 below the horizon), each shaped
-    ``(aoi, azimuth, radial)``.
-    """
-    w = _azimuth_weights(t.azimuth_deg, t.symmetry)[:, None] * _radial_weights(t.radial_deg)
-    ti = t.theta_i_deg[:, None, None]
-    d = scatter_to_direction(ti, t.radial_deg[None, None, :], t.azimuth_deg[None, :, None])
-    return np.broadcast_to(w, d.shape[1:]), np.clip(d[2], 0.0, None)
-
-
 def grid_integral(obj: BsdfTable | Measurement | Mapping[str, Any]) -> dict[str, Any]:
     """Hemispherical integral ``int f cos(theta_r) d omega`` of each block on its own grid.
+
+    The ``.bsdf`` face of :func:`labbrdf.integrate.grid_integral`, which holds the
+    quadrature rule and its limits.
 
     Parameters
     ----------
@@ -947,324 +785,17 @@ def grid_integral(obj: BsdfTable | Measurement | Mapping[str, Any]) -> dict[str,
         fraction of the projected solid angle of the hemisphere (pi sr) that the grid does
         not cover; ``tis`` (the file's values, NaN when unknown) and ``ratio`` = tis /
         integral.
-
-    Notes
-    -----
-    Each grid node owns a cell bounded by the midpoints to its neighbours (the end nodes
-    own half cells; a full azimuth circle wraps; a PlaneSymmetrical half counts twice).
-    The solid angle of a cell about the specular direction is exactly
-    ``(cos r_lo - cos r_hi) (a_hi - a_lo)``, and the projection factor is ``cos theta_r`` at
-    the node, 0 below the horizon (the definition of the hemispherical reflectance, e.g.
-    Nicodemus et al., NBS Monograph 160, 1977). This is a first-order rule, so a file's
-    TIS (integrated by the instrument on its own, finer native sampling) need not agree:
-    on the Radiant imaging-sphere export the TIS is 4-20 % above this integral. Causes:
-    coarse radial steps (10 deg beyond 20 deg) across a curved lobe, the part of the
-    hemisphere beyond the largest radial angle that the grid does not cover
-    (``uncovered_fraction``), the zeros the instrument writes at directions next to the
-    horizon, and the cells that straddle the horizon (cut at the node, not at z = 0).
     """
+    from ..integrate import grid_integral as quadrature  # scipy, only when asked for
+
     t = _table_of(obj)
-    w, cz = _cos_weights(t)
-    integral = np.einsum("rcazq,azq->rca", t.values, w * cz)
-    covered = np.sum(w * cz, axis=(1, 2)) / np.pi
-    tis = np.asarray(t.tis, float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = tis / integral
-    return {
-        "integral": integral,
-        "uncovered_fraction": 1.0 - covered,
-        "tis": tis,
-        "ratio": ratio,
-    }
-
-
-# ------------------------------------------------------------------------------ writer
-
-
-def _fmt(v: float, digits: int) -> str:
-    return f"{v:.{digits - 1}E}"
-
-
-def _check_grid(name: str, a: NDArray[np.float64], lo: float, hi: float) -> None:
-    if a.ndim != 1 or a.size == 0 or not np.isfinite(a).all():
-        raise ValueError(f"{name}: expected a non-empty 1-D list of finite angles [deg]")
-    if a.min() < lo or a.max() > hi or (a.size > 1 and not np.all(np.diff(a) > 0)):
-        raise ValueError(f"{name}: expected strictly increasing values in [{lo:g}, {hi:g}] deg")
-
-
-def write_bsdf(
-    path: str | os.PathLike[str],
-    *,
-    theta_i_deg: ArrayLike,
-    radial_deg: ArrayLike,
-    azimuth_deg: ArrayLike,
-    values: ArrayLike,
-    tis: ArrayLike | None = None,
-    symmetry: str = "Asymmetrical",
-    spectral: str | None = None,
-    scatter_type: str = "BRDF",
-    rotation_deg: ArrayLike = (0,),
-    channels: Sequence[str] | None = None,
-    comments: Iterable[str] = (),
-    digits: int = 6,
-    overwrite: bool = False,
-) -> Path:
-    """Write a Zemax / Radiant ``.bsdf`` tabular file, atomically.
-
-    Parameters
-    ----------
-    path : str or path-like
-        Output file; an existing file is refused unless ``overwrite``.
-    theta_i_deg, radial_deg, azimuth_deg : array_like
-        The grid [deg]: angles of incidence (specular angles), scatter radial and azimuth
-        angles (strictly increasing; azimuths within [0, 180] for PlaneSymmetrical).
-    values : array_like
-        ``(rotation, channel, aoi, azimuth, radial)`` BSDF [sr^-1], finite.
-    tis : array_like, optional
-        ``(rotation, channel, aoi)`` total integrated scatter; by default computed with
-        :func:`grid_integral`.
-    symmetry : {"PlaneSymmetrical", "Asymmetrical", "Asymmetrical4D"}
-    spectral : {"Monochrome", "XYZ"}, optional
-        By default from ``channels`` or from the channel axis of ``values`` (1 or 3).
-    scatter_type : {"BRDF", "BTDF"}
-    rotation_deg : array_like
-        Sample rotations [deg].
-    channels : sequence of str, optional
-        ``("X", "Y", "Z")`` for tristimulus data, ``("",)`` or None for monochrome.
-    comments : iterable of str
-        Written as ``#`` lines at the top.
-    digits : int
-        Significant digits of each value (and TIS), 1..17.
-    overwrite : bool
-        Replace an existing file.
-
-    Returns
-    -------
-    pathlib.Path
-        The file written.
-    """
-    target = Path(path)
-    if target.exists() and not overwrite:
-        raise FileExistsError(f"{target} exists; pass overwrite=True to replace it")
-    if symmetry not in SYMMETRIES:
-        raise ValueError(f"symmetry {symmetry!r}: expected one of {list(SYMMETRIES)}")
-    if scatter_type not in SCATTER_TYPES:
-        raise ValueError(f"scatter_type {scatter_type!r}: expected one of {list(SCATTER_TYPES)}")
-    if not (isinstance(digits, int) and 1 <= digits <= 17):
-        raise ValueError(f"digits={digits!r}: expected an integer in 1..17")
-    ti = np.atleast_1d(np.asarray(theta_i_deg, float))
-    rad = np.atleast_1d(np.asarray(radial_deg, float))
-    az = np.atleast_1d(np.asarray(azimuth_deg, float))
-    rot = np.atleast_1d(np.asarray(rotation_deg, float))
-    _check_grid("theta_i_deg", ti, 0.0, 90.0)
-    _check_grid("radial_deg", rad, 0.0, 180.0)
-    _check_grid("azimuth_deg", az, 0.0, 180.0 if symmetry == SYMMETRIES[0] else 360.0)
-    _check_grid("rotation_deg", rot, -360.0, 360.0)
-    v = np.asarray(values, float)
-    if v.ndim != 5:
-        raise ValueError(
-            f"values: expected 5 axes (rotation, channel, aoi, azimuth, radial), got {v.ndim}"
-        )
-    if spectral is None:
-        if channels is not None:
-            spectral = "XYZ" if tuple(channels) == ("X", "Y", "Z") else "Monochrome"
-        else:
-            spectral = "XYZ" if v.shape[1] == 3 else "Monochrome"
-    if spectral not in SPECTRAL:
-        raise ValueError(f"spectral {spectral!r}: expected one of {list(SPECTRAL)}")
-    want_ch = ("X", "Y", "Z") if spectral == "XYZ" else ("",)
-    if channels is not None and tuple(channels) not in (want_ch, ("Monochrome",)):
-        raise ValueError(f"channels {tuple(channels)} do not fit spectral {spectral!r}")
-    shape = (rot.size, len(want_ch), ti.size, az.size, rad.size)
-    if v.shape != shape:
-        raise ValueError(f"values: expected shape {shape}, got {v.shape}")
-    if not np.isfinite(v).all():
-        raise ValueError("values: expected finite numbers (no NaN or inf)")
-    if tis is None:
-        tis_a = grid_integral(
-            {
-                "values": v,
-                "theta_i_deg": ti,
-                "azimuth_deg": az,
-                "radial_deg": rad,
-                "symmetry": symmetry,
-            }
-        )["integral"]
-    else:
-        tis_a = np.asarray(tis, float)
-        if tis_a.shape != shape[:3] or not np.isfinite(tis_a).all():
-            raise ValueError(f"tis: expected finite numbers of shape {shape[:3]}")
-    head = [f"#{c}" for c in comments]
-    head += [
-        "Source  Measured",
-        f"Symmetry  {symmetry}",
-        f"SpectralContent  {spectral}",
-        f"ScatterType  {scatter_type}",
-    ]
-    for key, arr in zip(_HEADER_LISTS, (rot, ti, az, rad), strict=True):
-        head += [f"{key}  {arr.size}", "\t".join(f"{x:.15g}" for x in arr)]
-    head.append("")
-    parts = ["\n".join(head)]
-    for c, name in enumerate(SPECTRAL[spectral]):
-        sec = [name, "DataBegin"]
-        for r in range(rot.size):
-            for a in range(ti.size):
-                sec.append(f"TIS {_fmt(tis_a[r, c, a], digits)}")
-                block = v[r, c, a]
-                sec += ["\t".join(_fmt(x, digits) for x in row) for row in block.tolist()]
-        sec.append("DataEnd")
-        parts.append("\n".join(sec))
-    with atomic_output(target) as tmp, open(tmp, "w", encoding="ascii", newline="\n") as fh:
-        fh.write("\n".join(parts) + "\n")
-    return target
-
-
-def model_to_bsdf(
-    model: Any,
-    params: Mapping[str, float] | Any,
-    path: str | os.PathLike[str],
-    *,
-    theta_i_deg: ArrayLike,
-    radial_deg: ArrayLike,
-    azimuth_deg: ArrayLike,
-    wavelength_nm: float | None = None,
-    symmetry: str = "PlaneSymmetrical",
-    digits: int = 6,
-    comments: Iterable[str] = (),
-    overwrite: bool = False,
-) -> Path:
-    """Evaluate a labbrdf model on a scatter grid and write it as a ``.bsdf`` file.
-
-    Each grid point (specular angle, radial, azimuth) is converted to (theta_i, theta_r,
-    phi_r) by :func:`scatter_to_angles` (the reader's geometry); below-horizon points get
-    0; the TIS of each block is the :func:`grid_integral` of the values written.
-
-    Parameters
-    ----------
-    model : labbrdf.models.Model
-        E.g. ``labbrdf.models.get("smooth3")``.
-    params : mapping or Parameters
-        Parameter values (None: the model's current values).
-    path : str or path-like
-        Output file (see :func:`write_bsdf`).
-    theta_i_deg, radial_deg, azimuth_deg : array_like
-        The grid [deg].
-    wavelength_nm : float, optional
-        Passed to the model's ``evaluate`` [nm].
-    symmetry : str
-        ``PlaneSymmetrical`` (azimuths 0..180) for an isotropic model, else
-        ``Asymmetrical``.
-    digits, comments, overwrite
-        As in :func:`write_bsdf`.
-    """
-    ti = np.atleast_1d(np.asarray(theta_i_deg, float))
-    rad = np.atleast_1d(np.asarray(radial_deg, float))
-    az = np.atleast_1d(np.asarray(azimuth_deg, float))
-    tr, pr, above = scatter_to_angles(ti[:, None, None], rad[None, None, :], az[None, :, None])
-    tib = np.broadcast_to(ti[:, None, None], tr.shape)
-    f = model.evaluate(
-        np.radians(tib),
-        np.radians(np.where(above, tr, 0.0)),
-        np.radians(pr),
-        wavelength=wavelength_nm,
-        params=params,
-    )
-    vals = np.where(above, np.asarray(f, float), 0.0)[None, None]
-    name = getattr(model, "name", type(model).__name__)
-    return write_bsdf(
-        path,
-        theta_i_deg=ti,
-        radial_deg=rad,
-        azimuth_deg=az,
-        values=vals,
-        symmetry=symmetry,
-        comments=(
-            f"labbrdf model {name}",
-            *([f"{_WAVELENGTH_COMMENT}{float(wavelength_nm):.17g}"] if wavelength_nm else []),
-            *comments,
-        ),
-        digits=digits,
-        overwrite=overwrite,
-    )
-
-
-def binned_to_bsdf(
-    path: str | os.PathLike[str],
-    *,
-    theta_i_deg: float,
-    values: ArrayLike,
-    theta_edges_deg: ArrayLike,
-    phi_edges_deg: ArrayLike,
-    radial_deg: ArrayLike,
-    azimuth_deg: ArrayLike,
-    wavelength_nm: float | None = None,
-    symmetry: str = "PlaneSymmetrical",
-    comments: Iterable[str] = (),
-    digits: int = 6,
-    overwrite: bool = False,
-) -> Path:
-    """Write a BRDF binned on a (theta_r, phi_r) grid (a tracer's S0) as a ``.bsdf`` file.
-
-    Each scatter grid point (radial, azimuth about the specular direction of
-    ``theta_i_deg``) is converted to (theta_r, phi_r) by :func:`scatter_to_angles` and takes
-    the value of the bin it falls in; below the horizon it is 0.
-
-    Parameters
-    ----------
-    path : str or path-like
-        Output file; an existing file is refused unless ``overwrite``.
-    theta_i_deg : float
-        Angle of incidence of the binned data [deg].
-    values : array_like, shape (n_theta, n_phi)
-        Bin-averaged BRDF [sr^-1], e.g. :meth:`labbrdf.TraceResult.s0`.
-    theta_edges_deg, phi_edges_deg : array_like
-        Bin edges [deg], ``n_theta + 1`` in [0, 90] and ``n_phi + 1`` in [0, 360]
-        (outward azimuth, source at 0).
-    radial_deg, azimuth_deg : array_like
-        The scatter grid to write [deg].
-    wavelength_nm : float, optional
-        Written as a ``#labbrdf wavelength_nm`` comment, read back by :func:`read_zemax_bsdf`.
-    symmetry, comments, digits, overwrite :
-        As in :func:`write_bsdf`.
-
-    Returns
-    -------
-    pathlib.Path
-
-    Notes
-    -----
-    The file holds bin averages at the grid points, not point values: features narrower
-    than a bin (a near-specular spike of a smooth surface) are smeared over the bin width,
-    as in the binned data themselves. Choose a scatter grid no finer than the bins.
-    """
-    v = np.asarray(values, float)
-    te = np.asarray(theta_edges_deg, float)
-    pe = np.asarray(phi_edges_deg, float)
-    if v.ndim != 2 or v.shape != (te.size - 1, pe.size - 1):
-        raise ValueError(
-            f"values: expected shape ({te.size - 1}, {pe.size - 1}) from the edges, got {v.shape}"
-        )
-    v = np.where(np.isfinite(v), v, 0.0)
-    rad = np.atleast_1d(np.asarray(radial_deg, float))
-    az = np.atleast_1d(np.asarray(azimuth_deg, float))
-    tr, pr, above = scatter_to_angles(float(theta_i_deg), rad[None, :], az[:, None])
-    i = np.clip(np.searchsorted(te, tr, side="right") - 1, 0, v.shape[0] - 1)
-    phi = pe[0] + np.mod(pr - pe[0], 360.0)  # into the edges' period (they may start at -0.5)
-    j = np.clip(np.searchsorted(pe, phi, side="right") - 1, 0, v.shape[1] - 1)
-    grid = np.where(above, v[i, j], 0.0)
-    return write_bsdf(
-        path,
-        theta_i_deg=[float(theta_i_deg)],
-        radial_deg=rad,
-        azimuth_deg=az,
-        values=grid[None, None, None],
-        symmetry=symmetry,
-        comments=(
-            *([f"{_WAVELENGTH_COMMENT}{float(wavelength_nm):.17g}"] if wavelength_nm else []),
-            *comments,
-        ),
-        digits=digits,
-        overwrite=overwrite,
+    return quadrature(
+        t.values,
+        t.theta_i_deg,
+        t.azimuth_deg,
+        t.radial_deg,
+        symmetry=t.symmetry,
+        tis=t.tis,
     )
 
 

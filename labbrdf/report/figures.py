@@ -405,6 +405,29 @@ def save_trace_maps_png(result: Any, path: str | Any, stokes_in: Any = (1, 0, 0,
     return save_png(uri, path)
 
 
+def height_map_image(heights_m: Any, pixel_size_m: Sequence[float]) -> tuple[Any, list[float]]:
+    """Image and extent [um] that show a map as the instrument and Gwyddion do.
+
+    Parameters
+    ----------
+    heights_m : ndarray (M, N)
+        ``heights[i, j]`` at ``(x, y) = (i dx, j dy)`` (SurfaceTopography's order).
+    pixel_size_m : sequence of float
+        (dx, dy) [m].
+
+    Returns
+    -------
+    image : ndarray (N, M)
+        ``image[j, i] = heights[i, j]``: x along the columns (horizontal), y along the rows.
+    extent : list of float
+        ``[0, L_x, L_y, 0]`` [um] for ``imshow(..., origin="upper")``: the origin at the
+        top left and y growing downwards, as Gwyddion draws a map.
+    """
+    z = np.asarray(heights_m)
+    dx, dy = (float(p) for p in pixel_size_m)
+    return z.T, [0.0, z.shape[0] * dx * 1e6, z.shape[1] * dy * 1e6, 0.0]
+
+
 def surface_figure(
     heights_m: Any, pixel_size_m: Sequence[float], stats: Any, title: str = ""
 ) -> str:
@@ -444,13 +467,21 @@ def surface_figure(
     fig, axes = plt.subplots(1, 3, figsize=(13.5, 4.0))
     ax = axes[0]
     if z.ndim == 2:
-        ext = [0, z.shape[1] * px[1] * 1e6, z.shape[0] * px[0] * 1e6, 0]
+        img, ext = height_map_image(z, px)
         # colour range of the central 99 % of the heights: a few spikes would flatten it
         lo_nm, hi_nm = (float(v) * 1e9 for v in np.nanpercentile(z, [0.5, 99.5]))
-        im = ax.imshow(z * 1e9, extent=ext, cmap="viridis", aspect="equal", vmin=lo_nm, vmax=hi_nm)
+        im = ax.imshow(
+            img * 1e9,
+            extent=ext,
+            origin="upper",
+            cmap="viridis",
+            aspect="equal",
+            vmin=lo_nm,
+            vmax=hi_nm,
+        )
         fig.colorbar(im, ax=ax, label="height [nm]", extend="both")
-        ax.set_xlabel("y [\u00b5m]")
-        ax.set_ylabel("x [\u00b5m]")
+        ax.set_xlabel("x [\u00b5m]")
+        ax.set_ylabel("y [\u00b5m]")
         ax.set_title("levelled height map")
     else:
         ax.plot(np.arange(z.size) * px[0] * 1e6, z * 1e9, lw=0.7)
@@ -720,8 +751,9 @@ def panels_figure(
     panels : sequence of mappings
         ``{"title": str, "xlabel": str, "ylabel": str, "logy": bool (optional),
         "series": [{"label": str, "x": array, "y": array, "yerr": array or None,
-        "band": array or None, "style": "line" | "points"}]}``. ``yerr`` draws error bars
-        (1 sigma), ``band`` a shaded y +- band.
+        "band": array or None, "style": "line" | "points", "colour": str (optional)}]}``.
+        ``yerr`` draws error bars (1 sigma), ``band`` a shaded y +- band; ``colour`` (a
+        matplotlib colour) pairs series, e.g. a measurement and its model.
     title : str
         Figure title.
     ncols : int
@@ -751,6 +783,7 @@ def panels_figure(
         series = list(p.get("series", []))
         for k, s in enumerate(series):
             c = _COLOURS[k % len(_COLOURS)] if len(series) <= len(_COLOURS) else None
+            c = s.get("colour", c)
             x = np.asarray(s["x"], float)
             y = np.asarray(s["y"], float)
             order = np.argsort(x, kind="stable")

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import __version__, models
+from ..films import FilmModel
 from ..fitting import METHOD
 from ..parallel import Executor, as_executor
 from ..provenance import versions
@@ -25,6 +26,7 @@ from .context import Context
 from .sections import Section, run
 from .sections.brdf import brdf_section
 from .sections.colour import colour_section
+from .sections.film import film_model_of, film_section
 from .sections.fits import fits_section
 from .sections.ingest import ingest_files
 from .sections.measured import measured_section
@@ -78,6 +80,7 @@ def user_report(
     title: str | None = None,
     start: Mapping[str, float] | None = None,
     selection: Mapping[str, Any] | None = None,
+    film_model: str | os.PathLike[str] | FilmModel | None = None,
     **kw: Any,
 ) -> int:
     """Build a report for the given files and write it (atomically) to ``out``.
@@ -112,6 +115,12 @@ def user_report(
     selection : mapping, optional
         Rows to keep, as :func:`labbrdf.selection.select` takes them (``wavelength``,
         ``theta_i``, ``quantity``, ``sample``); applied to every file after reading.
+    film_model : path-like or FilmModel, optional
+        A film model (a TOML file, :func:`labbrdf.films.load_model`, or a
+        :class:`~labbrdf.films.FilmModel`, e.g. the stated default of one transparent
+        Cauchy layer on c-Si with the thickness free,
+        :func:`labbrdf.report.sections.film.default_film_model`) fitted to every psi/Delta
+        file whose angles of incidence disagree (section ``film``). None: no film fit.
     **kw :
         ``quick`` is accepted for symmetry with :func:`~labbrdf.report.validate` (no effect).
 
@@ -124,7 +133,8 @@ def user_report(
     Raises
     ------
     ValueError
-        No paths, an unknown model name or option, or an output folder that is refused
+        No paths, an unknown model name or option, a film model file with an error
+        (naming the file and the line), or an output folder that is refused
         (:class:`labbrdf.outputs.OutputError`), all before any work.
     """
     unknown = set(kw) - {"quick"}
@@ -135,12 +145,17 @@ def user_report(
         raise ValueError("paths: expected at least one data file")
     from ..outputs import check_report_dir
 
-    check_report_dir(out, inputs=paths)  # refused before the fits, not after
+    # the model file is an input too: never inside the replaced folder
+    model_file: list[str | os.PathLike[str]] = (
+        [Path(film_model)] if isinstance(film_model, (str, os.PathLike)) else []
+    )
+    check_report_dir(out, inputs=paths + model_file)  # refused before the fits, not after
     opts = dict(options or {})
     try:
         models.get(model, **opts)
     except Exception as exc:
         raise ValueError(f"model: {exc}") from None
+    film, film_how = film_model_of(film_model)
     b = Builder(
         title or f"labbrdf report: {model} fits",
         progress=progress,
@@ -152,6 +167,7 @@ def user_report(
             "method": method,
             "seed": seed,
             "files": [str(p) for p in paths],
+            "film_model": film_how or None,
             "environment": versions(),
         },
     )
@@ -195,6 +211,11 @@ def user_report(
         ("measured", "Measured data, file by file", measured_section),
         ("nk", "Optical constants and cross-instrument comparison", nk_section),
         (
+            "film",
+            "Film stacks fitted to angle-dependent psi/Delta",
+            lambda ctx: film_section(ctx, film, how=film_how),
+        ),
+        (
             "fits",
             f"Fitted {model} parameters per sample and wavelength",
             lambda ctx: fits_section(ctx, [(model, opts)]) if _brdf_scans(ctx) else None,
@@ -219,6 +240,6 @@ def user_report(
         b.results["title"] = f"labbrdf report: {len(paths)} file(s), nothing fitted"
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
-    write_report(out, b.results, page, inputs=paths)
+    write_report(out, b.results, page, inputs=paths + model_file)
     b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
     return code

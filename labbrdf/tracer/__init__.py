@@ -138,6 +138,9 @@ def trace(
     events = 0
     block_hemi = np.zeros((config.n_blocks, 4, 4))
     block_rays = np.zeros(config.n_blocks, dtype=np.int64)
+    evaluated = config.resolved_estimator == "evaluated"
+    cells = np.zeros((config.batches * nb, 16)) if evaluated else None
+    batch_rays = np.zeros(config.batches, dtype=np.int64)
     expected = 0
     for tallies in map(_unit, work_units(config, blocks_per_unit)):
         for t in tallies:
@@ -152,6 +155,9 @@ def trace(
             absorbed = absorbed + t.absorbed
             terminated = terminated + t.terminated
             events += t.events
+            if cells is not None:
+                cells[t.cell_keys] = cells[t.cell_keys] + t.cell_sums
+                batch_rays = batch_rays + t.batch_rays
             for b, h, r in zip(t.blocks, t.block_hemi, t.block_rays, strict=True):
                 block_hemi[b] = h.reshape(4, 4) / r
                 block_rays[b] = r
@@ -160,6 +166,26 @@ def trace(
         raise RuntimeError(f"map returned {expected} of {config.n_groups} fold groups")
     n = config.rays
     shape = (grid.n_theta, grid.n_phi)
+    batch_mueller = stderr = None
+    info: dict[str, float] = {}
+    if cells is not None:
+        first, exit_sums, info = _evaluated(config, grid, cells)
+        # f = first + sum_b exit_b / N, f_b = first + exit_b / N_b (plain sums, no BLAS:
+        # a bare substrate's batches are then bit-identical and its error exactly 0)
+        f = first + exit_sums.sum(axis=0) / n
+        per = np.where(batch_rays > 0, 1.0 / np.maximum(batch_rays, 1), 0.0)
+        batch_mueller = first + exit_sums * per[:, None, None, None, None]
+        omega = grid.cos_solid_angle_sr[:, :, None, None]
+        sums = (f * (n * omega)).reshape(nb, 16)
+        sumsq = np.zeros_like(sums)
+        dev = batch_mueller - f
+        bw = batch_rays[:, None, None, None, None].astype(float)
+        nbat = config.batches
+        stderr = np.sqrt((bw * dev * dev).sum(axis=0) / n / (nbat - 1))
+        bh = (batch_mueller * omega).sum(axis=(1, 2))  # (B, 4, 4) per ray
+        block_hemi, block_rays = bh, batch_rays
+        hemi = (f * omega).sum(axis=(0, 1)).reshape(16) * n
+        batch_mueller = batch_mueller.astype(np.float32)
     return TraceResult(
         config=config,
         sums=sums.reshape(*shape, 4, 4),
@@ -176,4 +202,25 @@ def trace(
         block_rays=block_rays,
         seconds=time.perf_counter() - t0,
         events=events,
+        stderr=stderr,
+        batch_mueller=batch_mueller,
+        info=info,
     )
+
+
+def _evaluated(
+    config: TraceConfig, grid: Grid, cells: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
+    """First-surface map (n_theta, n_phi, 4, 4) and per-batch exit sums (B, ...) [sr^-1]."""
+    from .estimator import exit_map, first_surface_map
+
+    t0 = time.perf_counter()
+    first = first_surface_map(config)
+    info = {"first_surface_seconds": time.perf_counter() - t0}
+    shape = (config.batches, grid.n_theta, grid.n_phi, 4, 4)
+    if config.coating is not None and not config.coherent:
+        sums, more = exit_map(config, cells.reshape(shape))
+        info.update(more)
+    else:
+        sums = np.zeros(shape)
+    return first, sums, info

@@ -15,6 +15,9 @@ __all__ = ["Coating", "Substrate", "TraceConfig"]
 
 SCATTERING = ("single", "multiple")
 TERMINATION = ("threshold", "roulette")
+ESTIMATORS = ("auto", "evaluated", "counting")
+# each batch holds (n_bins x 16) float64 sums: 4.2 MB on the 1-degree grid
+MAX_BATCHES = 64
 
 
 def _check(cond: bool, name: str, expected: str, value: Any) -> None:
@@ -149,15 +152,53 @@ class Coating:
     thickness_nm : float
         Physical thickness [nm] >= 0.
     alpha : float
-        GGX roughness of the top (air/coating) interface [1].
+        GGX roughness of the top (air/coating) interface [1] (kept for reference when
+        ``ndf`` is given).
+    ndf : TabulatedNDF or None
+        Tabulated slope distribution of the top interface (a measured table, or
+        :meth:`TabulatedNDF.beckmann` / :meth:`TabulatedNDF.ggx`), seen from above; seen
+        from below the walk uses its mirror image (the point reflection of the slopes).
+        None = GGX with ``alpha``. The exit operator of the evaluated estimator is built
+        for GGX, so a table on the coating is traced with counting.
     """
 
     n: float = 1.5
     k: float = 0.0
     thickness_nm: float = 162.5
     alpha: float = 0.2
+    ndf: TabulatedNDF | None = None
+
+    @classmethod
+    def from_surface(
+        cls, heights: Any, pixel_size: Any = None, *, bins: int = 64, **kw: Any
+    ) -> Coating:
+        """Coating whose top interface follows the slopes of a measured height map.
+
+        As :meth:`Substrate.from_surface` (levelled, table of ``bins`` cells per axis);
+        ``alpha`` = the ML GGX alpha of the same slopes; ``**kw``: n, k, thickness_nm.
+        """
+        sub = Substrate.from_surface(heights, pixel_size, bins=bins)
+        return cls(alpha=sub.alpha, ndf=sub.ndf, **kw)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-safe dict (the table, if any, as :meth:`TabulatedNDF.to_dict`)."""
+        return {
+            "n": self.n,
+            "k": self.k,
+            "thickness_nm": self.thickness_nm,
+            "alpha": self.alpha,
+            "ndf": None if self.ndf is None else self.ndf.to_dict(),
+        }
 
     def __post_init__(self) -> None:
+        if isinstance(self.ndf, dict):
+            object.__setattr__(self, "ndf", TabulatedNDF.from_dict(self.ndf))
+        _check(
+            self.ndf is None or isinstance(self.ndf, TabulatedNDF),
+            "coating.ndf",
+            "a TabulatedNDF or None",
+            type(self.ndf).__name__,
+        )
         _check(_finite(self.n) and self.n > 0, "coating.n", "a finite number > 0", self.n)
         _check(_finite(self.k) and self.k >= 0, "coating.k", "a finite number >= 0", self.k)
         _check(
@@ -212,6 +253,21 @@ class TraceConfig:
         not an ideal mirror); the facets use the coating's alpha.
     block_rays : int
         Rays per random-number block (part of the definition of the random streams).
+    estimator : {"auto", "evaluated", "counting"}
+        How the map is estimated (``docs/tracer.md``). ``"counting"``: exiting rays are
+        counted into bins (the paper's estimator). ``"evaluated"`` (single scattering
+        with a rough first interface only): the first interface's reflection is evaluated
+        in closed form at every bin, the walk below it follows reflection and refraction
+        with their Mueller weights instead of a random choice, and the exit through a
+        rough top interface is applied as an operator on the up-going internal
+        directions. ``"auto"``: evaluated wherever it applies, else counting.
+    scalar : bool
+        Scalar mode: the unpolarized Fresnel reflectance/transmittance ``(Rs + Rp) / 2``
+        at every vertex and no polarization carried between vertices (what scalar codes
+        such as pbrt-v4 or layerlab compute); only the M00 element is non-zero.
+    batches : int
+        Independent batches (ray index modulo ``batches``) of the evaluated estimator,
+        for its standard errors; part of the definition of its floating-point sums.
     fold_blocks : int
         Consecutive blocks that a worker adds up (in block order) before returning one
         tally; the driver then adds these group tallies in group order. Part of the
@@ -235,6 +291,9 @@ class TraceConfig:
     coherent: bool = False
     block_rays: int = 32768
     fold_blocks: int = 4
+    estimator: str = "auto"
+    batches: int = 8
+    scalar: bool = False
 
     def __post_init__(self) -> None:
         if isinstance(self.substrate, dict):
@@ -304,6 +363,23 @@ class TraceConfig:
             "an integer >= 1",
             self.fold_blocks,
         )
+        _check(self.estimator in ESTIMATORS, "estimator", f"one of {ESTIMATORS}", self.estimator)
+        _check(isinstance(self.scalar, bool), "scalar", "True or False", self.scalar)
+        _check(
+            isinstance(self.batches, int)
+            and not isinstance(self.batches, bool)
+            and 2 <= self.batches <= MAX_BATCHES,
+            "batches",
+            f"an integer in [2, {MAX_BATCHES}] (each batch keeps a map of all bins)",
+            self.batches,
+        )
+        _check(
+            self.estimator != "evaluated" or self.evaluated_applies,
+            "estimator",
+            "'counting' or 'auto' here: 'evaluated' needs scattering='single' and a rough "
+            "first interface (alpha > 0; a GGX coating top, not a table)",
+            self.estimator,
+        )
         _check(
             not self.coherent or self.coating is not None,
             "coherent",
@@ -328,11 +404,38 @@ class TraceConfig:
             self.coherent,
         )
         _check(
+            not (self.coherent and self.coating is not None and self.coating.ndf is not None),
+            "coherent",
+            "False with a tabulated coating NDF (the coherent facets are GGX)",
+            self.coherent,
+        )
+        _check(
             not (self.coherent and self.substrate.mirror),
             "coherent",
             "False with an ideal-mirror substrate (the film needs n + ik)",
             self.coherent,
         )
+
+    @property
+    def evaluated_applies(self) -> bool:
+        """Whether ``estimator="evaluated"`` covers this run.
+
+        It needs single scattering (the multiple-scattering walk's exits are counted) and a
+        rough first interface (the coating's top, or the substrate, or the coherent facets),
+        whose reflection has a closed form; a coating's top must be GGX.
+        """
+        if self.scattering != "single":
+            return False
+        if self.coating is not None:
+            return self.coating.alpha > 0 and self.coating.ndf is None
+        return self.substrate.ndf is not None or self.substrate.alpha > 0
+
+    @property
+    def resolved_estimator(self) -> str:
+        """``"evaluated"`` or ``"counting"`` (``"auto"`` resolved)."""
+        if self.estimator == "auto":
+            return "evaluated" if self.evaluated_applies else "counting"
+        return self.estimator
 
     @property
     def n_blocks(self) -> int:
@@ -359,10 +462,12 @@ class TraceConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-safe dict."""
-        if self.substrate.ndf is None:
+        coat_table = self.coating is not None and self.coating.ndf is not None
+        if self.substrate.ndf is None and not coat_table:
             return asdict(self)
-        d = asdict(self.replace(substrate=Substrate()))
+        d = asdict(self.replace(substrate=Substrate(), coating=None))
         d["substrate"] = self.substrate.to_dict()
+        d["coating"] = None if self.coating is None else self.coating.to_dict()
         return d
 
     def to_json(self) -> str:

@@ -50,6 +50,16 @@ class TraceResult:
         Wall time of the run [s].
     events : int
         Facet events traced.
+    stderr : ndarray, shape (n_theta, n_phi, 4, 4), or None
+        Evaluated estimator: standard error of :attr:`mueller` from the spread of the
+        ``config.batches`` independent batches [sr^-1]; None for counting (whose error
+        comes from the per-ray spread in ``sumsq``).
+    batch_mueller : ndarray, shape (batches, n_theta, n_phi, 4, 4), float32, or None
+        Evaluated estimator: each batch's Mueller BRDF (for errors of derived maps such as
+        the DOP, :meth:`dop_stderr`). With the evaluated estimator ``block_hemi`` and
+        ``block_rays`` hold the batches', not the blocks', hemispherical sums and rays.
+    info : dict
+        Timings of the evaluated estimator's parts [s] and the operator's size [MB].
     """
 
     config: TraceConfig
@@ -62,6 +72,9 @@ class TraceResult:
     block_rays: NDArray[np.int64]
     seconds: float = 0.0
     events: int = 0
+    stderr: NDArray[np.float64] | None = None
+    batch_mueller: NDArray[np.float32] | None = None
+    info: dict[str, float] = field(default_factory=dict)
     _grid: Grid = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -110,8 +123,25 @@ class TraceResult:
         return self.sums / (self.rays * w)
 
     @property
+    def estimator(self) -> str:
+        """``"evaluated"`` or ``"counting"``: what produced this result.
+
+        Read from the result itself (its batch errors), not from the config: a file
+        written before the evaluated estimator existed holds a counting run whatever its
+        config would resolve to today.
+        """
+        return "evaluated" if self.stderr is not None else "counting"
+
+    @property
     def mueller_stderr(self) -> NDArray[np.float64]:
-        """Monte Carlo standard error of :attr:`mueller` from the per-ray spread [sr^-1]."""
+        """Monte Carlo standard error of :attr:`mueller` [sr^-1].
+
+        Evaluated estimator: from the spread of the independent batches (:attr:`stderr`).
+        Counting: from the per-ray spread (every ray is an independent sample); zero where
+        no ray exited, so compare only bins with enough rays (:attr:`counts`).
+        """
+        if self.stderr is not None:
+            return self.stderr
         n = self.rays
         mean = self.sums / n
         var = np.maximum(self.sumsq / n - mean * mean, 0.0) / n
@@ -131,6 +161,25 @@ class TraceResult:
         pol = np.sqrt((st[..., 1:] ** 2).sum(axis=-1))
         with np.errstate(divide="ignore", invalid="ignore"):
             return np.where(st[..., 0] > 0, pol / st[..., 0], np.nan)
+
+    def dop_stderr(self, stokes_in: ArrayLike = UNPOLARIZED) -> NDArray[np.float64]:
+        """Standard error of :meth:`dop` from the spread of the batch DOPs [1].
+
+        Evaluated estimator only (NaN maps for counting, whose per-ray errors do not carry
+        the covariances the DOP needs). ``sqrt(sum_b N_b (d_b - d)^2 / (N (B - 1)))``, the
+        batch DOPs d_b weighted by their rays.
+        """
+        if self.batch_mueller is None:
+            return np.full(self.sums.shape[:2], np.nan)
+        s = _stokes(stokes_in)
+        st = self.batch_mueller.astype(np.float64) @ s
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d_b = np.sqrt((st[..., 1:] ** 2).sum(axis=-1)) / st[..., 0]
+        d = self.dop(stokes_in)
+        w = self.block_rays.astype(float)[:, None, None]
+        nb = w.shape[0]
+        var = (w * (d_b - d) ** 2).sum(axis=0) / w.sum() / (nb - 1)
+        return np.sqrt(var)
 
     def albedo(self, stokes_in: ArrayLike = UNPOLARIZED) -> float:
         """Directional-hemispherical reflectance: exited S0 / incident S0 [1]."""
@@ -180,6 +229,11 @@ class TraceResult:
         return final
 
     def _savez(self, fh: Any) -> None:
+        extra: dict[str, Any] = {}
+        if self.stderr is not None:
+            extra["stderr"] = self.stderr
+        if self.batch_mueller is not None:
+            extra["batch_mueller"] = self.batch_mueller
         np.savez_compressed(
             fh,
             mueller=self.mueller,
@@ -198,6 +252,8 @@ class TraceResult:
             ledger=np.array(json.dumps(self.ledger, sort_keys=True)),
             seconds=np.array(self.seconds),
             events=np.array(self.events),
+            info=np.array(json.dumps(self.info, sort_keys=True)),
+            **extra,
         )
 
     @classmethod
@@ -218,6 +274,9 @@ class TraceResult:
                     block_rays=z["block_rays"],
                     seconds=float(z["seconds"]),
                     events=int(z["events"]),
+                    stderr=z["stderr"] if "stderr" in z else None,
+                    batch_mueller=z["batch_mueller"] if "batch_mueller" in z else None,
+                    info=json.loads(str(z["info"])) if "info" in z else {},
                 )
         except (KeyError, ValueError, OSError) as exc:
             raise ValueError(f"{path}: not a labbrdf TraceResult .npz ({exc})") from exc
@@ -235,6 +294,7 @@ def trace_summary(result: TraceResult) -> dict[str, Any]:
             "terminated": led["terminated"],
         },
         "rays": result.rays,
+        "estimator": result.estimator,
         "seconds": result.seconds,
         "events": result.events,
         "config": result.config.to_dict(),

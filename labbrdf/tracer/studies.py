@@ -141,20 +141,34 @@ def _symmetry_z(res: TraceResult, what: str, min_count: int) -> float:
     n_phi = res.phi_r_deg.size
     j = np.arange(n_phi)
     mirror = (2 * j0 - j) % n_phi
-    cnt = res.counts
-    ok = (cnt >= min_count) & (cnt[:, mirror] >= min_count)
+    pop = _populated(res, min_count)
+    ok = pop & pop[:, mirror]
     if what == "S0":
         val = res.s0()
         err = res.mueller_stderr[..., 0, 0]
+    elif res.estimator == "evaluated":
+        val = res.dop()
+        err = res.dop_stderr()
     else:
         val = res.dop()
         # DOP error ~ 1/sqrt(count) (binomial-like spread of the per-ray polarization)
-        err = 1.0 / np.sqrt(np.maximum(cnt, 1))
+        err = 1.0 / np.sqrt(np.maximum(res.counts, 1))
     diff = np.abs(val - val[:, mirror])
     sig = np.sqrt(err**2 + err[:, mirror] ** 2)
     with np.errstate(divide="ignore", invalid="ignore"):
         z = np.where(ok & (sig > 0), diff / sig, 0.0)
     return float(np.nanmax(z))
+
+
+def _populated(res: TraceResult, min_count: int) -> np.ndarray:
+    """Bins whose values can be judged.
+
+    Counting: at least ``min_count`` counted rays. Evaluated (which counts no rays):
+    S0 > 0 with a finite DOP error.
+    """
+    if res.estimator == "evaluated":
+        return (res.s0() > 0) & np.isfinite(res.dop_stderr())
+    return res.counts >= min_count
 
 
 def _extent(res: TraceResult, val: np.ndarray, ok: np.ndarray, ref: float) -> float:
@@ -166,7 +180,7 @@ def _extent(res: TraceResult, val: np.ndarray, ok: np.ndarray, ref: float) -> fl
 def _stats(res: TraceResult, min_count: int) -> dict[str, float]:
     s0 = res.s0()
     dop = res.dop()
-    ok = res.counts >= min_count
+    ok = _populated(res, min_count)
     if not ok.any():
         raise ValueError(
             f"no bin has min_count={min_count} exiting rays ({res.config.rays} rays on a "
@@ -179,7 +193,7 @@ def _stats(res: TraceResult, min_count: int) -> dict[str, float]:
     return {
         "S0_peak": float(s0.max()),
         "S0_centre": float(s0[i0, j0]),
-        "S0_extent_sr": _extent(res, s0, res.counts > 0, float(s0[i0, j0])),
+        "S0_extent_sr": _extent(res, s0, _populated(res, 1), float(s0[i0, j0])),
         "S0_plane_argmax_deg": float(res.theta_r_deg[int(np.argmax(plane))]),
         "DOP_peak": float(dmap[imax, jmax]),
         "DOP_peak_theta_deg": float(res.theta_r_deg[imax]),

@@ -77,6 +77,11 @@ class BlockTally:
     terminated: float
     hemi: NDArray[np.float64]  # (16,) summed exit Mueller over the hemisphere
     events: int
+    # estimator="evaluated": Mueller sums of the rays reaching the top interface from
+    # below, per (batch, internal cell), flat key batch * n_bins + cell; rays per batch
+    cell_keys: NDArray[np.int64] | None = None
+    cell_sums: NDArray[np.float64] | None = None  # (len(cell_keys), 16)
+    batch_rays: NDArray[np.int64] | None = None  # (batches,)
 
 
 def _grid(cfg: TraceConfig) -> Grid:
@@ -103,6 +108,10 @@ class _Setup:
         self.n_above_sub = self.n_coat if self.layered else 1.0
         # tabulated substrate distribution (None: GGX everywhere, the original path)
         self.ndf_sub = None if cfg.coherent else sub.ndf
+        # tabulated top interface (seen from above; from below: its point reflection)
+        self.ndf_top = coat.ndf if (coat is not None and self.layered) else None
+        self.evaluated = cfg.resolved_estimator == "evaluated"
+        self.scalar = bool(cfg.scalar)
 
     def lambda_of(
         self,
@@ -110,13 +119,31 @@ class _Setup:
         kz_loc: NDArray[np.float64],
         on_sub: NDArray[np.bool_],
         alpha: NDArray[np.float64],
+        below: NDArray[np.bool_] | None = None,
     ) -> NDArray[np.float64]:
-        """Smith Lambda of the travel directions (GGX, or the substrate's table)."""
+        """Smith Lambda of the travel directions (GGX, or the interfaces' tables)."""
         lam = smith_lambda(kz_loc, alpha)
         if self.ndf_sub is not None and on_sub.any():
             # the substrate is always seen from above: its local frame is the global one
             lam[on_sub] = self.ndf_sub.smith_lambda(k[:, on_sub])
+        if self.ndf_top is not None and not on_sub.all():
+            top = ~on_sub
+            lam[top] = self.ndf_top.smith_lambda(self._top_dirs(k, top, below))
         return lam
+
+    @staticmethod
+    def _top_dirs(
+        k: NDArray[np.float64], top: NDArray[np.bool_], below: NDArray[np.bool_] | None
+    ) -> NDArray[np.float64]:
+        """Directions of top-interface rays in the frame of the table seen from above.
+
+        The lower side of a height field, seen through the point reflection r -> -r, has
+        the same slope distribution as the upper side: a direction k below is -k above.
+        """
+        d = k[:, top]
+        if below is None:
+            return d
+        return np.where(below[top], -d, d)
 
     def g1_of(
         self,
@@ -124,11 +151,15 @@ class _Setup:
         kz_loc: NDArray[np.float64],
         on_sub: NDArray[np.bool_],
         alpha: NDArray[np.float64],
+        below: NDArray[np.bool_] | None = None,
     ) -> NDArray[np.float64]:
-        """Smith G1 of the travel directions (GGX, or the substrate's table)."""
+        """Smith G1 of the travel directions (GGX, or the interfaces' tables)."""
         g = smith_g1(kz_loc, alpha)
         if self.ndf_sub is not None and on_sub.any():
             g[on_sub] = self.ndf_sub.smith_g1(k[:, on_sub])
+        if self.ndf_top is not None and not on_sub.all():
+            top = ~on_sub
+            g[top] = self.ndf_top.smith_g1(self._top_dirs(k, top, below))
         return g
 
     def beer_lambert(self, kz: NDArray[np.float64]) -> NDArray[np.float64] | None:
@@ -137,6 +168,12 @@ class _Setup:
         return np.exp(-4 * np.pi * self.k_coat * self.d / (self.lam * np.abs(kz)))
 
     def substrate_abcs(
+        self, cos_i: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray]:
+        out = self._substrate_abcs(cos_i)
+        return _scalar(out) if self.scalar else out
+
+    def _substrate_abcs(
         self, cos_i: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray]:
         if self.coherent:
@@ -159,6 +196,14 @@ class _Setup:
         self, cos_i: NDArray[np.float64], on_top: NDArray[np.bool_], below: NDArray[np.bool_]
     ) -> tuple[tuple, tuple, NDArray[np.float64], NDArray[np.float64]]:
         """Reflection/transmission numbers for a mix of top-interface and substrate rays."""
+        refl, tr, cos_t, eta = self._layered_abcs(cos_i, on_top, below)
+        if self.scalar:
+            refl, tr = _scalar(refl), _scalar(tr)
+        return refl, tr, cos_t, eta
+
+    def _layered_abcs(
+        self, cos_i: NDArray[np.float64], on_top: NDArray[np.bool_], below: NDArray[np.bool_]
+    ) -> tuple[tuple, tuple, NDArray[np.float64], NDArray[np.float64]]:
         nc = self.n_coat
         n1 = np.where(on_top & below, nc, np.where(on_top, 1.0, nc)).astype(np.complex128)
         n2 = np.where(on_top, np.where(below, 1.0, nc), 0.0).astype(np.complex128)
@@ -179,7 +224,9 @@ class _Setup:
         return refl, tr, cos_t, eta
 
 
-def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
+def trace_block(
+    cfg: TraceConfig, block: int, *, raw: list[tuple[NDArray, NDArray, NDArray]] | None = None
+) -> BlockTally:
     """Trace the rays of block ``block`` with generator ``SeedSequence([seed, block])``.
 
     Parameters
@@ -187,6 +234,10 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
     cfg : TraceConfig
     block : int
         Block index in ``range(cfg.n_blocks)``.
+    raw : list or None
+        Evaluated estimator: if given, every recorded up-going ray is also appended as
+        ``(global ray index, direction (3, n), Mueller rows (16, n) in its meridional
+        frame)``, for checks of the exit operator by direct evaluation.
 
     Returns
     -------
@@ -212,6 +263,10 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
     h = np.full(n, np.inf)
     fresh = np.ones(n, dtype=bool)
     bounces = np.zeros(n, dtype=np.int32)
+    rid = cfg.block_rays * block + np.arange(n, dtype=np.int64)  # global ray index
+    booked = 0.0  # evaluated: the sampled weight of the branches not followed
+    dep_key: list[NDArray] = []
+    dep_rows: list[NDArray] = []
     absorbed = 0.0
     terminated = 0.0
     events = 0
@@ -233,12 +288,12 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
                 terminated += float(M[0, 0, back].sum())
                 alive &= ~back
                 go = leave & ~back
-                g = np.where(go, su.g1_of(k, kz_loc, iface == SUB, alpha), 1.0)
+                g = np.where(go, su.g1_of(k, kz_loc, iface == SUB, alpha, below), 1.0)
                 terminated += float((M[0, 0] * (1.0 - g))[go].sum())
                 M *= g
                 leave = go
         else:
-            lam = su.lambda_of(k, kz_loc, iface == SUB, alpha)
+            lam = su.lambda_of(k, kz_loc, iface == SUB, alpha, below)
             leave, h_new = sample_height(kz_loc, lam, h, rng.random(m_))
             h = np.where(leave, h, h_new)
 
@@ -267,7 +322,7 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
                         # travels towards it)
                         kz_new = np.where(up, -k[2, ci], k[2, ci])
                         a_new = np.where(up, su.alpha_top, su.alpha_sub)
-                        lam_new = su.lambda_of(k[:, ci], kz_new, ~up, a_new)
+                        lam_new = su.lambda_of(k[:, ci], kz_new, ~up, a_new, up)
                         _, h[ci] = sample_height(
                             kz_new, lam_new, np.full(ci.size, np.inf), rng.random(ci.size)
                         )
@@ -281,7 +336,7 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
         if not alive.all():
             k, s, M = k[:, alive], s[:, alive], M[:, :, alive]
             iface, below, h = iface[alive], below[alive], h[alive]
-            fresh, bounces = fresh[alive], bounces[alive]
+            fresh, bounces, rid = fresh[alive], bounces[alive], rid[alive]
         m_ = k.shape[1]
         if m_ == 0:
             break
@@ -298,25 +353,73 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
             on_sub = ~on_top
             m[:, on_sub] = su.ndf_sub.sample_visible(wi[:, on_sub], rng)
         m[2] = np.where(below, -m[2], m[2])
+        if su.ndf_top is not None and on_top.any():
+            # from below: the point reflection of the table's visible normals for k
+            sign = np.where(below[on_top], -1.0, 1.0)
+            m[:, on_top] = sign * su.ndf_top.sample_visible(-k[:, on_top] * sign, rng)
         cos_i = np.clip(-(k[0] * m[0] + k[1] * m[1] + k[2] * m[2]), 0.0, 1.0)
         s_loc = s_axis(k, m, s)
         rotate_frame(M, k, s, s_loc)
         m00 = M[0, 0].copy()
         kr = k + 2.0 * cos_i * m
         trans = None
+        kill_all = False
         if not su.layered:
             A, B, C, S = su.substrate_abcs(cos_i)
             apply_fresnel(M, A, B, C, S)
+            if su.scalar:
+                M[1:] = 0.0
             knew = kr
+            if su.evaluated:
+                # the first (and only followed) event: its reflection is evaluated in
+                # closed form; the sampled weight only closes the energy ledger
+                krn = kr / np.sqrt((kr * kr).sum(axis=0))
+                g = su.g1_of(krn, krn[2], ~on_top, a)
+                booked += float((M[0, 0] * g).sum())
+                terminated += float((M[0, 0] * (1.0 - g)).sum())
+                kill_all = True
         else:
             refl, tr, cos_t, eta = su.layered_abcs(cos_i, on_top, below)
             s0 = M[0, 0]
             with np.errstate(divide="ignore", invalid="ignore"):
                 pr = np.where(s0 > 0, (refl[0] * s0 + refl[1] * M[1, 0]) / s0, refl[0])
                 pr = np.where(on_top, np.clip(pr, 0.0, 1.0), 1.0)  # opaque substrate
-                trans = u[2] >= pr
-                wr = np.where(trans, 0.0, 1.0 / np.where(trans, 1.0, pr))
-                wt = np.where(trans, 1.0 / np.where(trans, 1.0 - pr, 1.0), 0.0)
+                if su.evaluated:
+                    # no random branch: refract into the coating from air (the
+                    # reflection is evaluated), reflect at the top from below (the
+                    # transmission is applied by the exit operator), both with their
+                    # Mueller weights
+                    trans = on_top & ~below
+                    wr = np.where(trans, 0.0, 1.0)
+                    wt = np.where(trans, 1.0, 0.0)
+                    up_ = on_top & below
+                    if up_.any():
+                        _deposit(grid, cfg.batches, k, s_loc, M, up_, rid, dep_key, dep_rows, raw)
+                else:
+                    trans = u[2] >= pr
+                    wr = np.where(trans, 0.0, 1.0 / np.where(trans, 1.0, pr))
+                    wt = np.where(trans, 1.0 / np.where(trans, 1.0 - pr, 1.0), 0.0)
+            if su.evaluated:
+                # the branch not followed, sampled, for the ledger only: the reflected
+                # ray of the entry, the transmitted ray of an internal event; both leave
+                # into the air with Smith G1 of their direction
+                entry = on_top & ~below
+                up_ = on_top & below
+                other = np.where(entry, 1.0, 0.0), np.where(up_, 1.0, 0.0)
+                w_o = (refl[0] * other[0] + tr[0] * other[1]) * M[0, 0] + (
+                    refl[1] * other[0] + tr[1] * other[1]
+                ) * M[1, 0]
+                kt_ = eta * k + (eta * cos_i - cos_t) * m
+                k_o = np.where(entry, kr, kt_)
+                k_o = k_o / np.sqrt((k_o * k_o).sum(axis=0))
+                g = np.where(
+                    entry | up_,
+                    su.g1_of(k_o, k_o[2], np.zeros_like(on_top), np.full(m_, su.alpha_top)),
+                    0.0,
+                )
+                booked += float((w_o * g).sum())
+                terminated += float((w_o * (1.0 - g)).sum())
+                m00 = m00 - w_o
             apply_fresnel(
                 M,
                 refl[0] * wr + tr[0] * wt,
@@ -324,6 +427,8 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
                 refl[2] * wr + tr[2] * wt,
                 refl[3] * wr + tr[3] * wt,
             )
+            if su.scalar:
+                M[1:] = 0.0
             if trans.any():
                 kt = eta * k + (eta * cos_i - cos_t) * m
                 knew = np.where(trans, kt, kr)
@@ -333,6 +438,8 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
         s = s_loc
         absorbed += float((m00 - M[0, 0]).sum())
         bounces += 1
+        if kill_all:
+            break
         fresh[:] = False
         if trans is not None and trans.any():
             below = below ^ trans
@@ -366,8 +473,26 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
         if not alive.all():
             k, s, M = k[:, alive], s[:, alive], M[:, :, alive]
             iface, below, h = iface[alive], below[alive], h[alive]
-            fresh, bounces = fresh[alive], bounces[alive]
+            fresh, bounces, rid = fresh[alive], bounces[alive], rid[alive]
 
+    cell_keys = cell_sums = batch_rays = None
+    if su.evaluated:
+        batch_rays = np.bincount(
+            (cfg.block_rays * block + np.arange(n)) % cfg.batches, minlength=cfg.batches
+        ).astype(np.int64)
+        if dep_key:
+            key = np.concatenate(dep_key)
+            rows_d = np.concatenate(dep_rows, axis=1)
+            nkeys = cfg.batches * grid.n_bins
+            cnt = np.bincount(key, minlength=nkeys)
+            cell_keys = np.flatnonzero(cnt)
+            dense = np.empty((16, nkeys))
+            for e in range(16):
+                dense[e] = np.bincount(key, weights=rows_d[e], minlength=nkeys)
+            cell_sums = dense[:, cell_keys].T.copy()
+        else:
+            cell_keys = np.zeros(0, dtype=np.int64)
+            cell_sums = np.zeros((0, 16))
     # binning of the exits, in the LB exit frames phi_hat(phi)
     if ex_k:
         ke = np.concatenate(ex_k, axis=1)
@@ -390,12 +515,55 @@ def trace_block(cfg: TraceConfig, block: int) -> BlockTally:
         sums=sums,
         sumsq=sumsq,
         counts=counts,
-        exited=float(hemi[0]),
+        exited=float(hemi[0]) + booked,
         absorbed=absorbed,
         terminated=terminated,
         hemi=hemi,
         events=events,
+        cell_keys=cell_keys,
+        cell_sums=cell_sums,
+        batch_rays=batch_rays,
     )
+
+
+def _scalar(abcs: tuple) -> tuple:
+    """Scalar mode: the unpolarized reflectance A alone, B = C = S = 0.
+
+    With the rows 1-3 of M zeroed after each vertex the ray then carries only S0, weighted
+    by ``(|r_s|^2 + |r_p|^2) / 2`` (or the transmittance) at every vertex, which is what
+    a scalar (unpolarized) code computes.
+    """
+    z = np.zeros_like(abcs[0])
+    return abcs[0], z, z, z
+
+
+def _deposit(
+    grid: Grid,
+    batches: int,
+    k: NDArray[np.float64],
+    s: NDArray[np.float64],
+    M: NDArray[np.float64],
+    sel: NDArray[np.bool_],
+    rid: NDArray[np.int64],
+    keys: list[NDArray],
+    rows: list[NDArray],
+    raw: list[tuple[NDArray, NDArray, NDArray]] | None = None,
+) -> None:
+    """Record the selected up-going rays just below the top interface.
+
+    Each ray's Mueller matrix is expressed in the meridional frame ``phi_hat(phi_u)`` of
+    its direction (the frame call of the exit binning) and keyed by its batch
+    (global ray index modulo ``batches``) and its direction cell.
+    """
+    ks = k[:, sel]
+    Mc = M[:, :, sel].copy()
+    idx, phi = grid.index(ks)
+    s_det = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+    rotate_frame(Mc, ks, s[:, sel], s_det)
+    keys.append((rid[sel] % batches) * grid.n_bins + idx)
+    rows.append(Mc.reshape(16, -1))
+    if raw is not None:
+        raw.append((rid[sel], ks, Mc.reshape(16, -1)))
 
 
 @dataclass
@@ -422,6 +590,9 @@ class GroupTally:
     events: int
     block_hemi: NDArray[np.float64]  # (n, 16) per-block hemispherical sums
     block_rays: NDArray[np.int64]  # (n,)
+    cell_keys: NDArray[np.int64] | None = None  # evaluated: see BlockTally
+    cell_sums: NDArray[np.float64] | None = None
+    batch_rays: NDArray[np.int64] | None = None
 
 
 def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
@@ -437,8 +608,16 @@ def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
     events = 0
     bh = np.zeros((len(blocks), 16))
     br = np.zeros(len(blocks), dtype=np.int64)
+    ev = cfg.resolved_estimator == "evaluated"
+    cells = np.zeros((cfg.batches * nb, 16)) if ev else None
+    brays = np.zeros(cfg.batches, dtype=np.int64) if ev else None
     for i, b in enumerate(blocks):
         t = trace_block(cfg, b)
+        if cells is not None:
+            assert t.cell_keys is not None and t.cell_sums is not None
+            assert brays is not None and t.batch_rays is not None
+            cells[t.cell_keys] = cells[t.cell_keys] + t.cell_sums
+            brays = brays + t.batch_rays
         sums = sums + t.sums
         sumsq = sumsq + t.sumsq
         counts = counts + t.counts
@@ -450,6 +629,10 @@ def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
         bh[i] = t.hemi
         br[i] = t.rays
     nz = np.flatnonzero(counts)
+    ck = cs = None
+    if cells is not None:
+        ck = np.flatnonzero(np.any(cells != 0, axis=1))
+        cs = cells[ck]
     return GroupTally(
         group,
         blocks,
@@ -464,6 +647,9 @@ def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
         events,
         bh,
         br,
+        ck,
+        cs,
+        brays,
     )
 
 

@@ -15,6 +15,7 @@ import pytest
 
 from labbrdf import models
 from labbrdf.adapters import zemax_bsdf as z
+from labbrdf.bsdf_export import model_to_bsdf, write_bsdf
 from labbrdf.report.user import user_report
 
 MICRO = {"n": 1.5, "k": 0.0, "diffuse": True}
@@ -84,7 +85,7 @@ def test_real_file_energy_table(real: tuple[dict, Path]) -> None:
 def synthetic(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
     d = tmp_path_factory.mktemp("syn")
     m = models.get("microfacet", **MICRO)
-    clean = z.model_to_bsdf(
+    clean = model_to_bsdf(
         m,
         TRUTH,
         d / "clean.bsdf",
@@ -95,7 +96,7 @@ def synthetic(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
     t = z.read_table(clean)
     rng = np.random.default_rng(1)
     noisy = t.values * np.exp(NOISE * rng.standard_normal(t.values.shape))
-    path = z.write_bsdf(
+    path = write_bsdf(
         d / "micro.bsdf",
         theta_i_deg=t.theta_i_deg,
         radial_deg=t.radial_deg,
@@ -196,7 +197,7 @@ def test_energy_check_fails_for_a_model_above_one(tmp_path: Path) -> None:
     p = {"alpha": 0.3, "scale": 30.0, "kd": 0.5}
     rho = float(integrate_rho(m, p, 30.0))
     assert rho > 1.0
-    path = z.model_to_bsdf(
+    path = model_to_bsdf(
         m,
         p,
         tmp_path / "bright.bsdf",

@@ -173,6 +173,7 @@ def _rough_run(alpha: float, theta: float):
         substrate=Substrate(n=1.55, k=7.71, alpha=alpha),
         scattering="single",
         seed=7,
+        estimator="counting",
     )
     return trace(cfg)
 
@@ -230,6 +231,7 @@ def test_single_scattering_albedo_matches_quadrature(oracles, material, alpha):
             scattering="single",
             theta_step_deg=10.0,
             phi_step_deg=10.0,
+            estimator="counting",
         )
         res = trace(cfg)
         for s_in, col in (

@@ -77,3 +77,13 @@ def test_claims_are_evaluated_with_evidence(studies):
 def test_claims_refuse_maps_without_enough_rays(studies):
     with pytest.raises(ValueError, match="no bin has min_count=10000000 exiting rays"):
         evaluate_claims(studies[:1], min_count=10_000_000)
+
+
+def test_claims_can_be_judged_on_evaluated_single_scattering_maps():
+    """The evaluated estimator counts no rays: its bins are judged by S0 > 0 and their
+    batch errors, so every study yields its statistics instead of 'no bin has rays'."""
+    runs = factor_studies(rays=3000, seed=3, step=10.0, scattering="single")
+    assert all(r.estimator == "evaluated" for _, _, r in runs)
+    claims = evaluate_claims(runs)
+    assert claims
+    json.dumps(claims)  # JSON-safe like the counting claims

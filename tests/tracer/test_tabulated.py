@@ -158,6 +158,7 @@ def test_ggx_table_reproduces_the_ggx_tracer(scattering, theta, coating):
         scattering=scattering,
         substrate=Substrate(alpha=alpha),
         coating=coating,
+        estimator="counting",
         theta_step_deg=5.0,
         phi_step_deg=10.0,
     )

@@ -173,7 +173,11 @@ def test_single_scattering_energy_below_multiple_scattering():
     # the random walk adds the inter-reflections the single-scattering model terminates
     kw = {"rays": 40_000, "theta_i_deg": 60.0, "theta_step_deg": 5.0, "phi_step_deg": 5.0}
     sub = Substrate(alpha=0.6, mirror=True)
-    single = trace(TraceConfig(substrate=sub, scattering="single", block_rays=2000, **kw))
+    single = trace(
+        TraceConfig(
+            substrate=sub, scattering="single", block_rays=2000, estimator="counting", **kw
+        )
+    )
     assert single.albedo() < 1 - K * single.albedo_stderr()
     assert single.ledger["terminated"] == pytest.approx(1 - single.albedo(), abs=1e-12)
 
@@ -188,7 +192,9 @@ def test_single_scattering_energy_below_multiple_scattering():
         TraceConfig(rays=5000, substrate=AL, scattering="multiple"),
         TraceConfig(rays=5000, substrate=AL, coating=Coating(k=0.01, thickness_nm=2000.0)),
         TraceConfig(rays=5000, coating=Coating(), termination="roulette", tau=0.05),
-        TraceConfig(rays=5000, coating=Coating(), scattering="single", tau=0.05),
+        TraceConfig(
+            rays=5000, coating=Coating(), scattering="single", tau=0.05, estimator="counting"
+        ),
         TraceConfig(rays=5000, coating=Coating(), max_bounces=2),
     ],
     ids=["single", "multiple", "absorbing-coat", "roulette", "coat-single", "max-bounces"],
@@ -298,6 +304,7 @@ def test_s0_reciprocity_between_swapped_directions(substrate, coating, scatterin
         "scattering": scattering,
         "theta_step_deg": 3.0,
         "phi_step_deg": 3.0,
+        "estimator": "counting",
     }
     ra = trace(TraceConfig(theta_i_deg=30.0, **kw))
     rb = trace(TraceConfig(theta_i_deg=54.0, seed=1, **kw))

@@ -13,6 +13,7 @@ module                    section id(s)
 :mod:`.ingest`            ``ingest``
 :mod:`.measured`          ``measured``
 :mod:`.nk`                ``nk``
+:mod:`.film`              ``film`` (user: a stack fitted to angle-dependent psi/Delta)
 :mod:`.fits`              ``fits``
 :mod:`.scans`             ``scans``
 :mod:`.spectra`           ``spectra``

@@ -99,11 +99,22 @@ def _pseudo_figure(points: pd.DataFrame) -> str:
 
 
 def _at(c: pd.DataFrame, wl: float) -> dict[str, float | None]:
+    """Combined n, k at the wavelength nearest ``wl`` (None where the angles disagree)."""
     if c.empty:
         return {"n": None, "k": None}
     i = int(np.argmin(np.abs(c["wavelength_nm"].to_numpy(float) - wl)))
     r = c.iloc[i]
-    return {"wl": float(r["wavelength_nm"]), "n": float(r["n"]), "k": float(r["k"])}
+    n, k = float(r["n"]), float(r["k"])
+    return {
+        "wl": float(r["wavelength_nm"]),
+        "n": n if np.isfinite(n) else None,
+        "k": k if np.isfinite(k) else None,
+    }
+
+
+def _combined_ok(c: pd.DataFrame) -> np.ndarray:
+    """Rows of a combined table with one n, k (the angles agree, or a single angle)."""
+    return np.isfinite(c["n"].to_numpy(float)) & np.isfinite(c["k"].to_numpy(float))
 
 
 def _compare(
@@ -229,14 +240,29 @@ def _r0_figure(ctx: Context, i: int, src: str, comb: pd.DataFrame) -> None:
     """The predicted normal-incidence Fresnel reflectance from the combined n, k."""
     b = ctx.b
     first = _members(comb)[0][1]
-    r = ell.fresnel_reflectances(
-        np.maximum(first["n"].to_numpy(float), 0.0),
-        np.maximum(first["k"].to_numpy(float), 0.0),
-        np.zeros(len(first)),
-        n_sigma=first["n_sigma"].to_numpy(float),
-        k_sigma=first["k_sigma"].to_numpy(float),
-        nk_cov=first["nk_cov"].to_numpy(float),
+    ok = _combined_ok(first)
+    if not ok.any():
+        b.note(
+            "no reflectance prediction",
+            f"{src}: the angles of incidence disagree at every wavelength; pseudo-constants "
+            "of a stack predict no reflectance of the sample.",
+        )
+        return
+    r_ok = ell.fresnel_reflectances(
+        np.maximum(first["n"].to_numpy(float)[ok], 0.0),
+        np.maximum(first["k"].to_numpy(float)[ok], 0.0),
+        np.zeros(int(ok.sum())),
+        n_sigma=first["n_sigma"].to_numpy(float)[ok],
+        k_sigma=first["k_sigma"].to_numpy(float)[ok],
+        nk_cov=first["nk_cov"].to_numpy(float)[ok],
     )
+
+    def full(v: np.ndarray) -> np.ndarray:  # NaN (a gap) where the angles disagree
+        out = np.full(len(first), np.nan)
+        out[ok] = v
+        return out
+
+    rs, rp, rm, rm_sigma = (full(v) for v in (r_ok.rs, r_ok.rp, r_ok.r, r_ok.r_sigma))
     x = first["wavelength_nm"].to_numpy(float)
     b.figure(
         f"nk_{i}_{slug(src)}_r0",
@@ -251,9 +277,9 @@ def _r0_figure(ctx: Context, i: int, src: str, comb: pd.DataFrame) -> None:
                     "xlabel": "wavelength [nm]",
                     "ylabel": "R [1]",
                     "series": [
-                        {"label": "R_s", "x": x, "y": r.rs},
-                        {"label": "R_p", "x": x, "y": r.rp},
-                        {"label": "(R_s + R_p)/2", "x": x, "y": r.r, "band": r.r_sigma},
+                        {"label": "R_s", "x": x, "y": rs},
+                        {"label": "R_p", "x": x, "y": rp},
+                        {"label": "(R_s + R_p)/2", "x": x, "y": rm, "band": rm_sigma},
                     ],
                 }
             ],
@@ -295,7 +321,10 @@ def nk_section(ctx: Context) -> None:
         "(inverse-covariance weighted mean where the file gives sigmas). The consistency "
         "of the angles is a chi-square test (p-value); a bulk, clean, isotropic material "
         "gives the same n, k at every angle, while a film or roughness makes the pseudo "
-        "constants depend on the angle."
+        "constants depend on the angle. Where the angles disagree the values are "
+        "pseudo-constants of a stack, not a material's n, k: they are not combined into one "
+        "value, and no reflectance is predicted from them (a fitted stack model does that: "
+        "section film, with --film-model)."
     )
     summary: list[dict[str, Any]] = []
     cmp_rows: list[dict[str, Any]] = []
@@ -319,35 +348,8 @@ def nk_section(ctx: Context) -> None:
         chi = comb.loc[tested, "chi2"].to_numpy(float) / np.maximum(dof[tested], 1)
         a500 = _at(comb, 500.0)
         n_ang = int(pts["theta_i_deg"].round(2).nunique())
-        if not tested.any():
-            verdict = (
-                "one angle of incidence per wavelength"
-                if int(comb["n_angles"].max()) < 2
-                else f"{int(comb['n_angles'].max())} angles per wavelength and no sigmas in the "
-                "file: too few for the scatter test"
-            ) + ": the angle-to-angle consistency cannot be tested"
-            short = "not testable"
-        else:
-            # fraction of wavelengths flagged by chance alone: alpha, binomial 3-sigma margin
-            a = ell.P_ANGLE_DEPENDENT
-            chance = a + 3.0 * np.sqrt(a * (1.0 - a) / int(tested.sum()))
-            frac = frac_dep or 0.0
-            said = (
-                f"the angles disagree (p < {a:g}) at {100 * frac:.0f}% of the "
-                f"{int(tested.sum())} wavelengths, {100 * a:g}% expected by chance"
-            )
-            if frac > 0.5:
-                verdict = said + ": angle-dependent, a film or roughness, not a bulk material"
-                short = "angle-dependent: film or roughness"
-            elif frac > chance:
-                verdict = (
-                    said + ": angle-dependent over part of the spectrum (a film or roughness, "
-                    "not a bulk material, there); elsewhere consistent with a bulk material"
-                )
-                short = "partly angle-dependent"
-            else:
-                verdict = said + ": consistent with a bulk material"
-                short = "consistent with bulk"
+        av = nkmod.angle_verdict(comb)
+        verdict, short = av.text, av.short
         b.text(
             f"{len(pts)} psi/Delta pairs at {n_ang} angle(s), {len(comb)} combined "
             f"(wavelength{', series member' if len(_members(comb)) > 1 else ''}) rows. "
@@ -365,15 +367,25 @@ def nk_section(ctx: Context) -> None:
                 else ""
             )
         )
-        b.figure(
-            f"nk_{tag}_combined",
-            f"{src}: combined optical constants n and k",
-            "Derived from measured psi/Delta: n [1] and k [1] against wavelength [nm], "
-            "combined over the angles of incidence; band = 1-sigma (propagated from the "
-            "file's sigmas, or the angle-to-angle scatter where that is larger or sigmas are "
-            "missing).",
-            _nk_figure(src, comb),
-        )
+        any_ok = bool(_combined_ok(comb).any())
+        stack_like = not any_ok or av.kind == "stack"
+        if stack_like:
+            b.text(
+                f"The values of {src} are pseudo-constants of a stack, one per angle of "
+                "incidence (figure below), not a material's optical constants: they are not "
+                "combined where the angles disagree, and give no reflectance prediction."
+            )
+        if any_ok:
+            b.figure(
+                f"nk_{tag}_combined",
+                f"{src}: combined optical constants n and k",
+                "Derived from measured psi/Delta: n [1] and k [1] against wavelength [nm], "
+                "combined over the angles of incidence; band = 1-sigma (propagated from the "
+                "file's sigmas, or the angle-to-angle scatter where that is larger or sigmas "
+                "are missing), times sqrt(chi2/dof) where the angles disagree.",
+                _nk_figure(src, comb),
+                details=stack_like,
+            )
         cols = [k for k in _SERIES if k in comb.columns]
         b.table(
             f"nk_{tag}",
@@ -393,7 +405,9 @@ def nk_section(ctx: Context) -> None:
             ],
             comb.to_dict("records"),
             caption="n, k combined over the angles of incidence; chi2/dof and p test their "
-            f"agreement; angle-dependent = p < {ell.P_ANGLE_DEPENDENT:g}.",
+            f"agreement; angle-dependent = p < {ell.P_ANGLE_DEPENDENT:g} (sigmas times "
+            "sqrt(chi2/dof) there; no n, k at all for a sample whose angles disagree at most "
+            "wavelengths: pseudo-constants of a stack).",
             details=True,
         )
         b.figure(
@@ -403,9 +417,10 @@ def nk_section(ctx: Context) -> None:
             "pseudo n and k [1] against wavelength [nm] with propagated 1-sigma error bars. "
             "Lines that do not overlap mean the sample is not a bare bulk material.",
             _pseudo_figure(pts),
-            details=True,
+            details=not stack_like,
         )
-        nk_ok = ~comb["angle_dependent"].to_numpy(bool) & tested
+        nk_ok = comb["combined"].to_numpy(bool) & ~comb["angle_dependent"].to_numpy(bool)
+        nk_ok &= tested
         if nk_ok.any():
             c_ok = comb[nk_ok]
             neg = c_ok["k"].to_numpy(float) < -3 * np.nan_to_num(c_ok["k_sigma"].to_numpy(float))
@@ -423,8 +438,9 @@ def nk_section(ctx: Context) -> None:
             b.skip(
                 f"nk.k_physical.{tag}",
                 f"{src}: k >= 0 within 3 sigma where the angles agree",
-                "no wavelength where the angles agree (or only one angle): pseudo-constants "
-                "of a layered sample need not have k >= 0",
+                "no wavelength where the angles agree (or only one angle, or they agree at "
+                "a few wavelengths by chance in a sample whose angles disagree elsewhere): "
+                "pseudo-constants of a layered sample need not have k >= 0",
             )
         summary.append(
             {

@@ -202,7 +202,20 @@ def _stat_rows(st: Any) -> list[dict[str, Any]]:
         ("c", "correlation length c = sqrt(c_major c_minor)", 1e6, "\u00b5m", areal),
         ("anisotropy_ratio", "anisotropy ratio c_major / c_minor", 1.0, "1", areal),
         ("anisotropy_angle_deg", "anisotropy angle (c_major from +x)", 1.0, "deg", areal),
-        ("alpha", "alpha = sqrt(2) sigma / c (Dong 2022)", 1.0, "1", True),
+        (
+            "alpha_gaussian_acf",
+            "alpha_gaussian_acf = sqrt(2) sigma / c (Dong 2022; not used by the tracer)",
+            1.0,
+            "1",
+            True,
+        ),
+        (
+            "alpha_ggx_ml",
+            "alpha_ggx_ml: ML GGX alpha of the slopes (the tracer's)",
+            1.0,
+            "1",
+            True,
+        ),
         ("height_skewness", "height skewness", 1.0, "1", True),
         ("height_kurtosis", "height kurtosis (3 = Gaussian)", 1.0, "1", True),
     ]
@@ -328,6 +341,7 @@ def surface_section(ctx: Context) -> None:
             ],
             _stat_rows(st),
             caption=f"{st.n_valid} valid points, {st.n_blocks} jackknife blocks. "
+            f"Bandwidth of every slope and alpha: {st.bandwidth}. "
             "Undefined values are blank (e.g. c when the ACF does not fall below 1/e "
             "within half the map).",
         )
@@ -349,6 +363,13 @@ def surface_section(ctx: Context) -> None:
             "one is the better description; the KS distance says whether it describes "
             "the slopes at all.",
         )
+        for w in hm.warnings:
+            b.note("geometry", w)
+        for text in st.notes:
+            if text != st.slope_fits.warning and not text.startswith(
+                ("profile:", "the ACF does not")
+            ):
+                b.note("note", text)
         if st.slope_fits.warning:
             b.note("warning", st.slope_fits.warning)
         if not math.isfinite(st.c):
@@ -359,10 +380,11 @@ def surface_section(ctx: Context) -> None:
                 "after levelling), so alpha = sqrt(2) sigma / c is undefined too",
             )
         per_axis = st.slope_rms_x if hm.is_profile else st.slope_rms / math.sqrt(2)
-        if math.isfinite(st.alpha) and not 2 / 3 <= st.alpha / per_axis <= 1.5:
+        a_acf = st.alpha_gaussian_acf
+        if math.isfinite(a_acf) and not 2 / 3 <= a_acf / per_axis <= 1.5:
             b.note(
                 "alpha",
-                f"sqrt(2) sigma / c = {st.alpha:.3g} differs from the measured RMS slope per "
+                f"sqrt(2) sigma / c = {a_acf:.3g} differs from the measured RMS slope per "
                 f"axis ({per_axis:.3g}): the two agree only for a Gaussian ACF sampled finely "
                 "enough. Here the slopes come from roughness on scales much shorter than c "
                 "(or the ACF is not Gaussian), so the ML alphas of the measured slopes, not "

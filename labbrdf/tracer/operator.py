@@ -1,0 +1,253 @@
+"""The exit through a rough top interface as a linear operator on internal up-going cells.
+
+The weighted walk of ``estimator="evaluated"`` records, just below the top interface,
+every up-going ray's Mueller matrix in the meridional frame ``phi_hat(phi_u)`` of its
+direction, summed in cells of the exit grid (polar cells 0..90 deg, the same azimuth
+cells). The exit BRDF is then
+
+    f(bin o) = (1 / N) sum_cells T10(o, u) W(u),
+
+``T10(o, u)`` the cos-weighted bin average of the closed-form BTDF
+(:func:`.evaluate.transmission_mueller`) from the cell's centroid direction. The interface
+is statistically isotropic, so in meridional frames ``T10`` depends on the polar bin, the
+polar cell and the azimuth difference only: the azimuth sum is a circular convolution,
+done with real FFTs. Mirror symmetry about the plane of incidence gives
+``T10(-dphi) = P T10(dphi) P``, ``P = diag(1, 1, -1, -1)``, so only ``dphi`` in [0, 180]
+deg is evaluated.
+
+Storage: the spectrum in complex64 (float32 parts), shape (n_freq, 4 n_theta, 4 n_cells):
+91 x 91 x 181 x 16 x 8 bytes = 192 MB for the 1-degree grid. The cell discretisation
+(each ray treated as if it left from its cell's centroid) is the operator's only
+approximation; its bias is of order (cell width / lobe width)^2 / 24 (docs/tracer.md).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .binning import Grid
+from .evaluate import bin_nodes, cell_centroids, transmission_mueller
+from .interfaces import fresnel_abcs
+from .sampling import ggx_d, smith_g1
+
+__all__ = ["ExitOperator", "build_exit_operator", "cache_dir", "exit_operator"]
+
+# part of the cache key: bump when the operator's definition changes
+VERSION = 1
+
+PARITY = np.array([1, 1, -1, -1])[:, None] * np.array([1, 1, -1, -1])[None, :]
+
+
+@dataclass(frozen=True)
+class ExitOperator:
+    """Spectrum of ``T10`` over the azimuth difference, complex64.
+
+    Attributes
+    ----------
+    spectrum : ndarray, shape (n_phi // 2 + 1, 4 n_theta, 4 n_cells), complex64
+        ``rfft`` over ``dphi`` of ``T10[o_theta, i, u_theta, k, dphi]`` [sr^-1].
+    n_theta, n_phi : int
+        Grid size (bins and cells share it).
+    seconds : float
+        Build time [s].
+    """
+
+    spectrum: NDArray[np.complex64]
+    n_theta: int
+    n_phi: int
+    seconds: float
+
+    @property
+    def nbytes(self) -> int:
+        """Size of the stored spectrum [bytes]."""
+        return int(self.spectrum.nbytes)
+
+    def apply(self, cells: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Exit BRDF sums of up-going cell sums.
+
+        Parameters
+        ----------
+        cells : ndarray, shape (B, n_theta, n_phi, 4, 4)
+            Summed Mueller weights of the rays reaching the interface from below, per
+            batch and cell, in the cells' meridional frames.
+
+        Returns
+        -------
+        ndarray, shape (B, n_theta, n_phi, 4, 4)
+            ``sum_cells T10 W`` per bin [sr^-1 x rays]; divide by the rays.
+        """
+        b, nt, npf = cells.shape[0], self.n_theta, self.n_phi
+        used = np.flatnonzero(np.any(cells != 0, axis=(0, 2, 3, 4)))
+        out = np.zeros((b, nt, npf, 4, 4))
+        if used.size == 0:
+            return out
+        if used.size > 0.7 * nt:  # a column copy would cost more than it saves
+            used = np.arange(nt)
+        spec_in = np.fft.rfft(cells[:, used], axis=2)  # (B, u, F, 4, 4)
+        nf = spec_in.shape[2]
+        # (F, 4u, 4B): rows (u, k), columns (b, j)
+        x = spec_in.transpose(2, 1, 3, 0, 4).reshape(nf, used.size * 4, b * 4)
+        if used.size == nt:
+            op = self.spectrum
+        else:
+            cols = (used[:, None] * 4 + np.arange(4)[None, :]).ravel()
+            op = self.spectrum[:, :, cols]
+        y = np.matmul(op, x.astype(np.complex64))  # (F, 4 nt, 4B)
+        y = y.reshape(nf, nt, 4, b, 4).transpose(3, 1, 0, 2, 4)  # (B, nt, F, 4, 4)
+        out[...] = np.fft.irfft(y.astype(np.complex128), n=npf, axis=2)
+        return out
+
+
+def build_exit_operator(
+    grid: Grid,
+    n_below: float,
+    alpha: float,
+    *,
+    n_above: float = 1.0,
+    nodes: tuple[int, int] = (1, 1),
+) -> ExitOperator:
+    """Build ``T10`` for a GGX interface from a dielectric ``n_below`` into ``n_above``.
+
+    Parameters
+    ----------
+    grid : Grid
+        Exit grid (also the grid of the internal cells).
+    n_below, n_above : float
+        Real indices below (the coating) and above [1].
+    alpha : float
+        GGX roughness of the interface [1], > 0.
+    nodes : (int, int)
+        Gauss-Legendre nodes per output bin in sin^2 theta and phi.
+
+    Returns
+    -------
+    ExitOperator
+    """
+    if not alpha > 0:
+        raise ValueError(f"the exit operator needs a rough interface, got alpha={alpha!r}")
+    t0 = time.perf_counter()
+    nt, npf = grid.n_theta, grid.n_phi
+    half = npf // 2 + 1
+    theta_o, dphi_o, w = bin_nodes(grid, *nodes)
+    theta_u = cell_centroids(grid)
+    step = np.radians(grid.phi_step_deg)
+    ni, nj = w.shape[1:]
+
+    def abcs_t(c: NDArray[np.float64]) -> tuple:
+        return fresnel_abcs(n_below, n_above, c)[1]
+
+    def d_of(m: NDArray[np.float64]) -> NDArray[np.float64]:
+        return ggx_d(m[2], alpha)
+
+    def g1_of(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        return smith_g1(v[2], alpha)
+
+    # per output row: every (node, cell row, azimuth difference in [0, 180] deg) point
+    grids = np.meshgrid(np.arange(ni * nj), np.arange(nt), np.arange(half), indexing="ij")
+    a, iu, dj = (g.ravel() for g in grids)
+    ai, aj = a // nj, a % nj
+    flat = iu * half + dj
+    tu = theta_u[iu]
+    ku = np.stack([np.sin(tu), np.zeros_like(tu), np.cos(tu)])
+    ph = dj * step + dphi_o[aj]
+    rest = np.arange(half, npf)
+    spec = np.empty((half, nt * 4, nt * 4), dtype=np.complex64)
+    for io in range(nt):
+        th = theta_o[io, ai]
+        wo = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)])
+        M = transmission_mueller(ku, wo, n_below, n_above, abcs_t, d_of, g1_of)
+        rows = M.reshape(16, -1) * w[io, ai, aj]
+        T = np.empty((16, nt * half))
+        for e in range(16):
+            T[e] = np.bincount(flat, weights=rows[e], minlength=nt * half)
+        T4 = T.reshape(4, 4, nt, half)
+        # full circle from the half: T(-dphi) = P T(dphi) P
+        full = np.empty((4, 4, nt, npf))
+        full[..., :half] = T4
+        full[..., half:] = T4[..., npf - rest] * PARITY[:, :, None, None]
+        sp = np.fft.rfft(full, axis=-1)  # (i, k, u, F)
+        spec[:, io * 4 : io * 4 + 4, :] = sp.transpose(3, 0, 2, 1).reshape(half, 4, nt * 4)
+    return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
+
+
+def cache_dir() -> Path:
+    """The user's cache folder for operators: ``$XDG_CACHE_HOME/labbrdf/tracer``.
+
+    ``~/.cache`` when ``XDG_CACHE_HOME`` is unset; never the working folder.
+    """
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "labbrdf" / "tracer"
+
+
+def _key(grid: Grid, n_below: float, alpha: float, n_above: float, nodes: tuple) -> str:
+    spec = {
+        "version": VERSION,
+        "theta_step_deg": float(grid.theta_step_deg),
+        "phi_step_deg": float(grid.phi_step_deg),
+        "n_below": float(n_below),
+        "n_above": float(n_above),
+        "alpha": float(alpha),
+        "nodes": [int(v) for v in nodes],
+        "distribution": "ggx",
+    }
+    return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
+
+
+def exit_operator(
+    grid: Grid,
+    n_below: float,
+    alpha: float,
+    *,
+    n_above: float = 1.0,
+    nodes: tuple[int, int] = (1, 1),
+    cache: bool = True,
+) -> ExitOperator:
+    """:func:`build_exit_operator`, cached under :func:`cache_dir`.
+
+    The file name is a hash of everything the operator depends on (grid, indices, alpha,
+    quadrature, format version). A file is written to a temporary name in the cache folder
+    and renamed into place (atomic on POSIX), so concurrent runs and interrupted writes
+    never leave a half-written operator under the final name; an unreadable or
+    mismatched file is rebuilt. A cache folder that cannot be written only costs the
+    rebuild next time.
+    """
+    if not cache:
+        return build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes)
+    path = cache_dir() / f"exit-{_key(grid, n_below, alpha, n_above, nodes)}.npy"
+    nt, npf = grid.n_theta, grid.n_phi
+    shape = (npf // 2 + 1, 4 * nt, 4 * nt)
+    t0 = time.perf_counter()
+    try:
+        # memory-mapped first: the header's shape is checked before anything is read
+        mm = np.load(path, allow_pickle=False, mmap_mode="r")
+        if mm.shape == shape and mm.dtype == np.complex64:
+            spec = np.array(mm)
+            del mm
+            return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
+    except (OSError, ValueError, EOFError):
+        pass
+    op = build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".exit-", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                np.save(fh, op.spectrum, allow_pickle=False)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+    except OSError:
+        pass
+    return op
