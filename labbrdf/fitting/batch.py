@@ -43,6 +43,57 @@ def _fit_chunk(
     return out
 
 
+def _groups(
+    d: pd.DataFrame, by: list[str], qty: str, unt: str
+) -> tuple[list[tuple[Any, ...]], list[FitData | str]]:
+    """The key of every group of ``d`` by ``by`` (sorted, NaN last), and its FitData.
+
+    A group that holds several samples or wavelengths (columns not in ``by``) gets the
+    reason it is not fitted instead of a FitData.
+    """
+    arrays = {
+        c: d[c].to_numpy()
+        for c in ("theta_i_deg", "theta_r_deg", "value", "sigma", "phi_r_deg", "wavelength_nm")
+        if c in d.columns
+    }
+    codes = {
+        k: pd.factorize(d[k], use_na_sentinel=False)[0]
+        for k in ("sample", "wavelength_nm")
+        if k in d.columns and k not in by
+    }
+    keys: list[tuple[Any, ...]] = []
+    groups: list[FitData | str] = []
+    for key, idx in sorted(
+        d.groupby(by, sort=True, dropna=False).indices.items(), key=lambda kv: _sort_key(kv[0])
+    ):
+        keys.append(key if isinstance(key, tuple) else (key,))
+        several = [(k, np.unique(c[idx]).size) for k, c in codes.items()]
+        several = [(k, m) for k, m in several if m > 1]
+        groups.append(
+            several_groups_message(*several[0])
+            if several
+            else FitData.from_arrays(arrays, idx, qty, unt)
+        )
+    return keys, groups
+
+
+def _row(row: dict[str, Any], s: dict[str, Any], param_names: list[str]) -> dict[str, Any]:
+    """One table row: the group keys ``row`` and the columns of a fit summary ``s``."""
+    for name in param_names:
+        ps = (s.get("params") or {}).get(name) or {}
+        ci = ps.get("ci95") or [None, None]
+        row[name] = ps.get("value", np.nan)
+        row[f"{name}_stderr"] = ps.get("stderr")
+        row[f"{name}_ci95_lo"], row[f"{name}_ci95_hi"] = ci
+        row[f"{name}_flags"] = ";".join(ps.get("flags", []))
+    for col in ("rmse", "rmse_pct", "chisqr", "redchi", "ndata", "nfev"):
+        row[col] = s.get(col)
+    row["success"] = bool(s.get("success", False))
+    row["message"] = s.get("message", "")
+    row["elapsed_s"] = s.get("elapsed_s")
+    return row
+
+
 def _param_names(todo: list[tuple[int, Model, FitData]]) -> list[str]:
     """The parameter names of the groups' models, in first-seen order."""
     names: dict[str, None] = {}
@@ -138,29 +189,7 @@ def fit_many(
     if isinstance(model, Model):
         setup_params(model, fit_kw.get("params"), fit_kw.get("fix"))  # fail early on names
     d, qty, unt = select_rows(data, fit_kw.pop("quantity", None), fit_kw.pop("unit", None))
-    arrays = {
-        c: d[c].to_numpy()
-        for c in ("theta_i_deg", "theta_r_deg", "value", "sigma", "phi_r_deg", "wavelength_nm")
-        if c in d.columns
-    }
-    codes = {
-        k: pd.factorize(d[k], use_na_sentinel=False)[0]
-        for k in ("sample", "wavelength_nm")
-        if k in d.columns and k not in by
-    }
-    keys: list[tuple[Any, ...]] = []
-    groups: list[FitData | str] = []
-    for key, idx in sorted(
-        d.groupby(by, sort=True, dropna=False).indices.items(), key=lambda kv: _sort_key(kv[0])
-    ):
-        keys.append(key if isinstance(key, tuple) else (key,))
-        several = [(k, np.unique(c[idx]).size) for k, c in codes.items()]
-        several = [(k, m) for k, m in several if m > 1]
-        groups.append(
-            several_groups_message(*several[0])
-            if several
-            else FitData.from_arrays(arrays, idx, qty, unt)
-        )
+    keys, groups = _groups(d, by, qty, unt)
     kw = dict(fit_kw, method=method, seed=seed)
     todo: list[tuple[int, Model, FitData]] = []
     for i, g in enumerate(groups):
@@ -188,21 +217,8 @@ def fit_many(
         row: dict[str, Any] = {b: _plain(v) for b, v in zip(by, key, strict=True)}
         if i in fitted:
             results.append((dict(row), fitted[i]))
-        g = groups[i]
-        s = summaries.get(i) or {"success": False, "message": f"not fitted: {g}"}
-        for name in param_names:
-            ps = (s.get("params") or {}).get(name) or {}
-            ci = ps.get("ci95") or [None, None]
-            row[name] = ps.get("value", np.nan)
-            row[f"{name}_stderr"] = ps.get("stderr")
-            row[f"{name}_ci95_lo"], row[f"{name}_ci95_hi"] = ci
-            row[f"{name}_flags"] = ";".join(ps.get("flags", []))
-        for col in ("rmse", "rmse_pct", "chisqr", "redchi", "ndata", "nfev"):
-            row[col] = s.get(col)
-        row["success"] = bool(s.get("success", False))
-        row["message"] = s.get("message", "")
-        row["elapsed_s"] = s.get("elapsed_s")
-        rows.append(row)
+        s = summaries.get(i) or {"success": False, "message": f"not fitted: {groups[i]}"}
+        rows.append(_row(row, s, param_names))
     out = pd.DataFrame(rows)
     num = [c for c in out.columns if c.endswith(("_stderr", "_ci95_lo", "_ci95_hi"))]
     num += ["rmse", "rmse_pct", "chisqr", "redchi", "elapsed_s"] + param_names
