@@ -9,8 +9,8 @@ so that ``import labbrdf`` stays cheap, and ``dir(labbrdf)`` lists them all:
   psi/Delta with propagated sigmas)
 - models and fits: :mod:`models` (:func:`labbrdf.models.get`), :func:`fit`,
   :func:`fit_many`, :class:`FitResult`, :func:`hemispherical_reflectance`
-- films: :class:`Stack`, :class:`Layer`, :func:`fit_film` (thin-film stacks fitted to
-  psi/Delta and reflectance)
+- films: :class:`Stack`, :class:`Layer`, :func:`fit_film`, :class:`FilmFit` (thin-film
+  stacks fitted to psi/Delta and reflectance)
 - roughness: :func:`read_height_map`, :func:`roughness_statistics`
 - the tracer: :func:`trace`, :class:`TraceConfig`, :class:`Substrate`, :class:`Coating`,
   :class:`TraceResult`
@@ -45,6 +45,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "Stack": ("labbrdf.films", "Stack"),
     "Layer": ("labbrdf.films", "Layer"),
     "fit_film": ("labbrdf.films", "fit_film"),
+    "FilmFit": ("labbrdf.fitting.film", "FilmFit"),
     "read_height_map": ("labbrdf.adapters.topography", "read_height_map"),
     "roughness_statistics": ("labbrdf.topography", "roughness_statistics"),
     "trace": ("labbrdf.tracer", "trace"),
@@ -123,6 +124,7 @@ if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__
     from .errors import LabbrdfError
     from .films import Layer, Stack, fit_film
     from .fitting import FitError, FitResult, fit, fit_many
+    from .fitting.film import FilmFit
     from .integrate import hemispherical_reflectance
     from .models import ModelError
     from .nk import combined_table, nk_table

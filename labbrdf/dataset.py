@@ -223,6 +223,39 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
     Copy-on-Write keeps the result independent of ``df``; without it, on pandas 2, the
     table is copied as before). Every check runs on every row.
     """
+    _check_columns(df)
+    idx = df.index
+    fresh = isinstance(idx, pd.RangeIndex) and idx.start == 0 and idx.step == 1
+    out = df if fresh else df.reset_index(drop=True)
+    cols = list(COLUMNS) + [c for c in OPTIONAL_COLUMNS if c in out.columns]
+    out = out[cols]
+    if not _copy_on_write():  # pragma: no cover - pandas 2 without Copy-on-Write
+        out = out.copy()
+
+    unit_col = out["unit"]  # before the conversion below: factorizes fast if categorical
+    _check_strings(out)
+    floats = [c for c, t in {**COLUMNS, **OPTIONAL_COLUMNS}.items() if t == "float64"]
+    for name in floats:
+        if name not in out.columns or out[name].dtype == np.float64:
+            continue
+        try:
+            out[name] = pd.to_numeric(out[name], errors="raise").astype("float64")
+        except (TypeError, ValueError) as exc:
+            raise DatasetError(f"column {name!r}: expected numbers ({exc})") from None
+    qcodes, quniq, known = _check_quantities_and_units(out, unit_col)
+    value = out["value"].to_numpy()
+    _check_ranges(out, value)
+    _check_psi_delta(value, qcodes, quniq)
+    cat_index = np.array(
+        [list(QUANTITIES).index(v) if k else -1 for v, k in zip(quniq, known, strict=True)],
+        dtype=np.int8,
+    )
+    out["quantity"] = pd.Categorical.from_codes(cat_index[qcodes], dtype=_QUANTITY_DTYPE)
+    return out
+
+
+def _check_columns(df: pd.DataFrame) -> None:
+    """Refuse anything but a non-empty DataFrame with the schema's columns, each once."""
     if not isinstance(df, pd.DataFrame):
         raise DatasetError(f"expected a pandas DataFrame, got {type(df).__name__}")
     missing = [c for c in COLUMNS if c not in df.columns]
@@ -238,15 +271,10 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
         raise DatasetError(f"duplicate column(s) {dup}; each column must appear once")
     if len(df) == 0:
         raise DatasetError("the table has no rows")
-    idx = df.index
-    fresh = isinstance(idx, pd.RangeIndex) and idx.start == 0 and idx.step == 1
-    out = df if fresh else df.reset_index(drop=True)
-    cols = list(COLUMNS) + [c for c in OPTIONAL_COLUMNS if c in out.columns]
-    out = out[cols]
-    if not _copy_on_write():  # pragma: no cover - pandas 2 without Copy-on-Write
-        out = out.copy()
 
-    unit_col = out["unit"]  # before the conversion below: factorizes fast if categorical
+
+def _check_strings(out: pd.DataFrame) -> None:
+    """Check the string columns and store them as object strings in ``out``."""
     for name in ("sample", "instrument", "source", "unit"):
         col = out[name]
         bad = _not_str(col, nonempty=True)
@@ -265,16 +293,15 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
             raise DatasetError(f"column 'channel': expected a string in {_rows(bad)}")
         out["channel"] = _as_object(col)
 
-    floats = [c for c, t in {**COLUMNS, **OPTIONAL_COLUMNS}.items() if t == "float64"]
-    for name in floats:
-        if name not in out.columns or out[name].dtype == np.float64:
-            continue
-        try:
-            out[name] = pd.to_numeric(out[name], errors="raise").astype("float64")
-        except (TypeError, ValueError) as exc:
-            raise DatasetError(f"column {name!r}: expected numbers ({exc})") from None
 
-    # quantity and unit checks work on the distinct values, not row by row
+def _check_quantities_and_units(
+    out: pd.DataFrame, unit_col: pd.Series
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Refuse an unknown quantity or a unit that does not fit its quantity.
+
+    The checks work on the distinct values, not row by row. Returns the quantity codes of
+    the rows, the distinct quantities and which of them are known.
+    """
     qcodes, quniq = _codes(out["quantity"])
     quniq = np.array([str(v) for v in quniq], dtype=object)
     known = np.isin(quniq, list(QUANTITIES))
@@ -302,8 +329,11 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
                 f"column 'unit': {unit[i]!r} does not fit quantity {q_i!r} "
                 f"(expected {QUANTITIES[q_i]}) in {_rows(bad)}"
             )
+    return qcodes, quniq, known
 
-    value = out["value"].to_numpy()
+
+def _check_ranges(out: pd.DataFrame, value: np.ndarray) -> None:
+    """Check the range of the value, sigma, wavelength, angle and zone columns."""
     if not _in_range(value, -math.inf, math.inf):
         bad = ~np.isfinite(value)
         if bad.any():
@@ -334,6 +364,10 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
         bad = np.isinf(a) | (a < 0) | (a >= 360)
         if bad.any():
             raise DatasetError(f"column 'phi_r_deg': expected [0, 360) deg or NaN in {_rows(bad)}")
+
+
+def _check_psi_delta(value: np.ndarray, qcodes: np.ndarray, quniq: np.ndarray) -> None:
+    """Psi in [0, 90] deg and Delta in [0, 360) deg (the rows are found only when needed)."""
     psi = _is_code(qcodes, quniq == "psi") if not _in_range(value, 0.0, 90.0) else None
     if psi is not None and not _in_range(value[psi], 0.0, 90.0):
         bad = psi & ((value < 0) | (value > 90))
@@ -348,12 +382,6 @@ def validate(df: pd.DataFrame) -> pd.DataFrame:
             raise DatasetError(
                 f"column 'value': delta outside [0, 360) deg (Nebraska convention) in {_rows(bad)}"
             )
-    cat_index = np.array(
-        [list(QUANTITIES).index(v) if k else -1 for v, k in zip(quniq, known, strict=True)],
-        dtype=np.int8,
-    )
-    out["quantity"] = pd.Categorical.from_codes(cat_index[qcodes], dtype=_QUANTITY_DTYPE)
-    return out
 
 
 def _not_str(col: pd.Series, *, nonempty: bool) -> np.ndarray:

@@ -1,10 +1,13 @@
-"""Pseudo-optical constants from ellipsometric psi, Delta with propagated uncertainties.
+"""The ellipsometric inversion: optical constants from psi, Delta with propagated uncertainties.
 
-Physics layer on top of :mod:`labbrdf.optics` (NumPy and SciPy only, no pandas): the
-two-phase (ambient / bulk substrate, no film) inversion of every measured point with its
-first-order covariance, a condition number that refuses the ill-conditioned near-normal
-geometry, the inverse-covariance combination of several angles of incidence with a
-chi-square consistency test, and Fresnel reflectance predictions with propagated sigma.
+Physics layer on top of :mod:`labbrdf.optics` (NumPy and SciPy only, no pandas). The optics
+core computes the forward quantities (Fresnel amplitudes, psi and Delta of a given index);
+everything that goes back from measured psi, Delta to an index lives here: the two-phase
+(ambient / bulk substrate, no film) inversion of every measured point with its first-order
+covariance, the ONE condition number of that inversion with its ONE set of thresholds
+(:data:`COND_WARN`, :data:`COND_MAX`, :class:`IllConditionedWarning`) that every caller uses,
+the inverse-covariance combination of several angles of incidence with a chi-square
+consistency test, and Fresnel reflectance predictions with propagated sigma.
 
 Conventions are those of :mod:`labbrdf.optics`: Nebraska psi, Delta (``Delta = 180 deg`` at
 normal incidence), ``N = n + ik`` with ``k >= 0``, angles in degrees at the public API.
@@ -42,6 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import stats
 
 from . import optics
+from .optics import _angle, _finite, _physical_root, _real_index
 
 __all__ = [
     "COND_MAX",
@@ -54,6 +58,7 @@ __all__ = [
     "combine_angles",
     "condition_number",
     "fresnel_reflectances",
+    "nk_from_psi_delta",
     "nk_jacobian",
     "normal_reflectance",
     "pseudo_nk",
@@ -62,29 +67,144 @@ __all__ = [
 FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
-#: Above this condition number a warning is issued: with a psi/Delta accuracy of 0.02 deg
-#: (3.5e-4 rad, a typical absolute accuracy of a rotating-element ellipsometer) the
-#: relative error of ``|N|`` reaches 1 %. Reached below about 20 deg for Si or Ta,
-#: 12 deg for glass.
+#: Above this condition number [1/rad] the inversion warns (:class:`IllConditionedWarning`):
+#: with a psi/Delta accuracy of 0.02 deg (3.5e-4 rad, a typical absolute accuracy of a
+#: rotating-element ellipsometer) the relative error of ``|N|`` reaches 1 %. Reached below
+#: about 20 deg for Si or Ta, 12 deg for glass. Justification: ``docs/ellipsometry.md``.
 COND_WARN = 30.0
-#: Above this condition number :func:`pseudo_nk` raises (by default): 0.02 deg of psi or
-#: Delta then moves ``|N|`` by more than 10 %. Reached below about 6 deg for Si or Ta,
-#: 4 deg for glass; the condition number grows as ``1/theta^2`` towards normal incidence.
-#: The same threshold at which :func:`labbrdf.optics.nk_from_psi_delta` warns.
-COND_MAX = optics.NK_COND_MAX
+#: Above this condition number [1/rad] the inversion is refused where the caller asks for
+#: ``on_ill_conditioned="raise"`` (the default of :func:`pseudo_nk`): 0.02 deg of psi or
+#: Delta then moves ``|N|`` by more than 10 %, and the index is not determined by the data.
+#: Reached below about 6 deg for Si or Ta, 4 deg for glass; the condition number grows as
+#: ``1/theta^2`` towards normal incidence.
+COND_MAX = 300.0
 #: p-value below which the pseudo-constants of several angles are flagged angle-dependent.
 P_ANGLE_DEPENDENT = 0.01
 
 OnIll = Literal["raise", "warn", "ignore"]
 
 
-#: the warning class of the optics core (one class, whichever layer warns)
-IllConditionedWarning = optics.IllConditionedWarning
+class IllConditionedWarning(UserWarning):
+    """The inversion psi, Delta -> n, k is ill-conditioned (near normal incidence)."""
 
 
 # --------------------------------------------------------------------------------------
 # inversion and its Jacobian
 # --------------------------------------------------------------------------------------
+
+
+def _on_ill(on_ill: str) -> OnIll:
+    if on_ill not in ("raise", "warn", "ignore"):
+        raise ValueError(
+            f"on_ill_conditioned: expected 'raise', 'warn' or 'ignore'; got {on_ill!r}"
+        )
+    return on_ill  # type: ignore[return-value]
+
+
+def _check_conditioning(cond: FloatArray, theta_deg: FloatArray, on_ill: OnIll) -> None:
+    """Apply the one threshold set (:data:`COND_WARN`, :data:`COND_MAX`) to ``cond``.
+
+    ``theta_deg`` broadcasts against ``cond`` (it names the angle of the worst point). A
+    non-finite condition number (``N = 0``) counts as ill-conditioned. ``stacklevel=3``:
+    the warning points at the caller of the public function that calls this.
+    """
+    if _on_ill(on_ill) == "ignore" or cond.size == 0:
+        return
+    flat = np.ravel(cond)
+    worst = int(np.argmax(np.where(np.isnan(flat), np.inf, flat)))
+    c_max = float(flat[worst])
+    t_at = float(np.ravel(np.broadcast_to(theta_deg, cond.shape))[worst])
+    if not c_max <= COND_MAX and on_ill == "raise":
+        raise ValueError(
+            f"psi/Delta inversion is ill-conditioned: condition number {c_max:.3g} > "
+            f"{COND_MAX:g} at theta_i = {t_at:.4g} deg (near normal incidence every sample "
+            "gives psi = 45, Delta = 180 deg); measure at a larger angle or pass "
+            "on_ill_conditioned='warn'"
+        )
+    if not c_max <= COND_WARN:
+        nbad = int(np.count_nonzero(~(flat <= COND_WARN)))
+        warnings.warn(
+            f"psi/Delta inversion is ill-conditioned at {nbad} point(s): condition number up "
+            f"to {c_max:.3g} (> {COND_WARN:g}) at theta_i = {t_at:.4g} deg; n, k are "
+            "sensitive to small psi/Delta errors",
+            IllConditionedWarning,
+            stacklevel=3,
+        )
+
+
+def nk_from_psi_delta(
+    psi_deg: ArrayLike,
+    delta_deg: ArrayLike,
+    theta_deg: ArrayLike,
+    n_ambient: ArrayLike = 1.0,
+    *,
+    on_ill_conditioned: OnIll = "warn",
+) -> ComplexArray:
+    """Two-phase (bare substrate) inversion of psi, Delta to ``N = n + ik``.
+
+    Parameters
+    ----------
+    psi_deg : array_like of float
+        Ellipsometric psi in [0, 90] [deg].
+    delta_deg : array_like of float
+        Ellipsometric Delta in the Nebraska convention [deg]; any finite value (taken
+        modulo 360).
+    theta_deg : array_like of float
+        Angle of incidence in the open interval (0, 90) [deg]: at 0 and 90 deg every
+        substrate gives the same (psi, Delta).
+    n_ambient : array_like of float, optional
+        Real index of the lossless ambient, > 0 [1]. Default 1.
+    on_ill_conditioned : {"warn", "raise", "ignore"}
+        The condition number (:func:`condition_number`) is checked against the one
+        threshold set: above :data:`COND_WARN` an :class:`IllConditionedWarning` names it
+        and the angle (default ``"warn"``; near normal incidence every sample gives
+        psi -> 45, Delta -> 180 deg and the index is not determined by the data);
+        ``"raise"`` also refuses points above :data:`COND_MAX` with a ``ValueError``, as
+        :func:`pseudo_nk` does by default; ``"ignore"`` checks nothing.
+
+    Returns
+    -------
+    ndarray of complex
+        The (pseudo-)index ``N = n + ik`` [1]:
+        ``N^2 = n0^2 sin^2(theta) [1 + tan^2(theta) ((1 - rho)/(1 + rho))^2]`` with the LB
+        ``rho = tan(psi) exp(-i Delta)`` (Azzam and Bashara [1]_ section 4.3;
+        docs/models.md section 3.1). Any overlayer or roughness makes it a pseudo-index.
+
+    Raises
+    ------
+    ValueError
+        For non-finite input, ``psi`` outside [0, 90], ``theta`` outside (0, 90), a
+        non-real ``n_ambient``, ``(psi, Delta) = (45, 180)`` (``rho = -1``: an infinite
+        index), an unknown ``on_ill_conditioned``, or an ill-conditioned point with
+        ``on_ill_conditioned="raise"``.
+
+    Notes
+    -----
+    The root of ``N^2`` is taken with ``Re(N) + Im(N) >= 0`` (branch cut on the negative
+    imaginary axis of ``N^2``). For physical data (``Im(N^2) >= 0``) it is the principal
+    root with ``n, k >= 0``, as in docs/models.md 3.1. When noise pushes ``Im(N^2)``
+    slightly negative, a dielectric-like point (``Re N^2 > 0``) comes back with a small
+    ``k < 0`` (reported, not clipped: docs/models.md 3.2), and a metal-like point (``Re N^2 < 0``,
+    ``n`` near 0) with a small ``n < 0`` instead of a sign-flipped ``k``.
+    """
+    on_ill = _on_ill(on_ill_conditioned)
+    psi = np.radians(_finite("psi_deg", psi_deg, np.float64))
+    if np.any((psi < 0) | (psi > np.pi / 2)):
+        raise ValueError("psi_deg: expected psi in [0, 90] deg")
+    delta = np.radians(_finite("delta_deg", delta_deg, np.float64))
+    theta = np.radians(_angle("theta_deg", theta_deg, open_ends=True))
+    n0 = _real_index("n_ambient", n_ambient)
+    if np.any((psi == np.pi / 4) & (np.mod(np.degrees(delta), 360.0) == 180.0)):
+        raise ValueError("psi_deg, delta_deg: (45, 180) deg means rho = -1, an infinite index")
+    rho = np.tan(psi) * np.exp(-1j * delta)
+    sin_t = np.sin(theta)
+    u = (1.0 - rho) / (1.0 + rho)
+    eps = (n0 * sin_t) ** 2 * (1.0 + np.tan(theta) ** 2 * u * u)
+    big_n = np.asarray(_physical_root(eps + 0j))
+    if on_ill != "ignore":
+        cond = condition_number(psi_deg, delta_deg, theta_deg, n0)
+        _check_conditioning(cond, np.degrees(theta), on_ill)
+    return big_n
 
 
 def _inputs(psi_deg: ArrayLike, delta_deg: ArrayLike, theta_deg: ArrayLike) -> tuple:
@@ -98,7 +218,7 @@ def nk_jacobian(
     psi_deg: ArrayLike,
     delta_deg: ArrayLike,
     theta_deg: ArrayLike,
-    n_ambient: float = 1.0,
+    n_ambient: ArrayLike = 1.0,
 ) -> tuple[ComplexArray, ComplexArray, ComplexArray, ComplexArray]:
     """The two-phase index and its complex derivatives with respect to psi, Delta, theta.
 
@@ -108,13 +228,13 @@ def nk_jacobian(
         Ellipsometric angles, Nebraska convention [deg].
     theta_deg : array_like of float
         Angle of incidence in (0, 90) [deg].
-    n_ambient : float, optional
+    n_ambient : array_like of float, optional
         Real index of the lossless ambient [1]. Default 1.
 
     Returns
     -------
     N : ndarray of complex
-        ``n + ik`` from :func:`labbrdf.optics.nk_from_psi_delta` [1].
+        ``n + ik`` from :func:`nk_from_psi_delta` [1].
     dN_dpsi, dN_ddelta, dN_dtheta : ndarray of complex
         Derivatives of ``N`` [1/deg]. The real part is the derivative of ``n``, the imaginary
         part that of ``k``.
@@ -133,12 +253,12 @@ def nk_jacobian(
     derivatives; they are checked against central differences in the tests.
     """
     psi, delta, theta = _inputs(psi_deg, delta_deg, theta_deg)
-    big_n = np.asarray(optics.nk_from_psi_delta(psi, delta, theta, n_ambient, warn=False))
+    big_n = nk_from_psi_delta(psi, delta, theta, n_ambient, on_ill_conditioned="ignore")
     p, d, t = np.radians(psi), np.radians(delta), np.radians(theta)
     rho = np.tan(p) * np.exp(-1j * d)
     u = (1.0 - rho) / (1.0 + rho)
     s, c = np.sin(t), np.cos(t)
-    n0sq = float(n_ambient) ** 2
+    n0sq = np.asarray(n_ambient, dtype=float) ** 2
     deps_drho = n0sq * (s * s) * np.tan(t) ** 2 * 2.0 * u * (-2.0 / (1.0 + rho) ** 2)
     dn_drho = deps_drho / (2.0 * big_n)
     deg = np.pi / 180.0
@@ -153,9 +273,12 @@ def condition_number(
     psi_deg: ArrayLike,
     delta_deg: ArrayLike,
     theta_deg: ArrayLike,
-    n_ambient: float = 1.0,
+    n_ambient: ArrayLike = 1.0,
 ) -> FloatArray:
     """Relative condition number of the inversion (psi, Delta) -> N [1/rad].
+
+    The one condition number of the psi/Delta inversion in labbrdf: :func:`nk_from_psi_delta`,
+    :func:`pseudo_nk` (its ``cond``), the nk table and report all use it.
 
     Parameters
     ----------
@@ -163,7 +286,7 @@ def condition_number(
         Ellipsometric angles, Nebraska convention [deg].
     theta_deg : array_like of float
         Angle of incidence in (0, 90) [deg].
-    n_ambient : float, optional
+    n_ambient : array_like of float, optional
         Real index of the ambient [1]. Default 1.
 
     Returns
@@ -182,7 +305,12 @@ def condition_number(
     and :data:`COND_MAX` for the thresholds.
     """
     big_n, dn_dpsi, _, _ = nk_jacobian(psi_deg, delta_deg, theta_deg, n_ambient)
-    return np.asarray(np.abs(dn_dpsi) * (180.0 / np.pi) / np.abs(big_n))
+    return _kappa(big_n, dn_dpsi)
+
+
+def _kappa(big_n: ComplexArray, dn_dpsi_deg: ComplexArray) -> FloatArray:
+    """``|dN/dpsi| / |N|`` per radian, from the per-degree derivative of :func:`nk_jacobian`."""
+    return np.asarray(np.abs(dn_dpsi_deg) * (180.0 / np.pi) / np.abs(big_n))
 
 
 @dataclass(frozen=True)
@@ -219,33 +347,6 @@ class PseudoNK:
         )
 
 
-def _check_conditioning(cond: FloatArray, theta: FloatArray, on_ill: OnIll) -> None:
-    if on_ill not in ("raise", "warn", "ignore"):
-        raise ValueError(
-            f"on_ill_conditioned: expected 'raise', 'warn' or 'ignore'; got {on_ill!r}"
-        )
-    if on_ill == "ignore" or cond.size == 0:
-        return
-    worst = int(np.argmax(cond.ravel()))
-    c_max, t_at = float(cond.ravel()[worst]), float(theta.ravel()[worst])
-    if c_max > COND_MAX and on_ill == "raise":
-        raise ValueError(
-            f"psi/Delta inversion is ill-conditioned: condition number {c_max:.3g} > "
-            f"{COND_MAX:g} at theta_i = {t_at:.4g} deg (near normal incidence every sample "
-            "gives psi = 45, Delta = 180 deg); measure at a larger angle or pass "
-            "on_ill_conditioned='warn'"
-        )
-    if c_max > COND_WARN:
-        nbad = int(np.count_nonzero(cond > COND_WARN))
-        warnings.warn(
-            f"psi/Delta inversion is ill-conditioned at {nbad} point(s): condition number up "
-            f"to {c_max:.3g} (> {COND_WARN:g}) at theta_i = {t_at:.4g} deg; n, k are "
-            "sensitive to small psi/Delta errors",
-            IllConditionedWarning,
-            stacklevel=3,
-        )
-
-
 def pseudo_nk(
     psi_deg: ArrayLike,
     delta_deg: ArrayLike,
@@ -273,9 +374,11 @@ def pseudo_nk(
     n_ambient : float, optional
         Real index of the ambient [1]. Default 1.
     on_ill_conditioned : {"raise", "warn", "ignore"}
-        What to do when a point's condition number exceeds :data:`COND_MAX`: raise a
-        ``ValueError`` naming the condition number and the angle (default), or only warn.
-        Points above :data:`COND_WARN` always warn unless ``"ignore"``.
+        What to do when a point's condition number (:func:`condition_number`) exceeds
+        :data:`COND_MAX`: raise a ``ValueError`` naming the condition number and the angle
+        (default), or only warn. Points above :data:`COND_WARN` always warn
+        (:class:`IllConditionedWarning`) unless ``"ignore"``. The same rule as
+        :func:`nk_from_psi_delta`, whose default is ``"warn"``.
 
     Returns
     -------
@@ -285,7 +388,7 @@ def pseudo_nk(
     Raises
     ------
     ValueError
-        For invalid input (as :func:`labbrdf.optics.nk_from_psi_delta`), or an
+        For invalid input (as :func:`nk_from_psi_delta`), or an
         ill-conditioned point with ``on_ill_conditioned="raise"``.
 
     Notes
@@ -297,7 +400,7 @@ def pseudo_nk(
     """
     psi, delta, theta = _inputs(psi_deg, delta_deg, theta_deg)
     big_n, d_psi, d_delta, d_theta = nk_jacobian(psi, delta, theta, n_ambient)
-    cond = np.abs(d_psi) * (180.0 / np.pi) / np.abs(big_n)
+    cond = _kappa(big_n, d_psi)
     _check_conditioning(cond, theta, on_ill_conditioned)
     s_psi = np.asarray(psi_sigma_deg, dtype=float)
     s_delta = np.asarray(delta_sigma_deg, dtype=float)

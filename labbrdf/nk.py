@@ -789,7 +789,7 @@ def coating_from_fit(path: str | os.PathLike[str], wavelength_nm: float) -> tupl
     Parameters
     ----------
     path : path-like
-        A film fit's JSON (:meth:`labbrdf.films.FilmFit.save_json`, ``labbrdf film
+        A film fit's JSON (:meth:`labbrdf.FilmFit.save_json`, ``labbrdf film
         --fit-json FIT.json``) whose stack has exactly one layer over the substrate
         (the tracer's one coating).
     wavelength_nm : float

@@ -1,4 +1,4 @@
-"""Optics core: Fresnel amplitudes, Stokes/Mueller algebra, ellipsometry, thin films.
+"""Optics core: Fresnel amplitudes, Stokes/Mueller algebra, psi/Delta, thin films.
 
 Pure NumPy (physics layer): no pandas I/O, matplotlib or nlopt. Every public function is
 vectorised with NumPy broadcasting; angles are in degrees at the public API (radians inside).
@@ -32,11 +32,13 @@ Conventions (the ONE labbrdf convention, "LB"; also in ``docs/conventions.md``)
   Stokes vector in the frame of the outgoing ray (reflected or transmitted), both frames
   built as above. Matrices are ``(..., 4, 4)`` arrays; apply them with ``np.matmul``.
 * Ellipsometry: ``rho = tan(psi) exp(i Delta)`` in the Nebraska convention (Muller 1969;
-  Azzam and Bashara), with ``Delta = 180 deg`` at normal incidence and ``0 < Delta < 180``
+  Azzam and Bashara [2]_), with ``Delta = 180 deg`` at normal incidence and ``0 < Delta < 180``
   for a bare absorber; ``Delta`` is returned in ``[0, 360)``. With the LB amplitudes above
   this is ``tan(psi) = |rp/rs|``, ``Delta = arg(rs rp*)`` (docs/models.md section 3.2: the
   Nebraska rho is the complex conjugate of the LB ``rp/rs``, and (psi, Delta) are the same
-  numbers in both conventions).
+  numbers in both conventions). This module computes psi and Delta of a known substrate
+  (:func:`psi_delta`); the inverse problem, psi and Delta to an index with its condition
+  number, is :mod:`labbrdf.ellipsometry`.
 
 Error policy
 ------------
@@ -51,7 +53,7 @@ References
 .. [1] M. Born, E. Wolf, *Principles of Optics*, 7th ed., Cambridge University Press (1999),
    sections 1.5 (Fresnel formulae) and 1.6 (thin films).
 .. [2] R. M. A. Azzam, N. M. Bashara, *Ellipsometry and Polarized Light*, North-Holland
-   (1977), sections 4.2-4.3 (two-phase inversion).
+   (1977), sections 4.2-4.3 (the ellipsometric ratio of a bare substrate).
 .. [3] X. Zou, L. Bai, Z. Wu, "Mirror reflectance spectrum modeling of smooth samples",
    Acta Optica Sinica 33(6) 0612008 (2013), doi:10.3788/AOS201333.0612008, eqs. (4)-(6).
 .. [4] K. Berger, A. Weidlich, A. Wilkie, M. Wimmer, "Modeling and verifying the polarizing
@@ -64,7 +66,6 @@ References
 
 from __future__ import annotations
 
-import warnings
 from typing import Any
 
 import numpy as np
@@ -81,7 +82,6 @@ __all__ = [
     "mueller_reflection",
     "mueller_rotation",
     "mueller_transmission",
-    "nk_from_psi_delta",
     "psi_delta",
     "reflectance",
     "transmission_factor",
@@ -588,7 +588,7 @@ def dop(stokes: ArrayLike) -> FloatArray:
 
 
 # --------------------------------------------------------------------------------------
-# ellipsometry
+# ellipsometric angles of a known substrate (the inversion is labbrdf.ellipsometry)
 # --------------------------------------------------------------------------------------
 
 
@@ -642,123 +642,6 @@ def psi_delta(
     psi = np.degrees(np.arctan2(np.abs(rp), np.abs(rs)))
     delta = _wrap360(np.degrees(np.angle(rs * np.conj(rp))))
     return _arrays(psi, delta)
-
-
-#: Condition number [1/rad] of the inversion above which :func:`nk_from_psi_delta` warns:
-#: 0.02 deg of psi or Delta error (a rotating-element ellipsometer's accuracy) then moves
-#: ``|N|`` by more than 10 %. It grows as ``1/theta^2`` towards normal incidence (about 6 deg
-#: for Si or Ta, 4 deg for glass).
-NK_COND_MAX = 300.0
-
-
-class IllConditionedWarning(UserWarning):
-    """The inversion psi, Delta -> n, k is ill-conditioned (near normal incidence)."""
-
-
-def nk_condition_number(
-    psi_deg: ArrayLike, delta_deg: ArrayLike, theta_deg: ArrayLike, n_ambient: ArrayLike = 1.0
-) -> NDArray[np.float64]:
-    """Relative condition number ``|dN/dpsi| / |N|`` [1/rad] of :func:`nk_from_psi_delta`.
-
-    ``dN/dpsi = (d eps/d psi) / (2 N)`` with ``eps`` as in :func:`nk_from_psi_delta`,
-    ``d eps/d rho = -4 n0^2 sin^2 t tan^2 t u / (1 + rho)^2`` and
-    ``d rho/d psi = exp(-i Delta) / cos^2 psi``; ``|dN/dDelta| <= |dN/dpsi| / 2``, so this is
-    the largest relative change of N per radian of psi/Delta error.
-    """
-    psi = np.radians(np.asarray(psi_deg, float))
-    delta = np.radians(np.asarray(delta_deg, float))
-    theta = np.radians(np.asarray(theta_deg, float))
-    n0 = np.asarray(n_ambient, float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rho = np.tan(psi) * np.exp(-1j * delta)
-        u = (1.0 - rho) / (1.0 + rho)
-        s2, t2 = np.sin(theta) ** 2, np.tan(theta) ** 2
-        big_n = np.sqrt((n0**2 * s2 * (1.0 + t2 * u * u)) + 0j)
-        deps = (
-            -4.0 * n0**2 * s2 * t2 * u / (1.0 + rho) ** 2 * np.exp(-1j * delta) / np.cos(psi) ** 2
-        )
-        return np.asarray(np.abs(deps / (2.0 * big_n)) / np.abs(big_n))
-
-
-def nk_from_psi_delta(
-    psi_deg: ArrayLike,
-    delta_deg: ArrayLike,
-    theta_deg: ArrayLike,
-    n_ambient: ArrayLike = 1.0,
-    *,
-    warn: bool = True,
-) -> ComplexArray:
-    """Two-phase (bare substrate) inversion of psi, Delta to ``N = n + ik``.
-
-    Parameters
-    ----------
-    psi_deg : array_like of float
-        Ellipsometric psi in [0, 90] [deg].
-    delta_deg : array_like of float
-        Ellipsometric Delta in the Nebraska convention [deg]; any finite value (taken
-        modulo 360).
-    theta_deg : array_like of float
-        Angle of incidence in the open interval (0, 90) [deg]: at 0 and 90 deg every
-        substrate gives the same (psi, Delta).
-    n_ambient : array_like of float, optional
-        Real index of the lossless ambient, > 0 [1]. Default 1.
-    warn : bool, optional
-        Issue :class:`IllConditionedWarning`, with the condition number
-        (:func:`nk_condition_number`) and the angle, where it exceeds :data:`NK_COND_MAX`
-        (near normal incidence, where every sample gives psi -> 45, Delta -> 180 deg and
-        the index is not determined by the data). Default True.
-
-    Returns
-    -------
-    ndarray of complex
-        The (pseudo-)index ``N = n + ik`` [1]:
-        ``N^2 = n0^2 sin^2(theta) [1 + tan^2(theta) ((1 - rho)/(1 + rho))^2]`` with the LB
-        ``rho = tan(psi) exp(-i Delta)`` (Azzam and Bashara [2]_ section 4.3;
-        docs/models.md section 3.1). Any overlayer or roughness makes it a pseudo-index.
-
-    Raises
-    ------
-    ValueError
-        For non-finite input, ``psi`` outside [0, 90], ``theta`` outside (0, 90), a
-        non-real ``n_ambient``, or ``(psi, Delta) = (45, 180)`` (``rho = -1``: an infinite
-        index).
-
-    Notes
-    -----
-    The root of ``N^2`` is taken with ``Re(N) + Im(N) >= 0`` (branch cut on the negative
-    imaginary axis of ``N^2``). For physical data (``Im(N^2) >= 0``) it is the principal
-    root with ``n, k >= 0``, as in docs/models.md 3.1. When noise pushes ``Im(N^2)``
-    slightly negative, a dielectric-like point (``Re N^2 > 0``) comes back with a small
-    ``k < 0`` (reported, not clipped: docs/models.md 3.2), and a metal-like point (``Re N^2 < 0``,
-    ``n`` near 0) with a small ``n < 0`` instead of a sign-flipped ``k``.
-    """
-    psi = np.radians(_finite("psi_deg", psi_deg, np.float64))
-    if np.any((psi < 0) | (psi > np.pi / 2)):
-        raise ValueError("psi_deg: expected psi in [0, 90] deg")
-    delta = np.radians(_finite("delta_deg", delta_deg, np.float64))
-    theta = np.radians(_angle("theta_deg", theta_deg, open_ends=True))
-    n0 = _real_index("n_ambient", n_ambient)
-    if np.any((psi == np.pi / 4) & (np.mod(np.degrees(delta), 360.0) == 180.0)):
-        raise ValueError("psi_deg, delta_deg: (45, 180) deg means rho = -1, an infinite index")
-    rho = np.tan(psi) * np.exp(-1j * delta)
-    sin_t = np.sin(theta)
-    u = (1.0 - rho) / (1.0 + rho)
-    eps = (n0 * sin_t) ** 2 * (1.0 + np.tan(theta) ** 2 * u * u)
-    if warn:
-        cond = nk_condition_number(psi_deg, delta_deg, theta_deg, n_ambient)
-        bad = ~(cond <= NK_COND_MAX)
-        if np.any(bad):
-            i = int(np.argmax(np.where(bad, cond, -np.inf)))
-            at = np.ravel(np.degrees(theta) * np.ones_like(cond))[i]
-            warnings.warn(
-                f"psi/Delta -> n, k is ill-conditioned at {int(np.count_nonzero(bad))} "
-                f"point(s): condition number up to {np.ravel(cond)[i]:.3g} /rad (> "
-                f"{NK_COND_MAX:g}) at theta = {at:.4g} deg; near normal incidence the "
-                "index is not determined by psi and Delta",
-                IllConditionedWarning,
-                stacklevel=2,
-            )
-    return np.asarray(_physical_root(eps + 0j))
 
 
 def berger_reflectances(

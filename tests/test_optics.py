@@ -1,7 +1,8 @@
 """Oracle-free tests of labbrdf.optics: invariants, analytic limits, shapes, error paths.
 
 Tolerances are stated next to each assertion in units of the float64 epsilon ``EPS`` and
-follow from the number of rounding operations or from an explicit condition number.
+follow from the number of rounding operations. The inverse problem (psi, Delta to n, k) is
+tested with :mod:`labbrdf.ellipsometry` in ``tests/test_ellipsometry.py``.
 """
 
 from __future__ import annotations
@@ -10,9 +11,6 @@ import warnings
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
-from hypothesis.extra import numpy as hnp
 
 from labbrdf import optics
 
@@ -354,116 +352,6 @@ def test_psi_delta_depends_only_on_the_relative_index():
     np.testing.assert_allclose(a, b, rtol=16 * EPS)
 
 
-def test_inversion_with_a_non_unit_ambient():
-    psi, delta = optics.psi_delta(2.0 + 0.5j, 65.0, n_ambient=1.33)
-    n = optics.nk_from_psi_delta(psi, delta, 65.0, n_ambient=1.33)
-    assert abs(n - (2.0 + 0.5j)) <= 1e-13
-
-
-def test_inversion_accepts_delta_in_any_period():
-    psi, delta = optics.psi_delta(N_AL, 70.0)
-    a = optics.nk_from_psi_delta(psi, delta, 70.0)
-    b = optics.nk_from_psi_delta(psi, delta - 360.0, 70.0)
-    assert abs(a - b) <= 1e-13
-
-
-def test_inversion_of_slightly_negative_im_eps_for_a_metal_keeps_k_positive():
-    # n = 0 metal: N^2 = -k^2 is real and psi = 45 deg exactly; psi a hair above 45 deg
-    # (noise) gives Im(N^2) = -1.8e-7 < 0. The principal root would return k = -4; the
-    # branch rule returns n = -2.3e-8, k = +4.
-    psi, delta = optics.psi_delta(4.0j, 60.0)
-    n = optics.nk_from_psi_delta(psi + 1e-7, delta, 60.0)
-    assert n.imag == pytest.approx(4.0, rel=1e-12)
-    assert -1e-7 < n.real < 0
-
-
-def test_inversion_of_a_noisy_dielectric_reports_negative_k_rather_than_clipping():
-    psi, delta = optics.psi_delta(1.5, 45.0)
-    n = optics.nk_from_psi_delta(psi, delta + 0.01, 45.0)
-    assert n.imag < 0  # docs/models.md 3.2: do not clip silently
-    assert n.real == pytest.approx(1.5, abs=1e-3)
-
-
-def _relative_inversion_error(n: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    psi, delta = optics.psi_delta(n, theta)
-    back = optics.nk_from_psi_delta(psi, delta, theta)
-    return np.abs(back - n) / np.abs(n)
-
-
-_SIZE = 100
-
-
-@st.composite
-def _well_conditioned_samples(draw):
-    """(N, theta) arrays from the well-conditioned domain of the two-phase inversion.
-
-    * theta in [20, 85] deg: towards 0 deg rho -> -1 and psi, Delta stop depending on N
-      (the inversion diverges like 1/theta^2); towards 90 deg every N gives rho -> 1.
-    * absorbers: n in [0.05, 10], k in [0.01, 10], |N| >= 0.25. A weak absorber with
-      |N| < sin(theta) reflects almost totally (psi -> 45 deg), and N is carried by the
-      tiny deviation of psi from 45 deg; the |N| floor keeps that corner out.
-    * lossless dielectrics: n in [1.2, 10], k = 0. Close to the ambient (n -> 1) rs and rp
-      both vanish and psi loses relative accuracy like eps/|N - 1|.
-    Within this domain a random scan of 4e5 points gave a worst relative error of 7e-14.
-    """
-
-    # fill=nothing(): every element is drawn (no constant background), 100 points per example
-    def arr(dtype, elements):
-        return draw(hnp.arrays(dtype, _SIZE, elements=elements, fill=st.nothing()))
-
-    theta = arr(float, st.floats(20.0, 85.0))
-    n = arr(float, st.floats(0.05, 10.0))
-    k = arr(float, st.floats(0.01, 10.0))
-    dielectric = arr(bool, st.booleans())
-    big = np.hypot(n, k)
-    scale = np.where(big < 0.25, 0.25 / big, 1.0)
-    absorber = n * scale + 1j * k * scale
-    lossless = np.clip(n, 1.2, 10.0) + 0j
-    return np.where(dielectric, lossless, absorber), theta
-
-
-# vector draws are deliberately large (the health check flags that); derandomize and no
-# database make the run reproducible
-@settings(
-    max_examples=100,
-    deadline=None,
-    derandomize=True,
-    database=None,
-    suppress_health_check=[HealthCheck.large_base_example, HealthCheck.too_slow],
-)
-@given(_well_conditioned_samples())
-def test_psi_delta_round_trip_to_1e_12_in_the_well_conditioned_domain(sample):
-    n, theta = sample
-    err = _relative_inversion_error(n, theta)
-    assert np.all(err <= 1e-12), (n[np.argmax(err)], theta[np.argmax(err)], err.max())
-
-
-def test_psi_delta_round_trip_error_scales_with_the_condition_number():
-    # Condition-number-scaled criterion on a seeded wide grid (theta 5..88 deg, metals and
-    # dielectrics): |dN|/|N| <= 16 eps K with
-    # K = 1 + |dN/drho| |rho| / |N| * (psi/(sin psi cos psi) + |Delta| + 1), the
-    # amplification of one rounding of rho, psi and Delta (radians). 16 allows for the
-    # ~10 roundings in the forward and inverse chain; the worst ratio seen is 4.6.
-    rng = np.random.default_rng(20261122)
-    m = 20000
-    n = 10 ** rng.uniform(-1, 1.3, m) + 1j * 10 ** rng.uniform(-2, 1.3, m)
-    theta = rng.uniform(5.0, 88.0, m)
-    keep = np.abs(n) >= 0.5
-    n, theta = n[keep], theta[keep]
-    err = _relative_inversion_error(n, theta)
-    psi, delta = optics.psi_delta(n, theta)
-    p, d, t = np.radians(psi), np.radians(delta), np.radians(theta)
-    rho = np.tan(p) * np.exp(-1j * d)
-    u = (1 - rho) / (1 + rho)
-    dn_drho = np.sin(t) ** 2 * np.tan(t) ** 2 * u * (-2 / (1 + rho) ** 2) / n
-    cond = 1 + np.abs(dn_drho) * np.abs(rho) / np.abs(n) * (
-        p / (np.sin(p) * np.cos(p)) + np.abs(d) + 1
-    )
-    ratio = err / (EPS * cond)
-    assert np.all(ratio <= 16), (n[np.argmax(ratio)], theta[np.argmax(ratio)], ratio.max())
-    assert cond.max() > 1e3  # the grid does reach ill-conditioned points
-
-
 # --------------------------------------------------------------------------------------
 # Berger's corrected real form
 # --------------------------------------------------------------------------------------
@@ -629,9 +517,6 @@ _CASES = {
     "mueller_reflection": lambda n, t: (
         optics.mueller_reflection(*optics.fresnel(1.0, n, t)[:2]),
     ),
-    "nk_from_psi_delta": lambda n, t: (
-        optics.nk_from_psi_delta(*optics.psi_delta(n, np.clip(t, 1, 89)), np.clip(t, 1, 89)),
-    ),
 }
 
 
@@ -675,7 +560,6 @@ def test_no_runtime_warning_at_the_edges_of_the_valid_domain():
         optics.berger_reflectances(1.0, 0.0, [0.0, 90.0])
         optics.berger_reflectances(0.0, 3.0, [0.0, 90.0])
         optics.film_mueller_incoherent(1.0, 1.5, N_AL, [0.0, 1e7], 650.0, 90.0)
-        optics.nk_from_psi_delta([0.0, 90.0], [0.0, 180.0], 45.0)
 
 
 # --------------------------------------------------------------------------------------
@@ -716,25 +600,6 @@ def test_no_runtime_warning_at_the_edges_of_the_valid_domain():
             r"n_ambient: expected a real index > 0",
         ),
         (lambda: optics.psi_delta(1.33, 60.0, n_ambient=1.33), r"n: equals n_ambient"),
-        (
-            lambda: optics.nk_from_psi_delta(95.0, 100.0, 60.0),
-            r"psi_deg: expected psi in \[0, 90\]",
-        ),
-        (
-            lambda: optics.nk_from_psi_delta(-1.0, 100.0, 60.0),
-            r"psi_deg: expected psi in \[0, 90\]",
-        ),
-        (lambda: optics.nk_from_psi_delta(30.0, np.nan, 60.0), r"delta_deg: expected finite"),
-        (
-            lambda: optics.nk_from_psi_delta(30.0, 100.0, 0.0),
-            r"theta_deg: .*open interval \(0, 90\)",
-        ),
-        (
-            lambda: optics.nk_from_psi_delta(30.0, 100.0, 90.0),
-            r"theta_deg: .*open interval \(0, 90\)",
-        ),
-        (lambda: optics.nk_from_psi_delta(45.0, -180.0, 60.0), r"psi_deg, delta_deg: \(45, 180\)"),
-        (lambda: optics.nk_from_psi_delta(30, 100, 60, n_ambient=-1.0), r"n_ambient: expected"),
         (lambda: optics.berger_reflectances(-1.0, 1.0, 30.0), r"n: expected values >= 0"),
         (lambda: optics.berger_reflectances(1.0, -1.0, 30.0), r"k: expected values >= 0"),
         (lambda: optics.berger_reflectances(0.0, 0.0, 30.0), r"n, k: the index N = n \+ ik"),

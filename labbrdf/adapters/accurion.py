@@ -28,10 +28,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
 from ..dataset import Measurement, wrap_delta
 from ._base import AdapterError, Format, decode, read_bytes, split_lines
 from ._numblock import (
+    Block,
     build_frame,
     check_rows,
     delta_range,
@@ -208,6 +210,42 @@ def read_accurion(path: str | os.PathLike[str]) -> Measurement:
     """
     raw = read_bytes(path)
     text, encoding = decode(raw, path, ("utf-8", "latin-1"))
+    meta, names, block, col = _read_table(path, text, encoding)
+    wl, aoi, psi, delta = col["Lambda"], col["AOI"], col["Psi"], col["Delta"]
+    n = len(wl)
+    data, dropped = _data_zones(path, block, col, meta)
+    failed = data & ~(np.isfinite(psi) & np.isfinite(delta))
+    if failed.any():
+        dropped.append(
+            {"count": int(failed.sum()), "reason": "Psi/Delta NaN (the zone did not null)"}
+        )
+    keep = data & ~failed
+    if not keep.any():
+        raise AdapterError(path, f"no valid Psi/Delta rows (dropped: {dropped})")
+    frame = _frame(path, meta, col, keep)
+    for c, key in (("Bandwidth", "bandwidth_nm_range"), ("ExposureTime", "exposure_range")):
+        if c in col and np.isfinite(col[c][keep]).any():
+            meta[key] = [float(np.nanmin(col[c][keep])), float(np.nanmax(col[c][keep]))]
+    if "ROIidx" in col:
+        meta["roi_indices"] = sorted({int(x) for x in col["ROIidx"][keep] if np.isfinite(x)})
+    ignored = [c for c in names if c and c not in COLUMN_MAP and c not in ("ROIidx",)]
+    meta["columns_not_in_schema"] = ignored
+    meta["data_lines"] = int(n)
+    meta["blank_lines_skipped"] = block.blank_lines
+    meta["dropped_rows"] = dropped
+    meta["delta_convention"] = "Nebraska, as written by the EP4 software (0..360 deg)"
+    meta["delta_range_in_file"] = delta_range(delta[keep])
+    meta["delta_range"] = "[0, 360)"
+    meta["angles_deg"] = group_angles(aoi[keep])
+    meta["wavelength_nm"] = [float(wl[keep].min()), float(wl[keep].max())]
+    meta["sigma"] = "none in the file (NaN)"
+    return measurement(path, frame, meta)
+
+
+def _read_table(
+    path: str | os.PathLike[str], text: str, encoding: str
+) -> tuple[dict[str, Any], list[str], Block, dict[str, np.ndarray]]:
+    """The header's meta, the column names, the checked block and its columns by name."""
     names, units, body, first, meta = _layout(path, text)
     p = Path(path)
     meta = {"source_file": p.name, "encoding": encoding, **meta}
@@ -240,9 +278,18 @@ def read_accurion(path: str | os.PathLike[str]) -> Measurement:
         path, block, np.isfinite(psi) & ((psi < 0) | (psi > 90)), "Psi must be within [0, 90] deg"
     )
     check_rows(path, block, np.isinf(psi) | np.isinf(delta), "Psi/Delta must be finite or NaN")
+    return meta, names, block, col
 
-    n = len(wl)
-    data = np.ones(n, dtype=bool)
+
+def _data_zones(
+    path: str | os.PathLike[str],
+    block: Block,
+    col: dict[str, np.ndarray],
+    meta: dict[str, Any],
+) -> tuple[np.ndarray, list[dict[str, Any]]]:
+    """The rows of the data zones, and the zone rows dropped (see :func:`read_accurion`)."""
+    wl, aoi, psi, delta = col["Lambda"], col["AOI"], col["Psi"], col["Delta"]
+    data = np.ones(len(wl), dtype=bool)
     dropped: list[dict[str, Any]] = []
     if "Zone" in col:
         zone = col["Zone"]
@@ -280,14 +327,18 @@ def read_accurion(path: str | os.PathLike[str]) -> Measurement:
                 }
                 for i in np.flatnonzero(z5)
             ]
-    failed = data & ~(np.isfinite(psi) & np.isfinite(delta))
-    if failed.any():
-        dropped.append(
-            {"count": int(failed.sum()), "reason": "Psi/Delta NaN (the zone did not null)"}
-        )
-    keep = data & ~failed
-    if not keep.any():
-        raise AdapterError(path, f"no valid Psi/Delta rows (dropped: {dropped})")
+    return data, dropped
+
+
+def _frame(
+    path: str | os.PathLike[str],
+    meta: dict[str, Any],
+    col: dict[str, np.ndarray],
+    keep: np.ndarray,
+) -> pd.DataFrame:
+    """The tidy frame of the rows ``keep``: a psi row then a delta row for each."""
+    p = Path(path)
+    wl, aoi, psi, delta = col["Lambda"], col["AOI"], col["Psi"], col["Delta"]
     r = np.flatnonzero(keep)
     m = r.size
 
@@ -306,7 +357,7 @@ def read_accurion(path: str | os.PathLike[str]) -> Measurement:
         sample = sample.removesuffix(suffix)
     if meta.get("title"):
         sample = re.split(r"[\\/]", meta["title"])[-1] or sample
-    frame = build_frame(
+    return build_frame(
         sample=sample,
         instrument="accurion-ep4",
         source=p.name,
@@ -319,23 +370,6 @@ def read_accurion(path: str | os.PathLike[str]) -> Measurement:
         phi_r_deg=180.0,
         **optional,
     )
-    for c, key in (("Bandwidth", "bandwidth_nm_range"), ("ExposureTime", "exposure_range")):
-        if c in col and np.isfinite(col[c][keep]).any():
-            meta[key] = [float(np.nanmin(col[c][keep])), float(np.nanmax(col[c][keep]))]
-    if "ROIidx" in col:
-        meta["roi_indices"] = sorted({int(x) for x in col["ROIidx"][keep] if np.isfinite(x)})
-    ignored = [c for c in names if c and c not in COLUMN_MAP and c not in ("ROIidx",)]
-    meta["columns_not_in_schema"] = ignored
-    meta["data_lines"] = int(n)
-    meta["blank_lines_skipped"] = block.blank_lines
-    meta["dropped_rows"] = dropped
-    meta["delta_convention"] = "Nebraska, as written by the EP4 software (0..360 deg)"
-    meta["delta_range_in_file"] = delta_range(delta[keep])
-    meta["delta_range"] = "[0, 360)"
-    meta["angles_deg"] = group_angles(aoi[keep])
-    meta["wavelength_nm"] = [float(wl[keep].min()), float(wl[keep].max())]
-    meta["sigma"] = "none in the file (NaN)"
-    return measurement(path, frame, meta)
 
 
 FORMATS: tuple[Format, ...] = (

@@ -32,6 +32,7 @@ from __future__ import annotations
 import datetime as _dt
 import os
 import re
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -96,79 +97,11 @@ def read_cary_csv(path: str | os.PathLike[str]) -> Measurement:
     lines = split_lines(text)
     if len(lines) < 3:
         raise AdapterError(path, "expected sample names, column titles and data rows")
-    titles = lines[1].split(",")
-    if titles and titles[-1].strip() == "":
-        titles = titles[:-1]
-    if len(titles) < 2 or len(titles) % 2:
-        raise AdapterError(
-            path, "row 2: expected 'Wavelength (nm),<Y mode>' pairs, one per sample", 2
-        )
-    nsample = len(titles) // 2
-    width = 2 * nsample
-    modes = []
-    for k in range(nsample):
-        if titles[2 * k].strip() != _XHEADER:
-            raise AdapterError(
-                path,
-                f"row 2, column {2 * k + 1}: expected {_XHEADER!r}, found "
-                f"{titles[2 * k].strip()[:30]!r} (only nm scans are supported)",
-                2,
-            )
-        mode = titles[2 * k + 1].strip()
-        if mode not in _YMODES:
-            raise AdapterError(
-                path,
-                f"row 2, column {2 * k + 2}: Y mode {mode!r} is not one of {sorted(_YMODES)}",
-                2,
-            )
-        modes.append(mode)
-    names_row = _cells(lines[0], width)
-    if names_row is None:
-        raise AdapterError(
-            path, f"row 1: expected {nsample} sample names each followed by an empty cell", 1
-        )
-    names = [names_row[2 * k].strip() for k in range(nsample)]
-    if any(not n for n in names) or any(names_row[2 * k + 1].strip() for k in range(nsample)):
-        raise AdapterError(
-            path, "row 1: expected a sample name then an empty cell for every sample", 1
-        )
-
-    x = np.full((len(lines), nsample), np.nan)
-    y = np.full((len(lines), nsample), np.nan)
-    present = np.zeros((len(lines), nsample), dtype=bool)
-    half = np.zeros((len(lines), nsample), dtype=bool)
-    i = 2
-    while i < len(lines) and lines[i].strip():
-        cells = _cells(lines[i], width)
-        if cells is None:
-            raise AdapterError(
-                path,
-                f"expected {width} cells ({nsample} x,y pairs) and a trailing comma, found "
-                f"{len(lines[i].split(','))}",
-                i + 1,
-            )
-        for k in range(nsample):
-            cx, cy = cells[2 * k].strip(), cells[2 * k + 1].strip()
-            if cx and cy:
-                x[i, k] = number(cx, path, i + 1, f"{names[k]} wavelength")
-                y[i, k] = number(cy, path, i + 1, f"{names[k]} {modes[k]}")
-                present[i, k] = True
-            elif cx or cy:
-                half[i, k] = True
-                if cx:
-                    x[i, k] = number(cx, path, i + 1, f"{names[k]} wavelength")
-                else:
-                    number(cy, path, i + 1, f"{names[k]} {modes[k]}")
-        i += 1
-    end = i
-    if end == 2:
-        raise AdapterError(path, "no data rows after the column titles", 3)
-    if end == len(lines):
-        raise AdapterError(
-            path,
-            "the data are not followed by a blank line and the metadata blocks (file truncated?)",
-            end,
-        )
+    modes = _y_modes(path, lines[1])
+    nsample = len(modes)
+    names = _sample_names(path, lines[0], nsample)
+    cols = _columns(path, lines, names, modes)
+    end = cols.end
     blocks = _footer_blocks(lines, end)
     paired = len(blocks) == nsample and all(
         b["name"] == n for b, n in zip(blocks, names, strict=True)
@@ -180,7 +113,27 @@ def read_cary_csv(path: str | os.PathLike[str]) -> Measurement:
             f"do not match the {nsample} samples {names}",
             end + 1,
         )
+    frames, samples_meta, dropped_total = _samples(path, names, modes, cols, blocks, paired)
+    meta: dict[str, Any] = {
+        "format": "agilent-cary-winuv-csv",
+        "encoding": encoding,
+        "samples": samples_meta,
+        "dropped_points": dropped_total,
+    }
+    return finish(path, frames, meta)
 
+
+def _samples(
+    path: str | os.PathLike[str],
+    names: list[str],
+    modes: list[str],
+    cols: _Columns,
+    blocks: list[dict[str, Any]],
+    paired: bool,
+) -> tuple[list[pd.DataFrame], list[dict[str, Any]], int]:
+    """Each sample's frame and meta (with its metadata block), and the points dropped."""
+    nsample, end = len(names), cols.end
+    x, y, present, half = cols.x, cols.y, cols.present, cols.half
     frames: list[pd.DataFrame] = []
     samples_meta: list[dict[str, Any]] = []
     dropped_total = 0
@@ -221,13 +174,111 @@ def read_cary_csv(path: str | os.PathLike[str]) -> Measurement:
                 **{key: val for key, val in block.items() if key != "name"},
             }
         )
-    meta: dict[str, Any] = {
-        "format": "agilent-cary-winuv-csv",
-        "encoding": encoding,
-        "samples": samples_meta,
-        "dropped_points": dropped_total,
-    }
-    return finish(path, frames, meta)
+    return frames, samples_meta, dropped_total
+
+
+def _y_modes(path: str | os.PathLike[str], line: str) -> list[str]:
+    """Row 2, the column titles: the Y mode of every sample."""
+    titles = line.split(",")
+    if titles and titles[-1].strip() == "":
+        titles = titles[:-1]
+    if len(titles) < 2 or len(titles) % 2:
+        raise AdapterError(
+            path, "row 2: expected 'Wavelength (nm),<Y mode>' pairs, one per sample", 2
+        )
+    nsample = len(titles) // 2
+    modes = []
+    for k in range(nsample):
+        if titles[2 * k].strip() != _XHEADER:
+            raise AdapterError(
+                path,
+                f"row 2, column {2 * k + 1}: expected {_XHEADER!r}, found "
+                f"{titles[2 * k].strip()[:30]!r} (only nm scans are supported)",
+                2,
+            )
+        mode = titles[2 * k + 1].strip()
+        if mode not in _YMODES:
+            raise AdapterError(
+                path,
+                f"row 2, column {2 * k + 2}: Y mode {mode!r} is not one of {sorted(_YMODES)}",
+                2,
+            )
+        modes.append(mode)
+    return modes
+
+
+def _sample_names(path: str | os.PathLike[str], line: str, nsample: int) -> list[str]:
+    """Row 1: a sample name then an empty cell for every sample."""
+    names_row = _cells(line, 2 * nsample)
+    if names_row is None:
+        raise AdapterError(
+            path, f"row 1: expected {nsample} sample names each followed by an empty cell", 1
+        )
+    names = [names_row[2 * k].strip() for k in range(nsample)]
+    if any(not n for n in names) or any(names_row[2 * k + 1].strip() for k in range(nsample)):
+        raise AdapterError(
+            path, "row 1: expected a sample name then an empty cell for every sample", 1
+        )
+    return names
+
+
+@dataclass
+class _Columns:
+    """The x, y pairs of every sample by line (NaN where a sample has no point)."""
+
+    x: np.ndarray
+    y: np.ndarray
+    #: both x and y written
+    present: np.ndarray
+    #: only one of x and y written (a point the instrument did not record)
+    half: np.ndarray
+    #: the blank line that ends the data
+    end: int
+
+
+def _columns(
+    path: str | os.PathLike[str], lines: list[str], names: list[str], modes: list[str]
+) -> _Columns:
+    """The data rows from row 3 up to the blank line before the metadata blocks."""
+    nsample = len(names)
+    width = 2 * nsample
+    x = np.full((len(lines), nsample), np.nan)
+    y = np.full((len(lines), nsample), np.nan)
+    present = np.zeros((len(lines), nsample), dtype=bool)
+    half = np.zeros((len(lines), nsample), dtype=bool)
+    i = 2
+    while i < len(lines) and lines[i].strip():
+        cells = _cells(lines[i], width)
+        if cells is None:
+            raise AdapterError(
+                path,
+                f"expected {width} cells ({nsample} x,y pairs) and a trailing comma, found "
+                f"{len(lines[i].split(','))}",
+                i + 1,
+            )
+        for k in range(nsample):
+            cx, cy = cells[2 * k].strip(), cells[2 * k + 1].strip()
+            if cx and cy:
+                x[i, k] = number(cx, path, i + 1, f"{names[k]} wavelength")
+                y[i, k] = number(cy, path, i + 1, f"{names[k]} {modes[k]}")
+                present[i, k] = True
+            elif cx or cy:
+                half[i, k] = True
+                if cx:
+                    x[i, k] = number(cx, path, i + 1, f"{names[k]} wavelength")
+                else:
+                    number(cy, path, i + 1, f"{names[k]} {modes[k]}")
+        i += 1
+    end = i
+    if end == 2:
+        raise AdapterError(path, "no data rows after the column titles", 3)
+    if end == len(lines):
+        raise AdapterError(
+            path,
+            "the data are not followed by a blank line and the metadata blocks (file truncated?)",
+            end,
+        )
+    return _Columns(x, y, present, half, end)
 
 
 def _check_steps(

@@ -22,10 +22,12 @@ from __future__ import annotations
 
 import os
 import re
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from ..dataset import Measurement, wrap_delta
@@ -160,6 +162,113 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
     text, encoding = decode(raw, path)
     lines = split_lines(text)
     p = Path(path)
+    f, head, aoi_file = _count_line(path, lines)
+    aoi = abs(aoi_file)
+    meta: dict[str, Any] = {
+        "source_file": p.name,
+        "encoding": encoding,
+        "variant": "dynamic" if f.dynamic else "static",
+        "count_line": head,
+        "aoi_in_file": aoi_file,
+        "aoi_sign": "written negative by the instrument; stored as |AOI|"
+        if aoi_file < 0
+        else "as written",
+    }
+    if not f.dynamic and len(head) >= 6:
+        meta["align_x"], meta["align_y"], meta["average_intensity"] = head[3:6]
+    wl = _led_table(f, meta)
+    k0 = 2 + f.nwl
+    if not f.dynamic:
+        rows = _static_rows(f, k0, wl)
+    else:
+        rows = _dynamic_rows(f, k0, wl, meta)
+    bad = ~((rows.nn >= -1) & (rows.nn <= 1))
+    if bad.any():
+        raise AdapterError(
+            path,
+            "N must be within [-1, 1] (N = cos 2 psi)",
+            int(rows.lineno[np.flatnonzero(bad)[0]]),
+        )
+    _footer(f, rows.footer_start, meta)
+    frame = _frame(path, rows, aoi)
+    meta["delta_convention"] = (
+        "Nebraska: Delta = atan2(S, C), sign checked against a Fresnel "
+        "calculation (see filmsense_psi_delta)"
+    )
+    meta["delta_range"] = "[0, 360)"
+    meta["depolarization"] = "1 - P (P: degree of polarisation as written)"
+    meta["angles_deg"] = group_angles([aoi])
+    meta["wavelength_nm"] = [float(wl.min()), float(wl.max())]
+    meta["sigma"] = "none in the file (NaN)"
+    return measurement(path, frame, meta)
+
+
+def _frame(path: str | os.PathLike[str], rows: _Rows, aoi: float) -> pd.DataFrame:
+    """The tidy frame: psi and delta from N, C, S and depolarization 1 - P for each row."""
+    psi, delta = filmsense_psi_delta(rows.nn, rows.cc, rows.ss)
+    m = psi.size
+    quantity = np.tile(np.array(["psi", "delta", "depolarization"], dtype=object), m)
+    values = np.column_stack([psi, delta, 1.0 - rows.pp]).ravel()
+    units = np.tile(np.array(["deg", "deg", "1"], dtype=object), m)
+    optional: dict[str, Any] = {}
+    if rows.times is not None:
+        optional["time_s"] = np.repeat(rows.times, 3)
+    return build_frame(
+        sample=Path(path).stem,
+        instrument="filmsense",
+        source=Path(path).name,
+        quantity=quantity,
+        value=values,
+        unit=units,
+        wavelength_nm=np.repeat(rows.wl_rows, 3),
+        theta_i_deg=aoi,
+        theta_r_deg=aoi,
+        phi_r_deg=180.0,
+        **optional,
+    )
+
+
+@dataclass
+class _Lines:
+    """The lines of an export with the counts its line 2 announces."""
+
+    path: str | os.PathLike[str]
+    lines: list[str]
+    dynamic: bool
+    nwl: int
+    nsets: int
+
+    def need(self, k: int, what: str) -> str:
+        """Line ``k`` (0-based), or an error saying the file ends early."""
+        if k >= len(self.lines):
+            raise AdapterError(
+                self.path,
+                f"file ends early: expected {what} on line {k + 1} "
+                f"(line 2 announces {self.nwl} wavelengths"
+                + (f" and {self.nsets} time points)" if self.dynamic else ")"),
+                k + 1,
+            )
+        return self.lines[k]
+
+
+@dataclass
+class _Rows:
+    """The N, C, S, P values of every (time point and) wavelength, with their lines."""
+
+    nn: np.ndarray
+    cc: np.ndarray
+    ss: np.ndarray
+    pp: np.ndarray
+    lineno: np.ndarray
+    times: np.ndarray | None
+    wl_rows: np.ndarray
+    footer_start: int
+
+
+def _count_line(
+    path: str | os.PathLike[str], lines: list[str]
+) -> tuple[_Lines, list[float], float]:
+    """Check the magic line 1 and read the count line 2: the lines, line 2 and the AOI."""
     magic = lines[0].strip() if lines else ""
     if magic not in _MAGIC:
         raise AdapterError(
@@ -185,38 +294,18 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
         raise AdapterError(
             path, f"line 2: expected positive integer counts, found {nwl:g} and {nsets:g}", 2
         )
-    nwl, nsets = int(nwl), int(nsets)
-    aoi = abs(aoi_file)
-    if aoi > 90:
+    if abs(aoi_file) > 90:
         raise AdapterError(path, f"line 2: AOI {aoi_file:g} deg is outside [-90, 90]", 2)
-    meta: dict[str, Any] = {
-        "source_file": p.name,
-        "encoding": encoding,
-        "variant": "dynamic" if dynamic else "static",
-        "count_line": head,
-        "aoi_in_file": aoi_file,
-        "aoi_sign": "written negative by the instrument; stored as |AOI|"
-        if aoi_file < 0
-        else "as written",
-    }
-    if not dynamic and len(head) >= 6:
-        meta["align_x"], meta["align_y"], meta["average_intensity"] = head[3:6]
+    return _Lines(path, lines, dynamic, int(nwl), int(nsets)), head, aoi_file
 
-    def need(k: int, what: str) -> str:
-        if k >= len(lines):
-            raise AdapterError(
-                path,
-                f"file ends early: expected {what} on line {k + 1} "
-                f"(line 2 announces {nwl} wavelengths"
-                + (f" and {nsets} time points)" if dynamic else ")"),
-                k + 1,
-            )
-        return lines[k]
 
+def _led_table(f: _Lines, meta: dict[str, Any]) -> np.ndarray:
+    """Read the LED lines into ``meta["led_table"]``; return the wavelengths [nm]."""
+    path = f.path
     led = []
     width = None
-    for k in range(2, 2 + nwl):
-        row = _numbers(path, need(k, "an LED line"), k + 1, "LED line", at_least=2)
+    for k in range(2, 2 + f.nwl):
+        row = _numbers(path, f.need(k, "an LED line"), k + 1, "LED line", at_least=2)
         if width is None:
             width = len(row)
             if width != len(_LED_COLUMNS):
@@ -242,74 +331,80 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
         + [f"col{j + 1}" for j in range(len(_LED_COLUMNS), width or 0)],
         "rows": led,
     }
-    k0 = 2 + nwl
+    return wl
 
-    if not dynamic:
-        rows = [
-            _numbers(path, need(k, "an N C S P I line"), k + 1, "N C S P I line", count=5)
-            for k in range(k0, k0 + nwl)
-        ]
-        a = np.array(rows)
-        lineno = np.arange(k0, k0 + nwl) + 1
-        nn, cc, ss, pp = a[:, 0], a[:, 1], a[:, 2], a[:, 3]
-        times = None
-        footer_start = k0 + nwl
-        wl_rows = wl
-    else:
-        names = [s.strip() for s in need(k0, "the column-name row").rstrip(" \t").split("\t")]
-        if names[0] != "Time":
-            raise AdapterError(
-                path,
-                f"expected the column-name row starting with 'Time', found {names[0][:30]!r}",
-                k0 + 1,
-            )
-        leds = [nm[:-2] for nm in names if nm.endswith("_N")]
-        if len(leds) != nwl:
-            raise AdapterError(
-                path,
-                f"the name row has {len(leds)} LED groups (*_N), line 2 "
-                f"announces {nwl} wavelengths",
-                k0 + 1,
-            )
-        idx = {}
-        for q in ("N", "C", "S", "P"):
-            for led_name in leds:
-                key = f"{led_name}_{q}"
-                if key not in names:
-                    raise AdapterError(path, f"column {key!r} missing from the name row", k0 + 1)
-                idx[key] = names.index(key)
-        rows = [
-            _numbers(path, need(k, "a time-point row"), k + 1, "time-point row", count=len(names))
-            for k in range(k0 + 1, k0 + 1 + nsets)
-        ]
-        a = np.array(rows)
-        t = a[:, 0]
 
-        def grid(q: str) -> np.ndarray:  # (time, led) -> flat, time-major
-            return np.column_stack([a[:, idx[f"{ln}_{q}"]] for ln in leds]).ravel()
+def _static_rows(f: _Lines, k0: int, wl: np.ndarray) -> _Rows:
+    """The static variant: one ``N C S P I`` line per wavelength from line ``k0``."""
+    nwl = f.nwl
+    rows = [
+        _numbers(f.path, f.need(k, "an N C S P I line"), k + 1, "N C S P I line", count=5)
+        for k in range(k0, k0 + nwl)
+    ]
+    a = np.array(rows)
+    lineno = np.arange(k0, k0 + nwl) + 1
+    return _Rows(a[:, 0], a[:, 1], a[:, 2], a[:, 3], lineno, None, wl, k0 + nwl)
 
-        nn, cc, ss, pp = grid("N"), grid("C"), grid("S"), grid("P")
-        lineno = np.repeat(np.arange(k0 + 1, k0 + 1 + nsets) + 1, nwl)
-        times = np.repeat(t, nwl)
-        wl_rows = np.tile(wl, nsets)
-        meta["led_names"] = leds
-        extra = [c for c in names if c != "Time" and not re.fullmatch(r".+_[NCSPI]", c)]
-        meta["per_time_point"] = {c: a[:, names.index(c)].tolist() for c in extra}
-        footer_start = k0 + 1 + nsets
 
-    bad = ~((nn >= -1) & (nn <= 1))
-    if bad.any():
+def _dynamic_rows(f: _Lines, k0: int, wl: np.ndarray, meta: dict[str, Any]) -> _Rows:
+    """The dynamic variant: a column-name row, then one row per time point."""
+    path, nwl, nsets = f.path, f.nwl, f.nsets
+    names = [s.strip() for s in f.need(k0, "the column-name row").rstrip(" \t").split("\t")]
+    if names[0] != "Time":
         raise AdapterError(
-            path, "N must be within [-1, 1] (N = cos 2 psi)", int(lineno[np.flatnonzero(bad)[0]])
+            path,
+            f"expected the column-name row starting with 'Time', found {names[0][:30]!r}",
+            k0 + 1,
         )
+    leds = [nm[:-2] for nm in names if nm.endswith("_N")]
+    if len(leds) != nwl:
+        raise AdapterError(
+            path,
+            f"the name row has {len(leds)} LED groups (*_N), line 2 announces {nwl} wavelengths",
+            k0 + 1,
+        )
+    idx = {}
+    for q in ("N", "C", "S", "P"):
+        for led_name in leds:
+            key = f"{led_name}_{q}"
+            if key not in names:
+                raise AdapterError(path, f"column {key!r} missing from the name row", k0 + 1)
+            idx[key] = names.index(key)
+    rows = [
+        _numbers(path, f.need(k, "a time-point row"), k + 1, "time-point row", count=len(names))
+        for k in range(k0 + 1, k0 + 1 + nsets)
+    ]
+    a = np.array(rows)
+    t = a[:, 0]
 
+    def grid(q: str) -> np.ndarray:  # (time, led) -> flat, time-major
+        return np.column_stack([a[:, idx[f"{ln}_{q}"]] for ln in leds]).ravel()
+
+    meta["led_names"] = leds
+    extra = [c for c in names if c != "Time" and not re.fullmatch(r".+_[NCSPI]", c)]
+    meta["per_time_point"] = {c: a[:, names.index(c)].tolist() for c in extra}
+    return _Rows(
+        grid("N"),
+        grid("C"),
+        grid("S"),
+        grid("P"),
+        np.repeat(np.arange(k0 + 1, k0 + 1 + nsets) + 1, nwl),
+        np.repeat(t, nwl),
+        np.tile(wl, nsets),
+        k0 + 1 + nsets,
+    )
+
+
+def _footer(f: _Lines, footer_start: int, meta: dict[str, Any]) -> None:
+    """Refuse a data row after the announced ones; keep the footer and its fit results."""
+    lines = f.lines
     footer = [ln for ln in lines[footer_start:] if ln.strip()]
     for j, ln in enumerate(lines[footer_start:]):
         if _is_numeric_row(ln):
             raise AdapterError(
-                path,
+                f.path,
                 "unexpected data row after the rows line 2 announces "
-                f"({nwl} wavelengths" + (f", {nsets} time points)" if dynamic else ")"),
+                f"({f.nwl} wavelengths" + (f", {f.nsets} time points)" if f.dynamic else ")"),
                 footer_start + j + 1,
             )
     if footer:
@@ -323,38 +418,6 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
                 meta[mt.group(1).lower()] = mt.group(2).strip()
         if fit:
             meta["software_fit"] = fit
-
-    psi, delta = filmsense_psi_delta(nn, cc, ss)
-    m = psi.size
-    quantity = np.tile(np.array(["psi", "delta", "depolarization"], dtype=object), m)
-    values = np.column_stack([psi, delta, 1.0 - pp]).ravel()
-    units = np.tile(np.array(["deg", "deg", "1"], dtype=object), m)
-    optional: dict[str, Any] = {}
-    if times is not None:
-        optional["time_s"] = np.repeat(times, 3)
-    frame = build_frame(
-        sample=p.stem,
-        instrument="filmsense",
-        source=p.name,
-        quantity=quantity,
-        value=values,
-        unit=units,
-        wavelength_nm=np.repeat(wl_rows, 3),
-        theta_i_deg=aoi,
-        theta_r_deg=aoi,
-        phi_r_deg=180.0,
-        **optional,
-    )
-    meta["delta_convention"] = (
-        "Nebraska: Delta = atan2(S, C), sign checked against a Fresnel "
-        "calculation (see filmsense_psi_delta)"
-    )
-    meta["delta_range"] = "[0, 360)"
-    meta["depolarization"] = "1 - P (P: degree of polarisation as written)"
-    meta["angles_deg"] = group_angles([aoi])
-    meta["wavelength_nm"] = [float(wl.min()), float(wl.max())]
-    meta["sigma"] = "none in the file (NaN)"
-    return measurement(path, frame, meta)
 
 
 FORMATS: tuple[Format, ...] = (

@@ -177,24 +177,7 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
         # report where cp932 fails, not where UTF-8 did (a valid cp932 footer is not UTF-8)
         text, encoding = decode(raw, path, ("cp932",))
     lines = split_lines(text)
-    if not lines or not lines[0].startswith("TITLE"):
-        raise AdapterError(path, "expected a JASCO text export starting with 'TITLE'", 1)
-    sep = "\t" if "\t" in lines[0] else ","
-    header: dict[str, str] = {}
-    i = 0
-    while i < len(lines) and lines[i].strip().rstrip(sep).strip() != "XYDATA":
-        line = lines[i]
-        if line.strip():
-            if sep not in line:
-                raise AdapterError(
-                    path, f"expected 'KEY{sep!r}VALUE' header line, found {line[:40]!r}", i + 1
-                )
-            key, _, value = line.partition(sep)
-            header[key.strip()] = value.strip()
-        i += 1
-    if i == len(lines):
-        raise AdapterError(path, "no 'XYDATA' line: not a JASCO text export or truncated")
-    xy_line = i + 1
+    header, sep, xy_line = _text_header(path, lines)
     xunits = header.get("XUNITS", "")
     if xunits.upper() not in ("NANOMETERS", "NM"):
         raise AdapterError(path, f"XUNITS {xunits!r}: only wavelength in NANOMETERS is supported")
@@ -209,24 +192,8 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
             raise AdapterError(path, f"NPOINTS {header['NPOINTS']!r}: expected an integer")
         # a data row "x<TAB>y<LF>" takes at least 4 bytes
         check_count(path, "NPOINTS", int(npoints), file_size=len(raw), bytes_per_point=4)
-
-    xs: list[float] = []
-    ys: list[float] = []
-    i = xy_line
-    while i < len(lines) and lines[i].strip() and not _SECTION.fullmatch(lines[i].strip()):
-        cells = lines[i].split(sep)
-        if len(cells) != 2:
-            raise AdapterError(
-                path, f"expected 2 cells 'x{sep!r}y' in the data, found {len(cells)}", i + 1
-            )
-        xs.append(number(cells[0], path, i + 1, "X"))
-        ys.append(number(cells[1], path, i + 1, "Y"))
-        i += 1
-    if not xs:
-        raise AdapterError(path, "no data rows after XYDATA", xy_line)
-    end_of_data = i
+    xs, ys, end_of_data = _text_xy(path, lines, xy_line, sep)
     footer, footer_en = _read_footer(path, lines, end_of_data, sep)
-
     if npoints is not None:
         if npoints != len(xs):
             raise AdapterError(
@@ -235,21 +202,7 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
                 f"(file truncated or edited?)",
                 end_of_data,
             )
-    if "FIRSTX" in header and "DELTAX" in header:
-        first = number(header["FIRSTX"], path, None, "FIRSTX")
-        delta = number(header["DELTAX"], path, None, "DELTAX")
-        with np.errstate(over="ignore", invalid="ignore"):
-            grid = first + delta * np.arange(len(xs))
-            off = ~(np.abs(np.asarray(xs) - grid) <= 0.01 * abs(delta) + 1e-9)
-        if off.any():
-            k = int(np.flatnonzero(off)[0])
-            raise AdapterError(
-                path,
-                f"X {xs[k]} is not on the FIRSTX + i*DELTAX grid (expected {grid[k]:.6g}): "
-                "a data row is missing or duplicated",
-                xy_line + 1 + k,
-            )
-
+    _check_text_grid(path, header, xs, xy_line)
     accessory = footer_en.get("accessory", "")
     quantity = _reflectance_quantity(quantity, accessory)
     sample = footer_en.get("sample name") or header.get("TITLE") or Path(path).stem
@@ -273,6 +226,77 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
         "dropped_points": dropped,
     }
     return finish(path, [frame], meta)
+
+
+def _text_header(
+    path: str | os.PathLike[str], lines: list[str]
+) -> tuple[dict[str, str], str, int]:
+    """The ``KEY<sep>VALUE`` header up to ``XYDATA``.
+
+    Returns the header, the separator and the index of the first data row.
+    """
+    if not lines or not lines[0].startswith("TITLE"):
+        raise AdapterError(path, "expected a JASCO text export starting with 'TITLE'", 1)
+    sep = "\t" if "\t" in lines[0] else ","
+    header: dict[str, str] = {}
+    i = 0
+    while i < len(lines) and lines[i].strip().rstrip(sep).strip() != "XYDATA":
+        line = lines[i]
+        if line.strip():
+            if sep not in line:
+                raise AdapterError(
+                    path, f"expected 'KEY{sep!r}VALUE' header line, found {line[:40]!r}", i + 1
+                )
+            key, _, value = line.partition(sep)
+            header[key.strip()] = value.strip()
+        i += 1
+    if i == len(lines):
+        raise AdapterError(path, "no 'XYDATA' line: not a JASCO text export or truncated")
+    return header, sep, i + 1
+
+
+def _text_xy(
+    path: str | os.PathLike[str], lines: list[str], xy_line: int, sep: str
+) -> tuple[list[float], list[float], int]:
+    """The ``x<sep>y`` rows from ``xy_line`` to a blank line or a section title.
+
+    Returns the X and Y values and the index of the line that ends them.
+    """
+    xs: list[float] = []
+    ys: list[float] = []
+    i = xy_line
+    while i < len(lines) and lines[i].strip() and not _SECTION.fullmatch(lines[i].strip()):
+        cells = lines[i].split(sep)
+        if len(cells) != 2:
+            raise AdapterError(
+                path, f"expected 2 cells 'x{sep!r}y' in the data, found {len(cells)}", i + 1
+            )
+        xs.append(number(cells[0], path, i + 1, "X"))
+        ys.append(number(cells[1], path, i + 1, "Y"))
+        i += 1
+    if not xs:
+        raise AdapterError(path, "no data rows after XYDATA", xy_line)
+    return xs, ys, i
+
+
+def _check_text_grid(
+    path: str | os.PathLike[str], header: dict[str, str], xs: list[float], xy_line: int
+) -> None:
+    """Refuse an X off the FIRSTX + i*DELTAX grid the header states (a lost or doubled row)."""
+    if "FIRSTX" in header and "DELTAX" in header:
+        first = number(header["FIRSTX"], path, None, "FIRSTX")
+        delta = number(header["DELTAX"], path, None, "DELTAX")
+        with np.errstate(over="ignore", invalid="ignore"):
+            grid = first + delta * np.arange(len(xs))
+            off = ~(np.abs(np.asarray(xs) - grid) <= 0.01 * abs(delta) + 1e-9)
+        if off.any():
+            k = int(np.flatnonzero(off)[0])
+            raise AdapterError(
+                path,
+                f"X {xs[k]} is not on the FIRSTX + i*DELTAX grid (expected {grid[k]:.6g}): "
+                "a data row is missing or duplicated",
+                xy_line + 1 + k,
+            )
 
 
 def _read_footer(

@@ -117,59 +117,9 @@ def read_oceanoptics(path: str | os.PathLike[str]) -> Measurement:
         raise AdapterError(
             path, "no '>>>>>Begin Spectral Data<<<<<' line: not an Ocean Optics export"
         )
-    header: dict[str, str] = {}
-    data_from = None
-    for n, line in enumerate(lines[:begin], start=1):
-        s = line.strip()
-        if not s or set(s) <= {"+"}:
-            continue
-        if s.startswith("Data from"):
-            data_from = s
-            header["Data from"] = s[len("Data from") :].strip()[:1000]
-            continue
-        key, colon, value = s.partition(":")
-        if colon:
-            header[key.strip()[:200]] = value.strip()[:1000]
-        elif n == 1:
-            header["title"] = s[:1000]
-    mode = header.get("XAxis mode")
-    if mode is not None and mode.strip().lower() != "wavelengths":
-        at = next(i for i, s in enumerate(lines[:begin], start=1) if s.startswith("XAxis"))
-        raise AdapterError(
-            path,
-            f"XAxis mode {mode!r}: only Wavelengths is supported (save the spectrum with "
-            "the wavelength axis)",
-            at,
-        )
+    header, data_from = _header(path, lines, begin)
     quantity, scale, basis = _mode(path, data_from)
-    xs: list[float] = []
-    ys: list[float] = []
-    end = len(lines)
-    for n in range(begin + 1, len(lines)):
-        s = lines[n].strip()
-        if not s:
-            continue
-        if _END.fullmatch(s):
-            end = n
-            break
-        fields = s.split("\t")
-        if len(fields) != 2:
-            raise AdapterError(
-                path,
-                f"expected 2 TAB-separated fields (wavelength, value), found {len(fields)}",
-                n + 1,
-            )
-        fields = [f.replace(",", ".", 1) if "." not in f else f for f in fields]
-        xs.append(number(fields[0], path, n + 1, "wavelength"))
-        ys.append(number(fields[1], path, n + 1, "value"))
-        check_count(path, "rows", len(xs), line=n + 1)
-    for n in range(end + 1, len(lines)):
-        if lines[n].strip():
-            raise AdapterError(
-                path, f"text after the end of the spectral data: {lines[n].strip()[:30]!r}", n + 1
-            )
-    if not xs:
-        raise AdapterError(path, "no data rows after the spectral data marker", begin + 1)
+    xs, ys = _rows(path, lines, begin)
     declared = header.get("Number of Pixels in Spectrum")
     if declared is not None:
         at = next(
@@ -211,6 +161,72 @@ def read_oceanoptics(path: str | os.PathLike[str]) -> Measurement:
         "dropped_points": dropped,
     }
     return finish(path, [frame], meta)
+
+
+def _header(
+    path: str | os.PathLike[str], lines: list[str], begin: int
+) -> tuple[dict[str, str], str | None]:
+    """The ``key: value`` lines before the data marker, and the ``Data from`` line."""
+    header: dict[str, str] = {}
+    data_from = None
+    for n, line in enumerate(lines[:begin], start=1):
+        s = line.strip()
+        if not s or set(s) <= {"+"}:
+            continue
+        if s.startswith("Data from"):
+            data_from = s
+            header["Data from"] = s[len("Data from") :].strip()[:1000]
+            continue
+        key, colon, value = s.partition(":")
+        if colon:
+            header[key.strip()[:200]] = value.strip()[:1000]
+        elif n == 1:
+            header["title"] = s[:1000]
+    mode = header.get("XAxis mode")
+    if mode is not None and mode.strip().lower() != "wavelengths":
+        at = next(i for i, s in enumerate(lines[:begin], start=1) if s.startswith("XAxis"))
+        raise AdapterError(
+            path,
+            f"XAxis mode {mode!r}: only Wavelengths is supported (save the spectrum with "
+            "the wavelength axis)",
+            at,
+        )
+    return header, data_from
+
+
+def _rows(
+    path: str | os.PathLike[str], lines: list[str], begin: int
+) -> tuple[list[float], list[float]]:
+    """The wavelength, value rows between the begin and end markers."""
+    xs: list[float] = []
+    ys: list[float] = []
+    end = len(lines)
+    for n in range(begin + 1, len(lines)):
+        s = lines[n].strip()
+        if not s:
+            continue
+        if _END.fullmatch(s):
+            end = n
+            break
+        fields = s.split("\t")
+        if len(fields) != 2:
+            raise AdapterError(
+                path,
+                f"expected 2 TAB-separated fields (wavelength, value), found {len(fields)}",
+                n + 1,
+            )
+        fields = [f.replace(",", ".", 1) if "." not in f else f for f in fields]
+        xs.append(number(fields[0], path, n + 1, "wavelength"))
+        ys.append(number(fields[1], path, n + 1, "value"))
+        check_count(path, "rows", len(xs), line=n + 1)
+    for n in range(end + 1, len(lines)):
+        if lines[n].strip():
+            raise AdapterError(
+                path, f"text after the end of the spectral data: {lines[n].strip()[:30]!r}", n + 1
+            )
+    if not xs:
+        raise AdapterError(path, "no data rows after the spectral data marker", begin + 1)
+    return xs, ys
 
 
 FORMATS = (

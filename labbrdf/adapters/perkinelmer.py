@@ -119,6 +119,40 @@ def read_perkinelmer_asc(path: str | os.PathLike[str]) -> Measurement:
     hdr = _find(path, lines, "#HDR", 1)
     gr = _find(path, lines, "#GR", hdr + 1)
     data = _find(path, lines, "#DATA", gr + 1)
+    grm = _gr_block(path, lines, gr, data, len(raw))
+    xs, ys = _data_rows(path, lines, data, grm)
+    header = {key: lines[n - 1].strip() for n, key in _HEADER_LINES.items() if n <= hdr}
+    accessory = header.get("accessory", "")
+    sphere = bool(_SPHERE.search(accessory))
+    quantity, scale = _YUNITS[grm["y_unit"].upper()]
+    if quantity == "reflectance" and sphere:
+        quantity = "hemispherical_reflectance"
+    y = np.asarray(ys) * grm["y_scale"] + grm["y_offset"]
+    frame, dropped = spectrum_frame(
+        path=path,
+        sample=_sample_name(header.get("original_file", ""), path),
+        instrument=INSTRUMENT,
+        quantity=quantity,
+        scale=scale,
+        x_nm=xs,
+        y=y,
+    )
+    meta: dict[str, Any] = {
+        "format": "perkinelmer-uvwinlab-asc",
+        "peds_version": m.group(1),
+        "encoding": encoding,
+        **header,
+        "sphere": sphere,
+        "gr": grm,
+        "dropped_points": dropped,
+    }
+    return finish(path, [frame], meta)
+
+
+def _gr_block(
+    path: str | os.PathLike[str], lines: list[str], gr: int, data: int, file_size: int
+) -> dict[str, Any]:
+    """The #GR block (lines ``gr + 1`` up to #DATA): units, Y scale and offset, X grid."""
     block = [s.strip() for s in lines[gr + 1 : data]]
     if len(block) < 7:
         raise AdapterError(
@@ -140,8 +174,24 @@ def read_perkinelmer_asc(path: str | os.PathLike[str]) -> Measurement:
     if npoints != int(npoints) or npoints < 1:
         raise AdapterError(path, f"NPOINTS {block[6]!r}: expected a positive integer", gr + 8)
     # a data row "x<TAB>y<LF>" takes at least 4 bytes
-    check_count(path, "NPOINTS", int(npoints), line=gr + 8, file_size=len(raw), bytes_per_point=4)
+    check_count(path, "NPOINTS", int(npoints), line=gr + 8, file_size=file_size, bytes_per_point=4)
+    return {
+        "x_unit": xunit,
+        "y_unit": yunit,
+        "y_scale": yscale,
+        "y_offset": yoffset,
+        "firstx_nm": firstx,
+        "deltax_nm": deltax,
+        "npoints": int(npoints),
+        "extra": block[7:],
+    }
 
+
+def _data_rows(
+    path: str | os.PathLike[str], lines: list[str], data: int, grm: dict[str, Any]
+) -> tuple[list[float], list[float]]:
+    """The ``x<TAB>y`` rows after #DATA, checked against NPOINTS and the FIRSTX/DELTAX grid."""
+    firstx, deltax, npoints = grm["firstx_nm"], grm["deltax_nm"], grm["npoints"]
     xs: list[float] = []
     ys: list[float] = []
     last = data
@@ -173,42 +223,7 @@ def read_perkinelmer_asc(path: str | os.PathLike[str]) -> Measurement:
             f"X {xs[k]} is not on the FIRSTX + i*DELTAX grid (expected {grid[k]:.6g})",
             data + 2 + k,
         )
-
-    header = {key: lines[n - 1].strip() for n, key in _HEADER_LINES.items() if n <= hdr}
-    accessory = header.get("accessory", "")
-    sphere = bool(_SPHERE.search(accessory))
-    quantity, scale = _YUNITS[yunit.upper()]
-    if quantity == "reflectance" and sphere:
-        quantity = "hemispherical_reflectance"
-    y = np.asarray(ys) * yscale + yoffset
-    frame, dropped = spectrum_frame(
-        path=path,
-        sample=_sample_name(header.get("original_file", ""), path),
-        instrument=INSTRUMENT,
-        quantity=quantity,
-        scale=scale,
-        x_nm=xs,
-        y=y,
-    )
-    meta: dict[str, Any] = {
-        "format": "perkinelmer-uvwinlab-asc",
-        "peds_version": m.group(1),
-        "encoding": encoding,
-        **header,
-        "sphere": sphere,
-        "gr": {
-            "x_unit": xunit,
-            "y_unit": yunit,
-            "y_scale": yscale,
-            "y_offset": yoffset,
-            "firstx_nm": firstx,
-            "deltax_nm": deltax,
-            "npoints": int(npoints),
-            "extra": block[7:],
-        },
-        "dropped_points": dropped,
-    }
-    return finish(path, [frame], meta)
+    return xs, ys
 
 
 FORMATS = (

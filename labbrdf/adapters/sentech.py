@@ -29,6 +29,7 @@ from ._base import AdapterError, Format, decode, read_bytes
 from ._numblock import (
     MUELLER_S1_FLIP,
     NUMBER,
+    Block,
     build_frame,
     check_rows,
     delta_range,
@@ -122,21 +123,7 @@ def read_sentech(path: str | os.PathLike[str], kind: str | None = None) -> Measu
     raw = read_bytes(path)
     text, encoding = decode(raw, path)
     head, body = split_head(text, 1)
-    m = _HEADER.match(head[0]) if head else None
-    if m is None:
-        raise AdapterError(
-            path,
-            "expected the header '; WAVELENGTH <angle> <angle> ...' on "
-            "line 1 (SENTECH SpectraRay ASCII export)",
-            1,
-        )
-    tokens = m.group(1).split()
-    bad = [t for t in tokens if not NUMBER.fullmatch(t)]
-    if bad or not tokens:
-        raise AdapterError(path, f"header angles must be numbers, found {bad[:3] or 'none'}", 1)
-    angles = np.array([float(t) for t in tokens])
-    if not np.all(np.isfinite(angles) & (angles >= 0) & (angles <= 90)):
-        raise AdapterError(path, "header angles must be within [0, 90] deg", 1)
+    angles = _header_angles(path, head)
     n = angles.size
     block = parse_block(path, body, 2, n + 1, sep=None)
     if len(block.lines) == 0:
@@ -158,43 +145,20 @@ def read_sentech(path: str | os.PathLike[str], kind: str | None = None) -> Measu
     elif kind == "psi_delta" and (n % 2 or not np.all(angles[0::2] == angles[1::2])):
         raise AdapterError(path, "kind='psi_delta' needs the header angles in equal pairs", 1)
     p = Path(path)
-    rows = len(wl)
     meta: dict[str, Any] = {
         "source_file": p.name,
         "encoding": encoding,
         "header_angles_deg": angles.tolist(),
         "kind": kind,
-        "data_lines": rows,
+        "data_lines": len(wl),
         "blank_lines_skipped": block.blank_lines,
         "wavelength_nm": [float(wl.min()), float(wl.max())],
         "sigma": "none in the file (NaN)",
     }
     if kind == "psi_delta":
-        nao = n // 2
-        psi = v[:, 1::2]
-        delta = v[:, 2::2]
-        badpsi = np.asarray(((psi < 0) | (psi > 90)).any(axis=1))
-        check_rows(path, block, badpsi, "psi must be within [0, 90] deg")
-        aoi = angles[0::2]
-        # row-major: for each line, for each AOI: psi, delta
-        values = np.stack([psi, wrap_delta(delta)], axis=2).ravel()
-        quantity = np.tile(np.array(["psi", "delta"], dtype=object), rows * nao)
-        theta = np.tile(np.repeat(aoi, 2), rows)
-        wl_rows = np.repeat(wl, 2 * nao)
-        meta["delta_convention"] = "Nebraska, as written by SpectraRay (0..360 deg)"
-        meta["delta_range_in_file"] = delta_range(delta)
-        meta["delta_range"] = "[0, 360)"
-        meta["angles_deg"] = group_angles(aoi)
+        values, quantity, theta, wl_rows = _psi_delta_rows(path, block, angles, meta)
     else:
-        # to the labbrdf.optics convention: SpectraRay writes M12 = -cos 2psi
-        flip = np.array([-1.0 if q in MUELLER_S1_FLIP else 1.0 for q in _MM])
-        values = (v[:, 1:] * flip).ravel()
-        quantity = np.tile(_MM, rows)
-        theta = np.full(values.size, angles[0])
-        wl_rows = np.repeat(wl, 16)
-        meta["mueller"] = "row-major M11..M44, normalised by M11"
-        meta["mueller_convention"] = mueller_convention("SENTECH SpectraRay")
-        meta["angles_deg"] = group_angles(angles[:1])
+        values, quantity, theta, wl_rows = _mueller_rows(v, angles, meta)
     frame = build_frame(
         sample=p.stem,
         instrument="sentech-spectraray",
@@ -208,6 +172,68 @@ def read_sentech(path: str | os.PathLike[str], kind: str | None = None) -> Measu
         phi_r_deg=180.0,
     )
     return measurement(path, frame, meta)
+
+
+def _header_angles(path: str | os.PathLike[str], head: list[str]) -> np.ndarray:
+    """The angles [deg] of the header line ``; WAVELENGTH <angle> <angle> ...``."""
+    m = _HEADER.match(head[0]) if head else None
+    if m is None:
+        raise AdapterError(
+            path,
+            "expected the header '; WAVELENGTH <angle> <angle> ...' on "
+            "line 1 (SENTECH SpectraRay ASCII export)",
+            1,
+        )
+    tokens = m.group(1).split()
+    bad = [t for t in tokens if not NUMBER.fullmatch(t)]
+    if bad or not tokens:
+        raise AdapterError(path, f"header angles must be numbers, found {bad[:3] or 'none'}", 1)
+    angles = np.array([float(t) for t in tokens])
+    if not np.all(np.isfinite(angles) & (angles >= 0) & (angles <= 90)):
+        raise AdapterError(path, "header angles must be within [0, 90] deg", 1)
+    return angles
+
+
+def _psi_delta_rows(
+    path: str | os.PathLike[str], block: Block, angles: np.ndarray, meta: dict[str, Any]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Psi/Delta columns in pairs, one pair per AOI: values, quantities, theta_i, wavelengths."""
+    v = block.values
+    wl = v[:, 0]
+    rows = len(wl)
+    nao = angles.size // 2
+    psi = v[:, 1::2]
+    delta = v[:, 2::2]
+    badpsi = np.asarray(((psi < 0) | (psi > 90)).any(axis=1))
+    check_rows(path, block, badpsi, "psi must be within [0, 90] deg")
+    aoi = angles[0::2]
+    # row-major: for each line, for each AOI: psi, delta
+    values = np.stack([psi, wrap_delta(delta)], axis=2).ravel()
+    quantity = np.tile(np.array(["psi", "delta"], dtype=object), rows * nao)
+    theta = np.tile(np.repeat(aoi, 2), rows)
+    wl_rows = np.repeat(wl, 2 * nao)
+    meta["delta_convention"] = "Nebraska, as written by SpectraRay (0..360 deg)"
+    meta["delta_range_in_file"] = delta_range(delta)
+    meta["delta_range"] = "[0, 360)"
+    meta["angles_deg"] = group_angles(aoi)
+    return values, quantity, theta, wl_rows
+
+
+def _mueller_rows(
+    v: np.ndarray, angles: np.ndarray, meta: dict[str, Any]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The 16 Mueller columns at one AOI: values, quantities, theta_i, wavelengths."""
+    wl = v[:, 0]
+    # to the labbrdf.optics convention: SpectraRay writes M12 = -cos 2psi
+    flip = np.array([-1.0 if q in MUELLER_S1_FLIP else 1.0 for q in _MM])
+    values = (v[:, 1:] * flip).ravel()
+    quantity = np.tile(_MM, len(wl))
+    theta = np.full(values.size, angles[0])
+    wl_rows = np.repeat(wl, 16)
+    meta["mueller"] = "row-major M11..M44, normalised by M11"
+    meta["mueller_convention"] = mueller_convention("SENTECH SpectraRay")
+    meta["angles_deg"] = group_angles(angles[:1])
+    return values, quantity, theta, wl_rows
 
 
 FORMATS: tuple[Format, ...] = (

@@ -40,6 +40,7 @@ from __future__ import annotations
 import datetime as _dt
 import os
 import struct
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -171,137 +172,17 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
         match the header; the message gives the byte offset.
     """
     raw = read_bytes(path)
-
-    def fail(message: str, offset: int) -> AdapterError:
-        return AdapterError(path, message, offset, unit="byte")
-
-    if len(raw) < _HEADER:
-        raise fail(f"file is {len(raw)} bytes, shorter than the 512-byte SPC header", len(raw))
-    if is_ole2(raw):
-        raise fail(
-            "this is an OLE2 compound document (magic D0 CF 11 E0 A1 B1 1A E1), not a "
-            "Galactic SPC: a Shimadzu UVProbe .spc? Read it with --format "
-            "shimadzu-uvprobe-spc on the command line or format='shimadzu-uvprobe-spc' in "
-            "Python",
-            0,
-        )
-    flags, version = raw[0], raw[1]
-    if version in (0x4D, 0x4C):
-        kind = "old-format (0x4D)" if version == 0x4D else "big-endian (0x4C)"
-        raise fail(f"{kind} SPC files are not supported; re-save as new LSB format (0x4B)", 1)
-    if version != 0x4B:
-        raise fail(f"version byte 0x{version:02X}: expected 0x4B (new LSB SPC)", 1)
-    fexp = struct.unpack_from("<b", raw, 3)[0]
-    npts, first, last, nsub = struct.unpack_from("<iddi", raw, 4)
-    xtype, ytype = raw[28], raw[29]
-    (flogoff,) = struct.unpack_from("<i", raw, 248)
-    if flags & _TXYXYS:
-        raise fail("subfiles with their own X arrays (TXYXYS) are not supported", 0)
-    if not flags & _TMULTI:
-        nsub = 1
-    if npts <= 0:
-        raise fail(f"fnpts {npts}: expected a positive point count", 4)
-    if nsub <= 0:
-        raise fail(f"fnsub {nsub}: expected a positive number of subfiles", 24)
-    width = 2 if flags & _TSPREC else 4
-    # before anything is allocated: the total against the cap and what the file can hold
-    check_count(
-        path, "fnpts", npts, line=4, unit="byte", file_size=len(raw), bytes_per_point=width
-    )
-    check_count(
-        path,
-        "fnpts * fnsub",
-        npts * nsub,
-        line=24,
-        unit="byte",
-        file_size=len(raw),
-        bytes_per_point=width,
-    )
-    if xtype not in _XUNITS:
-        raise fail(f"x type {xtype}: only nm (3) and micrometers (2) are supported", 28)
-    if ytype not in _YTYPES:
-        raise fail(
-            f"y type {ytype} ({_YTYPE_NAMES.get(ytype, 'unknown code')}): only absorbance (2), "
-            "transmission (128) and reflectance (129) are supported",
-            29,
-        )
-    xbytes = 4 * npts if flags & _TXVALS else 0
-    end = _HEADER + xbytes + nsub * (_SUBHEADER + width * npts)
-    if len(raw) < end:
-        raise fail(
-            f"file is {len(raw)} bytes but {nsub} subfile(s) of {npts} points need {end} "
-            "(truncated or fnpts wrong)",
-            4,
-        )
-    if flogoff == 0 and len(raw) != end:
-        raise fail(
-            f"file is {len(raw)} bytes, expected {end} for {nsub} subfile(s) of {npts} points "
-            "and no log block",
-            len(raw) if len(raw) < end else end,
-        )
-    if flogoff != 0 and not end <= flogoff < len(raw):
-        raise fail(
-            f"log block offset {flogoff} is outside the file after the data ({end}..{len(raw)})",
-            248,
-        )
-    xname, xscale = _XUNITS[xtype]
-    if flags & _TXVALS:
-        with np.errstate(invalid="ignore"):  # signalling NaNs warn on the cast
-            x = np.frombuffer(raw, "<f4", npts, _HEADER).astype(float)
-    else:
-        if not (np.isfinite(first) and np.isfinite(last)):
-            raise fail(f"first/last X {first}, {last}: expected finite numbers", 8)
-        with np.errstate(over="ignore", invalid="ignore"):
-            x = np.linspace(first, last, npts) if npts > 1 else np.array([first])
-    with np.errstate(over="ignore", invalid="ignore"):
-        x = x * xscale
-    if not np.all(np.isfinite(x) & (x > 0)):
-        raise fail("the X axis has non-finite or non-positive wavelengths", 8)
-    lo, hi = _WAVELENGTH_RANGE_NM
-    if not (x.min() >= lo and x.max() <= hi):
-        raise fail(
-            f"the X axis spans {x.min():.6g} to {x.max():.6g} nm, outside the {lo:g} to "
-            f"{hi:g} nm of an optical spectrum (corrupt ffirst/flast?)",
-            _HEADER if flags & _TXVALS else 8,
-        )
-    step = np.diff(x)
-    if npts > 1 and not (np.all(step > 0) or np.all(step < 0)):
-        k = int(np.flatnonzero(step * np.sign(x[-1] - x[0]) <= 0)[0])
-        raise fail(
-            "the X axis is not strictly monotonic"
-            + (f" (ffirst = flast = {first:g})" if not flags & _TXVALS else f" at point {k + 1}")
-            + ": wavelengths must be distinct",
-            _HEADER + 4 * (k + 1) if flags & _TXVALS else 8,
-        )
-
-    quantity = _YTYPES[ytype]
+    h = _header(path, raw)
+    flags, npts, nsub = h.flags, h.npts, h.nsub
+    x = _x_axis(path, raw, h)
+    quantity = _YTYPES[h.ytype]
     ylabel = None
     if flags & _TALABS:  # fcatxt at byte 218: X, Y, Z axis labels separated by NULs
         labels = raw[218:248].split(b"\x00")
         ylabel = labels[1].decode("latin-1").strip() if len(labels) > 1 else ""
     comment = _text(raw, 88, 130)
     base = comment or Path(path).stem
-    ys: list[tuple[np.ndarray, int]] = []
-    subnpts_all: list[int] = []
-    offset = _HEADER + xbytes
-    for _k in range(nsub):
-        subexp = struct.unpack_from("<b", raw, offset + 1)[0]
-        # subnpts counts the subfile's own X/Y pairs and matters only with TXYXYS (refused
-        # above); with one shared X axis the specification leaves it unused, and writers
-        # leave 0 or anything there: kept in meta, never checked
-        (sub_n,) = struct.unpack_from("<i", raw, offset + 16)
-        exp = subexp if nsub > 1 or fexp == 0 else fexp
-        start = offset + _SUBHEADER
-        if exp == -128:
-            with np.errstate(invalid="ignore"):
-                y = np.frombuffer(raw, "<f4", npts, start).astype(float)
-        elif width == 4:
-            y = np.frombuffer(raw, "<i4", npts, start).astype(float) * 2.0 ** (exp - 32)
-        else:
-            y = np.frombuffer(raw, "<i2", npts, start).astype(float) * 2.0 ** (exp - 16)
-        ys.append((y, int(exp)))
-        subnpts_all.append(int(sub_n))
-        offset = start + width * npts
+    ys, subnpts_all = _subfiles(raw, h)
     scale, in_file, basis = 1.0, None, None
     if quantity != "absorbance":
         scale, in_file, basis = _percent_or_fraction(np.concatenate([y for y, _ in ys]), ylabel)
@@ -324,13 +205,13 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
     meta: dict[str, Any] = {
         "format": "galactic-spc",
         "flags": int(flags),
-        "version": f"0x{version:02X}",
+        "version": f"0x{h.version:02X}",
         "experiment_type": int(raw[2]),
         "npoints": int(npts),
-        "first_x": float(first),
-        "last_x": float(last),
-        "x_unit": xname,
-        "y_type": int(ytype),
+        "first_x": float(h.first),
+        "last_x": float(h.last),
+        "x_unit": _XUNITS[h.xtype][0],
+        "y_type": int(h.ytype),
         "y_type_name": quantity,
         "y_axis_label": ylabel,
         "y_scale_in_file": in_file,
@@ -341,10 +222,193 @@ def read_spc(path: str | os.PathLike[str]) -> Measurement:
         "comment": comment,
         "method": _text(raw, 264, 48),
         "subfiles": subs,
-        "log_offset": int(flogoff),
+        "log_offset": int(h.flogoff),
         "dropped_points": dropped,
     }
     return finish(path, frames, meta)
+
+
+def _fail(path: str | os.PathLike[str], message: str, offset: int) -> AdapterError:
+    """An error at byte ``offset`` of the file."""
+    return AdapterError(path, message, offset, unit="byte")
+
+
+@dataclass(frozen=True)
+class _Header:
+    """The fields of the 512-byte header that lay out the file."""
+
+    flags: int
+    version: int
+    fexp: int
+    npts: int
+    first: float
+    last: float
+    nsub: int
+    xtype: int
+    ytype: int
+    flogoff: int
+    #: bytes per Y value (2 with TSPREC, else 4)
+    width: int
+    #: bytes of the explicit X array after the header (0 when evenly spaced)
+    xbytes: int
+    #: where the last subfile ends
+    end: int
+
+
+def _header(path: str | os.PathLike[str], raw: bytes) -> _Header:
+    """Check the version, flags, counts, units and size the header states."""
+    if len(raw) < _HEADER:
+        raise _fail(
+            path, f"file is {len(raw)} bytes, shorter than the 512-byte SPC header", len(raw)
+        )
+    if is_ole2(raw):
+        raise _fail(
+            path,
+            "this is an OLE2 compound document (magic D0 CF 11 E0 A1 B1 1A E1), not a "
+            "Galactic SPC: a Shimadzu UVProbe .spc? Read it with --format "
+            "shimadzu-uvprobe-spc on the command line or format='shimadzu-uvprobe-spc' in "
+            "Python",
+            0,
+        )
+    flags, version = raw[0], raw[1]
+    if version in (0x4D, 0x4C):
+        kind = "old-format (0x4D)" if version == 0x4D else "big-endian (0x4C)"
+        raise _fail(
+            path, f"{kind} SPC files are not supported; re-save as new LSB format (0x4B)", 1
+        )
+    if version != 0x4B:
+        raise _fail(path, f"version byte 0x{version:02X}: expected 0x4B (new LSB SPC)", 1)
+    fexp = struct.unpack_from("<b", raw, 3)[0]
+    npts, first, last, nsub = struct.unpack_from("<iddi", raw, 4)
+    xtype, ytype = raw[28], raw[29]
+    (flogoff,) = struct.unpack_from("<i", raw, 248)
+    if flags & _TXYXYS:
+        raise _fail(path, "subfiles with their own X arrays (TXYXYS) are not supported", 0)
+    if not flags & _TMULTI:
+        nsub = 1
+    if npts <= 0:
+        raise _fail(path, f"fnpts {npts}: expected a positive point count", 4)
+    if nsub <= 0:
+        raise _fail(path, f"fnsub {nsub}: expected a positive number of subfiles", 24)
+    width = 2 if flags & _TSPREC else 4
+    # before anything is allocated: the total against the cap and what the file can hold
+    check_count(
+        path, "fnpts", npts, line=4, unit="byte", file_size=len(raw), bytes_per_point=width
+    )
+    check_count(
+        path,
+        "fnpts * fnsub",
+        npts * nsub,
+        line=24,
+        unit="byte",
+        file_size=len(raw),
+        bytes_per_point=width,
+    )
+    if xtype not in _XUNITS:
+        raise _fail(path, f"x type {xtype}: only nm (3) and micrometers (2) are supported", 28)
+    if ytype not in _YTYPES:
+        raise _fail(
+            path,
+            f"y type {ytype} ({_YTYPE_NAMES.get(ytype, 'unknown code')}): only absorbance (2), "
+            "transmission (128) and reflectance (129) are supported",
+            29,
+        )
+    xbytes = 4 * npts if flags & _TXVALS else 0
+    end = _HEADER + xbytes + nsub * (_SUBHEADER + width * npts)
+    _check_size(path, raw, nsub, npts, end, flogoff)
+    return _Header(
+        flags, version, fexp, npts, first, last, nsub, xtype, ytype, flogoff, width, xbytes, end
+    )
+
+
+def _check_size(
+    path: str | os.PathLike[str], raw: bytes, nsub: int, npts: int, end: int, flogoff: int
+) -> None:
+    """Refuse a file shorter than its data, or longer without a log block after it."""
+    if len(raw) < end:
+        raise _fail(
+            path,
+            f"file is {len(raw)} bytes but {nsub} subfile(s) of {npts} points need {end} "
+            "(truncated or fnpts wrong)",
+            4,
+        )
+    if flogoff == 0 and len(raw) != end:
+        raise _fail(
+            path,
+            f"file is {len(raw)} bytes, expected {end} for {nsub} subfile(s) of {npts} points "
+            "and no log block",
+            len(raw) if len(raw) < end else end,
+        )
+    if flogoff != 0 and not end <= flogoff < len(raw):
+        raise _fail(
+            path,
+            f"log block offset {flogoff} is outside the file after the data ({end}..{len(raw)})",
+            248,
+        )
+
+
+def _x_axis(path: str | os.PathLike[str], raw: bytes, h: _Header) -> np.ndarray:
+    """The wavelengths [nm]: explicit or evenly spaced, finite, optical and monotonic."""
+    flags, npts, first, last = h.flags, h.npts, h.first, h.last
+    xscale = _XUNITS[h.xtype][1]
+    if flags & _TXVALS:
+        with np.errstate(invalid="ignore"):  # signalling NaNs warn on the cast
+            x = np.frombuffer(raw, "<f4", npts, _HEADER).astype(float)
+    else:
+        if not (np.isfinite(first) and np.isfinite(last)):
+            raise _fail(path, f"first/last X {first}, {last}: expected finite numbers", 8)
+        with np.errstate(over="ignore", invalid="ignore"):
+            x = np.linspace(first, last, npts) if npts > 1 else np.array([first])
+    with np.errstate(over="ignore", invalid="ignore"):
+        x = x * xscale
+    if not np.all(np.isfinite(x) & (x > 0)):
+        raise _fail(path, "the X axis has non-finite or non-positive wavelengths", 8)
+    lo, hi = _WAVELENGTH_RANGE_NM
+    if not (x.min() >= lo and x.max() <= hi):
+        raise _fail(
+            path,
+            f"the X axis spans {x.min():.6g} to {x.max():.6g} nm, outside the {lo:g} to "
+            f"{hi:g} nm of an optical spectrum (corrupt ffirst/flast?)",
+            _HEADER if flags & _TXVALS else 8,
+        )
+    step = np.diff(x)
+    if npts > 1 and not (np.all(step > 0) or np.all(step < 0)):
+        k = int(np.flatnonzero(step * np.sign(x[-1] - x[0]) <= 0)[0])
+        raise _fail(
+            path,
+            "the X axis is not strictly monotonic"
+            + (f" (ffirst = flast = {first:g})" if not flags & _TXVALS else f" at point {k + 1}")
+            + ": wavelengths must be distinct",
+            _HEADER + 4 * (k + 1) if flags & _TXVALS else 8,
+        )
+    return x
+
+
+def _subfiles(raw: bytes, h: _Header) -> tuple[list[tuple[np.ndarray, int]], list[int]]:
+    """The Y values and exponent of every subfile, and the subnpts each states."""
+    npts, nsub, width = h.npts, h.nsub, h.width
+    ys: list[tuple[np.ndarray, int]] = []
+    subnpts_all: list[int] = []
+    offset = _HEADER + h.xbytes
+    for _k in range(nsub):
+        subexp = struct.unpack_from("<b", raw, offset + 1)[0]
+        # subnpts counts the subfile's own X/Y pairs and matters only with TXYXYS (refused
+        # above); with one shared X axis the specification leaves it unused, and writers
+        # leave 0 or anything there: kept in meta, never checked
+        (sub_n,) = struct.unpack_from("<i", raw, offset + 16)
+        exp = subexp if nsub > 1 or h.fexp == 0 else h.fexp
+        start = offset + _SUBHEADER
+        if exp == -128:
+            with np.errstate(invalid="ignore"):
+                y = np.frombuffer(raw, "<f4", npts, start).astype(float)
+        elif width == 4:
+            y = np.frombuffer(raw, "<i4", npts, start).astype(float) * 2.0 ** (exp - 32)
+        else:
+            y = np.frombuffer(raw, "<i2", npts, start).astype(float) * 2.0 ** (exp - 16)
+        ys.append((y, int(exp)))
+        subnpts_all.append(int(sub_n))
+        offset = start + width * npts
+    return ys, subnpts_all
 
 
 FORMATS = (

@@ -352,6 +352,44 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
       (``M12 = +cos 2psi``) by flipping M12, M21, M23, M24, M32, M42, and
       ``meta["mueller_convention"]`` says so.
     """
+    meta, block = _read_block(path)
+    v = block.values
+    tags = _Tags(block)
+    dynamic = bool(meta["dynamic"])
+    _check_fields(path, block, tags, dynamic)
+    x = v[:, 0]
+    wl = _to_nm(path, x, meta["spectral_unit"], block, np.ones(tags.n, dtype=bool))
+    aoi = v[:, 1]
+    if not within(aoi, 0.0, 90.0):
+        check_rows(
+            path,
+            block,
+            ~(np.isfinite(aoi) & (aoi >= 0) & (aoi <= 90)),
+            "angle of incidence must be within [0, 90] deg",
+        )
+    time_s = v[:, 7] * 60.0 if dynamic else None
+    aoi = _reassign_aoi(tags, x, aoi, meta)
+    rt = meta["method"] == "RTmethod"
+    parts = _Parts(path, block, tags.n)
+    delta_seen = _collect(parts, tags, v, rt)
+    if sum(parts.counts()) == 0:
+        raise AdapterError(
+            path,
+            "no finite data values in the file"
+            + (f" (dropped: {parts.dropped})" if parts.dropped else ""),
+        )
+    theta = aoi
+    phi = np.full(tags.n, 180.0)
+    if rt:
+        theta = aoi.copy()
+        _rt_geometry(wl, aoi, v[:, 2], tags.codes, tags.code, tags.utags, theta, phi, meta)
+    frame = _frame(path, meta, parts, wl, theta, phi, time_s)
+    _finish_meta(meta, tags, block, parts, delta_seen, theta, wl)
+    return measurement(path, frame, meta)
+
+
+def _read_block(path: str | os.PathLike[str]) -> tuple[dict[str, Any], Block]:
+    """The header's meta (with source file and encoding) and the data block of a file."""
     raw = read_bytes(path)
     p = Path(path)
     if raw.isascii() and b"\x00" not in raw:
@@ -367,37 +405,52 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
     block = parse_block(path, body, first, 8, sep="\t", tagged=True, data=data, data_start=start)
     if len(block.lines) == 0:
         raise AdapterError(path, "no data rows after the header")
+    return meta, block
+
+
+class _Tags:
+    """The row tags of a block as small integer codes.
+
+    Comparisons on 10^6 object strings are slow, so each line's tag is a code into
+    ``utags`` (the distinct tags) and ``code`` maps a tag to its code.
+    """
+
+    def __init__(self, block: Block) -> None:
+        assert block.tags is not None
+        if block.tag_codes is not None:
+            tcodes, utags = block.tag_codes
+        else:
+            tcodes, tuniq = pd.factorize(block.tags)
+            utags = [str(t) for t in tuniq]
+        self.codes = tcodes
+        self.utags = utags
+        self.code = {t: k for k, t in enumerate(utags)}
+        self.n = len(tcodes)
+
+    def mask(self, *names: str) -> np.ndarray:
+        """The lines whose tag is one of ``names``."""
+        ks = [self.code[t] for t in names if t in self.code]
+        if len(ks) == len(self.utags):
+            return np.ones(self.n, dtype=bool)
+        return np.isin(self.codes, ks) if ks else np.zeros(self.n, dtype=bool)
+
+
+def _check_fields(path: str | os.PathLike[str], block: Block, tags: _Tags, dynamic: bool) -> None:
+    """Refuse an unknown tag and a line with missing or extra fields for its tag."""
     v = block.values
-    assert block.tags is not None
-    # tags as small integer codes: comparisons on 10^6 object strings are slow
-    if block.tag_codes is not None:
-        tcodes, utags = block.tag_codes
-    else:
-        tcodes, tuniq = pd.factorize(block.tags)
-        utags = [str(t) for t in tuniq]
-    code = {t: k for k, t in enumerate(utags)}
-    n = len(tcodes)
-
-    def is_tag(*names: str) -> np.ndarray:
-        ks = [code[t] for t in names if t in code]
-        if len(ks) == len(utags):
-            return np.ones(n, dtype=bool)
-        return np.isin(tcodes, ks) if ks else np.zeros(n, dtype=bool)
-
-    # ---- tags and field counts
-    unknown = [t for t in utags if t not in _NFIELDS]
+    unknown = [t for t in tags.utags if t not in _NFIELDS]
     if unknown:
         check_rows(
             path,
             block,
-            is_tag(unknown[0]),
+            tags.mask(unknown[0]),
             f"unsupported data tag {unknown[0]!r}; supported are {_SUPPORTED} "
             "and untagged Psi/Delta rows",
         )
     # required fields: all of the first nf must be present; an empty field is never a
     # value: a missing number is an error, only a written inf/NaN counts as "not
     # measured" (dropped and reported below)
-    missing, extra = _field_counts(v, tcodes, [_NFIELDS[t] for t in utags])
+    missing, extra = _field_counts(v, tags.codes, [_NFIELDS[t] for t in tags.utags])
     check_rows(
         path,
         block,
@@ -405,10 +458,9 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
         "missing field(s): expected x, AOI and the values of this row type "
         "(6 fields for Psi/Delta, 4 for dpolE/uR/pR/sR)",
     )
-    dynamic = bool(meta["dynamic"])
     if dynamic:
         # untagged dynamic rows: x AOI Psi Delta sPsi sDelta <empty> time_min
-        untagged = is_tag("")
+        untagged = tags.mask("")
         check_rows(
             path,
             block,
@@ -429,23 +481,17 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
         "too many fields for this row type (6 for Psi/Delta, 4 for dpolE/uR/pR/sR)",
     )
 
-    x = v[:, 0]
-    unit = meta["spectral_unit"]
-    wl = _to_nm(path, x, unit, block, np.ones(n, dtype=bool))
-    aoi = v[:, 1]
-    if not within(aoi, 0.0, 90.0):
-        check_rows(
-            path,
-            block,
-            ~(np.isfinite(aoi) & (aoi >= 0) & (aoi <= 90)),
-            "angle of incidence must be within [0, 90] deg",
-        )
-    time_s = v[:, 7] * 60.0 if dynamic else None
 
-    # ---- CompleteEASE 3.x: tagged rows with AOI 0 after a Psi/Delta row of the same x
+def _reassign_aoi(tags: _Tags, x: np.ndarray, aoi: np.ndarray, meta: dict[str, Any]) -> np.ndarray:
+    """CompleteEASE 3.x: tagged rows with AOI 0 after a Psi/Delta row of the same x.
+
+    They take that row's AOI (see :func:`read_woollam`); ``meta["aoi_reassigned"]``
+    counts them.
+    """
+    n = tags.n
     reassigned = 0
-    only_pd = all(t in _PSI_DELTA for t in utags)  # then there is nothing to reassign
-    is_pd = is_tag(*_PSI_DELTA) if not only_pd else None
+    only_pd = all(t in _PSI_DELTA for t in tags.utags)  # then there is nothing to reassign
+    is_pd = tags.mask(*_PSI_DELTA) if not only_pd else None
     zero = ~is_pd & (aoi == 0) if is_pd is not None else None
     if zero is not None and is_pd is not None and zero.any() and is_pd.any():
         last_pd = np.where(is_pd, np.arange(n), -1)
@@ -462,12 +508,19 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
             "reason": "tagged rows written with AOI 0 right after the Psi/Delta row of the "
             "same wavelength (CompleteEASE 3.x interleaved export) take that row's AOI",
         }
+    return aoi
 
-    parts: list[dict[str, Any]] = []
-    dropped: list[dict[str, Any]] = []
-    rt = meta["method"] == "RTmethod"
+
+class _Parts:
+    """The quantities of a file collected one tag at a time, with the rows dropped."""
+
+    def __init__(self, path: str | os.PathLike[str], block: Block, n: int) -> None:
+        self.path, self.block, self.n = path, block, n
+        self.parts: list[dict[str, Any]] = []
+        self.dropped: list[dict[str, Any]] = []
 
     def add(
+        self,
         rows: np.ndarray | None,
         quantity: str,
         value: np.ndarray,
@@ -480,18 +533,19 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
 
         Non-finite values are dropped and reported in ``dropped``.
         """
+        n = self.n
         if not within(sigma, 0.0, np.inf):  # NaN (no sigma) is fine, inf or < 0 is not
             bad_sigma = np.zeros(n, dtype=bool)
             bad_sigma[slice(None) if rows is None else rows] = ~np.isnan(sigma) & ~(
                 np.isfinite(sigma) & (sigma >= 0)
             )
-            check_rows(path, block, bad_sigma, "sigma must be a finite number >= 0")
+            check_rows(self.path, self.block, bad_sigma, "sigma must be a finite number >= 0")
         r = None if rows is None else np.flatnonzero(rows)
         if not within(value):
             good = np.isfinite(value)
             nbad = int((~good).sum())
             kind = "inf" if np.isinf(value[~good]).all() else "NaN/inf"
-            dropped.append(
+            self.dropped.append(
                 {
                     "tag": tag or "(untagged)",
                     "quantity": quantity,
@@ -501,7 +555,7 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
             )
             r = (np.arange(n) if r is None else r)[good]
             value, sigma = value[good], sigma[good]
-        parts.append(
+        self.parts.append(
             {
                 "r": r,
                 "count": n if r is None else len(r),
@@ -513,9 +567,27 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
             }
         )
 
+    def counts(self) -> list[int]:
+        return [pp["count"] for pp in self.parts]
+
+    # rows come grouped by tag and quantity (file order within each group)
+    def take(self, a: np.ndarray) -> np.ndarray:
+        """The per-line array ``a`` at the rows of every part, parts one after another."""
+        return np.concatenate([a if pp["r"] is None else a[pp["r"]] for pp in self.parts])
+
+    def num(self, key: str) -> np.ndarray:
+        return np.concatenate([pp[key] for pp in self.parts])
+
+    def lab(self, key: str) -> pd.Categorical:
+        return labels([pp[key] for pp in self.parts], self.counts())
+
+
+def _collect(parts: _Parts, tags: _Tags, v: np.ndarray, rt: bool) -> list[np.ndarray]:
+    """Add the quantities of every tag to ``parts``; return the Delta columns as written."""
+    path, block = parts.path, parts.block
     delta_seen: list[np.ndarray] = []
-    for t in sorted(utags):
-        rows = None if len(utags) == 1 else tcodes == code[t]
+    for t in sorted(tags.utags):
+        rows = None if len(tags.utags) == 1 else tags.codes == tags.code[t]
 
         def col(j: int, rows: np.ndarray | None = rows) -> np.ndarray:
             return v[:, j] if rows is None else v[rows, j]
@@ -541,81 +613,83 @@ def read_woollam(path: str | os.PathLike[str]) -> Measurement:
                 both = np.isfinite(psi) & np.isfinite(delta)
                 psi_v = np.where(both, psi, np.nan)
                 delta_v = np.where(both, wrap_delta(np.where(both, delta, 0.0)), np.nan)
-            add(rows, "psi", psi_v, col(4), "deg", ch, t)
-            add(rows, "delta", delta_v, col(5), "deg", ch, t)
+            parts.add(rows, "psi", psi_v, col(4), "deg", ch, t)
+            parts.add(rows, "delta", delta_v, col(5), "deg", ch, t)
         elif t in _DEPOL:
-            add(rows, "depolarization", col(2) / 100.0, col(3) / 100.0, "1", "", t)
+            parts.add(rows, "depolarization", col(2) / 100.0, col(3) / 100.0, "1", "", t)
         elif t in _REFL:
             q = "reflectance" if rt else "specular_intensity"
-            add(rows, q, col(2), col(3), "1", _REFL[t], t)
+            parts.add(rows, q, col(2), col(3), "1", _REFL[t], t)
         else:  # Mueller, converted to the labbrdf.optics convention
             sign = -1.0 if _MM[t] in MUELLER_S1_FLIP else 1.0
-            add(rows, _MM[t], sign * col(2), col(4), "1", "", t)
+            parts.add(rows, _MM[t], sign * col(2), col(4), "1", "", t)
+    return delta_seen
 
-    counts = [pp["count"] for pp in parts]
-    if sum(counts) == 0:
-        raise AdapterError(
-            path,
-            "no finite data values in the file" + (f" (dropped: {dropped})" if dropped else ""),
-        )
 
-    # rows come grouped by tag and quantity (file order within each group)
-    def take(a: np.ndarray) -> np.ndarray:
-        """The per-line array ``a`` at the rows of every part, parts one after another."""
-        return np.concatenate([a if pp["r"] is None else a[pp["r"]] for pp in parts])
-
-    def num(key: str) -> np.ndarray:
-        return np.concatenate([pp[key] for pp in parts])
-
-    def lab(key: str) -> pd.Categorical:
-        return labels([pp[key] for pp in parts], counts)
-
-    theta = aoi
-    phi = np.full(n, 180.0)
-    if rt:
-        theta = aoi.copy()
-        _rt_geometry(wl, aoi, v[:, 2], tcodes, code, utags, theta, phi, meta)
-
+def _frame(
+    path: str | os.PathLike[str],
+    meta: dict[str, Any],
+    parts: _Parts,
+    wl: np.ndarray,
+    theta: np.ndarray,
+    phi: np.ndarray,
+    time_s: np.ndarray | None,
+) -> pd.DataFrame:
+    """The tidy frame of the collected quantities."""
+    p = Path(path)
     optional: dict[str, Any] = {}
-    if any(pp["channel"] and pp["count"] for pp in parts):
-        optional["channel"] = lab("channel")
+    if any(pp["channel"] and pp["count"] for pp in parts.parts):
+        optional["channel"] = parts.lab("channel")
     if time_s is not None:
-        optional["time_s"] = take(time_s)
+        optional["time_s"] = parts.take(time_s)
     sample = meta["title"] or p.stem
     software = meta.get("software", "")
     instrument = (
         "woollam-completeease" if software.startswith("CompleteEASE") else ("woollam-wvase")
     )
-    frame = build_frame(
+    return build_frame(
         sample=sample,
         instrument=instrument,
         source=p.name,
-        quantity=lab("quantity"),
-        value=num("value"),
-        sigma=num("sigma"),
-        unit=lab("unit"),
-        wavelength_nm=take(wl),
-        theta_i_deg=take(theta),
-        theta_r_deg=take(theta),  # a second array: the columns must not share memory
-        phi_r_deg=take(phi),
+        quantity=parts.lab("quantity"),
+        value=parts.num("value"),
+        sigma=parts.num("sigma"),
+        unit=parts.lab("unit"),
+        wavelength_nm=parts.take(wl),
+        theta_i_deg=parts.take(theta),
+        theta_r_deg=parts.take(theta),  # a second array: the columns must not share memory
+        phi_r_deg=parts.take(phi),
         **optional,
     )
-    if dynamic:
+
+
+def _finish_meta(
+    meta: dict[str, Any],
+    tags: _Tags,
+    block: Block,
+    parts: _Parts,
+    delta_seen: list[np.ndarray],
+    theta: np.ndarray,
+    wl: np.ndarray,
+) -> None:
+    """Record in ``meta`` what was read: variant, tags, drops and conventions."""
+    if meta["dynamic"]:
         meta["time_unit_in_file"] = "min"
-    meta["variant"] = _variant(meta, "" in code)
-    counts_per_tag = np.bincount(tcodes, minlength=len(utags))
-    meta["tags"] = {t or "(untagged)": int(counts_per_tag[code[t]]) for t in sorted(utags)}
-    meta["data_lines"] = int(n)
+    meta["variant"] = _variant(meta, "" in tags.code)
+    counts_per_tag = np.bincount(tags.codes, minlength=len(tags.utags))
+    meta["tags"] = {
+        t or "(untagged)": int(counts_per_tag[tags.code[t]]) for t in sorted(tags.utags)
+    }
+    meta["data_lines"] = int(tags.n)
     meta["blank_lines_skipped"] = block.blank_lines
-    meta["dropped_rows"] = dropped
-    if any(t in _MM for t in utags):
+    meta["dropped_rows"] = parts.dropped
+    if any(t in _MM for t in tags.utags):
         meta["mueller_convention"] = mueller_convention("Woollam")
     meta["delta_convention"] = "Nebraska (Woollam): Delta = 180 deg at normal incidence"
     meta["delta_range_in_file"] = delta_range(np.concatenate(delta_seen)) if delta_seen else None
     meta["delta_range"] = "[0, 360)"
     meta["angles_deg"] = group_angles(theta)
     meta["wavelength_nm"] = [float(np.min(wl)), float(np.max(wl))]
-    return measurement(path, frame, meta)
 
 
 #: Below this angle of incidence a reflection ellipsometer cannot record a specular

@@ -28,7 +28,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..optics import fresnel_cos, nk_from_psi_delta
+from ..ellipsometry import nk_from_psi_delta
+from ..optics import fresnel_cos
 from .base import Model, ModelError, Parameters
 
 __all__ = ["Microfacet", "ggx_distribution", "smith_g1_ggx", "stokes_from_jones"]
@@ -125,7 +126,7 @@ class Microfacet(Model):
         one of ``n, k``, ``psi_delta`` and ``ideal_mirror``.
     psi_delta : tuple of float
         ``(psi_deg, delta_deg, theta_deg)`` measured by an ellipsometer on the same sample;
-        N comes from the two-phase inversion :func:`labbrdf.optics.nk_from_psi_delta`.
+        N comes from the two-phase inversion :func:`labbrdf.ellipsometry.nk_from_psi_delta`.
     ideal_mirror : bool
         F = 1 (rs = -1, rp = +1, the limit N -> i infinity).
     shadowing : {"smith", "none"}, default "smith"

@@ -35,74 +35,78 @@ NOTES_MISROUNDED = {("mirror", 500.0)}
 #: R(30, 50) and R(50, 30) [sr^-1] at 550 nm with the paper's fits, docs/models.md 1.3
 RECIPROCITY_550 = {"OSR": (0.1209, 0.1059), "mirror": (0.0173, 0.0971)}
 
+#: The errata, one row each: where in which paper, what is printed, what is correct, and
+#: where the correction matters in this report
+_ERRATA: tuple[dict[str, str], ...] = (
+    {
+        "where": "2013 Table 3",
+        "printed": "'integration result' at theta_i = 45 deg",
+        "correct": "reproduced at 46 deg with the proper 2 pi int f cos sin convention",
+        "used": "hemispherical section: both angles shown",
+    },
+    {
+        "where": "2013 eq. (8)",
+        "printed": "energy conserved iff k1 <= 4/pi",
+        "correct": "no k1 > 0 conserves energy at all angles; k1 <= 4/(pi max I/cos) on "
+        "[0, theta_max] (docs/models.md 1.4)",
+        "used": "energy checks: rho(theta_i) and the limit angle of every fit",
+    },
+    {
+        "where": "2013 section 2",
+        "printed": "the model is reciprocal",
+        "correct": "reciprocal iff k2 = 0 (docs/models.md 1.3)",
+        "used": "reciprocity defect of every fit",
+    },
+    {
+        "where": "2013 eq. (5)",
+        "printed": "(k' - sin g)",
+        "correct": "(k' - sin g tan g)",
+        "used": "not used by the report",
+    },
+    {
+        "where": "2013 eq. (6)",
+        "printed": "square missing inside the root",
+        "correct": "see docs/models.md 3.4",
+        "used": "ellipsometric inversion (optics)",
+    },
+    {
+        "where": "2022 eq. (14)",
+        "printed": "GGX D without alpha^2 in the numerator",
+        "correct": "D = alpha^2 / (pi cos^4 g (alpha^2 + tan^2 g)^2)",
+        "used": "tracer maps and validations",
+    },
+    {
+        "where": "2022 eq. (17)",
+        "printed": "rotation Mueller M[0,0] = 0",
+        "correct": "M[0,0] = 1",
+        "used": "tracer maps and validations",
+    },
+    {
+        "where": "2022 eq. (12)",
+        "printed": "-2 sqrt(Ts Tp) on the diagonal block",
+        "correct": "+2 Re(t_s t_p*) scaled by the beam-area factor",
+        "used": "tracer (coated surfaces)",
+    },
+    {
+        "where": "2022 eq. (2)",
+        "printed": "PSD exponent k_x^2 c_x + k_y^2 c_y",
+        "correct": "k_x^2 c_x^2 + k_y^2 c_y^2",
+        "used": "surface generation (not in maps)",
+    },
+    {
+        "where": "2022 section 4",
+        "printed": "maximum polarization at d = lambda/4",
+        "correct": "cannot appear in incoherent ray optics (a lossless varnish's thickness "
+        "only enters through absorption); needs coherent film amplitudes",
+        "used": "coating-thickness factor study",
+    },
+)
+
 
 def errata_section(ctx: Context) -> None:
     """The paper errata the report depends on, with the checks that confirm them."""
     b = ctx.b
-    rows = [
-        {
-            "where": "2013 Table 3",
-            "printed": "'integration result' at theta_i = 45 deg",
-            "correct": "reproduced at 46 deg with the proper 2 pi int f cos sin convention",
-            "used": "hemispherical section: both angles shown",
-        },
-        {
-            "where": "2013 eq. (8)",
-            "printed": "energy conserved iff k1 <= 4/pi",
-            "correct": "no k1 > 0 conserves energy at all angles; k1 <= 4/(pi max I/cos) on "
-            "[0, theta_max] (docs/models.md 1.4)",
-            "used": "energy checks: rho(theta_i) and the limit angle of every fit",
-        },
-        {
-            "where": "2013 section 2",
-            "printed": "the model is reciprocal",
-            "correct": "reciprocal iff k2 = 0 (docs/models.md 1.3)",
-            "used": "reciprocity defect of every fit",
-        },
-        {
-            "where": "2013 eq. (5)",
-            "printed": "(k' - sin g)",
-            "correct": "(k' - sin g tan g)",
-            "used": "not used by the report",
-        },
-        {
-            "where": "2013 eq. (6)",
-            "printed": "square missing inside the root",
-            "correct": "see docs/models.md 3.4",
-            "used": "ellipsometric inversion (optics)",
-        },
-        {
-            "where": "2022 eq. (14)",
-            "printed": "GGX D without alpha^2 in the numerator",
-            "correct": "D = alpha^2 / (pi cos^4 g (alpha^2 + tan^2 g)^2)",
-            "used": "tracer maps and validations",
-        },
-        {
-            "where": "2022 eq. (17)",
-            "printed": "rotation Mueller M[0,0] = 0",
-            "correct": "M[0,0] = 1",
-            "used": "tracer maps and validations",
-        },
-        {
-            "where": "2022 eq. (12)",
-            "printed": "-2 sqrt(Ts Tp) on the diagonal block",
-            "correct": "+2 Re(t_s t_p*) scaled by the beam-area factor",
-            "used": "tracer (coated surfaces)",
-        },
-        {
-            "where": "2022 eq. (2)",
-            "printed": "PSD exponent k_x^2 c_x + k_y^2 c_y",
-            "correct": "k_x^2 c_x^2 + k_y^2 c_y^2",
-            "used": "surface generation (not in maps)",
-        },
-        {
-            "where": "2022 section 4",
-            "printed": "maximum polarization at d = lambda/4",
-            "correct": "cannot appear in incoherent ray optics (a lossless varnish's thickness "
-            "only enters through absorption); needs coherent film amplitudes",
-            "used": "coating-thickness factor study",
-        },
-    ]
+    rows = list(_ERRATA)
     b.table(
         "errata",
         "Errata of the source papers that this report depends on",
@@ -119,6 +123,13 @@ def errata_section(ctx: Context) -> None:
     if t is None:
         raise Unavailable("published Tables 1-2 not found (fixtures/published)")
     m = models.get("smooth3")
+    _energy_limits(ctx, m)
+    _reciprocity(ctx, m)
+
+
+def _energy_limits(ctx: Context, m: models.Model) -> None:
+    """Erratum of eq. (8): where the paper's own fits reach rho = 1, with the checks."""
+    b = ctx.b
     erows, worst, worst_root = [], 0.0, 0.0
     for (sample, wl), ref in ENERGY_LIMIT_DEG.items():
         pv = paper_values(ctx.published, sample, wl)
@@ -180,6 +191,11 @@ def errata_section(ctx: Context) -> None:
             "bound 0.05). Excluded: mirror 500 nm, printed there as 76.3 but whose root is "
             "76.2498 deg (checked by quadrature above), so the printed value is misrounded.",
         )
+
+
+def _reciprocity(ctx: Context, m: models.Model) -> None:
+    """Erratum of the reciprocity claim: f(30, 50) and f(50, 30) of the 550 nm fits."""
+    b = ctx.b
     rrows, worst = [], 0.0
     for sample, (a_ref, b_ref) in RECIPROCITY_550.items():
         pv = paper_values(ctx.published, sample, 550.0)

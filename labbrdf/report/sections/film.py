@@ -4,17 +4,17 @@ Where the angles of incidence of a psi/Delta file disagree (:func:`labbrdf.nk.an
 ``stack`` or ``partly``), its two-phase pseudo-constants are those of a stack and give
 neither a material's n, k nor a reflectance (section ``nk``). Given a film model (a TOML
 file, :func:`labbrdf.films.load_model`, or the stated default :func:`default_film_model`),
-this section fits it to the file's psi/Delta at every angle (:func:`labbrdf.films.fit_film`)
+this section fits it to the file's psi/Delta at every angle (:func:`labbrdf.fit_film`)
 and shows the model, the parameters with their intervals, psi and Delta against wavelength
 per angle with the fit and the residuals, each layer's n, k with its uncertainty band, and
 the reflectance comparison redone with the fitted stack: the measured reflectance of the
 same sample (not used by the fit) against the stack's R_s, R_p
-(:meth:`labbrdf.films.FilmFit.compare_reflectance`), inside the fitted wavelength range.
+(:meth:`labbrdf.FilmFit.compare_reflectance`), inside the fitted wavelength range.
 
 Uncertainties of derived curves (n, k of a layer, predicted R) are first-order: central
 differences of the curve in each varying parameter, combined with the fit's covariance
 ``J C J^T``, times ``sqrt(chi2/nu)`` where chi-square rejects the film model
-(:attr:`labbrdf.films.FilmFit.misfit_scale`).
+(:attr:`labbrdf.FilmFit.misfit_scale`).
 """
 
 from __future__ import annotations
@@ -94,7 +94,7 @@ def _propagated(
 
 
 def _param_rows(summary: dict[str, Any]) -> list[dict[str, Any]]:
-    """The varying parameters of a :meth:`labbrdf.films.FilmFit.summary`, one row each."""
+    """The varying parameters of a :meth:`labbrdf.FilmFit.summary`, one row each."""
     groups = [(lay["name"], lay["parameters"]) for lay in summary["layers"]]
     groups.append(("substrate", summary["substrate"]["parameters"]))
     rows = []
@@ -318,6 +318,136 @@ def _ordinary(g: pd.DataFrame) -> pd.DataFrame:
     return rows
 
 
+def _flagged(
+    ellips: list[tuple[str, pd.DataFrame]],
+) -> list[tuple[str, pd.DataFrame, nkmod.AngleVerdict]]:
+    """(file, rows, angle verdict) of each psi/Delta file whose angles disagree."""
+    flagged = []
+    for src, g in ellips:
+        try:
+            comb = nkmod.combined_table(_ordinary(g), on_ill_conditioned="ignore")
+        except ValueError:
+            continue
+        verdict = nkmod.angle_verdict(comb)
+        if verdict.kind in ("stack", "partly"):
+            flagged.append((src, g, verdict))
+    return flagged
+
+
+def _model_text(ctx: Context, model: films.FilmModel, how: str) -> None:
+    """The film model in words: its layers, what is fitted, the fit window."""
+    free = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in model.free.items())
+    ctx.b.text(
+        f"Film model ({how or model.source}): ambient {_describe(model.stack.ambient)} / "
+        + " / ".join(f"{lay.name} ({_describe(lay.material)})" for lay in model.stack.layers)
+        + f" / substrate ({_describe(model.stack.substrate)}). Fitted: {free or 'nothing'}"
+        + (
+            f"; fit window {model.wavelength_range_nm[0]:g}-{model.wavelength_range_nm[1]:g} nm"
+            if model.wavelength_range_nm
+            else ""
+        )
+        + ". Each file's psi and Delta at all its angles are fitted together (global then "
+        "local optimiser, weighted by the file's sigmas); intervals are 95 %. The measured "
+        "reflectance of the same sample is not fitted: it is predicted from the stack."
+    )
+
+
+def _fit_shown(
+    ctx: Context, tag: str, src: str, verdict: nkmod.AngleVerdict, fit: films.FilmFit
+) -> None:
+    """One fit: its summary in words, the parameter table, psi/Delta and n, k figures."""
+    b = ctx.b
+    s = fit.summary()
+    b.text(
+        f"Verdict of section nk: {verdict.text}. Fit of {s['ndata']} values "
+        f"({s['wavelength_range_nm'][0]:.4g}-{s['wavelength_range_nm'][1]:.4g} nm), "
+        f"{s['nvarys']} parameters: chi2/nu {s['redchi']:.4g}, Woollam MSE "
+        f"{s['mse']:.4g}; {s['message']}."
+        + (" Notes: " + "; ".join(s["notes"]) + "." if s["notes"] else "")
+    )
+    b.table(
+        f"film_{tag}_params",
+        f"{src}: fitted parameters",
+        [
+            ("parameter", "parameter", ""),
+            ("value", "value", ".6g"),
+            ("stderr", "\u03c3", ".2g"),
+            ("ci_lo", "95 % low", ".6g"),
+            ("ci_hi", "95 % high", ".6g"),
+            ("ci_lo_scaled", "95 % low, scaled", ".6g"),
+            ("ci_hi_scaled", "95 % high, scaled", ".6g"),
+            ("units", "units", ""),
+            ("min", "box min", ".4g"),
+            ("max", "box max", ".4g"),
+            ("flags", "flags", ""),
+        ],
+        _param_rows(s),
+        caption=f"{s['ci_method']} intervals from the files' sigmas; 'scaled': times "
+        "sqrt(chi2/nu), given where chi-square rejects the film model (p < 0.01), which "
+        "then misses the data by more than the sigmas; units [1] where none is given.",
+    )
+    b.figure(
+        f"film_{tag}_psi_delta",
+        f"{src}: psi and Delta against wavelength per angle, with the fit",
+        "Measured psi and Delta [deg] (coloured points, one colour per angle of "
+        f"incidence, at most {_MAX_ANGLES} angles spread over the range) and the fitted "
+        "stack's (black lines) against wavelength [nm]; right: measured - fit, band = the "
+        "file's 1-sigma.",
+        _psi_delta_figure(fit),
+    )
+    b.figure(
+        f"film_{tag}_nk",
+        f"{src}: n and k of each layer of the fitted stack",
+        "Modelled: n [1] and k [1] of each layer and of the substrate against wavelength "
+        "[nm], band = 1-sigma propagated from the fit's covariance, times sqrt(chi2/nu) "
+        "where chi-square rejects the film model (zero for fixed parameters and tables).",
+        _nk_figure(fit),
+    )
+
+
+def _fit_file(
+    ctx: Context,
+    i: int,
+    src: str,
+    g: pd.DataFrame,
+    verdict: nkmod.AngleVerdict,
+    model: films.FilmModel,
+    ellips: list[tuple[str, pd.DataFrame]],
+    refl: list[tuple[str, pd.DataFrame]],
+    cmp_rows: list[dict[str, Any]],
+) -> None:
+    """Fit ``model`` to one file, show it, and compare the stack with measured reflectance.
+
+    Reflectance of the same file or sample, or any when the report has one psi/Delta file;
+    the comparison rows are added to ``cmp_rows``. A model that cannot be fitted is a
+    failed check.
+    """
+    b = ctx.b
+    tag = f"{i}_{slug(src)}"
+    b.heading(f"{src}: film fit", anchor=f"film_{tag}")
+    try:
+        fit = films.fit_film(model, _ordinary(g), method=ctx.method, seed=ctx.seed)
+    except ValueError as exc:
+        b.note("no film fit", f"{src}: {exc}")
+        b.check(
+            f"film.fit.{tag}",
+            f"{src}: the film model can be fitted",
+            False,
+            against="the film model and the file's psi/Delta",
+            justification=str(exc),
+        )
+        return
+    _fit_shown(ctx, tag, src, verdict, fit)
+    samples = {str(x).lower() for x in g["sample"]}
+    for j, (rs, rg) in enumerate(refl):
+        same = rs == src or bool(samples & {str(x).lower() for x in rg["sample"]})
+        if not same and not (len(ellips) == 1 and rs not in dict(ellips)):
+            continue
+        row = _reflectance(ctx, f"{tag}_r{j}_{slug(rs)}", src, fit, rs, rg)
+        if row is not None:
+            cmp_rows.append(row)
+
+
 def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") -> None:
     """Fit ``model`` to every angle-dependent psi/Delta file and redo its reflectance check.
 
@@ -334,15 +464,7 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
     ellips = [(s, g) for s, g, _m in frames if len(_ordinary(g))]
     if not ellips:
         raise Unavailable("no psi/Delta rows ingested: no film to fit")
-    flagged = []
-    for src, g in ellips:
-        try:
-            comb = nkmod.combined_table(_ordinary(g), on_ill_conditioned="ignore")
-        except ValueError:
-            continue
-        verdict = nkmod.angle_verdict(comb)
-        if verdict.kind in ("stack", "partly"):
-            flagged.append((src, g, verdict))
+    flagged = _flagged(ellips)
     if not flagged:
         raise Unavailable(
             "no psi/Delta file whose angles of incidence disagree: no stack to fit "
@@ -355,103 +477,11 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
             "--film-model FILE.toml, or --film-default for one transparent Cauchy layer on "
             "crystalline silicon (thickness free)"
         )
-    free = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in model.free.items())
-    b.text(
-        f"Film model ({how or model.source}): ambient {_describe(model.stack.ambient)} / "
-        + " / ".join(f"{lay.name} ({_describe(lay.material)})" for lay in model.stack.layers)
-        + f" / substrate ({_describe(model.stack.substrate)}). Fitted: {free or 'nothing'}"
-        + (
-            f"; fit window {model.wavelength_range_nm[0]:g}-{model.wavelength_range_nm[1]:g} nm"
-            if model.wavelength_range_nm
-            else ""
-        )
-        + ". Each file's psi and Delta at all its angles are fitted together (global then "
-        "local optimiser, weighted by the file's sigmas); intervals are 95 %. The measured "
-        "reflectance of the same sample is not fitted: it is predicted from the stack."
-    )
+    _model_text(ctx, model, how)
     refl = [(s, g) for s, g, _m in frames if (g["quantity"] == "reflectance").any()]
-    summary_rows: list[dict[str, Any]] = []
     cmp_rows: list[dict[str, Any]] = []
     for i, (src, g, verdict) in enumerate(flagged):
-        tag = f"{i}_{slug(src)}"
-        b.heading(f"{src}: film fit", anchor=f"film_{tag}")
-        try:
-            fit = films.fit_film(model, _ordinary(g), method=ctx.method, seed=ctx.seed)
-        except ValueError as exc:
-            b.note("no film fit", f"{src}: {exc}")
-            b.check(
-                f"film.fit.{tag}",
-                f"{src}: the film model can be fitted",
-                False,
-                against="the film model and the file's psi/Delta",
-                justification=str(exc),
-            )
-            continue
-        s = fit.summary()
-        b.text(
-            f"Verdict of section nk: {verdict.text}. Fit of {s['ndata']} values "
-            f"({s['wavelength_range_nm'][0]:.4g}-{s['wavelength_range_nm'][1]:.4g} nm), "
-            f"{s['nvarys']} parameters: chi2/nu {s['redchi']:.4g}, Woollam MSE "
-            f"{s['mse']:.4g}; {s['message']}."
-            + (" Notes: " + "; ".join(s["notes"]) + "." if s["notes"] else "")
-        )
-        b.table(
-            f"film_{tag}_params",
-            f"{src}: fitted parameters",
-            [
-                ("parameter", "parameter", ""),
-                ("value", "value", ".6g"),
-                ("stderr", "\u03c3", ".2g"),
-                ("ci_lo", "95 % low", ".6g"),
-                ("ci_hi", "95 % high", ".6g"),
-                ("ci_lo_scaled", "95 % low, scaled", ".6g"),
-                ("ci_hi_scaled", "95 % high, scaled", ".6g"),
-                ("units", "units", ""),
-                ("min", "box min", ".4g"),
-                ("max", "box max", ".4g"),
-                ("flags", "flags", ""),
-            ],
-            _param_rows(s),
-            caption=f"{s['ci_method']} intervals from the files' sigmas; 'scaled': times "
-            "sqrt(chi2/nu), given where chi-square rejects the film model (p < 0.01), which "
-            "then misses the data by more than the sigmas; units [1] where none is given.",
-        )
-        b.figure(
-            f"film_{tag}_psi_delta",
-            f"{src}: psi and Delta against wavelength per angle, with the fit",
-            "Measured psi and Delta [deg] (coloured points, one colour per angle of "
-            f"incidence, at most {_MAX_ANGLES} angles spread over the range) and the fitted "
-            "stack's (black lines) against wavelength [nm]; right: measured - fit, band = the "
-            "file's 1-sigma.",
-            _psi_delta_figure(fit),
-        )
-        b.figure(
-            f"film_{tag}_nk",
-            f"{src}: n and k of each layer of the fitted stack",
-            "Modelled: n [1] and k [1] of each layer and of the substrate against wavelength "
-            "[nm], band = 1-sigma propagated from the fit's covariance, times sqrt(chi2/nu) "
-            "where chi-square rejects the film model (zero for fixed parameters and tables).",
-            _nk_figure(fit),
-        )
-        summary_rows.append(
-            {
-                "file": src,
-                "redchi": s["redchi"],
-                "mse": s["mse"],
-                **{
-                    f"{lay['name']} [nm]": lay["parameters"]["thickness_nm"]["value"]
-                    for lay in s["layers"]
-                },
-            }
-        )
-        samples = {str(x).lower() for x in g["sample"]}
-        for j, (rs, rg) in enumerate(refl):
-            same = rs == src or bool(samples & {str(x).lower() for x in rg["sample"]})
-            if not same and not (len(ellips) == 1 and rs not in dict(ellips)):
-                continue
-            row = _reflectance(ctx, f"{tag}_r{j}_{slug(rs)}", src, fit, rs, rg)
-            if row is not None:
-                cmp_rows.append(row)
+        _fit_file(ctx, i, src, g, verdict, model, ellips, refl, cmp_rows)
     if cmp_rows:
         b.table(
             "film_reflectance_comparison",

@@ -40,124 +40,148 @@ def fits_section(
         pnames = list(recs[0].params)
         varying = [p for p in pnames if recs[0].params[p].get("vary", True)]
         has_pub = name == "smooth3" and "params" in ctx.published
-        cols: list[tuple[str, str, str]] = [
-            ("sample", "sample", ""),
-            ("wavelength_nm", "\u03bb [nm]", "g"),
-        ]
-        for p in varying:
-            u = recs[0].params[p].get("units") or ""
-            unit = f" [{u}]" if u and u != "1" else ""
-            cols += [
-                (p, f"{p}{unit}", ".5g"),
-                (f"{p}_stderr", f"\u03c3({p})", ".2g"),
-                (f"{p}_lo", f"{p} 95% lo", ".5g"),
-                (f"{p}_hi", f"{p} 95% hi", ".5g"),
-            ]
-            if has_pub:
-                cols.append((f"{p}_pub", f"{p} published", ".5g"))
-        cols += [("flags", "flags", ""), ("rmse_paper", "RMSE (paper's sense) [%]", ".4g")]
-        if has_pub:
-            cols.append(("rmse_pub", "RMSE published [%]", ".4g"))
-        cols += [
-            ("rmse_abs", "RMSE [data units]", ".3g"),
-            ("redchi", "\u03c7\u00b2/\u03bd", ".4g"),
-            ("nfev", "nfev", "d"),
-            ("success", "success", ""),
-        ]
-        rows = []
-        for r in recs:
-            row: dict[str, Any] = {"sample": r.sample, "wavelength_nm": r.wavelength_nm}
-            pub = published_params(ctx.published, r.sample, r.wavelength_nm) if has_pub else {}
-            flags = []
-            for p in varying:
-                q = r.params[p]
-                row.update(
-                    {
-                        p: q["value"],
-                        f"{p}_stderr": q["stderr"],
-                        f"{p}_lo": q["lo"],
-                        f"{p}_hi": q["hi"],
-                        f"{p}_pub": pub.get(p),
-                    }
-                )
-                flags += [f"{p}: {f}" for f in q["flags"]]
-            row["flags"] = "; ".join(flags)
-            row["rmse_paper"] = rmse_paper(r.summary)
-            row["rmse_pub"] = pub.get("rmse")
-            row["rmse_abs"] = rmse_abs(r.summary)
-            row["redchi"] = num(r.summary.get("redchi"))
-            row["nfev"] = r.summary.get("nfev")
-            row["success"] = bool(r.summary.get("success"))
-            rows.append(row)
         opts = ", ".join(f"{k}={v}" for k, v in recs[0].options.items()) or "defaults"
         b.table(
             f"fit_{name}",
             f"Fitted {name} parameters per sample and wavelength ({opts})",
-            cols,
-            rows,
+            _columns(recs, varying, has_pub),
+            [_row(ctx, r, varying, has_pub) for r in recs],
             caption=f"Measured: the scan rows of each (sample, wavelength). Modelled: {name} "
             f"fitted with nlopt {ctx.method} (seed {ctx.seed}). \u03c3 from the Jacobian at the "
             "optimum, 95% interval from the t distribution; flags mark parameters at a bound "
             "or not identifiable from the data."
             + (" 'published' columns: Zou, Bai, Wu 2013, Tables 1-2." if has_pub else ""),
         )
-        bad = [
-            f"{r.sample} {wl_label(r.wavelength_nm)}: {r.summary.get('message', '')}"
-            for r in recs
-            if not r.summary.get("success")
-        ]
-        b.check(
-            f"fits.{name}.success",
-            f"every {name} fit converged",
-            not bad,
-            against="the optimiser's success flag",
-            value=len(recs) - len(bad),
-            tolerance=len(recs),
-            justification="value = converged fits, tolerance = fits run",
-            reason="; ".join(bad)[:1000],
-        )
-        # chi-square consistency where the files give sigma
-        lohi = []
-        worst = None
-        ok = True
-        for r in recs:
-            red = num(r.summary.get("redchi"))
-            has_sigma = r.data["sigma"].notna().all()
-            nfree = len(r.data) - len(varying)
-            if red is None or not has_sigma or nfree < 1:
-                continue
-            lo = stats.chi2.ppf(0.0005, nfree) / nfree
-            hi = stats.chi2.ppf(0.9995, nfree) / nfree
-            lohi.append((lo, hi))
-            if not lo <= red <= hi:
-                ok = False
-            if worst is None or abs(math.log(red)) > abs(math.log(worst)):
-                worst = red
-        if chi2_models is not None and name not in chi2_models:
-            shown = "n/a" if worst is None else f"{worst:.4g}"
-            b.text(
-                f"{name}: reduced \u03c7\u00b2 up to {shown} (a finding, not a check: the "
-                "data were not generated with this model)."
-            )
-        elif lohi:
-            b.check(
-                f"fits.{name}.chi2",
-                f"{name}: reduced \u03c7\u00b2 of every fit consistent with the file's \u03c3",
-                ok,
-                against="the \u03c7\u00b2 distribution with \u03bd = N - n_par",
-                value=worst,
-                tolerance=[min(x for x, _ in lohi), max(y for _, y in lohi)],
-                justification="two-sided 99.9% interval of \u03c7\u00b2/\u03bd per fit; a model "
-                "that describes the data within their stated \u03c3 lands inside",
-            )
-        else:
-            b.skip(
-                f"fits.{name}.chi2",
-                f"{name}: reduced \u03c7\u00b2 consistent with \u03c3",
-                "the data carry no \u03c3 (or no redchi in the fit summary)",
-            )
+        _success_check(ctx, name, recs)
+        _chi2_check(ctx, name, recs, varying, chi2_models)
         if published_check and has_pub:
             _published_check(ctx, recs, varying)
+
+
+def _columns(
+    recs: Sequence[FitRecord], varying: Sequence[str], has_pub: bool
+) -> list[tuple[str, str, str]]:
+    """The parameter table's columns: each varying parameter with its sigma and interval."""
+    cols: list[tuple[str, str, str]] = [
+        ("sample", "sample", ""),
+        ("wavelength_nm", "\u03bb [nm]", "g"),
+    ]
+    for p in varying:
+        u = recs[0].params[p].get("units") or ""
+        unit = f" [{u}]" if u and u != "1" else ""
+        cols += [
+            (p, f"{p}{unit}", ".5g"),
+            (f"{p}_stderr", f"\u03c3({p})", ".2g"),
+            (f"{p}_lo", f"{p} 95% lo", ".5g"),
+            (f"{p}_hi", f"{p} 95% hi", ".5g"),
+        ]
+        if has_pub:
+            cols.append((f"{p}_pub", f"{p} published", ".5g"))
+    cols += [("flags", "flags", ""), ("rmse_paper", "RMSE (paper's sense) [%]", ".4g")]
+    if has_pub:
+        cols.append(("rmse_pub", "RMSE published [%]", ".4g"))
+    cols += [
+        ("rmse_abs", "RMSE [data units]", ".3g"),
+        ("redchi", "\u03c7\u00b2/\u03bd", ".4g"),
+        ("nfev", "nfev", "d"),
+        ("success", "success", ""),
+    ]
+    return cols
+
+
+def _row(ctx: Context, r: FitRecord, varying: Sequence[str], has_pub: bool) -> dict[str, Any]:
+    """One fit's line of the parameter table."""
+    row: dict[str, Any] = {"sample": r.sample, "wavelength_nm": r.wavelength_nm}
+    pub = published_params(ctx.published, r.sample, r.wavelength_nm) if has_pub else {}
+    flags = []
+    for p in varying:
+        q = r.params[p]
+        row.update(
+            {
+                p: q["value"],
+                f"{p}_stderr": q["stderr"],
+                f"{p}_lo": q["lo"],
+                f"{p}_hi": q["hi"],
+                f"{p}_pub": pub.get(p),
+            }
+        )
+        flags += [f"{p}: {f}" for f in q["flags"]]
+    row["flags"] = "; ".join(flags)
+    row["rmse_paper"] = rmse_paper(r.summary)
+    row["rmse_pub"] = pub.get("rmse")
+    row["rmse_abs"] = rmse_abs(r.summary)
+    row["redchi"] = num(r.summary.get("redchi"))
+    row["nfev"] = r.summary.get("nfev")
+    row["success"] = bool(r.summary.get("success"))
+    return row
+
+
+def _success_check(ctx: Context, name: str, recs: Sequence[FitRecord]) -> None:
+    bad = [
+        f"{r.sample} {wl_label(r.wavelength_nm)}: {r.summary.get('message', '')}"
+        for r in recs
+        if not r.summary.get("success")
+    ]
+    ctx.b.check(
+        f"fits.{name}.success",
+        f"every {name} fit converged",
+        not bad,
+        against="the optimiser's success flag",
+        value=len(recs) - len(bad),
+        tolerance=len(recs),
+        justification="value = converged fits, tolerance = fits run",
+        reason="; ".join(bad)[:1000],
+    )
+
+
+def _chi2_check(
+    ctx: Context,
+    name: str,
+    recs: Sequence[FitRecord],
+    varying: Sequence[str],
+    chi2_models: Sequence[str] | None,
+) -> None:
+    """Chi-square consistency where the files give sigma (a finding for other models)."""
+    b = ctx.b
+    lohi = []
+    worst = None
+    ok = True
+    for r in recs:
+        red = num(r.summary.get("redchi"))
+        has_sigma = r.data["sigma"].notna().all()
+        nfree = len(r.data) - len(varying)
+        if red is None or not has_sigma or nfree < 1:
+            continue
+        lo = stats.chi2.ppf(0.0005, nfree) / nfree
+        hi = stats.chi2.ppf(0.9995, nfree) / nfree
+        lohi.append((lo, hi))
+        if not lo <= red <= hi:
+            ok = False
+        if worst is None or abs(math.log(red)) > abs(math.log(worst)):
+            worst = red
+    if chi2_models is not None and name not in chi2_models:
+        shown = "n/a" if worst is None else f"{worst:.4g}"
+        b.text(
+            f"{name}: reduced \u03c7\u00b2 up to {shown} (a finding, not a check: the "
+            "data were not generated with this model)."
+        )
+    elif lohi:
+        b.check(
+            f"fits.{name}.chi2",
+            f"{name}: reduced \u03c7\u00b2 of every fit consistent with the file's \u03c3",
+            ok,
+            against="the \u03c7\u00b2 distribution with \u03bd = N - n_par",
+            value=worst,
+            tolerance=[min(x for x, _ in lohi), max(y for _, y in lohi)],
+            justification="two-sided 99.9% interval of \u03c7\u00b2/\u03bd per fit; a model "
+            "that describes the data within their stated \u03c3 lands inside",
+        )
+    else:
+        b.skip(
+            f"fits.{name}.chi2",
+            f"{name}: reduced \u03c7\u00b2 consistent with \u03c3",
+            "the data carry no \u03c3 (or no redchi in the fit summary)",
+        )
 
 
 def _published_check(ctx: Context, recs: Sequence[FitRecord], varying: Sequence[str]) -> None:

@@ -16,6 +16,7 @@ import math
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
 from ... import integrate, models
 from .. import figures
@@ -59,56 +60,45 @@ def _rho_sigma(rec: FitRecord, theta_deg: float) -> float | None:
     return math.sqrt(var) if var >= 0 else None
 
 
-def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
-    """Table 3 style: hemispherical integral of the fits against the spectrophotometer."""
-    b = ctx.b
-    recs = [r for r in ctx.fits.get("smooth3", []) if r.sample.lower() == sample.lower()]
-    if not recs:
-        raise Unavailable(f"no smooth3 fits of sample {sample}")
-    d = ctx.data
-    if d is None:
-        raise Unavailable("no data ingested")
-    meas = d[
-        (d["quantity"] == "hemispherical_reflectance")
-        & (d["sample"].str.lower() == sample.lower())
-    ]
-    t3 = ctx.published.get("table3")
-    m3 = models.get("smooth3")
-    rows = []
-    for r in sorted(recs, key=lambda x: x.wavelength_nm):
-        wl = r.wavelength_nm
-        row: dict[str, Any] = {"wavelength_nm": wl}
-        ms = meas[np.isclose(meas["wavelength_nm"], wl)]
-        srcs = sorted(set(ms["source"]))
-        row["measured"] = float(ms["value"].mean()) if len(ms) else None
-        row["measured_spread"] = float(ms["value"].max() - ms["value"].min()) if len(ms) else None
-        row["sources"] = ", ".join(srcs)
-        if t3 is not None:
-            p3 = t3[np.isclose(t3["wavelength_nm"], wl)]
-            row["t3_measured"] = num(p3["measured_pct"].iloc[0]) if len(p3) else None
-            row["t3_integration"] = num(p3["integration_pct"].iloc[0]) if len(p3) else None
-            row["t3_error"] = (
-                num(p3["error_pct"].iloc[0]) if len(p3) and "error_pct" in p3 else None
-            )
-        pv = paper_values(ctx.published, sample, wl)
-        for ang in (45, 46):
-            row[f"paper_{ang}"] = (
-                float(integrate.hemispherical_reflectance(m3, pv, ang)) if pv else None
-            )
-            row[f"ours_{ang}"] = (
-                float(integrate.hemispherical_reflectance(m3, r.values, ang)) if r.values else None
-            )
-        row["ours_46_sigma"] = _rho_sigma(r, 46.0) if r.values else None
-        if row["measured"] is not None and row["ours_46"] is not None:
-            row["rel_err_46"] = 100.0 * (row["ours_46"] - row["measured"]) / row["measured"]
-        else:
-            row["rel_err_46"] = None
-        rows.append(row)
-    for row in rows:
-        for k in ("t3_measured", "t3_integration"):
-            if row.get(k) is not None:
-                row[k] = row[k] / 100.0
-    b.table(
+def _row(
+    ctx: Context,
+    r: FitRecord,
+    meas: pd.DataFrame,
+    t3: pd.DataFrame | None,
+    m3: models.Model,
+    sample: str,
+) -> dict[str, Any]:
+    """One fitted wavelength: measured, Table 3 and the paper's and our integrals."""
+    wl = r.wavelength_nm
+    row: dict[str, Any] = {"wavelength_nm": wl}
+    ms = meas[np.isclose(meas["wavelength_nm"], wl)]
+    srcs = sorted(set(ms["source"]))
+    row["measured"] = float(ms["value"].mean()) if len(ms) else None
+    row["measured_spread"] = float(ms["value"].max() - ms["value"].min()) if len(ms) else None
+    row["sources"] = ", ".join(srcs)
+    if t3 is not None:
+        p3 = t3[np.isclose(t3["wavelength_nm"], wl)]
+        row["t3_measured"] = num(p3["measured_pct"].iloc[0]) if len(p3) else None
+        row["t3_integration"] = num(p3["integration_pct"].iloc[0]) if len(p3) else None
+        row["t3_error"] = num(p3["error_pct"].iloc[0]) if len(p3) and "error_pct" in p3 else None
+    pv = paper_values(ctx.published, sample, wl)
+    for ang in (45, 46):
+        row[f"paper_{ang}"] = (
+            float(integrate.hemispherical_reflectance(m3, pv, ang)) if pv else None
+        )
+        row[f"ours_{ang}"] = (
+            float(integrate.hemispherical_reflectance(m3, r.values, ang)) if r.values else None
+        )
+    row["ours_46_sigma"] = _rho_sigma(r, 46.0) if r.values else None
+    if row["measured"] is not None and row["ours_46"] is not None:
+        row["rel_err_46"] = 100.0 * (row["ours_46"] - row["measured"]) / row["measured"]
+    else:
+        row["rel_err_46"] = None
+    return row
+
+
+def _table(ctx: Context, sample: str, rows: list[dict[str, Any]]) -> None:
+    ctx.b.table(
         "hemispherical",
         f"Hemispherical reflectance of {sample}: model integral against the spectrophotometer "
         "(Table 3 style)",
@@ -134,7 +124,9 @@ def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
         "45 deg (the geometry the paper names) and at 46 deg (where its 'integration result' "
         "is actually reproduced; see the errata). \u03c3 from the fit covariance.",
     )
-    # figure
+
+
+def _figure(ctx: Context, sample: str, meas: pd.DataFrame, rows: list[dict[str, Any]]) -> None:
     meas_line = None
     for src, g in meas.groupby("source"):
         if len(g) > 5:
@@ -158,7 +150,7 @@ def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
         ys = [row[key] for row in rows if row.get(key) is not None]
         if xs:
             pts.append({"label": label, "wavelength": xs, "value": ys, "marker": mk})
-    b.figure(
+    ctx.b.figure(
         "hemispherical",
         f"Hemispherical reflectance of {sample} against wavelength (Table 3)",
         "Measured: spectrophotometer (line: synthetic interpolation through the three "
@@ -167,7 +159,11 @@ def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
         "triangles: the paper's printed integration result.",
         figures.hemispherical_figure(meas_line, pts),
     )
-    # checks
+
+
+def _table3_checks(ctx: Context, rows: list[dict[str, Any]]) -> None:
+    """The paper's parameters reproduce its Table 3 at 46 deg, and not at the stated 45."""
+    b = ctx.b
     have46 = [
         row
         for row in rows
@@ -205,6 +201,11 @@ def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
             "Table 3 reproduced at 46 deg",
             "published Tables 1 and 3 not found in fixtures/published",
         )
+
+
+def _fit_checks(ctx: Context, rows: list[dict[str, Any]]) -> None:
+    """Our fits' integral against the spectrophotometer and the paper fit's, within sigma."""
+    b = ctx.b
     both = [
         row
         for row in rows
@@ -254,3 +255,30 @@ def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
             justification="largest |ours - paper| / \u03c3(ours), \u03c3 propagated from the "
             "fit covariance; the fixtures were generated from the published parameters",
         )
+
+
+def hemispherical_section(ctx: Context, sample: str = "OSR") -> None:
+    """Table 3 style: hemispherical integral of the fits against the spectrophotometer."""
+    recs = [r for r in ctx.fits.get("smooth3", []) if r.sample.lower() == sample.lower()]
+    if not recs:
+        raise Unavailable(f"no smooth3 fits of sample {sample}")
+    d = ctx.data
+    if d is None:
+        raise Unavailable("no data ingested")
+    meas = d[
+        (d["quantity"] == "hemispherical_reflectance")
+        & (d["sample"].str.lower() == sample.lower())
+    ]
+    t3 = ctx.published.get("table3")
+    m3 = models.get("smooth3")
+    rows = [
+        _row(ctx, r, meas, t3, m3, sample) for r in sorted(recs, key=lambda x: x.wavelength_nm)
+    ]
+    for row in rows:
+        for k in ("t3_measured", "t3_integration"):
+            if row.get(k) is not None:
+                row[k] = row[k] / 100.0
+    _table(ctx, sample, rows)
+    _figure(ctx, sample, meas, rows)
+    _table3_checks(ctx, rows)
+    _fit_checks(ctx, rows)

@@ -290,180 +290,194 @@ def _r0_figure(ctx: Context, i: int, src: str, comb: pd.DataFrame) -> None:
     )
 
 
-def nk_section(ctx: Context) -> None:
-    """Optical constants per psi/Delta file and their reflectance predictions."""
-    b = ctx.b
-    frames = file_frames(ctx)
-    if not frames:
-        raise Unavailable("no data ingested")
+def _ordinary(g: pd.DataFrame) -> pd.DataFrame:
+    """The psi/Delta rows of a file with no channel or the ordinary (pp) channel."""
+    pd_rows = g[g["quantity"].isin(["psi", "delta"])]
+    if "channel" in pd_rows.columns:
+        ch = pd_rows["channel"].astype(object)
+        pd_rows = pd_rows[ch.isna() | ch.isin(["", "pp"])]
+    return pd_rows
 
-    def ordinary(g: pd.DataFrame) -> pd.DataFrame:
-        pd_rows = g[g["quantity"].isin(["psi", "delta"])]
-        if "channel" in pd_rows.columns:
-            ch = pd_rows["channel"].astype(object)
-            pd_rows = pd_rows[ch.isna() | ch.isin(["", "pp"])]
-        return pd_rows
 
-    ellips = [(s, g, m) for s, g, m in frames if len(ordinary(g))]
-    refl = [(s, g, m) for s, g, m in frames if (g["quantity"] == "reflectance").any()]
-    if not ellips:
-        b.skip(
-            "nk.constants",
-            "optical constants from psi/Delta",
-            "no psi/Delta rows: no optical constants",
+_INTRO = (
+    "Two-phase (bare substrate, ambient n = 1) pseudo-optical constants <N> = n + ik of "
+    "every psi/Delta point, combined per wavelength over the angles of incidence "
+    "(inverse-covariance weighted mean where the file gives sigmas). The consistency "
+    "of the angles is a chi-square test (p-value); a bulk, clean, isotropic material "
+    "gives the same n, k at every angle, while a film or roughness makes the pseudo "
+    "constants depend on the angle. Where the angles disagree the values are "
+    "pseudo-constants of a stack, not a material's n, k: they are not combined into one "
+    "value, and no reflectance is predicted from them (a fitted stack model does that: "
+    "section film, with --film-model)."
+)
+
+
+def _file_text(ctx: Context, pts: pd.DataFrame, comb: pd.DataFrame, verdict: str) -> None:
+    """The paragraph on one file: points, angles, verdict, ill-conditioned points, series."""
+    cond_bad = int((pts["cond"] > ell_cond_limit()).sum())
+    n_ang = int(pts["theta_i_deg"].round(2).nunique())
+    ctx.b.text(
+        f"{len(pts)} psi/Delta pairs at {n_ang} angle(s), {len(comb)} combined "
+        f"(wavelength{', series member' if len(_members(comb)) > 1 else ''}) rows. "
+        f"Verdict: {verdict}."
+        + (
+            f" {cond_bad} point(s) are ill-conditioned (condition number above "
+            f"{ell_cond_limit():g}): their n, k carry large uncertainties."
+            if cond_bad
+            else ""
         )
-        raise Unavailable(
-            "no psi/Delta rows ingested: no optical constants, no Fresnel prediction"
+        + (
+            f" The file is a series of {len(_members(comb))} members (times or spots); "
+            "the figure shows up to six of them."
+            if len(_members(comb)) > 1
+            else ""
         )
-    b.text(
-        "Two-phase (bare substrate, ambient n = 1) pseudo-optical constants <N> = n + ik of "
-        "every psi/Delta point, combined per wavelength over the angles of incidence "
-        "(inverse-covariance weighted mean where the file gives sigmas). The consistency "
-        "of the angles is a chi-square test (p-value); a bulk, clean, isotropic material "
-        "gives the same n, k at every angle, while a film or roughness makes the pseudo "
-        "constants depend on the angle. Where the angles disagree the values are "
-        "pseudo-constants of a stack, not a material's n, k: they are not combined into one "
-        "value, and no reflectance is predicted from them (a fitted stack model does that: "
-        "section film, with --film-model)."
     )
-    summary: list[dict[str, Any]] = []
-    cmp_rows: list[dict[str, Any]] = []
-    combined: dict[str, pd.DataFrame] = {}
-    for i, (src, g, _meta) in enumerate(ellips):
-        tag = f"{i}_{slug(src)}"
-        rows = ordinary(g)
-        b.heading(f"{src}: optical constants", anchor=f"nk_{tag}")
-        try:
-            pts = nkmod.nk_table(rows, on_ill_conditioned="ignore")
-            comb = nkmod.combined_table(pts)
-        except (ValueError, KeyError) as exc:
-            b.note("no optical constants", f"{src}: {exc}")
-            b.skip(f"nk.constants.{tag}", f"{src}: optical constants", str(exc))
-            continue
-        combined[src] = comb
-        cond_bad = int((pts["cond"] > ell_cond_limit()).sum())
-        dof = comb["dof"].to_numpy(int)
-        tested = dof > 0
-        frac_dep = float(comb.loc[tested, "angle_dependent"].mean()) if tested.any() else None
-        chi = comb.loc[tested, "chi2"].to_numpy(float) / np.maximum(dof[tested], 1)
-        a500 = _at(comb, 500.0)
-        n_ang = int(pts["theta_i_deg"].round(2).nunique())
-        av = nkmod.angle_verdict(comb)
-        verdict, short = av.text, av.short
-        b.text(
-            f"{len(pts)} psi/Delta pairs at {n_ang} angle(s), {len(comb)} combined "
-            f"(wavelength{', series member' if len(_members(comb)) > 1 else ''}) rows. "
-            f"Verdict: {verdict}."
-            + (
-                f" {cond_bad} point(s) are ill-conditioned (condition number above "
-                f"{ell_cond_limit():g}): their n, k carry large uncertainties."
-                if cond_bad
-                else ""
-            )
-            + (
-                f" The file is a series of {len(_members(comb))} members (times or spots); "
-                "the figure shows up to six of them."
-                if len(_members(comb)) > 1
-                else ""
-            )
-        )
-        any_ok = bool(_combined_ok(comb).any())
-        stack_like = not any_ok or av.kind == "stack"
-        if stack_like:
-            b.text(
-                f"The values of {src} are pseudo-constants of a stack, one per angle of "
-                "incidence (figure below), not a material's optical constants: they are not "
-                "combined where the angles disagree, and give no reflectance prediction."
-            )
-        if any_ok:
-            b.figure(
-                f"nk_{tag}_combined",
-                f"{src}: combined optical constants n and k",
-                "Derived from measured psi/Delta: n [1] and k [1] against wavelength [nm], "
-                "combined over the angles of incidence; band = 1-sigma (propagated from the "
-                "file's sigmas, or the angle-to-angle scatter where that is larger or sigmas "
-                "are missing), times sqrt(chi2/dof) where the angles disagree.",
-                _nk_figure(src, comb),
-                details=stack_like,
-            )
-        cols = [k for k in _SERIES if k in comb.columns]
-        b.table(
-            f"nk_{tag}",
-            f"{src}: combined n, k per wavelength",
-            [(c, c, ".6g") for c in cols]
-            + [
-                ("wavelength_nm", "\u03bb [nm]", ".6g"),
-                ("n", "n", ".5g"),
-                ("n_sigma", "\u03c3n", ".2g"),
-                ("k", "k", ".5g"),
-                ("k_sigma", "\u03c3k", ".2g"),
-                ("chi2", "\u03c7\u00b2", ".3g"),
-                ("dof", "dof", "d"),
-                ("p_value", "p", ".2g"),
-                ("angle_dependent", "angle-dependent", ""),
-                ("n_angles", "angles", "d"),
-            ],
-            comb.to_dict("records"),
-            caption="n, k combined over the angles of incidence; chi2/dof and p test their "
-            f"agreement; angle-dependent = p < {ell.P_ANGLE_DEPENDENT:g} (sigmas times "
-            "sqrt(chi2/dof) there; no n, k at all for a sample whose angles disagree at most "
-            "wavelengths: pseudo-constants of a stack).",
-            details=True,
-        )
+
+
+def _constants_figures(
+    ctx: Context, tag: str, src: str, pts: pd.DataFrame, comb: pd.DataFrame, stack_like: bool
+) -> None:
+    """The combined n, k (where any), their table and the pseudo-constants per angle."""
+    b = ctx.b
+    if bool(_combined_ok(comb).any()):
         b.figure(
-            f"nk_{tag}_pseudo",
-            f"{src}: pseudo-constants per angle of incidence",
-            "Derived from measured psi/Delta, one line per angle of incidence: two-phase "
-            "pseudo n and k [1] against wavelength [nm] with propagated 1-sigma error bars. "
-            "Lines that do not overlap mean the sample is not a bare bulk material.",
-            _pseudo_figure(pts),
-            details=not stack_like,
+            f"nk_{tag}_combined",
+            f"{src}: combined optical constants n and k",
+            "Derived from measured psi/Delta: n [1] and k [1] against wavelength [nm], "
+            "combined over the angles of incidence; band = 1-sigma (propagated from the "
+            "file's sigmas, or the angle-to-angle scatter where that is larger or sigmas "
+            "are missing), times sqrt(chi2/dof) where the angles disagree.",
+            _nk_figure(src, comb),
+            details=stack_like,
         )
-        nk_ok = comb["combined"].to_numpy(bool) & ~comb["angle_dependent"].to_numpy(bool)
-        nk_ok &= tested
-        if nk_ok.any():
-            c_ok = comb[nk_ok]
-            neg = c_ok["k"].to_numpy(float) < -3 * np.nan_to_num(c_ok["k_sigma"].to_numpy(float))
-            b.check(
-                f"nk.k_physical.{tag}",
-                f"{src}: k >= 0 within 3 sigma where the angles agree",
-                not neg.any(),
-                against="absorbing or transparent media have k >= 0",
-                value=int(neg.sum()),
-                tolerance=0,
-                justification=f"value = wavelengths with k < -3 sigma among {len(c_ok)} "
-                "where the angle test passes",
-            )
-        else:
-            b.skip(
-                f"nk.k_physical.{tag}",
-                f"{src}: k >= 0 within 3 sigma where the angles agree",
-                "no wavelength where the angles agree (or only one angle, or they agree at "
-                "a few wavelengths by chance in a sample whose angles disagree elsewhere): "
-                "pseudo-constants of a layered sample need not have k >= 0",
-            )
-        summary.append(
-            {
-                "file": src,
-                "sample": ", ".join(sorted({str(s) for s in rows["sample"]})),
-                "points": len(pts),
-                "angles": n_ang,
-                "wl_min": float(comb["wavelength_nm"].min()),
-                "wl_max": float(comb["wavelength_nm"].max()),
-                "wl_500": a500.get("wl"),
-                "n_500": a500["n"],
-                "k_500": a500["k"],
-                "chi2_dof": float(np.median(chi)) if len(chi) else None,
-                "frac_dep": frac_dep,
-                "verdict": short,
-            }
-        )
-        _r0_figure(ctx, i, src, comb)
-        # the file's own reflectance rows
-        if (g["quantity"] == "reflectance").any():
-            _compare(ctx, f"{tag}_own", src, comb, g, src, cmp_rows)
-    b.heading("Summary and reflectance predictions", anchor="nk_summary")
+    cols = [k for k in _SERIES if k in comb.columns]
     b.table(
+        f"nk_{tag}",
+        f"{src}: combined n, k per wavelength",
+        [(c, c, ".6g") for c in cols]
+        + [
+            ("wavelength_nm", "\u03bb [nm]", ".6g"),
+            ("n", "n", ".5g"),
+            ("n_sigma", "\u03c3n", ".2g"),
+            ("k", "k", ".5g"),
+            ("k_sigma", "\u03c3k", ".2g"),
+            ("chi2", "\u03c7\u00b2", ".3g"),
+            ("dof", "dof", "d"),
+            ("p_value", "p", ".2g"),
+            ("angle_dependent", "angle-dependent", ""),
+            ("n_angles", "angles", "d"),
+        ],
+        comb.to_dict("records"),
+        caption="n, k combined over the angles of incidence; chi2/dof and p test their "
+        f"agreement; angle-dependent = p < {ell.P_ANGLE_DEPENDENT:g} (sigmas times "
+        "sqrt(chi2/dof) there; no n, k at all for a sample whose angles disagree at most "
+        "wavelengths: pseudo-constants of a stack).",
+        details=True,
+    )
+    b.figure(
+        f"nk_{tag}_pseudo",
+        f"{src}: pseudo-constants per angle of incidence",
+        "Derived from measured psi/Delta, one line per angle of incidence: two-phase "
+        "pseudo n and k [1] against wavelength [nm] with propagated 1-sigma error bars. "
+        "Lines that do not overlap mean the sample is not a bare bulk material.",
+        _pseudo_figure(pts),
+        details=not stack_like,
+    )
+
+
+def _k_physical(ctx: Context, tag: str, src: str, comb: pd.DataFrame) -> None:
+    """Check k >= 0 within 3 sigma where the angles agree (skipped where they never do)."""
+    b = ctx.b
+    nk_ok = comb["combined"].to_numpy(bool) & ~comb["angle_dependent"].to_numpy(bool)
+    nk_ok &= comb["dof"].to_numpy(int) > 0
+    if nk_ok.any():
+        c_ok = comb[nk_ok]
+        neg = c_ok["k"].to_numpy(float) < -3 * np.nan_to_num(c_ok["k_sigma"].to_numpy(float))
+        b.check(
+            f"nk.k_physical.{tag}",
+            f"{src}: k >= 0 within 3 sigma where the angles agree",
+            not neg.any(),
+            against="absorbing or transparent media have k >= 0",
+            value=int(neg.sum()),
+            tolerance=0,
+            justification=f"value = wavelengths with k < -3 sigma among {len(c_ok)} "
+            "where the angle test passes",
+        )
+    else:
+        b.skip(
+            f"nk.k_physical.{tag}",
+            f"{src}: k >= 0 within 3 sigma where the angles agree",
+            "no wavelength where the angles agree (or only one angle, or they agree at "
+            "a few wavelengths by chance in a sample whose angles disagree elsewhere): "
+            "pseudo-constants of a layered sample need not have k >= 0",
+        )
+
+
+def _summary_row(
+    src: str, rows: pd.DataFrame, pts: pd.DataFrame, comb: pd.DataFrame, short: str
+) -> dict[str, Any]:
+    """One file's line of the summary table: n, k near 500 nm and the angle agreement."""
+    dof = comb["dof"].to_numpy(int)
+    tested = dof > 0
+    frac_dep = float(comb.loc[tested, "angle_dependent"].mean()) if tested.any() else None
+    chi = comb.loc[tested, "chi2"].to_numpy(float) / np.maximum(dof[tested], 1)
+    a500 = _at(comb, 500.0)
+    return {
+        "file": src,
+        "sample": ", ".join(sorted({str(s) for s in rows["sample"]})),
+        "points": len(pts),
+        "angles": int(pts["theta_i_deg"].round(2).nunique()),
+        "wl_min": float(comb["wavelength_nm"].min()),
+        "wl_max": float(comb["wavelength_nm"].max()),
+        "wl_500": a500.get("wl"),
+        "n_500": a500["n"],
+        "k_500": a500["k"],
+        "chi2_dof": float(np.median(chi)) if len(chi) else None,
+        "frac_dep": frac_dep,
+        "verdict": short,
+    }
+
+
+def _file_section(
+    ctx: Context, i: int, src: str, g: pd.DataFrame, cmp_rows: list[dict[str, Any]]
+) -> tuple[pd.DataFrame, dict[str, Any]] | None:
+    """One psi/Delta file: its constants, figures, checks and own reflectance comparison.
+
+    Returns the combined table and the summary row, or None where no constants follow.
+    """
+    b = ctx.b
+    tag = f"{i}_{slug(src)}"
+    rows = _ordinary(g)
+    b.heading(f"{src}: optical constants", anchor=f"nk_{tag}")
+    try:
+        pts = nkmod.nk_table(rows, on_ill_conditioned="ignore")
+        comb = nkmod.combined_table(pts)
+    except (ValueError, KeyError) as exc:
+        b.note("no optical constants", f"{src}: {exc}")
+        b.skip(f"nk.constants.{tag}", f"{src}: optical constants", str(exc))
+        return None
+    av = nkmod.angle_verdict(comb)
+    _file_text(ctx, pts, comb, av.text)
+    stack_like = not bool(_combined_ok(comb).any()) or av.kind == "stack"
+    if stack_like:
+        b.text(
+            f"The values of {src} are pseudo-constants of a stack, one per angle of "
+            "incidence (figure below), not a material's optical constants: they are not "
+            "combined where the angles disagree, and give no reflectance prediction."
+        )
+    _constants_figures(ctx, tag, src, pts, comb, stack_like)
+    _k_physical(ctx, tag, src, comb)
+    row = _summary_row(src, rows, pts, comb, av.short)
+    _r0_figure(ctx, i, src, comb)
+    # the file's own reflectance rows
+    if (g["quantity"] == "reflectance").any():
+        _compare(ctx, f"{tag}_own", src, comb, g, src, cmp_rows)
+    return comb, row
+
+
+def _summary_table(ctx: Context, summary: list[dict[str, Any]]) -> None:
+    ctx.b.table(
         "nk_summary",
         "Optical constants per file",
         [
@@ -483,7 +497,19 @@ def nk_section(ctx: Context) -> None:
         caption="n, k at the measured wavelength nearest 500 nm; chi2/dof of the angle "
         "agreement, median over wavelengths; the verdict in full is in each file's text.",
     )
-    # cross-instrument comparisons
+
+
+def _pairs(
+    ctx: Context,
+    ellips: list[tuple[str, pd.DataFrame, Any]],
+    refl: list[tuple[str, pd.DataFrame, Any]],
+    combined: dict[str, pd.DataFrame],
+) -> list[tuple[str, str, pd.DataFrame]]:
+    """(n, k file, reflectance file, its rows) of the cross-instrument comparisons.
+
+    An ellipsometer file of the same sample, or the only one in the report; a note for a
+    reflectance file with neither.
+    """
     pairs = []
     for rs, rg, _ in refl:
         rsamples = {str(s).lower() for s in rg["sample"]}
@@ -495,14 +521,73 @@ def nk_section(ctx: Context) -> None:
         if not match and len(combined) == 1 and rs not in combined:
             match = list(combined)
         if not match and rs not in combined:
-            b.note(
+            ctx.b.note(
                 "not compared",
                 f"reflectance of {rs}: no ellipsometer file of the same sample (and not exactly "
                 "one ellipsometer file in the report) - give the two files together to compare",
             )
         for s in match:
             pairs.append((s, rs, rg))
-    for j, (s, rs, rg) in enumerate(pairs):
+    return pairs
+
+
+def _comparison_table(ctx: Context, cmp_rows: list[dict[str, Any]]) -> None:
+    ctx.b.table(
+        "nk_reflectance_comparison",
+        "Measured reflectance against the Fresnel prediction from ellipsometric n, k",
+        [
+            ("nk_file", "n, k from", ""),
+            ("refl_file", "reflectance from", ""),
+            ("quantity", "compared", ""),
+            ("theta_i", "\u03b8i [deg]", ""),
+            ("points", "points", "d"),
+            ("wl_min", "\u03bb min [nm]", ".5g"),
+            ("wl_max", "\u03bb max [nm]", ".5g"),
+            ("mean_diff", "mean diff [1]", ".3g"),
+            ("rms_diff", "rms diff [1]", ".3g"),
+            ("median_sigma", "median \u03c3 diff [1]", ".2g"),
+            ("chi2_dof", "\u03c7\u00b2/dof", ".3g"),
+            ("p_value", "p", ".2g"),
+            ("outside", "rows outside n, k range", "d"),
+        ],
+        cmp_rows,
+        caption="diff = measured - predicted; sigma diff adds the measurement's and the "
+        "prediction's 1-sigma in quadrature (the prediction's alone where the file has "
+        "none: a lower bound). Spectrophotometer rows without an angle are taken at "
+        "normal incidence.",
+    )
+
+
+def nk_section(ctx: Context) -> None:
+    """Optical constants per psi/Delta file and their reflectance predictions."""
+    b = ctx.b
+    frames = file_frames(ctx)
+    if not frames:
+        raise Unavailable("no data ingested")
+    ellips = [(s, g, m) for s, g, m in frames if len(_ordinary(g))]
+    refl = [(s, g, m) for s, g, m in frames if (g["quantity"] == "reflectance").any()]
+    if not ellips:
+        b.skip(
+            "nk.constants",
+            "optical constants from psi/Delta",
+            "no psi/Delta rows: no optical constants",
+        )
+        raise Unavailable(
+            "no psi/Delta rows ingested: no optical constants, no Fresnel prediction"
+        )
+    b.text(_INTRO)
+    summary: list[dict[str, Any]] = []
+    cmp_rows: list[dict[str, Any]] = []
+    combined: dict[str, pd.DataFrame] = {}
+    for i, (src, g, _meta) in enumerate(ellips):
+        done = _file_section(ctx, i, src, g, cmp_rows)
+        if done is not None:
+            combined[src], row = done
+            summary.append(row)
+    b.heading("Summary and reflectance predictions", anchor="nk_summary")
+    _summary_table(ctx, summary)
+    # cross-instrument comparisons
+    for j, (s, rs, rg) in enumerate(_pairs(ctx, ellips, refl, combined)):
         _compare(ctx, f"x{j}_{slug(rs)}", s, combined[s], rg, rs, cmp_rows)
     if not refl:
         b.note(
@@ -514,30 +599,7 @@ def nk_section(ctx: Context) -> None:
             "no reflectance rows",
         )
     if cmp_rows:
-        b.table(
-            "nk_reflectance_comparison",
-            "Measured reflectance against the Fresnel prediction from ellipsometric n, k",
-            [
-                ("nk_file", "n, k from", ""),
-                ("refl_file", "reflectance from", ""),
-                ("quantity", "compared", ""),
-                ("theta_i", "\u03b8i [deg]", ""),
-                ("points", "points", "d"),
-                ("wl_min", "\u03bb min [nm]", ".5g"),
-                ("wl_max", "\u03bb max [nm]", ".5g"),
-                ("mean_diff", "mean diff [1]", ".3g"),
-                ("rms_diff", "rms diff [1]", ".3g"),
-                ("median_sigma", "median \u03c3 diff [1]", ".2g"),
-                ("chi2_dof", "\u03c7\u00b2/dof", ".3g"),
-                ("p_value", "p", ".2g"),
-                ("outside", "rows outside n, k range", "d"),
-            ],
-            cmp_rows,
-            caption="diff = measured - predicted; sigma diff adds the measurement's and the "
-            "prediction's 1-sigma in quadrature (the prediction's alone where the file has "
-            "none: a lower bound). Spectrophotometer rows without an angle are taken at "
-            "normal incidence.",
-        )
+        _comparison_table(ctx, cmp_rows)
 
 
 def ell_cond_limit() -> float:

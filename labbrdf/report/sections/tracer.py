@@ -396,22 +396,36 @@ def _oracle(shared: Path | None, name: str) -> pd.DataFrame | None:
     return pd.read_csv(p) if p.is_file() else None
 
 
-def validation_section(ctx: Context) -> None:
-    """Tracer against analytic limits (smooth Fresnel, white furnace, ledger) and oracles."""
-    b = ctx.b
-    n = int(ctx.scale["validation"])
-    shared = ctx.shared
-    no_shared = "../shared/oracles not available (the report builds without it)"
-    rows: list[dict[str, Any]] = []
-    ledger: list[float] = []
+def _albedo(res: TraceResult, ledger: list[float]) -> float:
+    """The run's albedo; its energy-ledger error is kept in ``ledger`` for the final check."""
+    ledger.append(_ledger_error(res))
+    return res.albedo()
 
-    def albedo(res: TraceResult) -> float:
-        """The run's albedo; its energy-ledger error is kept for the final check."""
-        ledger.append(_ledger_error(res))
-        return res.albedo()
 
-    # 1. smooth limit against Fresnel
+def _smooth_reference(shared: Path | None) -> tuple[np.ndarray, str]:
+    """Fresnel Mueller matrix (16 values) of smooth Al at 45 deg and where it comes from."""
     fres = _oracle(shared, "smooth_fresnel.csv")
+    if fres is not None:
+        ref = fres[
+            (fres["material"] == "Al")
+            & (fres["theta_i_deg"] == 45)
+            & (fres["source"] == "scatmech")
+        ]
+        if not len(ref):
+            ref = fres[(fres["material"] == "Al") & (fres["theta_i_deg"] == 45)].iloc[:1]
+        M_ref = ref[[f"M{i}{j}" for i in range(4) for j in range(4)]].to_numpy(float)[0]
+        return M_ref, f"smooth_fresnel.csv ({ref['source'].iloc[0]})"
+    rs, rp = optics.fresnel(1.0, complex(1.55, 7.71), 45.0)[:2]
+    M_ref = np.asarray(optics.mueller_reflection(rs, rp), float).reshape(16)
+    return M_ref, "labbrdf.optics (oracle table absent)"
+
+
+def _smooth_limit(
+    ctx: Context, n: int, shared: Path | None, ledger: list[float], rows: list[dict[str, Any]]
+) -> None:
+    """1. The smooth limit (alpha = 0) against Fresnel: albedo and specular Mueller matrix."""
+    b = ctx.b
+    M_ref, src = _smooth_reference(shared)
     res = _run(
         ctx,
         TraceConfig(
@@ -423,22 +437,8 @@ def validation_section(ctx: Context) -> None:
             scattering="single",
         ),
     )
-    A = albedo(res)
+    A = _albedo(res, ledger)
     mm = maps(res)
-    if fres is not None:
-        ref = fres[
-            (fres["material"] == "Al")
-            & (fres["theta_i_deg"] == 45)
-            & (fres["source"] == "scatmech")
-        ]
-        if not len(ref):
-            ref = fres[(fres["material"] == "Al") & (fres["theta_i_deg"] == 45)].iloc[:1]
-        M_ref = ref[[f"M{i}{j}" for i in range(4) for j in range(4)]].to_numpy(float)[0]
-        src = f"smooth_fresnel.csv ({ref['source'].iloc[0]})"
-    else:
-        rs, rp = optics.fresnel(1.0, complex(1.55, 7.71), 45.0)[:2]
-        M_ref = np.asarray(optics.mueller_reflection(rs, rp), float).reshape(16)
-        src = "labbrdf.optics (oracle table absent)"
     m = res.mueller
     it = int(np.argmin(np.abs(mm["theta"] - 45.0)))
     ip = int(np.argmin(np.abs(mm["phi"] - 180.0)))
@@ -478,7 +478,9 @@ def validation_section(ctx: Context) -> None:
         "to 10 significant digits",
     )
 
-    # 2. white furnace
+
+def _white_furnace(ctx: Context, n: int, ledger: list[float], rows: list[dict[str, Any]]) -> None:
+    """2. White furnace: a lossless microsurface with multiple scattering returns all."""
     res = _run(
         ctx,
         TraceConfig(
@@ -490,7 +492,7 @@ def validation_section(ctx: Context) -> None:
             scattering="multiple",
         ),
     )
-    A = albedo(res)
+    A = _albedo(res, ledger)
     rows.append(
         {
             "case": "ideal mirror microsurface, alpha = 1, 45 deg, multiple scattering",
@@ -501,7 +503,7 @@ def validation_section(ctx: Context) -> None:
             "source": "energy conservation",
         }
     )
-    b.check(
+    ctx.b.check(
         "tracer.white_furnace",
         "white furnace: an ideal-mirror microsurface (alpha = 1) with multiple scattering "
         "returns all the energy",
@@ -512,7 +514,103 @@ def validation_section(ctx: Context) -> None:
         justification="0.1 % of the energy at most: weight is only lost to the bounce limit",
     )
 
-    # 3. single-scattering rough Al: albedo and in-plane BRDF against the oracles
+
+def _albedo_z(
+    alb: pd.DataFrame, ti: float, A: float, n: int, rows: list[dict[str, Any]]
+) -> float | None:
+    """|A - A_ref| / sigma of rough Al at ``ti`` [deg] against the albedo oracle (None: no row).
+
+    The tracer's row is added to ``rows``.
+    """
+    ref = alb[
+        (alb["material"] == "Al")
+        & np.isclose(alb["alpha"], 0.2)
+        & np.isclose(alb["theta_i_deg"], ti)
+        & (alb["source"] == "scatmech_ggx_smith_quadrature")
+    ]
+    if not len(ref):
+        return None
+    a_ref = float(ref["A_unpol"].iloc[0])
+    sig = math.sqrt(max(a_ref * (1 - a_ref), 1e-300) / n)
+    rows.append(
+        {
+            "case": f"rough Al alpha 0.2, {ti:g} deg, single scattering",
+            "quantity": "albedo",
+            "tracer": A,
+            "reference": a_ref,
+            "tolerance": 4 * sig + 1.3e-6,
+            "source": "hemispherical_albedo.csv (SCATMECH quadrature)",
+        }
+    )
+    return abs(A - a_ref) / sig
+
+
+def _inplane_z(
+    inpl: pd.DataFrame, res: TraceResult, ti: float, k: int, n: int, series: list[dict[str, Any]]
+) -> list[float]:
+    """Largest |f - f_ref| / sigma per half-plane of the in-plane BRDF against the oracle.
+
+    Bins of 1 degree grouped by :data:`GROUP` in theta_r, the oracle's point values averaged
+    over the same bins with the same cos-solid-angle weights; the curves drawn are added to
+    ``series``.
+    """
+    mm = maps(res)
+    cosw = res.grid.cos_solid_angle_sr
+    ref = inpl[
+        (inpl["material"] == "Al")
+        & np.isclose(inpl["alpha"], 0.2)
+        & np.isclose(inpl["theta_i_deg"], ti)
+        & (inpl["source"] == "scatmech_facet_ggx_smith")
+    ]
+    zs = []
+    for phi in (180.0, 0.0):
+        rr = ref[np.isclose(ref["phi_r_deg"], phi)].sort_values("theta_r_deg")
+        rr = rr[(rr["theta_r_deg"] >= 5) & (rr["theta_r_deg"] <= 84)]
+        if len(rr) < GROUP:
+            continue
+        ip = int(np.argmin(np.abs(mm["phi"] - phi)))
+        th = rr["theta_r_deg"].to_numpy(float)
+        its = np.array([int(np.argmin(np.abs(mm["theta"] - t))) for t in th])
+        g = len(th) // GROUP * GROUP
+        w = cosw[its[:g], ip].reshape(-1, GROUP)
+        f_grp = (mm["s0"][its[:g], ip].reshape(-1, GROUP) * w).sum(1) / w.sum(1)
+        f_ref = (rr["f_M00"].to_numpy(float)[:g].reshape(-1, GROUP) * w).sum(1)
+        f_ref = f_ref / w.sum(1)
+        th_grp = th[:g].reshape(-1, GROUP).mean(1)
+        sig = np.sqrt(np.maximum(f_ref, 1e-12) / (n * w.sum(1)))
+        zs.append(float(np.max(np.abs(f_grp - f_ref) / sig)))
+        colour = f"C{2 * k + (phi == 0)}"
+        series.append(
+            {
+                "x": th_grp,
+                "y": f_ref,
+                "label": f"oracle {ti:g}\u00b0, \u03c6r={phi:g}\u00b0",
+                "style": "-",
+                "color": colour,
+            }
+        )
+        series.append(
+            {
+                "x": th_grp,
+                "y": f_grp,
+                "label": f"tracer {ti:g}\u00b0, \u03c6r={phi:g}\u00b0",
+                "style": "o",
+                "color": colour,
+            }
+        )
+    return zs
+
+
+def _rough_oracles(
+    ctx: Context,
+    n: int,
+    shared: Path | None,
+    no_shared: str,
+    ledger: list[float],
+    rows: list[dict[str, Any]],
+) -> None:
+    """3. Single-scattering rough Al: albedo and in-plane BRDF against the oracles."""
+    b = ctx.b
     alb = _oracle(shared, "hemispherical_albedo.csv")
     inpl = _oracle(shared, "rough_conductor_inplane.csv")
     if alb is None and inpl is None:
@@ -528,128 +626,91 @@ def validation_section(ctx: Context) -> None:
             no_shared,
             against="rough_conductor_inplane.csv",
         )
+        return
+    zs_a: list[float] = []
+    zs_f: list[float] = []
+    series: list[dict[str, Any]] = []
+    for k, ti in enumerate((30.0, 60.0)):
+        res = _run(
+            ctx,
+            TraceConfig(
+                wavelength_nm=650.0,
+                theta_i_deg=ti,
+                substrate=Substrate(1.55, 7.71, 0.2),
+                rays=n,
+                seed=10 + k,
+                scattering="single",
+                estimator="counting",
+            ),
+        )
+        A = _albedo(res, ledger)
+        if alb is not None:
+            z = _albedo_z(alb, ti, A, n, rows)
+            if z is not None:
+                zs_a.append(z)
+        if inpl is not None:
+            zs_f += _inplane_z(inpl, res, ti, k, n, series)
+    _rough_checks(ctx, n, zs_a, zs_f, series)
+
+
+def _rough_checks(
+    ctx: Context, n: int, zs_a: list[float], zs_f: list[float], series: list[dict[str, Any]]
+) -> None:
+    """The albedo and in-plane oracle checks of rough Al, and the in-plane figure."""
+    b = ctx.b
+    if zs_a:
+        b.check(
+            "tracer.albedo_oracle",
+            "single-scattering albedo of rough Al (alpha 0.2, 30 and 60 deg) equals the "
+            "SCATMECH quadrature",
+            max(zs_a) <= 4.0,
+            against="oracles/hemispherical_albedo.csv",
+            value=max(zs_a),
+            tolerance=4.0,
+            justification="largest |A - A_ref| / sigma, sigma = sqrt(A(1-A)/N) (an upper "
+            "bound for weights in [0, 1]); the oracle's own error (1.3e-6) is negligible",
+        )
     else:
-        zs_a, zs_f = [], []
-        series = []
-        for k, ti in enumerate((30.0, 60.0)):
-            res = _run(
-                ctx,
-                TraceConfig(
-                    wavelength_nm=650.0,
-                    theta_i_deg=ti,
-                    substrate=Substrate(1.55, 7.71, 0.2),
-                    rays=n,
-                    seed=10 + k,
-                    scattering="single",
-                    estimator="counting",
-                ),
-            )
-            A = albedo(res)
-            if alb is not None:
-                ref = alb[
-                    (alb["material"] == "Al")
-                    & np.isclose(alb["alpha"], 0.2)
-                    & np.isclose(alb["theta_i_deg"], ti)
-                    & (alb["source"] == "scatmech_ggx_smith_quadrature")
-                ]
-                if len(ref):
-                    a_ref = float(ref["A_unpol"].iloc[0])
-                    sig = math.sqrt(max(a_ref * (1 - a_ref), 1e-300) / n)
-                    zs_a.append(abs(A - a_ref) / sig)
-                    rows.append(
-                        {
-                            "case": f"rough Al alpha 0.2, {ti:g} deg, single scattering",
-                            "quantity": "albedo",
-                            "tracer": A,
-                            "reference": a_ref,
-                            "tolerance": 4 * sig + 1.3e-6,
-                            "source": "hemispherical_albedo.csv (SCATMECH quadrature)",
-                        }
-                    )
-            if inpl is not None:
-                mm = maps(res)
-                cosw = res.grid.cos_solid_angle_sr
-                ref = inpl[
-                    (inpl["material"] == "Al")
-                    & np.isclose(inpl["alpha"], 0.2)
-                    & np.isclose(inpl["theta_i_deg"], ti)
-                    & (inpl["source"] == "scatmech_facet_ggx_smith")
-                ]
-                for phi in (180.0, 0.0):
-                    rr = ref[np.isclose(ref["phi_r_deg"], phi)].sort_values("theta_r_deg")
-                    rr = rr[(rr["theta_r_deg"] >= 5) & (rr["theta_r_deg"] <= 84)]
-                    if len(rr) < GROUP:
-                        continue
-                    ip = int(np.argmin(np.abs(mm["phi"] - phi)))
-                    th = rr["theta_r_deg"].to_numpy(float)
-                    its = np.array([int(np.argmin(np.abs(mm["theta"] - t))) for t in th])
-                    g = len(th) // GROUP * GROUP
-                    w = cosw[its[:g], ip].reshape(-1, GROUP)
-                    f_grp = (mm["s0"][its[:g], ip].reshape(-1, GROUP) * w).sum(1) / w.sum(1)
-                    f_ref = (rr["f_M00"].to_numpy(float)[:g].reshape(-1, GROUP) * w).sum(1)
-                    f_ref = f_ref / w.sum(1)
-                    th_grp = th[:g].reshape(-1, GROUP).mean(1)
-                    sig = np.sqrt(np.maximum(f_ref, 1e-12) / (n * w.sum(1)))
-                    zs_f.append(float(np.max(np.abs(f_grp - f_ref) / sig)))
-                    colour = f"C{2 * k + (phi == 0)}"
-                    series.append(
-                        {
-                            "x": th_grp,
-                            "y": f_ref,
-                            "label": f"oracle {ti:g}\u00b0, \u03c6r={phi:g}\u00b0",
-                            "style": "-",
-                            "color": colour,
-                        }
-                    )
-                    series.append(
-                        {
-                            "x": th_grp,
-                            "y": f_grp,
-                            "label": f"tracer {ti:g}\u00b0, \u03c6r={phi:g}\u00b0",
-                            "style": "o",
-                            "color": colour,
-                        }
-                    )
-        if zs_a:
-            b.check(
-                "tracer.albedo_oracle",
-                "single-scattering albedo of rough Al (alpha 0.2, 30 and 60 deg) equals the "
-                "SCATMECH quadrature",
-                max(zs_a) <= 4.0,
-                against="oracles/hemispherical_albedo.csv",
-                value=max(zs_a),
-                tolerance=4.0,
-                justification="largest |A - A_ref| / sigma, sigma = sqrt(A(1-A)/N) (an upper "
-                "bound for weights in [0, 1]); the oracle's own error (1.3e-6) is negligible",
-            )
-        else:
-            b.skip("tracer.albedo_oracle", "albedo vs oracle", "no matching oracle rows")
-        if zs_f:
-            b.check(
-                "tracer.inplane_oracle",
-                "in-plane BRDF of rough Al (alpha 0.2, 30 and 60 deg, both half-planes, "
-                "theta_r 5-85 deg) equals the SCATMECH GGX/Smith values",
-                max(zs_f) <= 4.5,
-                against="oracles/rough_conductor_inplane.csv (point values at bin centres)",
-                value=max(zs_f),
-                tolerance=4.5,
-                justification="largest |f - f_ref| / sigma over 64 groups of five 1-degree "
-                "bins (theta_r 5-84 deg), sigma = sqrt(f_ref/(N Omega_cos)) (upper bound); "
-                "4.5 sigma keeps the family-wise false-alarm rate below 1e-3; the oracle's "
-                "point values are averaged over the same bins (midpoint rule)",
-            )
-            b.figure(
-                "tracer_inplane",
-                "Tracer against the oracle: in-plane BRDF of rough Al (alpha = 0.2)",
-                f"Modelled twice: lines = SCATMECH GGX + Smith point values (oracle table); "
-                f"markers = tracer bin averages ({n} rays, single scattering, 1-degree bins "
-                "grouped by 5 in theta_r, oracle averaged over the same bins), "
-                "S0 = f00 [sr^-1] for unpolarized input; phi_r = 180 deg is the specular "
-                "half-plane, 0 deg the back-scatter half.",
-                figures.xy_figure(series, r"$\theta_r$ [deg]", r"$f_{00}$ [sr$^{-1}$]", logy=True),
-            )
-        else:
-            b.skip("tracer.inplane_oracle", "in-plane BRDF vs oracle", "no matching oracle rows")
+        b.skip("tracer.albedo_oracle", "albedo vs oracle", "no matching oracle rows")
+    if zs_f:
+        b.check(
+            "tracer.inplane_oracle",
+            "in-plane BRDF of rough Al (alpha 0.2, 30 and 60 deg, both half-planes, "
+            "theta_r 5-85 deg) equals the SCATMECH GGX/Smith values",
+            max(zs_f) <= 4.5,
+            against="oracles/rough_conductor_inplane.csv (point values at bin centres)",
+            value=max(zs_f),
+            tolerance=4.5,
+            justification="largest |f - f_ref| / sigma over 64 groups of five 1-degree "
+            "bins (theta_r 5-84 deg), sigma = sqrt(f_ref/(N Omega_cos)) (upper bound); "
+            "4.5 sigma keeps the family-wise false-alarm rate below 1e-3; the oracle's "
+            "point values are averaged over the same bins (midpoint rule)",
+        )
+        b.figure(
+            "tracer_inplane",
+            "Tracer against the oracle: in-plane BRDF of rough Al (alpha = 0.2)",
+            f"Modelled twice: lines = SCATMECH GGX + Smith point values (oracle table); "
+            f"markers = tracer bin averages ({n} rays, single scattering, 1-degree bins "
+            "grouped by 5 in theta_r, oracle averaged over the same bins), "
+            "S0 = f00 [sr^-1] for unpolarized input; phi_r = 180 deg is the specular "
+            "half-plane, 0 deg the back-scatter half.",
+            figures.xy_figure(series, r"$\theta_r$ [deg]", r"$f_{00}$ [sr$^{-1}$]", logy=True),
+        )
+    else:
+        b.skip("tracer.inplane_oracle", "in-plane BRDF vs oracle", "no matching oracle rows")
+
+
+def validation_section(ctx: Context) -> None:
+    """Tracer against analytic limits (smooth Fresnel, white furnace, ledger) and oracles."""
+    b = ctx.b
+    n = int(ctx.scale["validation"])
+    shared = ctx.shared
+    no_shared = "../shared/oracles not available (the report builds without it)"
+    rows: list[dict[str, Any]] = []
+    ledger: list[float] = []
+    _smooth_limit(ctx, n, shared, ledger, rows)
+    _white_furnace(ctx, n, ledger, rows)
+    _rough_oracles(ctx, n, shared, no_shared, ledger, rows)
     _evaluated_oracle(ctx, shared, no_shared)
     b.table(
         "tracer_validation",
