@@ -245,10 +245,14 @@ SELECTION_KEYS = ("wavelength", "theta_i", "theta_r", "quantity", "sample")
 
 
 def _add_scheduler(p: argparse.ArgumentParser) -> None:
+    """The executor options of a command that runs tasks (:func:`_executor` reads them)."""
+    from .parallel import DEFAULT_SCHEDULER
+
     p.add_argument(
         "--scheduler",
-        default="processes",
-        help="serial, processes (default), local (dask LocalCluster on 127.0.0.1), "
+        default=DEFAULT_SCHEDULER,
+        help=f"serial, processes, local (dask LocalCluster on 127.0.0.1; default "
+        f"{DEFAULT_SCHEDULER}), "
         "tls://host:port (a dask scheduler with TLS) or tcp://host:port (unauthenticated: "
         "a trusted network only)",
     )
@@ -283,10 +287,16 @@ def _add_scheduler(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _check_executor(args: argparse.Namespace) -> None:
-    """Reject a bad ``--scheduler`` / ``--workers`` before any work is done."""
-    from .parallel import check_scheduler, configure
+def _executor(args: argparse.Namespace, progress: bool = True) -> Any:
+    """The :class:`labbrdf.parallel.Executor` of the command's options, built once.
 
+    A bad ``--scheduler``, ``--workers`` or security option is refused here, before any
+    work is done (exit 2).
+    """
+    from .parallel import Executor, check_scheduler, configure
+
+    if args.workers is not None and args.workers < 1:
+        raise UsageError(f"--workers must be >= 1, got {args.workers}")
     try:  # first: certificates given here decide what --scheduler local needs
         configure(
             dashboard=True if args.dashboard else None,
@@ -301,8 +311,16 @@ def _check_executor(args: argparse.Namespace) -> None:
         check_scheduler(args.scheduler)
     except ValueError as exc:
         raise UsageError(f"--scheduler: {exc}") from None
-    if args.workers is not None and args.workers < 1:
-        raise UsageError(f"--workers must be >= 1, got {args.workers}")
+    return Executor(
+        args.scheduler,
+        workers=args.workers,
+        progress=progress,
+        dashboard=True if args.dashboard else None,
+        tls_ca=args.tls_ca,
+        tls_cert=args.tls_cert,
+        tls_key=args.tls_key,
+        worker_timeout=args.worker_timeout,
+    )
 
 
 def _executor_errors(cmd: Any) -> Any:
@@ -497,7 +515,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from . import adapters, models
     from .fitting import fit_many
 
-    _check_executor(args)
+    executor = _executor(args, progress=not args.json)
     data = _selected(args, adapters.read_many(args.files))
     fix = _parse_assignments(args.fix, "--fix")
     options, start = _split_params(args.model, args.param)
@@ -511,9 +529,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
         "seed": args.seed,
         "fix": fix or None,
         "params": params or None,
-        "scheduler": args.scheduler,
-        "workers": args.workers,
-        "progress": not args.json,
+        "executor": executor,
         "return_results": True,
         "mask_zeros": not args.keep_zeros,
         "relative_floor": args.relative_floor,
@@ -525,8 +541,6 @@ def cmd_fit(args: argparse.Namespace) -> int:
     if args.nk_from:
         if "n" not in _model_options(args.model):
             raise UsageError(f"--nk-from: model {args.model!r} takes no index n, k")
-        tables: list[Any] = []
-        results: list[Any] = []
         nk = _nk_combined(args.nk_from)
         unstated = [
             str(m.get("source", "?")) for m in _metas(data) if m.get("wavelength_stated") is False
@@ -536,13 +550,25 @@ def cmd_fit(args: argparse.Namespace) -> int:
                 f"--nk-from: {', '.join(unstated)} state(s) no wavelength (the format has "
                 "no field for it); say at which wavelength to take n, k with --nk-wavelength NM"
             )
-        for wl, part in data.data.groupby("wavelength_nm", sort=True):
-            at = _nk_at(nk, float(args.nk_wavelength or wl), args.nk_from)
-            model = models.get(args.model, **{**options, "n": at[0], "k": at[1]})
-            t, r = fit_many(part, model, **kw)
-            tables.append(t.assign(n=at[0], k=at[1]))
-            results.extend(r)
-        table = pd.concat(tables, ignore_index=True)
+        # one batch, a model per wavelength (the index at that wavelength), wavelength
+        # first: the table lists each wavelength's groups together
+        index_at = {
+            wl: _nk_at(nk, float(args.nk_wavelength or wl), args.nk_from)
+            for wl in data.data["wavelength_nm"].unique()
+        }
+
+        def model_at(key: dict[str, Any]) -> Any:
+            n, k = index_at[key["wavelength_nm"]]
+            return models.get(args.model, **{**options, "n": n, "k": k})
+
+        by_wl = ["wavelength_nm", *(b for b in by if b != "wavelength_nm")]
+        table, results = fit_many(data, model_at, **{**kw, "by": by_wl})
+        nk_cols = pd.DataFrame([index_at[w] for w in table["wavelength_nm"]], columns=["n", "k"])
+        table = pd.concat([table, nk_cols], axis=1)
+        if "wavelength_nm" not in by:
+            table = table.drop(columns="wavelength_nm")
+            results = [({b: g[b] for b in by}, r) for g, r in results]
+        table = table[[*by, *(c for c in table.columns if c not in by)]]
     else:
         try:
             model = models.get(args.model, **options)
@@ -1140,9 +1166,8 @@ def _complex(text: str, what: str) -> complex:
 def cmd_trace(args: argparse.Namespace) -> int:
 
     from . import tracer
-    from .parallel import imap
 
-    _check_executor(args)  # the outputs were checked with the inputs by _checked_outputs
+    executor = _executor(args, progress=not args.json)  # outputs checked by _checked_outputs
     if (args.substrate is None) == (args.nk_from is None):
         raise UsageError("give the substrate index with --substrate N+Kj or --nk-from FILE")
     if args.nk_from is not None:
@@ -1213,17 +1238,8 @@ def cmd_trace(args: argparse.Namespace) -> int:
             "--thickness, --coating-alpha and --coating-surface need --coating (or --coating-from)"
         )
     config = tracer.TraceConfig(**kw)
-    mapper: Any = map
-    if args.scheduler != "serial":
-        mapper = functools.partial(
-            imap,
-            scheduler=args.scheduler,
-            workers=args.workers,
-            progress=not args.json,
-            desc="trace",
-        )
     t0 = time.perf_counter()
-    result = tracer.trace(config, map=mapper)
+    result = tracer.trace(config, map=functools.partial(executor.imap, desc="trace"))
     seconds = time.perf_counter() - t0
     if args.output:
         result.save(args.output)
@@ -1254,23 +1270,17 @@ def cmd_validate(args: argparse.Namespace) -> int:
     from .report import validate
     from .report.validate import default_fixtures_dir
 
-    _check_executor(args)
+    executor = _executor(args)
     check_report_dir(args.out, inputs=[default_fixtures_dir()], option="--out")  # the fixtures
-    return int(
-        validate(
-            out=args.out,
-            quick=args.quick,
-            progress=True,
-            scheduler=args.scheduler,
-            workers=args.workers,
-        )
-    )
+    return int(validate(out=args.out, quick=args.quick, progress=True, executor=executor))
 
 
+@_executor_errors
 def cmd_report(args: argparse.Namespace) -> int:
     from .report import user_report
     from .report.sections.film import default_film_model
 
+    executor = _executor(args, progress=not args.quiet)
     options, start = _split_params(args.model, args.param)
     selection = {k: getattr(args, k) for k in SELECTION_KEYS if getattr(args, k) is not None}
     return int(
@@ -1283,6 +1293,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             selection=selection,
             progress=not args.quiet,
             film_model=default_film_model() if args.film_default else args.film_model,
+            executor=executor,
         )
     )
 
@@ -1308,6 +1319,7 @@ def _add_geometry(s: argparse.ArgumentParser) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
+    from .fitting.core import METHOD
 
     p = argparse.ArgumentParser(
         prog="labbrdf",
@@ -1349,7 +1361,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("files", nargs="+", action=InputPath, metavar="FILE_OR_DATASET")
     s.add_argument("--model", required=True)
     s.add_argument("--by", default="sample,wavelength_nm", help="comma-separated group columns")
-    s.add_argument("--method", default="GN_CRS2_LM+LN_BOBYQA", help="nlopt GLOBAL[+LOCAL]")
+    s.add_argument("--method", default=METHOD, help="nlopt GLOBAL[+LOCAL]")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--fix", action="append", metavar="NAME=VALUE", help="fix a parameter")
     s.add_argument(
@@ -1467,7 +1479,7 @@ def build_parser() -> argparse.ArgumentParser:
         default="profile",
         help="95%% intervals from the profile of chi2 (default) or the covariance",
     )
-    s.add_argument("--method", default="GN_CRS2_LM+LN_BOBYQA", help="nlopt stages")
+    s.add_argument("--method", default=METHOD, help="nlopt stages")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument(
         "-o",
@@ -1672,6 +1684,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     s.add_argument("--quiet", action="store_true", help="no progress lines")
     _add_selection(s)
+    _add_scheduler(s)
     s.set_defaults(func=cmd_report)
     for sp in sub.choices.values():  # what _checked_outputs checks, per command
         sp.set_defaults(path_actions=tuple(path_actions(sp)))

@@ -1,8 +1,15 @@
 """One way to run a list of independent tasks: serially, on local processes, or on dask.
 
 >>> from labbrdf import parallel
->>> parallel.run(abs, [-1, -2, 3], scheduler="serial")
+>>> parallel.Executor("serial").map(abs, [-1, -2, 3])
 [1, 2, 3]
+
+An :class:`Executor` names where tasks run (scheduler, worker count, the dask security and
+timeout options); batch fits, tracer runs and reports all take one, and the CLI builds one
+from its options (``--scheduler``, ``--workers``, ``--tls-*``, ``--worker-timeout``,
+``--dashboard``). :func:`as_executor` turns None or a scheduler string into one, so that a
+Python caller may still write ``scheduler="serial"``. :func:`run` and :func:`imap` are the
+same runs with the options spelt out.
 
 Schedulers
 ----------
@@ -79,15 +86,19 @@ from concurrent.futures import (
     wait,
 )
 from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, replace
 from typing import Any, TypeVar
 
 from .errors import LabbrdfError
 
 __all__ = [
+    "DEFAULT_SCHEDULER",
     "DEFAULT_WORKER_TIMEOUT",
     "SCHEDULERS",
+    "Executor",
     "ParallelError",
     "Progress",
+    "as_executor",
     "check_scheduler",
     "configure",
     "imap",
@@ -100,6 +111,9 @@ R = TypeVar("R")
 
 #: the scheduler names besides ``tcp://`` / ``tls://`` addresses
 SCHEDULERS = ("serial", "processes", "local")
+
+#: the scheduler of an :class:`Executor` (and of :func:`run`, :func:`imap`) when none is named
+DEFAULT_SCHEDULER = "processes"
 
 #: how long a run waits for a worker on a ``tcp://`` / ``tls://`` scheduler that has none [s]
 DEFAULT_WORKER_TIMEOUT = 60.0
@@ -474,7 +488,7 @@ def imap(
     func: Callable[[T], R],
     items: Iterable[T],
     *,
-    scheduler: str = "processes",
+    scheduler: str = DEFAULT_SCHEDULER,
     workers: int | None = None,
     progress: bool = False,
     desc: str = "",
@@ -695,7 +709,7 @@ def run(
     func: Callable[[T], R],
     items: Iterable[T],
     *,
-    scheduler: str = "processes",
+    scheduler: str = DEFAULT_SCHEDULER,
     workers: int | None = None,
     progress: bool = False,
     desc: str = "",
@@ -717,3 +731,156 @@ def run(
             retries=retries,
         )
     )
+
+
+@dataclass(frozen=True)
+class Executor:
+    """Where a workflow's tasks run: one object passed to fits, traces and reports alike.
+
+    Parameters
+    ----------
+    scheduler : str
+        ``serial``, ``processes`` (default, :data:`DEFAULT_SCHEDULER`), ``local`` or a
+        ``tcp://`` / ``tls://`` dask scheduler address (see the module docstring).
+    workers : int, optional
+        Worker processes (``processes``, ``local``); default: the core count.
+    progress : bool
+        Show a progress bar on stderr for each run.
+    retries : int
+        Runs of a task after its worker died (``local``; see :func:`imap`).
+    dashboard : bool, optional
+        Start the ``local`` cluster's dashboard on 127.0.0.1.
+    tls_ca, tls_cert, tls_key : path-like, optional
+        PEM files for mutual TLS (see :func:`configure`).
+    worker_timeout : float, optional
+        How long to wait for a worker on a ``tcp://`` / ``tls://`` scheduler [s].
+
+    Raises
+    ------
+    ValueError
+        An unknown scheduler, ``workers`` < 1, ``retries`` < 0, or a bad security or
+        timeout option (:func:`configure`): at construction, before any work.
+    ImportError
+        A dask scheduler without dask.distributed (or ``local`` without ``cryptography``
+        and without certificates); the message says what to install.
+
+    Notes
+    -----
+    The dask options are those of this process (:func:`configure`): building an Executor
+    with any of them set configures the process, so the last Executor built decides them.
+    Results do not depend on the executor: every run returns its results in item order.
+    """
+
+    scheduler: str = DEFAULT_SCHEDULER
+    workers: int | None = None
+    progress: bool = False
+    retries: int = 2
+    dashboard: bool | None = None
+    tls_ca: str | os.PathLike[str] | None = None
+    tls_cert: str | os.PathLike[str] | None = None
+    tls_key: str | os.PathLike[str] | None = None
+    worker_timeout: float | None = None
+
+    def __post_init__(self) -> None:
+        # first the certificates: they decide what `local` needs (cryptography or not)
+        configure(
+            dashboard=self.dashboard,
+            tls_ca=self.tls_ca,
+            tls_cert=self.tls_cert,
+            tls_key=self.tls_key,
+            worker_timeout=self.worker_timeout,
+        )
+        check_scheduler(self.scheduler)
+        if self.workers is not None:
+            _workers(self.workers)
+        if int(self.retries) < 0:
+            raise ValueError(f"retries must be >= 0, got {self.retries}")
+
+    @property
+    def serial(self) -> bool:
+        """Whether tasks run in this process, in order."""
+        return self.scheduler == "serial"
+
+    @property
+    def nworkers(self) -> int:
+        """Worker processes a run is planned for (1 when serial; the core count by default)."""
+        return 1 if self.serial else _workers(self.workers)
+
+    def imap(
+        self,
+        func: Callable[[T], R],
+        items: Iterable[T],
+        *,
+        desc: str = "",
+        window: int | None = None,
+    ) -> Iterator[R]:
+        """``func`` of each item, yielded in item order (see :func:`imap`)."""
+        return imap(
+            func,
+            items,
+            scheduler=self.scheduler,
+            workers=self.workers,
+            progress=self.progress,
+            desc=desc,
+            retries=self.retries,
+            window=window,
+        )
+
+    def map(self, func: Callable[[T], R], items: Iterable[T], *, desc: str = "") -> list[R]:
+        """``[func(it) for it in items]`` on this executor, as a list in item order."""
+        return list(self.imap(func, items, desc=desc))
+
+    def __call__(self, func: Callable[[T], R], items: Iterable[T]) -> Iterator[R]:
+        """The ordered ``map(func, items)`` that :func:`labbrdf.tracer.trace` takes."""
+        return self.imap(func, items)
+
+    def with_progress(self, progress: bool) -> Executor:
+        """The same executor with the progress bar switched on or off."""
+        return replace(self, progress=bool(progress))
+
+
+def as_executor(
+    executor: Executor | str | None = None,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: bool | None = None,
+) -> Executor:
+    """The :class:`Executor` a workflow runs on, from what its caller gave.
+
+    Parameters
+    ----------
+    executor : Executor or str, optional
+        An Executor (returned as it is, but for ``progress``), or a scheduler name.
+    scheduler : str, optional
+        The older keyword for a scheduler name (not together with ``executor``).
+    workers : int, optional
+        Worker processes, with a scheduler name or none (an Executor has its own).
+    progress : bool, optional
+        Progress bar on stderr (default: the Executor's setting; off for a name).
+
+    Returns
+    -------
+    Executor
+        None and no scheduler give ``Executor()``: :data:`DEFAULT_SCHEDULER`.
+
+    Raises
+    ------
+    ValueError
+        Both ``executor`` and ``scheduler``, ``workers`` with an Executor, something
+        that is neither an Executor nor a string, or what :class:`Executor` refuses.
+    ImportError
+        As :class:`Executor` raises it.
+    """
+    if executor is not None and scheduler is not None:
+        raise ValueError("give either an executor or a scheduler, not both")
+    if isinstance(executor, Executor):
+        if workers is not None:
+            raise ValueError("workers: an Executor has its own worker count")
+        return executor if progress is None else executor.with_progress(progress)
+    spec = executor if executor is not None else scheduler
+    if spec is not None and not isinstance(spec, str):
+        raise ValueError(
+            f"executor must be an Executor or a scheduler name, got {type(spec).__name__}"
+        )
+    return Executor(spec or DEFAULT_SCHEDULER, workers=workers, progress=bool(progress))

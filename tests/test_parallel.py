@@ -93,6 +93,47 @@ def test_unknown_scheduler_and_workers():
         parallel.run(abs, [1], scheduler="processes", workers=0)
 
 
+def test_executor_map_gives_the_same_results_on_every_scheduler():
+    items = [0.5 * i for i in range(20)]
+    expected = [math.sqrt(x) for x in items]
+    assert parallel.Executor("serial").map(math.sqrt, items) == expected
+    pool = parallel.Executor("processes", workers=2)
+    assert pool.map(math.sqrt, items) == expected
+    assert list(pool.imap(math.sqrt, items, window=2)) == expected
+    assert list(pool(math.sqrt, items)) == expected  # the ordered map the tracer takes
+
+
+def test_executor_has_one_default_and_converts_scheduler_names_once():
+    assert parallel.Executor() == parallel.as_executor() == parallel.as_executor(None)
+    assert parallel.Executor().scheduler == parallel.DEFAULT_SCHEDULER == "processes"
+    ex = parallel.as_executor("serial", workers=3, progress=True)
+    assert ex == parallel.Executor("serial", workers=3, progress=True)
+    assert ex.serial and ex.nworkers == 1
+    assert parallel.as_executor(scheduler="serial") == parallel.Executor("serial")
+    assert parallel.as_executor(ex) is ex
+    assert parallel.as_executor(ex, progress=False) == parallel.Executor("serial", workers=3)
+    assert parallel.Executor("processes", workers=3).nworkers == 3
+
+
+def test_executor_refuses_bad_options_at_construction():
+    with pytest.raises(ValueError, match="unknown scheduler 'gpu'"):
+        parallel.Executor("gpu")
+    with pytest.raises(ValueError, match="workers must be >= 1, got 0"):
+        parallel.Executor("processes", workers=0)
+    with pytest.raises(ValueError, match="retries must be >= 0, got -1"):
+        parallel.Executor("serial", retries=-1)
+    with pytest.raises(ValueError, match="--worker-timeout: expected a finite number"):
+        parallel.Executor("serial", worker_timeout=-1.0)
+    with pytest.raises(ValueError, match="--tls-ca /nonexistent.pem: no such file"):
+        parallel.Executor("serial", tls_ca="/nonexistent.pem", tls_cert="/nonexistent.pem")
+    with pytest.raises(ValueError, match="either an executor or a scheduler, not both"):
+        parallel.as_executor("serial", scheduler="processes")
+    with pytest.raises(ValueError, match="an Executor has its own worker count"):
+        parallel.as_executor(parallel.Executor("serial"), workers=2)
+    with pytest.raises(ValueError, match="Executor or a scheduler name, got int"):
+        parallel.as_executor(3)  # type: ignore[arg-type]
+
+
 def test_progress_counts_every_task_once():
     buf = io.StringIO()
     bar = Progress(4, "fits", stream=buf)
@@ -169,9 +210,9 @@ def trace_block(item: tuple[TraceConfig, tuple[int, ...]]) -> int:
     return item[1][0]
 
 
-def fit_chunk(item: tuple[Any, list[tuple[int, Any]], dict, bool]) -> int:
-    """Key of a fit_many chunk ``(model, [(group index, FitData), ...], kw, keep)``."""
-    return item[1][0][0]
+def fit_chunk(item: tuple[list[tuple[int, Any, Any]], dict, bool]) -> int:
+    """Key of a fit_many chunk ``([(group index, model, FitData), ...], kw, keep)``."""
+    return item[0][0][0]
 
 
 class KillOnce:
@@ -590,9 +631,12 @@ def _trace_json(capsys, *extra: str) -> dict[str, Any]:
 
 def test_cli_trace_honours_scheduler_and_workers(spy, capsys):
     serial = _trace_json(capsys, "--scheduler", "serial")
-    assert spy.calls == []  # serial: no executor at all
+    assert spy.pools == []  # serial: in this process
     pool = _trace_json(capsys, "--scheduler", "processes", "--workers", "3")
-    assert [(c["scheduler"], c["workers"]) for c in spy.calls] == [("processes", 3)]
+    assert [(c["scheduler"], c["workers"]) for c in spy.calls] == [
+        ("serial", None),
+        ("processes", 3),
+    ]
     assert spy.pools == [3]  # a pool of 3 worker processes really ran the blocks
     assert pool == serial
 
@@ -651,8 +695,45 @@ def test_cli_validate_passes_scheduler_and_workers_to_the_report(monkeypatch, tm
     out = str(tmp_path / "rep")
     argv = ["validate", "--out", out, "--quick", "--scheduler", "processes", "--workers", "2"]
     assert main(argv) == 0
-    assert seen == {"out": out, "quick": True, "progress": True, "scheduler": "processes",
-                    "workers": 2}  # fmt: skip
+    ex = parallel.Executor("processes", workers=2, progress=True)
+    assert seen == {"out": out, "quick": True, "progress": True, "executor": ex}
+
+
+def test_cli_report_passes_its_executor_to_the_report(monkeypatch, fixtures_dir, tmp_path):
+    import labbrdf.report
+
+    seen: dict[str, Any] = {}
+
+    def fake_report(*args: Any, **kw: Any) -> int:
+        seen.update(kw)
+        return 0
+
+    monkeypatch.setattr(labbrdf.report, "user_report", fake_report)
+    scan = str(fixtures_dir / "specular" / "osr_specular.csv")
+    out = str(tmp_path / "rep")
+    argv = ["report", scan, "-o", out, "--quiet", "--scheduler", "serial", "--workers", "2"]
+    assert main(argv) == 0
+    assert seen["executor"] == parallel.Executor("serial", workers=2, progress=False)
+    assert main(["report", scan, "-o", out, "--quiet"]) == 0  # the one default
+    assert seen["executor"].scheduler == parallel.DEFAULT_SCHEDULER == "processes"
+
+
+@pytest.mark.parametrize(
+    "bad, message",
+    [
+        (["--scheduler", "gpu"], "unknown scheduler 'gpu'"),
+        (["--workers", "0"], "workers must be >= 1, got 0"),
+        (["--worker-timeout", "0"], "--worker-timeout"),
+    ],
+)
+def test_cli_report_refuses_bad_executor_options_before_any_work(
+    bad, message, fixtures_dir, tmp_path, capsys
+):
+    scan = str(fixtures_dir / "specular" / "osr_specular.csv")
+    out = tmp_path / "rep"
+    assert main(["report", scan, "-o", str(out), "--quiet", *bad]) == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
 
 
 @pytest.mark.slow

@@ -34,7 +34,7 @@ among them in its own ``__all__``. They may change without notice.
 from __future__ import annotations
 
 from .batch import fit_many
-from .core import ALGORITHMS, CONSTRAINED, fit, parse_method
+from .core import ALGORITHMS, CONSTRAINED, METHOD, fit, parse_method
 from .data import FITTABLE_QUANTITIES, FitData, FitError
 from .objective import Objective
 from .result import FitResult
@@ -47,6 +47,7 @@ __all__ = [
     "CONSTRAINED",
     "CORREL_MAX",
     "FITTABLE_QUANTITIES",
+    "METHOD",
     "REL_STDERR_MAX",
     "REL_STDERR_POOR",
     "FitData",

@@ -1,18 +1,22 @@
-"""Batch fits: one fit per group of a dataset, on the executor of :mod:`labbrdf.parallel`."""
+"""Batch fits: one fit per group of a dataset, on an :class:`labbrdf.parallel.Executor`.
+
+The one batch fitter of the package: the ``labbrdf fit`` command (``--nk-from`` included,
+with a model per wavelength) and the reports fit through :func:`fit_many`.
+"""
 
 from __future__ import annotations
 
-import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from .. import parallel  # imports only labbrdf.errors: usable from every layer
 from ..dataset import Measurement
 from ..models import Model
 from ..models import get as get_model
-from .core import fit, parse_method, setup_params
+from .core import METHOD, fit, parse_method, setup_params
 from .data import FitData, FitError, select_rows, several_groups_message
 from .result import FitResult
 
@@ -25,12 +29,12 @@ def _sort_key(key: Any) -> tuple[Any, ...]:
 
 
 def _fit_chunk(
-    payload: tuple[Model, list[tuple[int, FitData]], dict[str, Any], bool],
+    payload: tuple[list[tuple[int, Model, FitData]], dict[str, Any], bool],
 ) -> list[tuple[int, dict[str, Any], FitResult | None]]:
     """Worker: fit each group of a chunk; a group whose data cannot be fitted gives a row."""
-    model, groups, kw, keep = payload
+    groups, kw, keep = payload
     out: list[tuple[int, dict[str, Any], FitResult | None]] = []
-    for i, fd in groups:
+    for i, model, fd in groups:
         try:
             res = fit(model, fd, **kw)
             out.append((i, res.summary(), res if keep else None))
@@ -39,73 +43,14 @@ def _fit_chunk(
     return out
 
 
-def _plain(v: Any) -> Any:
-    return v.item() if isinstance(v, np.generic) else v
+def _groups(
+    d: pd.DataFrame, by: list[str], qty: str, unt: str
+) -> tuple[list[tuple[Any, ...]], list[FitData | str]]:
+    """The key of every group of ``d`` by ``by`` (sorted, NaN last), and its FitData.
 
-
-def fit_many(
-    data: Measurement | pd.DataFrame,
-    model: Model | str,
-    *,
-    by: Sequence[str] = ("sample", "wavelength_nm"),
-    method: str = "GN_CRS2_LM+LN_BOBYQA",
-    seed: int = 0,
-    scheduler: str = "processes",
-    workers: int | None = None,
-    progress: bool = True,
-    chunks: int | None = None,
-    return_results: bool = False,
-    **fit_kw: Any,
-) -> pd.DataFrame | tuple[pd.DataFrame, list[tuple[dict[str, Any], FitResult]]]:
-    """Fit one model to every group of a dataset; a parameter table like Tables 1-2 of 2013.
-
-    Parameters
-    ----------
-    data : Measurement or DataFrame
-        Dataset-schema rows. The fittable rows are selected once for the whole table, as
-        in :func:`fit` (a table that mixes quantities or units needs ``quantity=`` /
-        ``unit=``); groups without fittable rows get no row.
-    model : Model or str
-    by : sequence of str
-        Grouping columns; one fit per group, in sorted group order.
-    method, seed :
-        As for :func:`fit`. Every group uses the same ``seed``, so a row equals
-        ``fit(model, group, seed=seed)`` whatever the scheduler and worker count.
-    scheduler, workers, progress :
-        Passed to :func:`labbrdf.parallel.run` (``serial``, ``processes``, ``local``,
-        ``tcp://host:port``); the progress bar counts chunks of groups.
-    chunks : int, optional
-        Number of tasks the groups are split into (default ``4 x workers``, serial: 1),
-        so that per-task overhead stays small against 1-10 ms fits.
-    return_results : bool
-        Also return the :class:`FitResult` of every fitted group, as a list of
-        ``(group key dict, FitResult)`` in table order (groups that could not be fitted are
-        left out).
-    **fit_kw :
-        Any other :func:`fit` keyword (``fix``, ``energy_constraint``, ``quantity`` ...).
-
-    Returns
-    -------
-    pandas.DataFrame, or (DataFrame, list) with ``return_results``
-        One row per group: the group keys; per parameter ``<name>``, ``<name>_stderr``,
-        ``<name>_ci95_lo``, ``<name>_ci95_hi``, ``<name>_flags`` (``;``-joined); then
-        ``rmse``, ``rmse_pct``, ``chisqr``, ``redchi``, ``ndata``, ``nfev``, ``success``,
-        ``message``, ``elapsed_s``. A group that cannot be fitted (too few points, ...) gets
-        ``success=False`` and the reason in ``message``.
+    A group that holds several samples or wavelengths (columns not in ``by``) gets the
+    reason it is not fitted instead of a FitData.
     """
-    if isinstance(model, str):
-        model = get_model(model)
-    parse_method(method)
-    if isinstance(data, Measurement):
-        data = data.data
-    if not isinstance(data, pd.DataFrame):
-        raise FitError(f"data: expected a Measurement or DataFrame, got {type(data).__name__}")
-    by = [by] if isinstance(by, str) else list(by)
-    missing = [c for c in by if c not in data.columns]
-    if missing:
-        raise FitError(f"by: unknown column(s) {missing}; columns are {list(data.columns)}")
-    setup_params(model, fit_kw.get("params"), fit_kw.get("fix"))  # fail early on names
-    d, qty, unt = select_rows(data, fit_kw.pop("quantity", None), fit_kw.pop("unit", None))
     arrays = {
         c: d[c].to_numpy()
         for c in ("theta_i_deg", "theta_r_deg", "value", "sigma", "phi_r_deg", "wavelength_nm")
@@ -129,49 +74,153 @@ def fit_many(
             if several
             else FitData.from_arrays(arrays, idx, qty, unt)
         )
-    kw = dict(fit_kw, method=method, seed=seed)
-    todo = [(i, g) for i, g in enumerate(groups) if isinstance(g, FitData)]
-    from .. import parallel  # imports only labbrdf.errors: usable from every layer
+    return keys, groups
 
-    if chunks is None:
-        nw = workers or max(1, os.cpu_count() or 1)
-        chunks = 1 if scheduler == "serial" else 4 * nw
-    nchunks = max(1, min(int(chunks), len(todo)))
-    payloads = [(model, todo[c::nchunks], kw, return_results) for c in range(nchunks)]
-    payloads = payloads if todo else []
-    done = parallel.run(
-        _fit_chunk,
-        payloads,
-        scheduler=scheduler,
-        workers=workers,
-        progress=progress,
-        desc=f"fit {model.name}",
+
+def _row(row: dict[str, Any], s: dict[str, Any], param_names: list[str]) -> dict[str, Any]:
+    """One table row: the group keys ``row`` and the columns of a fit summary ``s``."""
+    for name in param_names:
+        ps = (s.get("params") or {}).get(name) or {}
+        ci = ps.get("ci95") or [None, None]
+        row[name] = ps.get("value", np.nan)
+        row[f"{name}_stderr"] = ps.get("stderr")
+        row[f"{name}_ci95_lo"], row[f"{name}_ci95_hi"] = ci
+        row[f"{name}_flags"] = ";".join(ps.get("flags", []))
+    for col in ("rmse", "rmse_pct", "chisqr", "redchi", "ndata", "nfev"):
+        row[col] = s.get(col)
+    row["success"] = bool(s.get("success", False))
+    row["message"] = s.get("message", "")
+    row["elapsed_s"] = s.get("elapsed_s")
+    return row
+
+
+def _param_names(todo: list[tuple[int, Model, FitData]]) -> list[str]:
+    """The parameter names of the groups' models, in first-seen order."""
+    names: dict[str, None] = {}
+    for _, m, _ in todo:
+        names.update(dict.fromkeys(m.params))
+    return list(names)
+
+
+def _plain(v: Any) -> Any:
+    return v.item() if isinstance(v, np.generic) else v
+
+
+def fit_many(
+    data: Measurement | pd.DataFrame,
+    model: Model | str | Callable[[dict[str, Any]], Model],
+    *,
+    by: Sequence[str] = ("sample", "wavelength_nm"),
+    method: str = METHOD,
+    seed: int = 0,
+    executor: parallel.Executor | str | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: bool | None = None,
+    chunks: int | None = None,
+    return_results: bool = False,
+    **fit_kw: Any,
+) -> pd.DataFrame | tuple[pd.DataFrame, list[tuple[dict[str, Any], FitResult]]]:
+    """Fit one model to every group of a dataset; a parameter table like Tables 1-2 of 2013.
+
+    Parameters
+    ----------
+    data : Measurement or DataFrame
+        Dataset-schema rows. The fittable rows are selected once for the whole table, as
+        in :func:`fit` (a table that mixes quantities or units needs ``quantity=`` /
+        ``unit=``); groups without fittable rows get no row.
+    model : Model, str or callable
+        The model (or its registry name) of every group; or ``model(key)``, called here
+        once per group with the group's key (``{column: value}`` of ``by``), giving the
+        model of that group (e.g. a microfacet model with the index n, k at the group's
+        wavelength).
+    by : sequence of str
+        Grouping columns; one fit per group, in sorted group order.
+    method, seed :
+        As for :func:`fit`. Every group uses the same ``seed``, so a row equals
+        ``fit(model, group, seed=seed)`` whatever the scheduler and worker count.
+    executor : Executor or str, optional
+        Where the fits run (:class:`labbrdf.parallel.Executor`, or a scheduler name:
+        ``serial``, ``processes``, ``local``, ``tcp://host:port``); default
+        :data:`labbrdf.parallel.DEFAULT_SCHEDULER`.
+    scheduler, workers :
+        The older spelling of ``executor``: a scheduler name and a worker count, turned
+        into an Executor once by :func:`labbrdf.parallel.as_executor` (``scheduler`` not
+        together with ``executor``, ``workers`` not with an Executor).
+    progress : bool, optional
+        Progress bar on stderr, counting chunks of groups (default: the Executor's
+        setting; on with a scheduler name or no executor).
+    chunks : int, optional
+        Number of tasks the groups are split into (default ``4 x`` the executor's
+        workers), so that per-task overhead stays small against 1-10 ms fits.
+    return_results : bool
+        Also return the :class:`FitResult` of every fitted group, as a list of
+        ``(group key dict, FitResult)`` in table order (groups that could not be fitted are
+        left out).
+    **fit_kw :
+        Any other :func:`fit` keyword (``fix``, ``energy_constraint``, ``quantity`` ...).
+
+    Returns
+    -------
+    pandas.DataFrame, or (DataFrame, list) with ``return_results``
+        One row per group: the group keys; per parameter ``<name>``, ``<name>_stderr``,
+        ``<name>_ci95_lo``, ``<name>_ci95_hi``, ``<name>_flags`` (``;``-joined); then
+        ``rmse``, ``rmse_pct``, ``chisqr``, ``redchi``, ``ndata``, ``nfev``, ``success``,
+        ``message``, ``elapsed_s``. A group that cannot be fitted (too few points, ...) gets
+        ``success=False`` and the reason in ``message``.
+    """
+    if progress is None and not isinstance(executor, parallel.Executor):
+        progress = True  # a scheduler name or no executor: a bar, as ``labbrdf fit`` shows
+    ex = parallel.as_executor(executor, scheduler=scheduler, workers=workers, progress=progress)
+    if isinstance(model, str):
+        model = get_model(model)
+    model_of: Callable[[dict[str, Any]], Model] | None = (
+        None if isinstance(model, Model) else model
     )
+    parse_method(method)
+    if isinstance(data, Measurement):
+        data = data.data
+    if not isinstance(data, pd.DataFrame):
+        raise FitError(f"data: expected a Measurement or DataFrame, got {type(data).__name__}")
+    by = [by] if isinstance(by, str) else list(by)
+    missing = [c for c in by if c not in data.columns]
+    if missing:
+        raise FitError(f"by: unknown column(s) {missing}; columns are {list(data.columns)}")
+    if isinstance(model, Model):
+        setup_params(model, fit_kw.get("params"), fit_kw.get("fix"))  # fail early on names
+    d, qty, unt = select_rows(data, fit_kw.pop("quantity", None), fit_kw.pop("unit", None))
+    keys, groups = _groups(d, by, qty, unt)
+    kw = dict(fit_kw, method=method, seed=seed)
+    todo: list[tuple[int, Model, FitData]] = []
+    for i, g in enumerate(groups):
+        if isinstance(g, FitData):
+            if model_of is None:
+                assert isinstance(model, Model)
+                m = model
+            else:
+                m = model_of(dict(zip(by, map(_plain, keys[i]), strict=True)))
+                setup_params(m, fit_kw.get("params"), fit_kw.get("fix"))
+            todo.append((i, m, g))
+    if chunks is None:
+        chunks = 4 * ex.nworkers
+    nchunks = max(1, min(int(chunks), len(todo)))
+    payloads = [(todo[c::nchunks], kw, return_results) for c in range(nchunks)]
+    payloads = payloads if todo else []
+    name = getattr(model, "name", None) or (todo[0][1].name if todo else "model")
+    done = ex.map(_fit_chunk, payloads, desc=f"fit {name}")
     summaries: dict[int, dict[str, Any]] = {i: s for chunk in done for i, s, _ in chunk}
     fitted = {i: r for chunk in done for i, _, r in chunk if r is not None}
+    param_names = list(model.params) if isinstance(model, Model) else _param_names(todo)
     rows = []
     results: list[tuple[dict[str, Any], FitResult]] = []
     for i, key in enumerate(keys):
         row: dict[str, Any] = {b: _plain(v) for b, v in zip(by, key, strict=True)}
         if i in fitted:
             results.append((dict(row), fitted[i]))
-        g = groups[i]
-        s = summaries.get(i) or {"success": False, "message": f"not fitted: {g}"}
-        for name in model.params:
-            ps = (s.get("params") or {}).get(name) or {}
-            ci = ps.get("ci95") or [None, None]
-            row[name] = ps.get("value", np.nan)
-            row[f"{name}_stderr"] = ps.get("stderr")
-            row[f"{name}_ci95_lo"], row[f"{name}_ci95_hi"] = ci
-            row[f"{name}_flags"] = ";".join(ps.get("flags", []))
-        for col in ("rmse", "rmse_pct", "chisqr", "redchi", "ndata", "nfev"):
-            row[col] = s.get(col)
-        row["success"] = bool(s.get("success", False))
-        row["message"] = s.get("message", "")
-        row["elapsed_s"] = s.get("elapsed_s")
-        rows.append(row)
+        s = summaries.get(i) or {"success": False, "message": f"not fitted: {groups[i]}"}
+        rows.append(_row(row, s, param_names))
     out = pd.DataFrame(rows)
     num = [c for c in out.columns if c.endswith(("_stderr", "_ci95_lo", "_ci95_hi"))]
-    num += ["rmse", "rmse_pct", "chisqr", "redchi", "elapsed_s"] + list(model.params)
+    num += ["rmse", "rmse_pct", "chisqr", "redchi", "elapsed_s"] + param_names
     out[num] = out[num].astype(float)
     return (out, results) if return_results else out

@@ -28,11 +28,16 @@ __all__ = [
     "EXACT_RTOL",
     "CONSTRAINED",
     "LOCAL_ROUNDS",
+    "METHOD",
     "RELATIVE_FLOOR",
     "fit",
     "parse_method",
     "setup_params",
 ]
+
+#: the default optimiser of every fit (film, batch, report, CLI): the global controlled
+#: random search CRS2 with local mutation, then BOBYQA from its best point
+METHOD = "GN_CRS2_LM+LN_BOBYQA"
 
 #: every nlopt algorithm, by name (``GN_CRS2_LM`` ...), read from the nlopt module itself
 ALGORITHMS: dict[str, int] = {
@@ -107,7 +112,7 @@ def parse_method(method: str) -> list[str]:
         For an unknown name, listing the valid ones.
     """
     if not isinstance(method, str) or not method.strip():
-        raise FitError(f"method must be a string such as 'GN_CRS2_LM+LN_BOBYQA', got {method!r}")
+        raise FitError(f"method must be a string such as {METHOD!r}, got {method!r}")
     stages = []
     for raw in method.split("+"):
         name = raw.strip().upper().removeprefix("NLOPT_")
@@ -400,7 +405,7 @@ def fit(
     model: Model | str,
     data: Measurement | pd.DataFrame | FitData,
     *,
-    method: str = "GN_CRS2_LM+LN_BOBYQA",
+    method: str = METHOD,
     seed: int = 0,
     params: Parameters | Mapping[str, Any] | None = None,
     fix: Mapping[str, float] | None = None,

@@ -30,7 +30,7 @@ from ..dataset import Measurement
 from ..films import FILM_QUANTITIES, NK_REPORT_NM, FilmError, FilmModel, Stack, load_model
 from ..jsonsafe import jsonable
 from ..models import Model, Parameters
-from .core import fit
+from .core import METHOD, fit
 from .data import FitData, FitError
 from .result import FitResult
 from .uncertainty import CORREL_MAX
@@ -566,7 +566,7 @@ def fit_film(
     free: Mapping[str, tuple[float, float]] | None = None,
     wavelength_range_nm: tuple[float, float] | None = None,
     default_sigma: Mapping[str, float] | None = None,
-    method: str = "GN_CRS2_LM+LN_BOBYQA",
+    method: str = METHOD,
     seed: int = 0,
     ci: str = "wald",
     maxeval: int | Sequence[int | None] | None = None,

@@ -1,57 +1,50 @@
-"""The state one report's sections share: the :class:`Context`, fit records, published tables.
+"""The state one report's sections share: the :class:`Context` and its fit records.
 
 Each section function (:mod:`labbrdf.report.sections`) takes the :class:`Context` and adds
 text, tables, figures and checks to its :class:`~labbrdf.report.builder.Builder`. Fits run
-through :func:`labbrdf.fitting.fit` and are kept as :class:`FitRecord` s built from
-:meth:`labbrdf.FitResult.summary` (a plain dict, so that it travels between
-processes). The published tables of Zou, Bai, Wu (2013) are read here
-(:func:`load_published`).
+through the batch fitter :func:`labbrdf.fitting.fit_many` on the report's
+:class:`~labbrdf.parallel.Executor` and are kept as :class:`FitRecord` s
+(:func:`fit_records`). The published tables of Zou, Bai, Wu (2013) are read by
+:mod:`labbrdf.report.published` into ``Context.published``.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypedDict, TypeVar
+from typing import Any, TypedDict
 
 import numpy as np
 import pandas as pd
 
-from .. import models, parallel
+from .. import models
 from ..adapters.topography import HeightMap
-from ..fitting import fit
+from ..fitting import METHOD, FitError, FitResult, fit_many
+from ..parallel import Executor
 from ..tracer import TraceResult
 from .builder import Builder, Unavailable, num
 
 __all__ = [
-    "METHOD",
     "SCAN_QUANTITIES",
     "Context",
     "FitRecord",
     "ParamRecord",
     "curve_grid",
-    "fit_task",
-    "load_published",
+    "fit_records",
     "model_curve",
-    "paper_values",
     "params_of",
-    "published_params",
     "rmse_abs",
     "rmse_paper",
     "run_fits",
-    "run_tasks",
 ]
 
 #: quantities fitted as BRDF scans
 SCAN_QUANTITIES = ("brdf", "specular_intensity")
 
-#: default optimiser: a global stage then a local one (docs/models.md, "Fitting")
-METHOD = "GN_CRS2_LM+LN_BOBYQA"
-
-_T = TypeVar("_T")
-_R = TypeVar("_R")
+#: the groups of a report's fits: one fit per sample and wavelength
+BY = ("sample", "wavelength_nm")
 
 
 class ParamRecord(TypedDict):
@@ -88,9 +81,8 @@ class Context:
 
     b: Builder
     quick: bool = False
-    scheduler: str | None = None
-    workers: int | None = None
-    progress: bool = False
+    #: where the fits and tracer runs go (default: :data:`labbrdf.parallel.DEFAULT_SCHEDULER`)
+    executor: Executor = field(default_factory=Executor)
     method: str = METHOD
     seed: int = 0
     #: further :func:`labbrdf.fitting.fit` keywords for every fit of the report (``maxeval``)
@@ -164,30 +156,63 @@ def rmse_abs(summary: Mapping[str, Any]) -> float | None:
 # --------------------------------------------------------------------------- fits
 
 
-def fit_task(
-    task: tuple[str, dict[str, Any], pd.DataFrame, str, int, dict[str, Any]],
-) -> dict[str, Any]:
-    """Fit one group (module level, so that process and dask schedulers can pickle it)."""
-    name, options, df, method, seed, fit_options = task
-    model = models.get(name, **options)
-    res = fit(model, df, method=method, seed=seed, **fit_options)
-    return dict(res.summary())
+def fit_records(
+    name: str,
+    options: Mapping[str, Any],
+    rows: pd.DataFrame,
+    table: pd.DataFrame,
+    results: Sequence[tuple[dict[str, Any], FitResult]],
+    by: Sequence[str] = BY,
+    group: str | Sequence[str] = "all",
+) -> list[FitRecord]:
+    """The :class:`FitRecord` s of a :func:`labbrdf.fitting.fit_many` run, in table order.
 
+    Parameters
+    ----------
+    name, options :
+        The model's registry name and options (a record rebuilds its model from them).
+    rows : DataFrame
+        The rows that were fitted; each record keeps those of its group.
+    table, results :
+        What ``fit_many(rows, ..., by=by, return_results=True)`` returned.
+    by : sequence of str
+        The grouping columns of that run.
+    group : str or sequence of str
+        The records' group label, one for all or one per result.
 
-def run_tasks(ctx: Context, func: Callable[[_T], _R], items: list[_T], desc: str) -> list[_R]:
-    """``[func(it) for it in items]`` on the report's scheduler (in this process if none)."""
-    if ctx.scheduler in (None, "serial") or len(items) < 2:
-        out = [func(it) for it in items]
-        ctx.b.log(f"  {desc}: {len(items)} done")
-        return out
-    return parallel.run(
-        func,
-        items,
-        scheduler=ctx.scheduler,
-        workers=ctx.workers,
-        progress=ctx.progress,
-        desc=desc,
-    )
+    Raises
+    ------
+    FitError
+        A group could not be fitted (too few points, ...): a report shows every group's
+        fit or none, naming the group and the reason.
+    """
+    failed = table[~table["success"].astype(bool) & table["message"].str.startswith("not fitted")]
+    if len(failed):
+        r = failed.iloc[0]
+        where = ", ".join(f"{c}={r[c]}" for c in by)
+        raise FitError(f"{name}: group {where}: {r['message']}")
+    labels = [group] * len(results) if isinstance(group, str) else list(group)
+    out = []
+    for (key, res), label in zip(results, labels, strict=True):
+        mask = np.ones(len(rows), bool)
+        for c, v in key.items():
+            mask &= (rows[c] == v).to_numpy()
+        summ = dict(res.summary())
+        ps = params_of(summ)
+        out.append(
+            FitRecord(
+                name,
+                dict(options),
+                str(key["sample"]),
+                float(key["wavelength_nm"]),
+                rows[mask].reset_index(drop=True),
+                summ,
+                {k: v["value"] for k, v in ps.items() if v["value"] is not None},
+                ps,
+                label,
+            )
+        )
+    return out
 
 
 def run_fits(
@@ -198,35 +223,20 @@ def run_fits(
 ) -> dict[str, list[FitRecord]]:
     """Fit each (model name, options) to each (sample, wavelength) group of the scan rows."""
     scans = ctx.scans() if scans is None else scans
-    groups = [
-        (str(s), float(w), g.reset_index(drop=True))
-        for (s, w), g in scans.groupby(["sample", "wavelength_nm"], sort=True)
-    ]
     out: dict[str, list[FitRecord]] = {}
     for name, options in model_specs:
-        tasks = [
-            (name, dict(options), g, ctx.method, ctx.seed, dict(ctx.fit_options))
-            for _, _, g in groups
-        ]
-        ctx.b.log(f"  fitting {name} to {len(tasks)} groups ({group})")
-        summaries = run_tasks(ctx, fit_task, tasks, f"fit {name}")
-        recs = []
-        for (s, w, g), summ in zip(groups, summaries, strict=True):
-            ps = params_of(summ)
-            recs.append(
-                FitRecord(
-                    name,
-                    dict(options),
-                    s,
-                    w,
-                    g,
-                    summ,
-                    {k: v["value"] for k, v in ps.items() if v["value"] is not None},
-                    ps,
-                    group,
-                )
-            )
-        out[name] = recs
+        table, results = fit_many(
+            scans,
+            models.get(name, **options),
+            by=BY,
+            method=ctx.method,
+            seed=ctx.seed,
+            executor=ctx.executor,
+            return_results=True,
+            **ctx.fit_options,
+        )
+        ctx.b.log(f"  fitted {name} to {len(table)} groups ({group})")
+        out[name] = fit_records(name, options, scans, table, results, BY, group)
     return out
 
 
@@ -251,78 +261,3 @@ def model_curve(
             params=rec.values,
         )
     )
-
-
-# --------------------------------------------------------------------------- published
-
-
-def _rename(df: pd.DataFrame) -> pd.DataFrame:
-    ren = {}
-    for c in df.columns:
-        lc = str(c).strip().lower()
-        for key in ("k1", "k2", "k3", "rmse", "sample"):
-            if lc.startswith(key):
-                ren[c] = key
-        if lc.startswith("wavelength") or lc in ("lambda_nm", "wl_nm"):
-            ren[c] = "wavelength_nm"
-        if lc.startswith("integration"):
-            ren[c] = "integration_pct"
-        if lc.startswith("measured") or lc.startswith("hemispherical"):
-            ren[c] = "measured_pct"
-        if lc.startswith("error") or lc.startswith("relative"):
-            ren[c] = "error_pct"
-    return df.rename(columns=ren)
-
-
-def load_published(ctx: Context, folder: Path) -> list[str]:
-    """Read the published Tables 1-3 into ``ctx.published``; returns the files read.
-
-    The files are ``zou2013_table{1,2,3}.csv`` of the fixtures' ``published/`` folder, with
-    their citation headers: Zou X., Bai L., Wu Z., "Mirror reflectance spectrum modeling of
-    smooth samples", Acta Optica Sinica 33(6), 0612008 (2013), doi:10.3788/AOS201333.0612008.
-    """
-    read = []
-    frames = []
-    for n, default_sample in ((1, "OSR"), (2, "mirror")):
-        p = folder / f"zou2013_table{n}.csv"
-        if p.is_file():
-            t = _rename(pd.read_csv(p, comment="#", skipinitialspace=True))
-            if "sample" not in t.columns:
-                t["sample"] = default_sample
-            t["sample"] = t["sample"].astype(str)
-            frames.append(t)
-            read.append(p.name)
-    if frames:
-        ctx.published["params"] = pd.concat(frames, ignore_index=True)
-    p = folder / "zou2013_table3.csv"
-    if p.is_file():
-        ctx.published["table3"] = _rename(pd.read_csv(p, comment="#", skipinitialspace=True))
-        read.append(p.name)
-    return read
-
-
-def published_params(ctx: Context, sample: str, wl: float) -> dict[str, float | None]:
-    """Published smooth3 k1, k2, k3 and RMSE (Tables 1-2) of a sample and wavelength.
-
-    Empty when the tables or the row are missing; a blank cell is None.
-    """
-    t = ctx.published.get("params")
-    if t is None:
-        return {}
-    m = t[(t["sample"].str.lower() == sample.lower()) & (np.isclose(t["wavelength_nm"], wl))]
-    if not len(m):
-        return {}
-    r = m.iloc[0]
-    return {k: num(r.get(k)) for k in ("k1", "k2", "k3", "rmse")}
-
-
-def paper_values(ctx: Context, sample: str, wl: float) -> dict[str, float] | None:
-    """The paper's smooth3 parameters (k1, k2, k3) of a sample and wavelength, or None."""
-    t = ctx.published.get("params")
-    if t is None:
-        return None
-    m = t[(t["sample"].str.lower() == sample.lower()) & np.isclose(t["wavelength_nm"], wl)]
-    if not len(m):
-        return None
-    r = m.iloc[0]
-    return {"k1": float(r["k1"]), "k2": float(r["k2"]), "k3": float(r["k3"])}

@@ -17,10 +17,12 @@ from typing import Any
 
 from .. import __version__, models
 from ..films import FilmModel
+from ..fitting import METHOD
+from ..parallel import Executor, as_executor
 from ..provenance import versions
 from . import html
 from .builder import Builder, Unavailable, write_report
-from .context import METHOD, Context
+from .context import Context
 from .sections import Section, run
 from .sections.brdf import brdf_section
 from .sections.colour import colour_section
@@ -72,8 +74,9 @@ def user_report(
     method: str = METHOD,
     seed: int = 0,
     progress: bool = True,
-    scheduler: str | None = None,
+    executor: Executor | str | None = None,
     workers: int | None = None,
+    scheduler: str | None = None,
     title: str | None = None,
     start: Mapping[str, float] | None = None,
     selection: Mapping[str, Any] | None = None,
@@ -97,8 +100,13 @@ def user_report(
         Optimiser (nlopt names joined by ``+``) and seed, as for :func:`labbrdf.fitting.fit`.
     progress : bool
         Progress lines on stderr.
-    scheduler, workers :
-        Executor for the fits (:mod:`labbrdf.parallel`); None runs in this process.
+    executor : Executor or str, optional
+        Where the fits and tracer runs go (:class:`labbrdf.parallel.Executor`, or a
+        scheduler name); default :data:`labbrdf.parallel.DEFAULT_SCHEDULER`.
+    workers : int, optional
+        Worker processes, with a scheduler name or the default executor.
+    scheduler : str, optional
+        The older keyword for a scheduler name (not together with ``executor``).
     title : str, optional
         Page title (default: "labbrdf report: <model> fits", or "... nothing fitted"
         when no section could fit the model).
@@ -165,9 +173,7 @@ def user_report(
     )
     ctx = Context(
         b,
-        scheduler=scheduler,
-        workers=workers,
-        progress=progress,
+        executor=as_executor(executor, scheduler=scheduler, workers=workers, progress=progress),
         method=method,
         seed=seed,
         fit_options={"params": dict(start)} if start else {},

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from .. import __version__
-from ..parallel import check_scheduler
+from ..parallel import Executor, as_executor
 from ..provenance import versions
 from . import html
 from .builder import Builder, write_report
@@ -152,9 +152,10 @@ def validate(
     out: str | os.PathLike[str] = "reports/validation",
     quick: bool = False,
     progress: bool = True,
-    scheduler: str | None = None,
+    executor: Executor | str | None = None,
     workers: int | None = None,
     *,
+    scheduler: str | None = None,
     fixtures_dir: str | os.PathLike[str] | None = None,
     shared_dir: str | os.PathLike[str] | Literal[False] | None = None,
     sections_to_run: Sequence[str] | None = None,
@@ -171,9 +172,13 @@ def validate(
         Small tracer scale (:data:`SCALES`) for tests and previews.
     progress : bool
         Progress lines on stderr.
-    scheduler, workers :
-        Executor for the fits and the tracer runs (see :mod:`labbrdf.parallel`); None runs
-        in this process.
+    executor : Executor or str, optional
+        Where the fits and the tracer runs go (:class:`labbrdf.parallel.Executor`, or a
+        scheduler name); default :data:`labbrdf.parallel.DEFAULT_SCHEDULER`.
+    workers : int, optional
+        Worker processes, with a scheduler name or the default executor.
+    scheduler : str, optional
+        The older keyword for a scheduler name (not together with ``executor``).
     fixtures_dir : path-like, optional
         The fixture folder (default: :func:`default_fixtures_dir`).
     shared_dir : path-like, False or None
@@ -204,8 +209,8 @@ def validate(
         shared = default_shared_dir()
     else:
         shared = Path(shared_dir) if Path(shared_dir).is_dir() else None
-    if scheduler is not None:
-        check_scheduler(scheduler)  # a bad name or missing dask fails here, not per section
+    # a bad scheduler name or missing dask fails here, not per section
+    ex = as_executor(executor, scheduler=scheduler, workers=workers, progress=progress)
     todo = list(SECTION_IDS if sections_to_run is None else sections_to_run)
     unknown = [s for s in todo if s not in SECTION_IDS]
     if unknown:
@@ -221,17 +226,15 @@ def validate(
             "shared_dir": str(shared) if shared else None,
             "python": platform.python_version(),
             "environment": versions(),
-            "scheduler": scheduler or "serial",
-            "workers": workers,
+            "scheduler": ex.scheduler,
+            "workers": ex.workers,
             "sections_run": todo,
         },
     )
     ctx = Context(
         b,
         quick=quick,
-        scheduler=scheduler,
-        workers=workers,
-        progress=progress,
+        executor=ex,
         fit_options=dict(fit_options or {}),
         scale=SCALES[scale_name],
         fixtures=fx,

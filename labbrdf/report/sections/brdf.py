@@ -15,8 +15,9 @@ import numpy as np
 import pandas as pd
 
 from ... import integrate, models
+from ...fitting import fit_many
 from ..builder import Unavailable, num, wl_label
-from ..context import Context, FitRecord, fit_task, params_of, run_tasks
+from ..context import BY, Context, FitRecord, fit_records
 
 __all__ = ["brdf_section", "brdf_fit_options", "energy_rows"]
 
@@ -48,17 +49,6 @@ def brdf_fit_options(ctx: Context, rows: pd.DataFrame) -> dict[str, Any]:
     return kw
 
 
-def _groups(rows: pd.DataFrame) -> list[tuple[str, float, float | None, pd.DataFrame]]:
-    """(sample, wavelength, theta_i or None for the joint fit, rows) of every fit to run."""
-    out: list[tuple[str, float, float | None, pd.DataFrame]] = []
-    for (s, w), g in rows.groupby(["sample", "wavelength_nm"], sort=True):
-        g = g.reset_index(drop=True)
-        for ti, gi in g.groupby("theta_i_deg", sort=True):
-            out.append((str(s), float(w), float(ti), gi.reset_index(drop=True)))
-        out.append((str(s), float(w), None, g))
-    return out
-
-
 def _label(ti: float | None) -> str:
     return "joint" if ti is None else f"{ti:g}"
 
@@ -66,28 +56,32 @@ def _label(ti: float | None) -> str:
 def run_brdf_fits(
     ctx: Context, model: str, options: Mapping[str, Any], rows: pd.DataFrame
 ) -> list[tuple[float | None, FitRecord]]:
-    """Fit ``model`` per (sample, wavelength, theta_i) and jointly per (sample, wavelength)."""
-    groups = _groups(rows)
+    """Fit ``model`` per (sample, wavelength, theta_i) and jointly per (sample, wavelength).
+
+    Returns (theta_i or None for the joint fit, record) for each (sample, wavelength) in
+    order: its fits per incidence, then its joint fit.
+    """
     kw = brdf_fit_options(ctx, rows)
-    tasks = [(model, dict(options), g, ctx.method, ctx.seed, dict(kw)) for _, _, _, g in groups]
-    ctx.b.log(f"  fitting {model} to {len(tasks)} BRDF groups (per incidence and joint)")
-    summaries = run_tasks(ctx, fit_task, tasks, f"fit {model} (brdf)")
-    out = []
-    for (s, w, ti, g), summ in zip(groups, summaries, strict=True):
-        ps = params_of(summ)
-        rec = FitRecord(
-            model,
-            dict(options),
-            s,
-            w,
-            g,
-            summ,
-            {k: v["value"] for k, v in ps.items() if v["value"] is not None},
-            ps,
-            f"theta_i={_label(ti)}",
+    m = models.get(model, **options)
+    recs: dict[tuple[str, float], list[tuple[float | None, FitRecord]]] = {}
+    for by in ([*BY, "theta_i_deg"], list(BY)):
+        table, results = fit_many(
+            rows,
+            m,
+            by=by,
+            method=ctx.method,
+            seed=ctx.seed,
+            executor=ctx.executor,
+            return_results=True,
+            **kw,
         )
-        out.append((ti, rec))
-    return out
+        tis = [float(k["theta_i_deg"]) if "theta_i_deg" in k else None for k, _ in results]
+        labels = [f"theta_i={_label(ti)}" for ti in tis]
+        ctx.b.log(f"  fitted {model} to {len(table)} BRDF groups by {', '.join(by)}")
+        recs_by = fit_records(model, options, rows, table, results, by, labels)
+        for ti, rec in zip(tis, recs_by, strict=True):
+            recs.setdefault((rec.sample, rec.wavelength_nm), []).append((ti, rec))
+    return [x for key in sorted(recs) for x in recs[key]]
 
 
 def _evaluate(rec: FitRecord, ti: Any, tr: Any, pr: Any) -> np.ndarray:

@@ -14,7 +14,8 @@ import math
 
 from ... import integrate, models
 from ..builder import Unavailable
-from ..context import Context, paper_values
+from ..context import Context
+from ..published import paper_values
 
 __all__ = ["errata_section"]
 
@@ -131,7 +132,7 @@ def _energy_limits(ctx: Context, m: models.Model) -> None:
     b = ctx.b
     erows, worst, worst_root = [], 0.0, 0.0
     for (sample, wl), ref in ENERGY_LIMIT_DEG.items():
-        pv = paper_values(ctx, sample, wl)
+        pv = paper_values(ctx.published, sample, wl)
         if pv is None:
             continue
         ang = integrate.energy_limit_angle(m, pv)
@@ -197,7 +198,7 @@ def _reciprocity(ctx: Context, m: models.Model) -> None:
     b = ctx.b
     rrows, worst = [], 0.0
     for sample, (a_ref, b_ref) in RECIPROCITY_550.items():
-        pv = paper_values(ctx, sample, 550.0)
+        pv = paper_values(ctx.published, sample, 550.0)
         if pv is None:
             continue
         fa = float(m.evaluate(math.radians(30), math.radians(50), params=pv))

@@ -13,7 +13,8 @@ from typing import Any
 from scipy import stats
 
 from ..builder import num, wl_label
-from ..context import Context, FitRecord, published_params, rmse_abs, rmse_paper, run_fits
+from ..context import Context, FitRecord, rmse_abs, rmse_paper, run_fits
+from ..published import published_params
 
 __all__ = ["fits_section"]
 
@@ -91,7 +92,7 @@ def _columns(
 def _row(ctx: Context, r: FitRecord, varying: Sequence[str], has_pub: bool) -> dict[str, Any]:
     """One fit's line of the parameter table."""
     row: dict[str, Any] = {"sample": r.sample, "wavelength_nm": r.wavelength_nm}
-    pub = published_params(ctx, r.sample, r.wavelength_nm) if has_pub else {}
+    pub = published_params(ctx.published, r.sample, r.wavelength_nm) if has_pub else {}
     flags = []
     for p in varying:
         q = r.params[p]
@@ -186,7 +187,7 @@ def _chi2_check(
 def _published_check(ctx: Context, recs: Sequence[FitRecord], varying: Sequence[str]) -> None:
     worst, n, bad = 0.0, 0, []
     for r in recs:
-        pub = published_params(ctx, r.sample, r.wavelength_nm)
+        pub = published_params(ctx.published, r.sample, r.wavelength_nm)
         for p in varying:
             se, v, pv = r.params[p]["stderr"], r.params[p]["value"], pub.get(p)
             if pv is None or v is None or not se:

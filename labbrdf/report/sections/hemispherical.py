@@ -21,7 +21,8 @@ import pandas as pd
 from ... import integrate, models
 from .. import figures
 from ..builder import Unavailable, num
-from ..context import Context, FitRecord, paper_values
+from ..context import Context, FitRecord
+from ..published import paper_values
 
 __all__ = ["hemispherical_section"]
 
@@ -80,7 +81,7 @@ def _row(
         row["t3_measured"] = num(p3["measured_pct"].iloc[0]) if len(p3) else None
         row["t3_integration"] = num(p3["integration_pct"].iloc[0]) if len(p3) else None
         row["t3_error"] = num(p3["error_pct"].iloc[0]) if len(p3) and "error_pct" in p3 else None
-    pv = paper_values(ctx, sample, wl)
+    pv = paper_values(ctx.published, sample, wl)
     for ang in (45, 46):
         row[f"paper_{ang}"] = (
             float(integrate.hemispherical_reflectance(m3, pv, ang)) if pv else None

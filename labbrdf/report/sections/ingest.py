@@ -9,7 +9,8 @@ from typing import Any
 
 from ... import adapters
 from ..builder import Unavailable
-from ..context import Context, load_published
+from ..context import Context
+from ..published import read_published
 
 __all__ = ["fixture_files", "fixtures_section", "ingest_files"]
 
@@ -39,7 +40,8 @@ def fixtures_section(ctx: Context) -> None:
         "from the extension and the header) into the common dataset. The fixtures are "
         "SYNTHETIC files in real export formats, see fixtures/README.md."
     )
-    pub = load_published(ctx, fx / "published")
+    tables, pub = read_published(fx / "published")
+    ctx.published.update(tables)
     b.text("Published tables read: " + (", ".join(pub) if pub else "none found") + ".")
     if not fx.is_dir():
         raise Unavailable(f"fixture folder {fx} not found")

@@ -6,7 +6,8 @@ import numpy as np
 
 from .. import figures
 from ..builder import Unavailable, slug
-from ..context import Context, published_params
+from ..context import Context
+from ..published import published_params
 
 __all__ = ["spectra_section"]
 
@@ -38,7 +39,7 @@ def spectra_section(ctx: Context, model_name: str = "smooth3") -> None:
                 },
             }
         ]
-        pubs = [published_params(ctx, s, w) for w in wl]
+        pubs = [published_params(ctx.published, s, w) for w in wl]
         if model_name == "smooth3" and any(pubs):
             series.append(
                 {

@@ -19,8 +19,6 @@ are upper bounds of the true errors, so the checks can only be stricter in reali
 
 from __future__ import annotations
 
-import builtins
-import functools
 import math
 from collections.abc import Callable, Iterable
 from pathlib import Path
@@ -29,7 +27,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from ... import optics, parallel
+from ... import optics
 from ...tracer import Substrate, TraceConfig, TraceResult, trace
 from ...tracer import studies as st
 from .. import figures
@@ -60,12 +58,8 @@ def _robust_max(res: TraceResult, s0: np.ndarray) -> float | None:
 
 
 def _map(ctx: Context) -> Callable[..., Iterable[Any]]:
-    """The ordered ``map`` that runs tracer work units on the report's scheduler."""
-    if ctx.scheduler in (None, "serial"):
-        return builtins.map
-    return functools.partial(
-        parallel.imap, scheduler=ctx.scheduler, workers=ctx.workers, progress=False
-    )
+    """The ordered ``map`` that runs tracer work units on the report's executor (no bar)."""
+    return ctx.executor.with_progress(False)
 
 
 def _run(ctx: Context, config: TraceConfig) -> TraceResult:
