@@ -1317,18 +1317,8 @@ def _add_geometry(s: argparse.ArgumentParser) -> None:
     )
 
 
-def build_parser() -> argparse.ArgumentParser:
-    from . import __version__
-    from .fitting.core import METHOD
-
-    p = argparse.ArgumentParser(
-        prog="labbrdf",
-        description="Optical-metrology toolkit: read instrument exports, fit BRDF models, "
-        "check physics, trace polarized rays, write validation reports.",
-    )
-    p.add_argument("--version", action="version", version=f"labbrdf {__version__}")
-    sub = p.add_subparsers(dest="command", required=True)
-
+def _ingest_parser(sub: Any) -> None:
+    """The ``ingest`` subcommand's options."""
     s = sub.add_parser("ingest", help="read instrument exports into one dataset")
     s.add_argument("files", nargs="+", action=InputPath, metavar="FILE")
     s.add_argument("--format", default=None, help="force an adapter (see `labbrdf formats`)")
@@ -1353,9 +1343,17 @@ def build_parser() -> argparse.ArgumentParser:
     _add_selection(s)
     s.set_defaults(func=cmd_ingest)
 
+
+def _formats_parser(sub: Any) -> None:
+    """The ``formats`` subcommand's options."""
     s = sub.add_parser("formats", help="list the supported export formats")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_formats)
+
+
+def _fit_parser(sub: Any) -> None:
+    """The ``fit`` subcommand's options."""
+    from .fitting.core import METHOD
 
     s = sub.add_parser("fit", help="fit a model per group (sample, wavelength)")
     s.add_argument("files", nargs="+", action=InputPath, metavar="FILE_OR_DATASET")
@@ -1415,6 +1413,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_scheduler(s)
     s.set_defaults(func=cmd_fit)
 
+
+def _nk_parser(sub: Any) -> None:
+    """The ``nk`` subcommand's options."""
     s = sub.add_parser("nk", help="optical constants n, k from ellipsometer psi/Delta")
     s.add_argument("files", nargs="+", action=InputPath, metavar="FILE")
     s.add_argument(
@@ -1436,6 +1437,11 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true")
     _add_selection(s)
     s.set_defaults(func=cmd_nk)
+
+
+def _film_parser(sub: Any) -> None:
+    """The ``film`` subcommand's options."""
+    from .fitting.core import METHOD
 
     s = sub.add_parser(
         "film",
@@ -1503,6 +1509,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_selection(s)
     s.set_defaults(func=cmd_film)
 
+
+def _surface_parser(sub: Any) -> None:
+    """The ``surface`` subcommand's options."""
     s = sub.add_parser("surface", help="roughness statistics of a height map or profile")
     s.add_argument("file", action=InputPath, metavar="FILE")
     s.add_argument("--channel", default=None, help="channel name or index (default: height)")
@@ -1534,6 +1543,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_surface)
 
+
+def _export_parser(sub: Any) -> None:
+    """The ``export`` subcommand's options."""
     s = sub.add_parser("export", help="write a model BRDF in an exchange format")
     s.add_argument("--format", default="zemax-bsdf", help="zemax-bsdf")
     s.add_argument("--model", default=None, help="a model (with --param) ...")
@@ -1550,6 +1562,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_overwrite(s)
     s.set_defaults(func=cmd_export)
 
+
+def _hemispherical_parser(sub: Any) -> None:
+    """The ``hemispherical`` subcommand's options."""
     s = sub.add_parser("hemispherical", help="directional-hemispherical reflectance of a model")
     s.add_argument("--model", required=True)
     s.add_argument("--param", action="append", metavar="NAME=VALUE")
@@ -1561,6 +1576,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_hemispherical)
 
+
+def _trace_parser(sub: Any) -> None:
+    """The ``trace`` subcommand's options."""
     s = sub.add_parser("trace", help="Monte Carlo polarization ray tracing (pBRDF)")
     s.add_argument("--substrate", default=None, help="complex index, e.g. 1.55+7.71j")
     s.add_argument(
@@ -1645,6 +1663,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_scheduler(s)
     s.set_defaults(func=cmd_trace)
 
+
+def _validate_parser(sub: Any) -> None:
+    """The ``validate`` subcommand's options."""
     s = sub.add_parser("validate", help="run the whole validation and write the HTML report")
     s.add_argument("--out", action=OutputPath, kind="dir", default="reports/validation")
     _add_overwrite(s)
@@ -1652,6 +1673,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_scheduler(s)
     s.set_defaults(func=cmd_validate)
 
+
+def _report_parser(sub: Any) -> None:
+    """The ``report`` subcommand's options."""
     s = sub.add_parser("report", help="HTML report for your own files")
     s.add_argument(
         "files",
@@ -1686,6 +1710,29 @@ def build_parser() -> argparse.ArgumentParser:
     _add_selection(s)
     _add_scheduler(s)
     s.set_defaults(func=cmd_report)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+
+    p = argparse.ArgumentParser(
+        prog="labbrdf",
+        description="Optical-metrology toolkit: read instrument exports, fit BRDF models, "
+        "check physics, trace polarized rays, write validation reports.",
+    )
+    p.add_argument("--version", action="version", version=f"labbrdf {__version__}")
+    sub = p.add_subparsers(dest="command", required=True)
+    _ingest_parser(sub)
+    _formats_parser(sub)
+    _fit_parser(sub)
+    _nk_parser(sub)
+    _film_parser(sub)
+    _surface_parser(sub)
+    _export_parser(sub)
+    _hemispherical_parser(sub)
+    _trace_parser(sub)
+    _validate_parser(sub)
+    _report_parser(sub)
     for sp in sub.choices.values():  # what _checked_outputs checks, per command
         sp.set_defaults(path_actions=tuple(path_actions(sp)))
     return p

@@ -179,35 +179,59 @@ def user_report(
         fit_options={"params": dict(start)} if start else {},
     )
 
-    def ingest(ctx: Context) -> None:
+    sections = _sections(model, opts, film, film_how, paths, selection)
+    run(ctx, sections)
+    if title is None and not _fitted(b.results):
+        b.results["title"] = f"labbrdf report: {len(paths)} file(s), nothing fitted"
+    code = b.finish()
+    page = html.render(b.results, b.images, b.swatches)
+    write_report(out, b.results, page, inputs=paths + model_file)
+    b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
+    return code
+
+
+def _ingest(
+    ctx: Context, paths: Sequence[str | os.PathLike[str]], selection: Mapping[str, Any] | None
+) -> None:
+    """Read every file (optical data or height maps), then apply the row selection."""
+    ctx.b.text(
+        f"{len(paths)} file(s) given; each was read with labbrdf.read into the common "
+        "dataset, or, for topography files (height maps and profiles), with "
+        "SurfaceTopography."
+    )
+    optical = ingest_height_maps(ctx, paths)
+    if optical:
+        ingest_files(ctx, optical)
+    elif not ctx.height_maps:
+        raise Unavailable("no file could be read")
+    if selection:
+        from ..selection import SelectionError, select
+
+        kept = []
+        for f in ctx.frames:
+            try:
+                kept.append(select(f, **selection))
+            except SelectionError:
+                continue
         ctx.b.text(
-            f"{len(paths)} file(s) given; each was read with labbrdf.read into the common "
-            "dataset, or, for topography files (height maps and profiles), with "
-            "SurfaceTopography."
+            "Selection applied to every file: "
+            + ", ".join(f"{k} {v}" for k, v in selection.items())
+            + f"; {sum(len(f) for f in kept)} of {sum(len(f) for f in ctx.frames)} rows kept."
         )
-        optical = ingest_height_maps(ctx, paths)
-        if optical:
-            ingest_files(ctx, optical)
-        elif not ctx.height_maps:
-            raise Unavailable("no file could be read")
-        if selection:
-            from ..selection import SelectionError, select
+        ctx.frames[:] = [f for f in kept if len(f)]
 
-            kept = []
-            for f in ctx.frames:
-                try:
-                    kept.append(select(f, **selection))
-                except SelectionError:
-                    continue
-            ctx.b.text(
-                "Selection applied to every file: "
-                + ", ".join(f"{k} {v}" for k, v in selection.items())
-                + f"; {sum(len(f) for f in kept)} of {sum(len(f) for f in ctx.frames)} rows kept."
-            )
-            ctx.frames[:] = [f for f in kept if len(f)]
 
-    sections: list[Section] = [
-        ("ingest", "Ingested files", ingest),
+def _sections(
+    model: str,
+    opts: dict[str, Any],
+    film: Any,
+    film_how: str,
+    paths: Sequence[str | os.PathLike[str]],
+    selection: Mapping[str, Any] | None,
+) -> list[Section]:
+    """The user report's sections, in order, bound to its model, film model and files."""
+    return [
+        ("ingest", "Ingested files", lambda ctx: _ingest(ctx, paths, selection)),
         ("measured", "Measured data, file by file", measured_section),
         ("nk", "Optical constants and cross-instrument comparison", nk_section),
         (
@@ -235,11 +259,3 @@ def user_report(
         ("colour", "Sample colour from spectrophotometer reflectance", colour_section),
         ("surface", "Measured surface topography", surface_section),
     ]
-    run(ctx, sections)
-    if title is None and not _fitted(b.results):
-        b.results["title"] = f"labbrdf report: {len(paths)} file(s), nothing fitted"
-    code = b.finish()
-    page = html.render(b.results, b.images, b.swatches)
-    write_report(out, b.results, page, inputs=paths + model_file)
-    b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
-    return code
