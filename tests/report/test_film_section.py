@@ -212,3 +212,15 @@ def test_film_default_fits_the_stated_default(tmp_path: Path) -> None:
     assert res["meta"]["film_model"] == default_film_model().source
     rows = res["tables"]["film_0_wafer_psi_csv_params"]["rows"]
     assert {r["parameter"] for r in rows} == {"film.thickness_nm", "film.A", "film.B"}
+
+
+def test_a_wrapping_delta_curve_is_drawn_with_a_gap_not_a_vertical_line() -> None:
+    import numpy as np
+
+    from labbrdf.report.sections.film import _break_at_wraps
+
+    x = np.array([1.0, 2.0, 3.0, 4.0])
+    xb, yb = _break_at_wraps(x, np.array([350.0, 355.0, 2.0, 8.0]))
+    assert np.isnan(yb[2]) and np.isnan(xb[2]) and len(yb) == 5
+    xb, yb = _break_at_wraps(x, np.array([10.0, 20.0, 30.0, 40.0]))
+    assert not np.isnan(yb).any()

@@ -123,6 +123,12 @@ def _param_rows(summary: dict[str, Any]) -> list[dict[str, Any]]:
     return rows
 
 
+def _break_at_wraps(x: np.ndarray, delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A Delta curve [deg] with a gap where it wraps between 360 and 0 (no vertical line)."""
+    jumps = np.flatnonzero(np.abs(np.diff(delta)) > 180.0) + 1
+    return np.insert(x, jumps, np.nan), np.insert(delta, jumps, np.nan)
+
+
 def _psi_delta_figure(fit: films.FilmFit) -> str:
     d = fit.data
     ell = d[d["quantity"].astype(str).isin(["psi", "delta"])]
@@ -147,7 +153,8 @@ def _psi_delta_figure(fit: films.FilmFit) -> str:
                 r = (r + 180.0) % 360.0 - 180.0
             lab = f"\u03b8i {th:g}\u00b0"
             series.append({"label": lab, "x": x, "y": meas, "style": "points", "colour": col})
-            series.append({"label": "", "x": x, "y": model, "style": "line", "colour": "k"})
+            xl, yl = _break_at_wraps(x, model) if q == "delta" else (x, model)
+            series.append({"label": "", "x": xl, "y": yl, "style": "line", "colour": "k"})
             resid.append(
                 {"label": lab, "x": x, "y": r, "band": g["sigma"].to_numpy(float), "colour": col}
             )
