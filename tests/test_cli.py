@@ -140,7 +140,7 @@ def test_dataset_csv_is_read_without_format(dataset_files, tmp_path, capsys):
 
 
 def test_every_real_export_reads_through_one_entry_point(real_exports):
-    """Issue 3: every optical real export reads by labbrdf.read without naming the format."""
+    """Every optical real export reads by labbrdf.read without naming the format."""
     import labbrdf
 
     # topography/ holds height maps (read by SurfaceTopography, not by an optical adapter)
