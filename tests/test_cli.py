@@ -144,17 +144,16 @@ def test_every_real_export_reads_through_one_entry_point(real_exports):
     import labbrdf
 
     # topography/ holds height maps (read by SurfaceTopography, not by an optical adapter)
-    # and zemax-bsdf/ waits for its own adapter: neither is an optical dataset we read yet
-    not_ours = {"topography", "zemax-bsdf"}
+    not_ours = {"topography"}
     files = sorted(
         p
         for p in real_exports.rglob("*")
         if p.is_file() and p.name != "PROVENANCE.md" and p.parent.name not in not_ours
     )
-    # 29 of the first collection + 5 optical files added later (38 - 3 topography - 1 bsdf)
+    # 29 of the first collection + 6 of the second (its 9 less 3 height maps, the .bsdf in)
     # + 8 of the third round (Ta2O5 wafer three ways, UVProbe .txt/.spc, Ocean Optics,
     # headerless columns, legacy .jws)
-    assert len(files) == 42
+    assert len(files) == 43
     for p in files:
         # a headerless column file says nothing of itself: its columns are declared
         columns = "wavelength_nm,absorbance" if p.parent.name == "generic-columns" else None
