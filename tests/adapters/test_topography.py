@@ -245,7 +245,13 @@ def _limited(argv, limit_gib):
         resource.setrlimit(resource.RLIMIT_AS, (lim, lim))
         from labbrdf.cli import main
         rc = main({argv!r})
-        sys.stderr.write("maxrss_kib %d\\n" % resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)
+        # VmHWM: this process's own peak (Linux carries ru_maxrss over from the parent)
+        try:
+            hwm = next(l for l in open("/proc/self/status") if l.startswith("VmHWM:"))
+            peak_kib = int(hwm.split()[1])
+        except (OSError, StopIteration):
+            peak_kib = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        sys.stderr.write("maxrss_kib %d\\n" % peak_kib)
         sys.exit(rc)
         """
     )
