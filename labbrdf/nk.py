@@ -55,6 +55,7 @@ __all__ = [
     "nk_at",
     "nk_json",
     "nk_table",
+    "ordinary_psi_delta",
 ]
 
 #: Stage positions closer than this (chained, per coordinate) are the same spot [mm].
@@ -139,6 +140,19 @@ def _series_keys(df: pd.DataFrame) -> list[str]:
     return keys
 
 
+def ordinary_psi_delta(df: pd.DataFrame) -> pd.DataFrame:
+    """The psi/Delta rows of ordinary ellipsometry: no channel, or the ``pp`` channel.
+
+    Generalised ellipsometry's cross channels (``ps``, ``sp``) are not a sample's psi and
+    Delta; they are left out wherever psi/Delta are inverted or fitted.
+    """
+    rows = df[df["quantity"].isin(["psi", "delta"])]
+    if "channel" in rows.columns:
+        ch = rows["channel"].astype(object)
+        rows = rows[ch.isna() | ch.isin(["", "pp"])]
+    return rows
+
+
 def nk_table(
     data: Measurement | pd.DataFrame,
     *,
@@ -180,10 +194,7 @@ def nk_table(
     them (e.g. the nulling zones of an Accurion file), by order of appearance.
     """
     df = _frame(data)
-    sel = df[df["quantity"].isin(["psi", "delta"])]
-    if "channel" in sel.columns:
-        ch = sel["channel"].astype(object)
-        sel = sel[ch.isna() | ch.isin(["", "pp"])]
+    sel = ordinary_psi_delta(df)
     if sel.empty:
         raise ValueError("no psi/delta rows (ordinary ellipsometry) in the data")
     sel = sel.assign(_wl=sel["wavelength_nm"].round(_WL_DECIMALS))

@@ -25,6 +25,7 @@ __all__ = [
     "compare_models_figure",
     "hemispherical_figure",
     "polar_maps_figure",
+    "reflectance_comparison_figure",
     "scan_figure",
     "spectra_figure",
     "spectrum_figure",
@@ -868,3 +869,34 @@ def map_figure(
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)
     return _finish_grid(fig, title, fontsize=10)
+
+
+def reflectance_comparison_figure(
+    measured: list[dict[str, Any]],
+    difference: list[dict[str, Any]],
+    panel_size: tuple[float, float] = (5.0, 3.2),
+) -> str:
+    """Two panels: measured and predicted reflectance, and their difference [1].
+
+    ``measured`` and ``difference`` are :func:`panels_figure` series lists; the sections
+    that set a model's prediction beside a spectrophotometer or ellipsometer reflectance
+    (the bulk n, k and the fitted film stack) draw it the same way.
+    """
+    return panels_figure(
+        [
+            {
+                "title": "reflectance",
+                "xlabel": "wavelength [nm]",
+                "ylabel": "R [1]",
+                "series": measured,
+            },
+            {
+                "title": "difference",
+                "xlabel": "wavelength [nm]",
+                "ylabel": "measured - predicted [1]",
+                "series": difference,
+            },
+        ],
+        ncols=2,
+        panel_size=panel_size,
+    )

@@ -264,24 +264,7 @@ def _reflectance(
         "1-sigma propagated from the fit's covariance (times sqrt(chi2/nu) where chi-square "
         "rejects the film model). Right: measured - predicted "
         "with the measurement's and the prediction's 1-sigma in quadrature.",
-        figures.panels_figure(
-            [
-                {
-                    "title": "reflectance",
-                    "xlabel": "wavelength [nm]",
-                    "ylabel": "R [1]",
-                    "series": series_m,
-                },
-                {
-                    "title": "difference",
-                    "xlabel": "wavelength [nm]",
-                    "ylabel": "measured - predicted [1]",
-                    "series": series_d,
-                },
-            ],  # fmt: skip
-            ncols=2,
-            panel_size=(5.6, 3.4),
-        ),
+        figures.reflectance_comparison_figure(series_m, series_d, panel_size=(5.6, 3.4)),
     )
     b.check(
         f"film.reflectance.{tag}",
@@ -317,14 +300,6 @@ def _fit_range(fit: films.FilmFit) -> tuple[float, float]:
     return float(w.min()), float(w.max())
 
 
-def _ordinary(g: pd.DataFrame) -> pd.DataFrame:
-    rows = g[g["quantity"].isin(["psi", "delta"])]
-    if "channel" in rows.columns:
-        ch = rows["channel"].astype(object)
-        rows = rows[ch.isna() | ch.isin(["", "pp"])]
-    return rows
-
-
 def _flagged(
     ellips: list[tuple[str, pd.DataFrame]],
 ) -> list[tuple[str, pd.DataFrame, nkmod.AngleVerdict]]:
@@ -332,7 +307,7 @@ def _flagged(
     flagged = []
     for src, g in ellips:
         try:
-            comb = nkmod.combined_table(_ordinary(g), on_ill_conditioned="ignore")
+            comb = nkmod.combined_table(nkmod.ordinary_psi_delta(g), on_ill_conditioned="ignore")
         except ValueError:
             continue
         verdict = nkmod.angle_verdict(comb)
@@ -433,7 +408,7 @@ def _fit_file(
     tag = f"{i}_{slug(src)}"
     b.heading(f"{src}: film fit", anchor=f"film_{tag}")
     try:
-        fit = films.fit_film(model, _ordinary(g), method=ctx.method, seed=ctx.seed)
+        fit = films.fit_film(model, nkmod.ordinary_psi_delta(g), method=ctx.method, seed=ctx.seed)
     except ValueError as exc:
         b.note("no film fit", f"{src}: {exc}")
         b.check(
@@ -468,7 +443,7 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
     """
     b = ctx.b
     frames = file_frames(ctx)
-    ellips = [(s, g) for s, g, _m in frames if len(_ordinary(g))]
+    ellips = [(s, g) for s, g, _m in frames if len(nkmod.ordinary_psi_delta(g))]
     if not ellips:
         raise Unavailable("no psi/Delta rows ingested: no film to fit")
     flagged = _flagged(ellips)

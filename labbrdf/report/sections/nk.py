@@ -203,24 +203,7 @@ def _compare(
         "the combined 1-sigma band"
         + ("" if has_sigma else " (the prediction's sigma alone: the file gives none)")
         + ".",
-        figures.panels_figure(
-            [
-                {
-                    "title": "reflectance",
-                    "xlabel": "wavelength [nm]",
-                    "ylabel": "R [1]",
-                    "series": series_m,
-                },
-                {
-                    "title": "difference",
-                    "xlabel": "wavelength [nm]",
-                    "ylabel": "measured - predicted [1]",
-                    "series": series_d,
-                },
-            ],
-            ncols=2,
-            panel_size=(5.0, 3.2),
-        ),
+        figures.reflectance_comparison_figure(series_m, series_d, panel_size=(5.0, 3.2)),
     )
     b.check(
         f"nk.reflectance.{tag}",
@@ -288,15 +271,6 @@ def _r0_figure(ctx: Context, i: int, src: str, comb: pd.DataFrame) -> None:
         ),
         details=True,
     )
-
-
-def _ordinary(g: pd.DataFrame) -> pd.DataFrame:
-    """The psi/Delta rows of a file with no channel or the ordinary (pp) channel."""
-    pd_rows = g[g["quantity"].isin(["psi", "delta"])]
-    if "channel" in pd_rows.columns:
-        ch = pd_rows["channel"].astype(object)
-        pd_rows = pd_rows[ch.isna() | ch.isin(["", "pp"])]
-    return pd_rows
 
 
 _INTRO = (
@@ -448,7 +422,7 @@ def _file_section(
     """
     b = ctx.b
     tag = f"{i}_{slug(src)}"
-    rows = _ordinary(g)
+    rows = nkmod.ordinary_psi_delta(g)
     b.heading(f"{src}: optical constants", anchor=f"nk_{tag}")
     try:
         pts = nkmod.nk_table(rows, on_ill_conditioned="ignore")
@@ -564,7 +538,7 @@ def nk_section(ctx: Context) -> None:
     frames = file_frames(ctx)
     if not frames:
         raise Unavailable("no data ingested")
-    ellips = [(s, g, m) for s, g, m in frames if len(_ordinary(g))]
+    ellips = [(s, g, m) for s, g, m in frames if len(nkmod.ordinary_psi_delta(g))]
     refl = [(s, g, m) for s, g, m in frames if (g["quantity"] == "reflectance").any()]
     if not ellips:
         b.skip(
