@@ -4,7 +4,8 @@ Everything a user needs is reachable from here; the names are imported lazily, o
 so that ``import labbrdf`` stays cheap, and ``dir(labbrdf)`` lists them all:
 
 - reading: :func:`read`, :func:`read_many`, :class:`Measurement`, :func:`select`,
-  :func:`formats`
+  :func:`formats`; :func:`read_inputs` reads a list of optical exports and height maps
+  (each file once) into :class:`Inputs`
 - optical constants: :func:`nk_table`, :func:`combined_table` (pseudo-constants from
   psi/Delta with propagated sigmas)
 - models and fits: :mod:`models` (:func:`labbrdf.models.get`), :func:`fit`,
@@ -33,6 +34,8 @@ __version__ = "0.1.0.dev0"
 _LAZY: dict[str, tuple[str, str]] = {
     "read": ("labbrdf.adapters", "read"),
     "read_many": ("labbrdf.adapters", "read_many"),
+    "read_inputs": ("labbrdf.adapters", "read_inputs"),
+    "Inputs": ("labbrdf.adapters", "Inputs"),
     "formats": ("labbrdf.adapters", "formats"),
     "Measurement": ("labbrdf.dataset", "Measurement"),
     "select": ("labbrdf.selection", "select"),
@@ -120,7 +123,7 @@ if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__
         topography,
         tracer,
     )
-    from .adapters import AdapterError, formats, read, read_many
+    from .adapters import AdapterError, Inputs, formats, read, read_inputs, read_many
     from .adapters.topography import read_height_map
     from .dataset import DatasetError, Measurement
     from .errors import LabbrdfError

@@ -365,25 +365,34 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     measurements = []
     failures: list[dict[str, str]] = []
     unselected: list[str] = []
-    for f in args.files:
-        try:
-            m = adapters.read(f, args.format, columns=args.columns)
-        except (ValueError, NotImplementedError) as exc:
-            if not args.keep_going:
-                print(f"labbrdf ingest: {exc}", file=sys.stderr)
-                return 2
-            failures.append({"file": str(f), "error": str(exc)})
+    try:
+        inputs = adapters.read_inputs(
+            args.files,
+            args.format,
+            columns=args.columns,
+            on_error="collect" if args.keep_going else "raise",
+        )
+    except (ValueError, NotImplementedError, OSError, ImportError) as exc:
+        print(f"labbrdf ingest: {exc}", file=sys.stderr)
+        return 2
+    maps = [(i.path, i.height_map) for i in inputs.files if i.height_map is not None]
+    for i in inputs.files:
+        path, m = i.path, i.measurement
+        if i.error:
+            failures.append({"file": path, "error": i.error})
+            continue
+        if m is None:  # a height map: reported below, not part of the dataset
             continue
         try:
             m = _selected(args, m)
         except SelectionError as exc:
-            unselected.append(f"{f}: {exc}")
+            unselected.append(f"{path}: {exc}")
             continue
         s = m.summary()
         measurements.append(m)
         rows.append(
             {
-                "file": str(f),
+                "file": path,
                 "format": m.meta.get("format", args.format),
                 "sample": s["sample"][0] if len(s["sample"]) == 1 else s["sample"],
                 "rows": s["rows"],
@@ -400,12 +409,14 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     if out is not None and measurements:
         write(concat(measurements), out)
     if args.json:
-        payload: Any = rows
+        payload: Any = rows + [{"file": p, "height_map": hm.summary()} for p, hm in maps]
         if failures:
-            payload = rows + [{"file": f["file"], "error": f["error"]} for f in failures]
+            payload = payload + [{"file": f["file"], "error": f["error"]} for f in failures]
         _emit_json(payload)
     else:
         _print_ingest_table(rows)
+        for p, hm in maps:
+            print(f"{p}: height map, not optical data: {hm.summary_line()}")
         if out is not None and measurements:
             print(f"wrote {out} ({sum(r['rows'] for r in rows)} rows)")
     for f in failures:
@@ -990,7 +1001,8 @@ def _grid(text: str, option: str) -> Any:
 
 def _height_map(path: str, channel: str | None, args: argparse.Namespace | None = None) -> Any:
     """Read a height map; ``--pixel-size`` / ``--unit`` of ``args`` state its geometry."""
-    from .adapters.topography import length_m, read_height_map
+    from .adapters import read_inputs
+    from .adapters.topography import length_m
 
     ch: int | str | None = int(channel) if channel and channel.isdigit() else channel
     unit = getattr(args, "unit", None)
@@ -1004,7 +1016,9 @@ def _height_map(path: str, channel: str | None, args: argparse.Namespace | None 
         if len(pixel) not in (1, 2):
             raise UsageError(f"--pixel-size {px_text!r}: one pitch or two (dx,dy)")
     try:
-        hm = read_height_map(path, ch, unit=unit, pixel_size=pixel)
+        (hm,) = read_inputs(
+            [path], kind="height_map", channel=ch, unit=unit, pixel_size=pixel, on_error="raise"
+        ).height_maps
     except MemoryError:
         raise UsageError(f"{path}: out of memory while reading the height map") from None
     for w in hm.warnings:

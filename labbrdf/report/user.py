@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import __version__, models
+from ..adapters import read_inputs
 from ..films import FilmModel
 from ..fitting import METHOD
 from ..parallel import Executor, as_executor
@@ -28,7 +29,7 @@ from .sections.brdf import brdf_section
 from .sections.colour import colour_section
 from .sections.film import film_model_of, film_section
 from .sections.fits import fits_section
-from .sections.ingest import ingest_files
+from .sections.ingest import ingest_read
 from .sections.measured import measured_section
 from .sections.nk import nk_section
 from .sections.physics import physics_section
@@ -195,13 +196,15 @@ def _ingest(
 ) -> None:
     """Read every file (optical data or height maps), then apply the row selection."""
     ctx.b.text(
-        f"{len(paths)} file(s) given; each was read with labbrdf.read into the common "
-        "dataset, or, for topography files (height maps and profiles), with "
-        "SurfaceTopography."
+        f"{len(paths)} file(s) given; each was read once with labbrdf.read_inputs: an "
+        "optical export into the common dataset, a topography file (height map or profile) "
+        "with SurfaceTopography."
     )
-    optical = ingest_height_maps(ctx, paths)
+    inputs = read_inputs(paths)
+    ingest_height_maps(ctx, inputs.files)
+    optical = [f for f in inputs.files if f.kind == "optical"]
     if optical:
-        ingest_files(ctx, optical)
+        ingest_read(ctx, optical)
     elif not ctx.height_maps:
         raise Unavailable("no file could be read")
     if selection:

@@ -8,11 +8,12 @@ from pathlib import Path
 from typing import Any
 
 from ... import adapters
+from ...adapters.inputs import InputFile
 from ..builder import Unavailable
 from ..context import Context
 from ..published import read_published
 
-__all__ = ["fixture_files", "fixtures_section", "ingest_files"]
+__all__ = ["fixture_files", "fixtures_section", "ingest_files", "ingest_read"]
 
 
 def fixture_files(folder: Path) -> list[Path]:
@@ -78,19 +79,42 @@ def ingest_files(
     *,
     check_id: str = "ingest.read",
 ) -> None:
-    """Read every file; a table of what each holds; a check that all were read."""
+    """Read every file as an optical export (``read_inputs``) and :func:`ingest_read` them."""
+    if not paths:
+        raise Unavailable("no input files")
+    ingest_read(ctx, adapters.read_inputs(paths, kind="optical").files, root, check_id=check_id)
+
+
+def ingest_read(
+    ctx: Context,
+    files: Sequence[InputFile],
+    root: Path | None = None,
+    *,
+    check_id: str = "ingest.read",
+) -> None:
+    """Files already read: a table of what each holds; a check that all were read.
+
+    Parameters
+    ----------
+    ctx : Context
+    files : sequence of InputFile
+        Optical inputs as :func:`labbrdf.adapters.read_inputs` read them (read or failed).
+    root : Path, optional
+        Files under it are named relative to it.
+    check_id : str
+        Id of the check that every file was read.
+    """
     b = ctx.b
-    files = [Path(p) for p in paths]
     if not files:
         raise Unavailable("no input files")
     rows, failures = [], []
-    for p in files:
+    for f in files:
+        p = Path(f.path)
         name = str(p.relative_to(root)) if root is not None and p.is_relative_to(root) else p.name
-        try:
-            m = adapters.read(p)
-        except Exception as exc:  # noqa: BLE001 - each failure is reported
-            failures.append(f"{name}: {exc}")
-            rows.append({"file": name, "status": "error", "error": str(exc)})
+        m = f.measurement
+        if m is None:
+            failures.append(f"{name}: {f.error}")
+            rows.append({"file": name, "status": "error", "error": f.error})
             continue
         fmt_name = m.meta.get("format") or m.meta.get("adapter") or ""
         if not fmt_name:
@@ -146,8 +170,8 @@ def ingest_files(
         "every input file reads into the common dataset",
         not failures,
         against="labbrdf.read (adapters) and the dataset schema",
-        value=len(paths) - len(failures),
-        tolerance=len(paths),
+        value=len(files) - len(failures),
+        tolerance=len(files),
         justification="value = files read, tolerance = files given; all must read",
         reason="; ".join(failures)[:2000],
         substantive=False,
