@@ -781,7 +781,7 @@ def _film_value(text: str, what: str) -> tuple[float, tuple[float, float] | None
 def _film_model(args: argparse.Namespace) -> Any:
     """The FilmModel of --model FILE, or of --substrate and --layer, or the default."""
     from . import films
-    from .dispersion import Tabulated
+    from .nk import tabulated_from_file
 
     if args.model is not None:
         if args.layer or args.substrate:
@@ -796,7 +796,7 @@ def _film_model(args: argparse.Namespace) -> Any:
         sub = (
             films.as_material(sub_text)
             if not os.path.exists(sub_text)
-            else Tabulated.from_file(sub_text)
+            else tabulated_from_file(sub_text)
         )
     except ValueError as exc:
         raise UsageError(f"--substrate {sub_text}: {exc}") from None
@@ -811,7 +811,7 @@ def _film_model(args: argparse.Namespace) -> Any:
         name, mat, thick = fields[0] or f"layer{j}", fields[1], fields[2]
         d, dbox = _film_value(thick, f"--layer {name}: thickness")
         try:
-            m = films.as_material(mat) if not os.path.exists(mat) else Tabulated.from_file(mat)
+            m = films.as_material(mat) if not os.path.exists(mat) else tabulated_from_file(mat)
         except ValueError as exc:
             raise UsageError(f"--layer {name}: {exc}") from None
         values = {}

@@ -40,7 +40,10 @@ from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
+from . import adapters
+from . import dispersion as disp
 from . import ellipsometry as ell
 from .dataset import Measurement
 
@@ -56,6 +59,7 @@ __all__ = [
     "nk_json",
     "nk_table",
     "ordinary_psi_delta",
+    "tabulated_from_file",
 ]
 
 #: Stage positions closer than this (chained, per coordinate) are the same spot [mm].
@@ -847,3 +851,81 @@ def coating_from_fit(path: str | os.PathLike[str], wavelength_nm: float) -> tupl
     layer = stack.layers[0]
     big_n = complex(np.asarray(stack.nk(wl)[layer.name]).ravel()[0])
     return big_n, float(layer.thickness_nm)
+
+
+# --------------------------------------------------------------------------- tables from files
+
+
+def tabulated_from_file(
+    path: str | os.PathLike[str], *, theta_deg: float | None = None
+) -> disp.Tabulated:
+    """Tabulated ``n, k`` of a material, read from a file.
+
+    Parameters
+    ----------
+    path : path-like
+        A text table ``wavelength_nm n [k]`` (comma, semicolon or whitespace separated,
+        ``#`` comments, an optional header line; :func:`labbrdf.dispersion.parse_nk_table`),
+        or any ellipsometer export labbrdf reads: its psi/Delta are inverted to two-phase
+        pseudo-constants (:func:`nk_table`) and averaged over the angles of incidence with
+        the inverse-variance weights of :func:`combined_table` (a bare, smooth substrate:
+        the pseudo-constants are the material's).
+    theta_deg : float, optional
+        Use only this angle of incidence of an ellipsometer file.
+
+    Returns
+    -------
+    labbrdf.dispersion.Tabulated
+        Keyed ``file:PATH`` (its ``to_dict`` names the file).
+
+    Raises
+    ------
+    labbrdf.dispersion.DispersionError
+        The file cannot be read as either; names the file (and the line of a table).
+    """
+    p = Path(path)
+    try:
+        text = p.read_text("utf-8", errors="replace")
+    except OSError as exc:
+        raise disp.DispersionError(f"{p}: cannot read ({exc.strerror})") from None
+    try:
+        w, n, k = disp.parse_nk_table(text, str(p))
+    except disp.DispersionError as table_error:
+        w, n, k = _pseudo_constants(p, theta_deg, table_error)
+    return disp.Tabulated(w, n, k, source=str(p), key=f"file:{p}")
+
+
+def _pseudo_constants(
+    path: Path, theta_deg: float | None, table_error: disp.DispersionError
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Pseudo-constants of an ellipsometer file, combined over angles."""
+    try:
+        meas = adapters.read(path)
+    except ValueError as exc:
+        raise disp.DispersionError(
+            f"{path}: neither an n,k table ({table_error}) nor an ellipsometer file ({exc})"
+        ) from None
+    df = meas.data
+    if theta_deg is not None:
+        keep = (~df["quantity"].isin(["psi", "delta"])) | (
+            np.abs(df["theta_i_deg"] - theta_deg) < 1e-3
+        )
+        df = df[keep]
+    try:
+        table = combined_table(df, on_ill_conditioned="ignore")
+    except ValueError as exc:
+        raise disp.DispersionError(f"{path}: no pseudo-constants ({exc})") from None
+    if "combined" in table and not bool(table["combined"].all()):
+        raise disp.DispersionError(
+            f"{path}: its angles of incidence disagree (pseudo-constants of a stack, not a "
+            "material's constants); fit the stack with `labbrdf film` and use its layers"
+        )
+    table = table.sort_values("wavelength_nm").drop_duplicates("wavelength_nm")
+    n = table["n"].to_numpy(float)
+    k = table["k"].to_numpy(float)
+    if np.any(n < 0) or np.any(k < 0):
+        raise disp.DispersionError(
+            f"{path}: the pseudo-constants have n < 0 or k < 0 at some wavelengths; they "
+            "are not a material's constants (a film or a rough surface)"
+        )
+    return table["wavelength_nm"].to_numpy(float), n, k
