@@ -148,13 +148,16 @@ def sniff(path: str | os.PathLike[str]) -> list[str]:
 
 def _kind(p: Path, head: bytes) -> str:
     """``"height_map"`` or ``"optical"`` from the name and the first bytes."""
-    hm = height_map_format(p, head)
-    if hm is None:
+    claim = height_map_format(p, head)
+    if claim is None:
         return "optical"
-    _, own_extension = hm
-    if own_extension or not any(f.sniff(head) for f in READERS.values()):
+    fmt, own_extension = claim
+    if own_extension:
         return "height_map"
-    return "optical"
+    shared = p.name.lower().endswith(fmt.shared_extensions)
+    if not shared and _by_extension(p):  # an optical format's own extension
+        return "optical"
+    return "optical" if any(f.sniff(head) for f in READERS.values()) else "height_map"
 
 
 def input_kind(path: str | os.PathLike[str]) -> str:
@@ -170,8 +173,9 @@ def input_kind(path: str | os.PathLike[str]) -> str:
     str
         ``"height_map"`` for an extension only topography instruments write
         (:data:`~labbrdf.adapters.topography.HEIGHT_MAP_FORMATS`), or for a file whose
-        first bytes a height-map sniffer claims and no optical sniffer does (a MetroPro
-        ``.dat`` beside WVASE ``.dat``); ``"optical"`` otherwise.
+        first bytes a height-map sniffer claims and no optical sniffer does, when its
+        extension is one the height-map format shares with optical exports (a MetroPro
+        ``.dat`` beside WVASE ``.dat``) or belongs to no format; ``"optical"`` otherwise.
 
     Raises
     ------

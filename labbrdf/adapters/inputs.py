@@ -130,8 +130,8 @@ def _read_as(
 
 def _guessed_kind(path: str | os.PathLike[str]) -> str:
     """The kind of a file that could not even be opened: its extension's, else optical."""
-    claimed = height_map_format(path, b"")
-    return "height_map" if claimed is not None and claimed[1] else "optical"
+    claim = height_map_format(path, b"")
+    return "height_map" if claim is not None and claim[1] else "optical"
 
 
 def _message(path: str | os.PathLike[str], exc: BaseException) -> str:

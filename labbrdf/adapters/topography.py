@@ -190,7 +190,9 @@ class HeightMapFormat:
     shared_extensions : tuple of str
         Extensions optical exports use too (MetroPro ``.dat`` beside WVASE and Accurion
         ``.dat``): such a file is a height map only when :attr:`sniff` claims it and no
-        optical sniffer does.
+        optical sniffer does. A file whose extension belongs to an optical format and is
+        not listed here stays optical whatever its content; one whose extension belongs
+        to no format is a height map when a sniffer here claims it.
     sniff : callable
         ``sniff(head: bytes) -> bool`` on the first bytes: cheap, never raises.
     """
@@ -215,7 +217,7 @@ HEIGHT_MAP_FORMATS: tuple[HeightMapFormat, ...] = (
     HeightMapFormat(
         "nanoscope",
         "Digital Instruments / Bruker Nanoscope AFM file",
-        (".di", ".spm", ".000", ".001", ".002", ".003"),
+        (".di", ".spm", ".000", ".001", ".002", ".003", ".004", ".005"),
         sniff=lambda head: head.startswith(b"\\*File list"),
     ),
     HeightMapFormat(
@@ -225,18 +227,28 @@ HEIGHT_MAP_FORMATS: tuple[HeightMapFormat, ...] = (
         sniff=lambda head: head.startswith(b"VCA DATA"),
     ),
     HeightMapFormat(
+        "bcr-stm",
+        "BCR-STM / BCRF scanning-probe file",
+        (".bcr", ".bcrf"),
+        sniff=lambda head: head.startswith((b"fileformat = bcr", b"fileformat = bcrf")),
+    ),
+    HeightMapFormat(
         "surfacetopography",
         "other topography formats SurfaceTopography reads (Gwyddion, X3P, Keyence, "
-        "Olympus LEXT, Wyko OPD, Digital Surf SUR, ...)",
+        "Olympus LEXT, Wyko OPD, Digital Surf SUR, NT-MDT, ...)",
         (
-            ".opd", ".sur", ".gwy", ".ibw", ".mi", ".nc", ".plu", ".plux", ".x3p", ".datx",
-            ".vk4", ".vk6", ".vk7", ".zmg", ".zon", ".lext", ".os3d", ".frt", ".sdf", ".nid",
+            ".opd", ".sur", ".gwy", ".ibw", ".mi", ".nc", ".plu", ".plux", ".apx", ".x3p",
+            ".datx", ".vk3", ".vk4", ".vk6", ".vk7", ".zmg", ".zon", ".lext", ".os3d", ".frt",
+            ".sdf", ".nid", ".ezd", ".mdt", ".al3d", ".tmd", ".jpk", ".mnt", ".oir", ".poir",
+            ".nms",
         ),
     ),
 )  # fmt: skip
 
 
-def height_map_format(path: str | os.PathLike[str], head: bytes) -> tuple[str, bool] | None:
+def height_map_format(
+    path: str | os.PathLike[str], head: bytes
+) -> tuple[HeightMapFormat, bool] | None:
     """Which height-map format claims a file, and whether by an extension of its own.
 
     Parameters
@@ -244,22 +256,23 @@ def height_map_format(path: str | os.PathLike[str], head: bytes) -> tuple[str, b
     path : path-like
         The file (its name decides first).
     head : bytes
-        Its first bytes.
+        Its first bytes (``b""`` to decide by the name alone).
 
     Returns
     -------
-    (str, bool) or None
-        ``(name, True)`` for an extension only height maps have; ``(name, False)`` when a
-        sniffer claims the content (the caller weighs it against the optical sniffers);
-        None when no height-map format claims the file.
+    (HeightMapFormat, bool) or None
+        ``(format, True)`` for an extension only height maps have; ``(format, False)`` when
+        a sniffer claims the content (the dispatcher weighs that against the optical
+        formats, :func:`labbrdf.adapters.input_kind`); None when no height-map format claims
+        the file.
     """
     name = os.fspath(path).lower()
     for f in HEIGHT_MAP_FORMATS:
         if name.endswith(f.extensions):
-            return f.name, True
+            return f, True
     for f in HEIGHT_MAP_FORMATS:
         if f.sniff(head):
-            return f.name, False
+            return f, False
     return None
 
 
