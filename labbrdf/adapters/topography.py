@@ -5,6 +5,11 @@ SurfaceTopography (optional extra ``labbrdf[topography]``) reads the instrument 
 plain XYZ and matrix ASCII, ...); it is imported only when a file is read. Everything is
 converted to metres here, so :mod:`labbrdf.topography` never sees a unit.
 
+Which files are height maps is this module's knowledge too: :data:`HEIGHT_MAP_FORMATS` lists
+the extensions only topography instruments write, the ones shared with optical exports
+(MetroPro ``.dat``) and the magic bytes that decide for those (:func:`height_map_format`);
+:func:`labbrdf.adapters.input_kind` weighs them against the optical sniffers.
+
 Plain XYZ (``x y z`` columns on a grid) and matrix ASCII files are also read by
 SurfaceTopography; a matrix file carries no lateral size, so ``physical_sizes`` (or
 ``pixel_size``) and ``unit`` must then be given.

@@ -1,7 +1,8 @@
 r"""Section ``surface``: measured height maps and profiles, and the Gaussian-surface check.
 
 User report (:func:`surface_section`): one part per height map read at ingest
-(:func:`ingest_height_maps`; profilometer, AFM or interferometer files read through
+(:func:`ingest_height_maps`: the profilometer, AFM or interferometer files among the inputs,
+which :func:`labbrdf.adapters.read_inputs` tells from optical exports and reads through
 SurfaceTopography, :mod:`labbrdf.adapters.topography`): the levelled map, its
 autocorrelation and slope histogram with the GGX and Beckmann fits; the roughness
 statistics of :func:`labbrdf.topography.roughness_statistics` with their block-jackknife
