@@ -414,11 +414,14 @@ def cmd_ingest(args: argparse.Namespace) -> int:
             payload = payload + [{"file": f["file"], "error": f["error"]} for f in failures]
         _emit_json(payload)
     else:
-        _print_ingest_table(rows)
+        if rows or not maps:
+            _print_ingest_table(rows)
         for p, hm in maps:
             print(f"{p}: height map, not optical data: {hm.summary_line()}")
         if out is not None and measurements:
             print(f"wrote {out} ({sum(r['rows'] for r in rows)} rows)")
+    if out is not None and maps and not measurements:
+        print(f"labbrdf ingest: no optical data, {out} not written", file=sys.stderr)
     for f in failures:
         print(f"labbrdf ingest: FAILED {f['error']}", file=sys.stderr)
     for u in unselected:

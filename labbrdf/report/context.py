@@ -98,7 +98,8 @@ class Context:
     #: results kept for later sections (and tests): the compare fits, the factor-study runs
     compare_fits: dict[str, list[FitRecord]] = field(default_factory=dict)
     factor_runs: list[tuple[str, str, TraceResult]] = field(default_factory=list)
-    #: user report: height maps and profiles read from topography files (section ``surface``)
+    #: user report: the height maps and profiles :func:`labbrdf.adapters.read_inputs` read
+    #: among the inputs (section ``surface``)
     height_maps: list[HeightMap] = field(default_factory=list)
 
     @property

@@ -318,3 +318,16 @@ def test_ingest_stops_at_an_unreadable_file_unless_keep_going(
     assert main(["ingest", "--keep-going", str(junk), str(wvase)]) == 2
     text = capsys.readouterr()
     assert f"FAILED {junk}" in text.err and wvase.name in text.out
+
+
+def test_ingest_of_height_maps_only_writes_nothing_and_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    pytest.importorskip("SurfaceTopography")
+    hm = write_bcrf(tmp_path / "afm.bcrf")
+    out = tmp_path / "data.csv"
+    assert main(["ingest", str(hm), "-o", str(out)]) == 0
+    text = capsys.readouterr()
+    assert not out.exists()
+    assert f"no optical data, {out} not written" in text.err
+    assert text.out.startswith(f"{hm}: height map")  # no empty optical table
