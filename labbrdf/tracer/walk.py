@@ -112,6 +112,8 @@ class _Setup:
         self.ndf_top = coat.ndf if (coat is not None and self.layered) else None
         self.evaluated = cfg.resolved_estimator == "evaluated"
         self.scalar = bool(cfg.scalar)
+        # Lambertian base instead of the conductor's microsurface (None: the conductor)
+        self.albedo = sub.albedo
 
     def lambda_of(
         self,
@@ -273,6 +275,17 @@ def trace_block(
     ex_k: list[NDArray] = []
     ex_s: list[NDArray] = []
     ex_M: list[NDArray] = []
+    if su.albedo is not None and not su.layered:
+        # a bare Lambertian base: one base event, then every ray leaves
+        absorbed += _base_event(su.albedo, rng, np.arange(n), k, s, M)
+        events += n
+        if su.evaluated:
+            booked += float(M[0, 0].sum())  # its BRDF albedo / pi is the closed form
+        else:
+            ex_k.append(k)
+            ex_s.append(s)
+            ex_M.append(M)
+        k = k[:, :0]
 
     while k.shape[1]:
         m_ = k.shape[1]
@@ -308,24 +321,11 @@ def trace_block(
             if su.layered:
                 cross_ = leave & ~out
                 if cross_.any():
-                    ci = np.nonzero(cross_)[0]
-                    att = su.beer_lambert(k[2, ci])
-                    if att is not None:
-                        absorbed += float((M[0, 0, ci] * (1.0 - att)).sum())
-                        M[:, :, ci] *= att
-                    up = iface[ci] == SUB
-                    iface[ci] = np.where(up, TOP, SUB)
-                    below[ci] = up
-                    fresh[ci] = True
-                    if not su.single:
-                        # arrival height on the next microsurface (always a hit: the ray
-                        # travels towards it)
-                        kz_new = np.where(up, -k[2, ci], k[2, ci])
-                        a_new = np.where(up, su.alpha_top, su.alpha_sub)
-                        lam_new = su.lambda_of(k[:, ci], kz_new, ~up, a_new, up)
-                        _, h[ci] = sample_height(
-                            kz_new, lam_new, np.full(ci.size, np.inf), rng.random(ci.size)
-                        )
+                    ab, ev = _cross(su, rng, np.nonzero(cross_)[0], k, s, M, iface, below, h)
+                    absorbed += ab
+                    events += ev.size
+                    bounces[ev] += 1
+                    fresh[cross_] = True
 
         # max bounces: a ray that would need one more event is terminated
         over = alive & (bounces >= cfg.max_bounces)
@@ -524,6 +524,86 @@ def trace_block(
         cell_sums=cell_sums,
         batch_rays=batch_rays,
     )
+
+
+def _cross(
+    su: _Setup,
+    rng: np.random.Generator,
+    ci: NDArray[np.int64],
+    k: NDArray[np.float64],
+    s: NDArray[np.float64],
+    M: NDArray[np.float64],
+    iface: NDArray[np.int8],
+    below: NDArray[np.bool_],
+    h: NDArray[np.float64],
+) -> tuple[float, NDArray[np.int64]]:
+    """Carry the rays ``ci`` across the coating to the other interface (in place).
+
+    Beer-Lambert along the way; a ray reaching a Lambertian base is re-emitted there
+    (:func:`_base_event`) and crosses back up in the same step, with the attenuation of
+    its new direction, to arrive at the top interface from below. With multiple
+    scattering the arrival height on the next microsurface is drawn (always a hit: the ray
+    travels towards it).
+
+    Returns
+    -------
+    absorbed : float
+        The M00 lost on the way (Beer-Lambert, the base's 1 - albedo).
+    base : ndarray of int
+        The rays that had a base event (one event each).
+    """
+    absorbed = 0.0
+    att = su.beer_lambert(k[2, ci])
+    if att is not None:
+        absorbed += float((M[0, 0, ci] * (1.0 - att)).sum())
+        M[:, :, ci] *= att
+    up = iface[ci] == SUB
+    base = ci[:0]
+    if su.albedo is not None and not up.all():
+        base = ci[~up]
+        absorbed += _base_event(su.albedo, rng, base, k, s, M)
+        att = su.beer_lambert(k[2, base])
+        if att is not None:
+            absorbed += float((M[0, 0, base] * (1.0 - att)).sum())
+            M[:, :, base] *= att
+        up[:] = True
+    iface[ci] = np.where(up, TOP, SUB)
+    below[ci] = up
+    if not su.single:
+        kz_new = np.where(up, -k[2, ci], k[2, ci])
+        a_new = np.where(up, su.alpha_top, su.alpha_sub)
+        lam_new = su.lambda_of(k[:, ci], kz_new, ~up, a_new, up)
+        _, h[ci] = sample_height(kz_new, lam_new, np.full(ci.size, np.inf), rng.random(ci.size))
+    return absorbed, base
+
+
+def _base_event(
+    albedo: float,
+    rng: np.random.Generator,
+    idx: NDArray[np.int64],
+    k: NDArray[np.float64],
+    s: NDArray[np.float64],
+    M: NDArray[np.float64],
+) -> float:
+    """Re-emit the rays ``idx`` from a Lambertian base (in place); returns the M00 absorbed.
+
+    The base is flat and depolarizing: ``M <- albedo * diag(1, 0, 0, 0) M`` (only the
+    intensity row survives, scaled by the albedo) and the new direction is drawn from the
+    cosine (Lambert) distribution over the upper hemisphere, ``cos theta = sqrt(1 - u1)``,
+    ``phi = 2 pi u2`` (Malley's method), so the reflected radiance is isotropic: the BRDF
+    is ``albedo / pi``. The Stokes frame is the meridional ``phi_hat(phi)`` (any frame
+    serves for an unpolarized ray).
+    """
+    u = rng.random((2, idx.size))
+    r = np.sqrt(u[0])
+    phi = 2.0 * np.pi * u[1]
+    absorbed = float(((1.0 - albedo) * M[0, 0, idx]).sum())
+    row = albedo * M[0][:, idx]
+    M[:, :, idx] = 0.0
+    M[0][:, idx] = row
+    k[:, idx] = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1.0 - u[0])])
+    s[:, idx] = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+    return absorbed
 
 
 def _scalar(abcs: tuple) -> tuple:
