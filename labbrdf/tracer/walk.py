@@ -251,15 +251,7 @@ def trace_block(
     grid = _grid(cfg)
     n = cfg.block_size(block)
     rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, block]))
-    th = np.radians(cfg.theta_i_deg)
-    k = np.zeros((3, n))
-    k[0] = -np.sin(th)
-    k[2] = -np.cos(th)
-    s = np.zeros((3, n))
-    s[1] = 1.0  # phi_hat(phi_i = 0)
-    M = np.zeros((4, 4, n))
-    for i in range(4):
-        M[i, i] = 1.0
+    k, s, M = _launch(cfg.theta_i_deg, n)
     iface = np.full(n, TOP if su.layered else SUB, dtype=np.int8)
     below = np.zeros(n, dtype=bool)
     h = np.full(n, np.inf)
@@ -400,22 +392,8 @@ def trace_block(
                     wr = np.where(trans, 0.0, 1.0 / np.where(trans, 1.0, pr))
                     wt = np.where(trans, 1.0 / np.where(trans, 1.0 - pr, 1.0), 0.0)
             if su.evaluated:
-                # the branch not followed, sampled, for the ledger only: the reflected
-                # ray of the entry, the transmitted ray of an internal event; both leave
-                # into the air with Smith G1 of their direction
-                entry = on_top & ~below
-                up_ = on_top & below
-                other = np.where(entry, 1.0, 0.0), np.where(up_, 1.0, 0.0)
-                w_o = (refl[0] * other[0] + tr[0] * other[1]) * M[0, 0] + (
-                    refl[1] * other[0] + tr[1] * other[1]
-                ) * M[1, 0]
-                kt_ = eta * k + (eta * cos_i - cos_t) * m
-                k_o = np.where(entry, kr, kt_)
-                k_o = k_o / np.sqrt((k_o * k_o).sum(axis=0))
-                g = np.where(
-                    entry | up_,
-                    su.g1_of(k_o, k_o[2], np.zeros_like(on_top), np.full(m_, su.alpha_top)),
-                    0.0,
+                w_o, g = _other_branch(
+                    su, k, m, kr, M, cos_i, (refl, tr, cos_t, eta), on_top, below
                 )
                 booked += float((w_o * g).sum())
                 terminated += float((w_o * (1.0 - g)).sum())
@@ -446,30 +424,7 @@ def trace_block(
             h = np.where(trans, -h, h)
 
         # 4. weight threshold / roulette
-        alive = np.ones(m_, dtype=bool)
-        if cfg.tau > 0:
-            low = M[0, 0] < cfg.tau
-            if low.any():
-                if cfg.termination == "threshold":
-                    terminated += float(M[0, 0, low].sum())
-                    alive &= ~low
-                else:
-                    idx = np.nonzero(low)[0]
-                    p = M[0, 0, idx] / cfg.tau
-                    survive = rng.random(idx.size) < p
-                    dead = idx[~survive]
-                    live = idx[survive]
-                    terminated += float(M[0, 0, dead].sum())
-                    before = M[0, 0, live].copy()
-                    M[:, :, live] /= p[survive]
-                    terminated += float((before - M[0, 0, live]).sum())
-                    alive[dead] = False
-        else:
-            dead = ~(M[0, 0] > 0)
-            if dead.any():
-                terminated += float(M[0, 0, dead].sum())
-                alive &= ~dead
-
+        alive, terminated = _weight_cut(cfg, rng, M, terminated)
         if not alive.all():
             k, s, M = k[:, alive], s[:, alive], M[:, :, alive]
             iface, below, h = iface[alive], below[alive], h[alive]
@@ -477,38 +432,8 @@ def trace_block(
 
     cell_keys = cell_sums = batch_rays = None
     if su.evaluated:
-        batch_rays = np.bincount(
-            (cfg.block_rays * block + np.arange(n)) % cfg.batches, minlength=cfg.batches
-        ).astype(np.int64)
-        if dep_key:
-            key = np.concatenate(dep_key)
-            rows_d = np.concatenate(dep_rows, axis=1)
-            nkeys = cfg.batches * grid.n_bins
-            cnt = np.bincount(key, minlength=nkeys)
-            cell_keys = np.flatnonzero(cnt)
-            dense = np.empty((16, nkeys))
-            for e in range(16):
-                dense[e] = np.bincount(key, weights=rows_d[e], minlength=nkeys)
-            cell_sums = dense[:, cell_keys].T.copy()
-        else:
-            cell_keys = np.zeros(0, dtype=np.int64)
-            cell_sums = np.zeros((0, 16))
-    # binning of the exits, in the LB exit frames phi_hat(phi)
-    if ex_k:
-        ke = np.concatenate(ex_k, axis=1)
-        se = np.concatenate(ex_s, axis=1)
-        Me = np.concatenate(ex_M, axis=2)
-        idx, phi = grid.index(ke)
-        s_det = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
-        rotate_frame(Me, ke, se, s_det)
-        rows = Me.reshape(16, -1)
-        sums, sumsq, counts = bin_exits(grid, idx, rows)
-        hemi = rows.sum(axis=1)
-    else:
-        nb = grid.n_bins
-        sums, sumsq = np.zeros((nb, 16)), np.zeros((nb, 16))
-        counts = np.zeros(nb, dtype=np.int64)
-        hemi = np.zeros(16)
+        cell_keys, cell_sums, batch_rays = _cell_tally(cfg, grid, block, n, dep_key, dep_rows)
+    sums, sumsq, counts, hemi = _bin_exit_rays(grid, ex_k, ex_s, ex_M)
     return BlockTally(
         block=block,
         rays=n,
@@ -524,6 +449,141 @@ def trace_block(
         cell_sums=cell_sums,
         batch_rays=batch_rays,
     )
+
+
+def _launch(
+    theta_i_deg: float, n: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Incident rays: direction, Stokes frame ``phi_hat(phi_i = 0)``, identity Mueller."""
+    th = np.radians(theta_i_deg)
+    k = np.zeros((3, n))
+    k[0] = -np.sin(th)
+    k[2] = -np.cos(th)
+    s = np.zeros((3, n))
+    s[1] = 1.0
+    M = np.zeros((4, 4, n))
+    for i in range(4):
+        M[i, i] = 1.0
+    return k, s, M
+
+
+def _other_branch(
+    su: _Setup,
+    k: NDArray[np.float64],
+    m: NDArray[np.float64],
+    kr: NDArray[np.float64],
+    M: NDArray[np.float64],
+    cos_i: NDArray[np.float64],
+    fresnel: tuple,
+    on_top: NDArray[np.bool_],
+    below: NDArray[np.bool_],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Evaluated walk: the branch not followed, sampled, for the ledger only.
+
+    The reflected ray of the entry, the transmitted ray of an internal top event; both
+    leave into the air with Smith G1 of their direction. Returns its M00 weight (before
+    masking; 0 for substrate events) and that G1 (0 where there is no such branch).
+    """
+    refl, tr, cos_t, eta = fresnel
+    entry = on_top & ~below
+    up_ = on_top & below
+    other = np.where(entry, 1.0, 0.0), np.where(up_, 1.0, 0.0)
+    w_o = (refl[0] * other[0] + tr[0] * other[1]) * M[0, 0] + (
+        refl[1] * other[0] + tr[1] * other[1]
+    ) * M[1, 0]
+    kt_ = eta * k + (eta * cos_i - cos_t) * m
+    k_o = np.where(entry, kr, kt_)
+    k_o = k_o / np.sqrt((k_o * k_o).sum(axis=0))
+    g = np.where(
+        entry | up_,
+        su.g1_of(k_o, k_o[2], np.zeros_like(on_top), np.full(k.shape[1], su.alpha_top)),
+        0.0,
+    )
+    return w_o, g
+
+
+def _weight_cut(
+    cfg: TraceConfig, rng: np.random.Generator, M: NDArray[np.float64], terminated: float
+) -> tuple[NDArray[np.bool_], float]:
+    """Step 4: the weight threshold ``tau`` or Russian roulette (in place on M).
+
+    Returns the rays that live on and ``terminated`` with the killed weight (and a
+    roulette survivor's boost, negative) added.
+    """
+    alive = np.ones(M.shape[2], dtype=bool)
+    if cfg.tau > 0:
+        low = M[0, 0] < cfg.tau
+        if low.any():
+            if cfg.termination == "threshold":
+                terminated += float(M[0, 0, low].sum())
+                alive &= ~low
+            else:
+                idx = np.nonzero(low)[0]
+                p = M[0, 0, idx] / cfg.tau
+                survive = rng.random(idx.size) < p
+                dead = idx[~survive]
+                live = idx[survive]
+                terminated += float(M[0, 0, dead].sum())
+                before = M[0, 0, live].copy()
+                M[:, :, live] /= p[survive]
+                terminated += float((before - M[0, 0, live]).sum())
+                alive[dead] = False
+    else:
+        dead = ~(M[0, 0] > 0)
+        if dead.any():
+            terminated += float(M[0, 0, dead].sum())
+            alive &= ~dead
+    return alive, terminated
+
+
+def _cell_tally(
+    cfg: TraceConfig,
+    grid: Grid,
+    block: int,
+    n: int,
+    dep_key: list[NDArray],
+    dep_rows: list[NDArray],
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]]:
+    """Evaluated estimator: the recorded up-going rays summed per (batch, cell).
+
+    Returns the occupied keys, their (n_keys, 16) Mueller sums and the rays per batch.
+    """
+    batch_rays = np.bincount(
+        (cfg.block_rays * block + np.arange(n)) % cfg.batches, minlength=cfg.batches
+    ).astype(np.int64)
+    if not dep_key:
+        return np.zeros(0, dtype=np.int64), np.zeros((0, 16)), batch_rays
+    key = np.concatenate(dep_key)
+    rows_d = np.concatenate(dep_rows, axis=1)
+    nkeys = cfg.batches * grid.n_bins
+    cnt = np.bincount(key, minlength=nkeys)
+    cell_keys = np.flatnonzero(cnt)
+    dense = np.empty((16, nkeys))
+    for e in range(16):
+        dense[e] = np.bincount(key, weights=rows_d[e], minlength=nkeys)
+    return cell_keys, dense[:, cell_keys].T.copy(), batch_rays
+
+
+def _bin_exit_rays(
+    grid: Grid, ex_k: list[NDArray], ex_s: list[NDArray], ex_M: list[NDArray]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64], NDArray[np.float64]]:
+    """Bin the exited rays in the LB exit frames ``phi_hat(phi)``.
+
+    Returns the per-bin sums and sums of squares (n_bins, 16), the counts and the
+    hemispherical sum (16,).
+    """
+    if not ex_k:
+        nb = grid.n_bins
+        return np.zeros((nb, 16)), np.zeros((nb, 16)), np.zeros(nb, dtype=np.int64), np.zeros(16)
+    ke = np.concatenate(ex_k, axis=1)
+    se = np.concatenate(ex_s, axis=1)
+    Me = np.concatenate(ex_M, axis=2)
+    idx, phi = grid.index(ke)
+    s_det = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+    rotate_frame(Me, ke, se, s_det)
+    rows = Me.reshape(16, -1)
+    sums, sumsq, counts = bin_exits(grid, idx, rows)
+    return sums, sumsq, counts, rows.sum(axis=1)
 
 
 def _cross(
