@@ -170,7 +170,7 @@ class Substrate:
             self.alpha,
         )
         _check(
-            self.mirror or complex(self.n, self.k) != 0,
+            self.mirror or self.albedo is not None or complex(self.n, self.k) != 0,
             "substrate n + ik",
             "non-zero (or mirror=True)",
             (self.n, self.k),

@@ -17,7 +17,10 @@ One step, for every live ray:
    exit and binning; down out of the top interface -> across the coating to the substrate;
    up out of the substrate under a coating -> across the coating to the top interface from
    below. Crossing the coating multiplies M by the Beer-Lambert factor
-   ``exp(-4 pi k_c d / (lambda |cos theta|))``.
+   ``exp(-4 pi k_c d / (lambda |cos theta|))``. A Lambertian base (``Substrate.lambertian``)
+   has no microsurface: a ray reaching it is re-emitted at once (``albedo * diag(1, 0, 0,
+   0)``, cosine-distributed direction) and crosses back up in the same step; a bare base
+   sends every ray straight out.
 3. *Scatter* a hitting ray: a visible GGX normal (Heitz 2018 / Dupuy & Benyoub 2023), the
    frame rotated to the facet's s axis, Fresnel reflection (conductor; ideal mirror; or
    coherent film) or, at the dielectric top interface, reflection or refraction chosen with
