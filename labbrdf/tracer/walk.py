@@ -283,7 +283,7 @@ def trace_block(
         k = k[:, :0]
 
     while k.shape[1]:
-        m_ = k.shape[1]
+        m_ = int(k.shape[1])
         alive = np.ones(m_, dtype=bool)
         kz_loc = np.where(below, -k[2], k[2])
         alpha = np.where(iface == TOP, su.alpha_top, su.alpha_sub)
