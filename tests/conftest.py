@@ -2,7 +2,9 @@
 
 Tests that need ../shared (real instrument exports, oracles) use the ``shared_dir``,
 ``real_exports`` or ``oracles`` fixtures, which skip cleanly where the folder is absent
-(a user's clone has no ../shared).
+(a user's clone has no ../shared). Paths inside the project (``project_root``,
+``fixtures_dir``, ``specular_scan``) are built here once, so a test file may move between
+folders without counting its parents.
 """
 
 from __future__ import annotations
@@ -19,6 +21,24 @@ SHARED = Path(os.environ.get("LABBRDF_SHARED", ROOT.parent / "shared"))
 #: relative tolerance against double-precision oracles (1e-10)
 RTOL_ORACLE = 1e-10
 
+#: a small serial trace of bare aluminium at 650 nm (n + ik = 1.55 + 7.71i), 2000 rays:
+#: the command line of the CLI tests that need a trace but not its statistics
+TRACE_ARGV = (
+    "trace",
+    "--substrate",
+    "1.55+7.71j",
+    "--alpha",
+    "0.2",
+    "--theta-i",
+    "45",
+    "--wavelength",
+    "650",
+    "--rays",
+    "2000",
+    "--scheduler",
+    "serial",
+)
+
 
 @pytest.fixture(autouse=True, scope="session")
 def _user_cache(tmp_path_factory: pytest.TempPathFactory):
@@ -33,8 +53,26 @@ def _user_cache(tmp_path_factory: pytest.TempPathFactory):
 
 
 @pytest.fixture(scope="session")
+def project_root() -> Path:
+    """The project folder (holds ``labbrdf/``): PYTHONPATH of a test's subprocess."""
+    return ROOT
+
+
+@pytest.fixture(scope="session")
 def fixtures_dir() -> Path:
     return FIXTURES
+
+
+@pytest.fixture(scope="session")
+def specular_scan() -> Path:
+    """The bundled specular BRDF scan (``fixtures/specular/osr_specular.csv``)."""
+    return FIXTURES / "specular" / "osr_specular.csv"
+
+
+@pytest.fixture
+def trace_argv() -> list[str]:
+    """:data:`TRACE_ARGV` as a fresh list (a test may append to it)."""
+    return list(TRACE_ARGV)
 
 
 @pytest.fixture(scope="session")
