@@ -1,7 +1,8 @@
 """Fixtures of the adapter tests: reading and error checks shared by the vendors' files, and
 a minimal OLE2 compound-document writer.
 
-The checks (``load``, ``pick``, ``approx``, ``write``, ``raises``) are fixtures that return
+The checks (``load``, ``pick``, ``approx``, ``value_at``, ``check_spectrum``, ``write``,
+``raises``) are fixtures that return
 plain functions, so that each vendor's file uses the same ones.
 
 Shimadzu UVProbe ``.spc`` and legacy JASCO ``.jws`` files are OLE2 compound documents. The
@@ -179,6 +180,28 @@ def _pick(m: labbrdf.Measurement, quantity: str, wl: float, aoi: float | None = 
     return rows.iloc[0]
 
 
+def _value_at(m: labbrdf.Measurement, wavelength: float, sample: str | None = None) -> float:
+    """The value of the single row at ``wavelength`` [nm] (of ``sample``)."""
+    d = m.data
+    sel = np.isclose(d["wavelength_nm"], wavelength, rtol=0, atol=1e-9)
+    if sample is not None:
+        sel &= d["sample"] == sample
+    assert sel.sum() == 1, f"{sel.sum()} rows at {wavelength} nm"
+    return float(d.loc[sel, "value"].iloc[0])
+
+
+def _check_spectrum(m: labbrdf.Measurement, quantity: str, n: int, lo: float, hi: float) -> None:
+    """A spectrophotometer spectrum: ``n`` rows of ``quantity`` from ``lo`` to ``hi`` [nm],
+    fractions (unit "1"), no angle of incidence and no uncertainty."""
+    d = m.data
+    assert len(d) == n
+    assert set(d["quantity"].astype(str)) == {quantity}
+    assert d["wavelength_nm"].min() == pytest.approx(lo, abs=1e-9)
+    assert d["wavelength_nm"].max() == pytest.approx(hi, abs=1e-9)
+    assert (d["unit"] == "1").all()
+    assert d["theta_i_deg"].isna().all() and d["sigma"].isna().all()
+
+
 def _approx(x: float) -> object:
     return pytest.approx(x, rel=REL, abs=1e-15)
 
@@ -215,6 +238,18 @@ def pick() -> Callable[..., Any]:
 def approx() -> Callable[[float], object]:
     """``approx(x)``: ``pytest.approx`` at :data:`REL` (digits quoted from a text export)."""
     return _approx
+
+
+@pytest.fixture(scope="session")
+def value_at() -> Callable[..., float]:
+    """``value_at(m, wavelength, sample=None)``: the value of the one row there."""
+    return _value_at
+
+
+@pytest.fixture(scope="session")
+def check_spectrum() -> Callable[[labbrdf.Measurement, str, int, float, float], None]:
+    """``check_spectrum(m, quantity, n, lo, hi)``: asserts a spectrum's shape and units."""
+    return _check_spectrum
 
 
 @pytest.fixture(scope="session")
