@@ -965,9 +965,8 @@ def test_tls_from_the_dask_config_and_a_local_cluster_on_tls(certs, serial):
 
 
 @pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
-def test_cli_tls_options_need_existing_files(tmp_path, capsys):
-    scan = ROOT / "labbrdf" / "data" / "fixtures" / "specular" / "osr_specular.csv"
-    argv = ["fit", str(scan), "--model", "smooth3", "--scheduler", "tls://127.0.0.1:1"]
+def test_cli_tls_options_need_existing_files(tmp_path, capsys, specular_scan):
+    argv = ["fit", str(specular_scan), "--model", "smooth3", "--scheduler", "tls://127.0.0.1:1"]
     assert main([*argv, "--tls-ca", str(tmp_path / "nope.pem"), "--tls-cert", "x"]) == 2
     assert "nope.pem" in capsys.readouterr().err
     assert main([*argv, "--tls-key", str(tmp_path / "k.pem")]) == 2
@@ -1121,9 +1120,8 @@ def test_default_worker_timeout_is_a_minute():
 
 @pytest.mark.parametrize("bad", ["0", "-1", "nan", "inf"])
 @pytest.mark.usefixtures("reset_parallel_options")
-def test_bad_worker_timeout_is_refused(bad, capsys):
-    scan = ROOT / "labbrdf" / "data" / "fixtures" / "specular" / "osr_specular.csv"
-    argv = ["fit", str(scan), "--model", "smooth3", "--scheduler", "serial"]
+def test_bad_worker_timeout_is_refused(bad, capsys, specular_scan):
+    argv = ["fit", str(specular_scan), "--model", "smooth3", "--scheduler", "serial"]
     assert main([*argv, "--worker-timeout", bad]) == 2
     assert "--worker-timeout: expected a finite number of seconds > 0" in capsys.readouterr().err
     with pytest.raises(ValueError, match="worker-timeout"):
