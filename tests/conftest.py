@@ -21,9 +21,9 @@ SHARED = Path(os.environ.get("LABBRDF_SHARED", ROOT.parent / "shared"))
 #: relative tolerance against double-precision oracles (1e-10)
 RTOL_ORACLE = 1e-10
 
-#: a small serial trace of bare aluminium at 650 nm (n + ik = 1.55 + 7.71i), 2000 rays:
-#: the command line of the CLI tests that need a trace but not its statistics
-TRACE_ARGV = (
+#: the sample the CLI tests trace: bare aluminium (n + ik = 1.55 + 7.71i), GGX alpha 0.2,
+#: 45 deg incidence, 650 nm; a test adds how much to trace (rays, seed, scheduler, outputs)
+TRACE_SAMPLE = (
     "trace",
     "--substrate",
     "1.55+7.71j",
@@ -33,10 +33,6 @@ TRACE_ARGV = (
     "45",
     "--wavelength",
     "650",
-    "--rays",
-    "2000",
-    "--scheduler",
-    "serial",
 )
 
 
@@ -70,9 +66,16 @@ def specular_scan() -> Path:
 
 
 @pytest.fixture
-def trace_argv() -> list[str]:
-    """:data:`TRACE_ARGV` as a fresh list (a test may append to it)."""
-    return list(TRACE_ARGV)
+def trace_sample() -> list[str]:
+    """:data:`TRACE_SAMPLE` as a fresh list (a test appends to it)."""
+    return list(TRACE_SAMPLE)
+
+
+@pytest.fixture
+def trace_argv(trace_sample: list[str]) -> list[str]:
+    """A small trace of :data:`TRACE_SAMPLE`: 2000 rays, serial (for the tests that need a
+    trace to run, not its statistics)."""
+    return [*trace_sample, "--rays", "2000", "--scheduler", "serial"]
 
 
 @pytest.fixture(scope="session")

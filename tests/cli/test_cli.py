@@ -243,19 +243,11 @@ def test_hemispherical_unknown_parameter(capsys):
     assert "k9" in capsys.readouterr().err
 
 
-def test_trace_json_and_npz(tmp_path, capsys):
+def test_trace_json_and_npz(tmp_path, capsys, trace_sample):
     out = tmp_path / "al.npz"
     code = main(
         [
-            "trace",
-            "--substrate",
-            "1.55+7.71j",
-            "--alpha",
-            "0.2",
-            "--theta-i",
-            "45",
-            "--wavelength",
-            "650",
+            *trace_sample,
             "--rays",
             "20000",
             "--seed",
