@@ -93,9 +93,8 @@ def _rebuild_adapter_error(
 class Example:
     """A real export of a format: the file a format's generic tests read and damage.
 
-    The files themselves are not shipped (they belong to the labs that wrote them); the
-    test suite finds them in its collection of real exports, one folder per format, and
-    skips where the collection is absent.
+    The files are not part of the package: the test suite finds them in its collection of
+    real exports, one folder per format, and skips where the collection is absent.
 
     Attributes
     ----------
@@ -108,7 +107,8 @@ class Example:
     rows_per_line : int, optional
         The most dataset rows one text line of the file gives (psi and Delta: 2; a line of
         three angles: 6; a Mueller matrix: 16). A damaged line may cost at most this many
-        rows, which bounds what the mutation tests of line-oriented formats accept.
+        rows, which bounds what the mutation tests of line-oriented formats accept; they
+        damage the examples that state it.
     """
 
     path: str
