@@ -293,12 +293,11 @@ def test_report_takes_model_options_and_a_selection(real_exports: Path, tmp_path
 
 
 @pytest.mark.slow
-def test_trace_exported_as_bsdf_is_read_back_and_fitted(tmp_path: Path, capsys):
+def test_trace_exported_as_bsdf_is_read_back_and_fitted(tmp_path: Path, capsys, trace_sample):
     from labbrdf.tracer import TraceResult
 
     run, out = tmp_path / "al.npz", tmp_path / "al.bsdf"
-    assert main(["trace", "--substrate", "1.55+7.71j", "--alpha", "0.2", "--theta-i", "45",
-                 "--wavelength", "650", "--rays", "400000", "--seed", "1",
+    assert main([*trace_sample, "--rays", "400000", "--seed", "1",
                  "--single-scattering", "-o", str(run), "--scheduler", "serial"]) == 0  # fmt: skip
     assert main(["export", "--trace", str(run), "--radial", "0:60:3", "--azimuth", "0:350:10",
                  "-o", str(out)]) == 0  # fmt: skip
