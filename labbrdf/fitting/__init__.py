@@ -33,7 +33,7 @@ among them in its own ``__all__``. They may change without notice.
 
 from __future__ import annotations
 
-from .batch import fit_many
+from .batch import fit_many, fit_many_nk, fit_records
 from .core import ALGORITHMS, CONSTRAINED, METHOD, fit, parse_method
 from .data import FITTABLE_QUANTITIES, FitData, FitError
 from .objective import Objective
@@ -56,5 +56,7 @@ __all__ = [
     "Objective",
     "fit",
     "fit_many",
+    "fit_many_nk",
+    "fit_records",
     "parse_method",
 ]
