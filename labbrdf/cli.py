@@ -8,6 +8,13 @@ written, ...), 3 ``fit``: some groups could not be fitted or did not converge (l
 ``success`` false and the reason), 141 the reader of our output went away; the error is on
 stderr. Every output path goes through :mod:`labbrdf.outputs`.
 
+One name, one meaning, in every subcommand: ``--wavelength NM`` is one wavelength [nm],
+``--wavelength-range MIN:MAX`` a range of rows; options are taken by their full names only
+(``allow_abbrev=False``), and older spellings are refused naming the new one. The library
+does the work: the commands parse text into values and call it once (e.g.
+:func:`labbrdf.tracer_setup.trace_config_from_inputs`); a
+:class:`labbrdf.errors.SetupError` is said with the options' names (:data:`OPTION_NAMES`).
+
 Arguments that name files are declared as :class:`InputPath` or :class:`OutputPath`; before
 a command runs, :func:`_checked_outputs` checks all its outputs against all its inputs and
 runs it under one rule (:func:`labbrdf.outputs.write_policy`): an existing output is
