@@ -610,7 +610,7 @@ def _option_errors() -> Iterator[None]:
 @_executor_errors
 def cmd_fit(args: argparse.Namespace) -> int:
     from . import adapters, models
-    from .fitting import fit_many, fit_many_nk, fit_records
+    from .fitting import auto_weighting, fit_many, fit_many_nk, fit_records
 
     executor = _executor(args, progress=not args.json)
     data = _selected(args, adapters.read_many(args.files))
@@ -631,10 +631,9 @@ def cmd_fit(args: argparse.Namespace) -> int:
         "mask_zeros": not args.keep_zeros,
         "relative_floor": args.relative_floor,
     }
-    if args.weighting != "auto":
-        kw["weighting"] = args.weighting
-    elif not _all_have_sigma(data.data):
-        kw["weighting"] = "relative"
+    weighting = args.weighting if args.weighting != "auto" else auto_weighting(data)
+    if weighting is not None:
+        kw["weighting"] = weighting
     if args.nk_from:
         with _option_errors():
             table, results = fit_many_nk(
@@ -673,13 +672,6 @@ def cmd_fit(args: argparse.Namespace) -> int:
         group = ", ".join(f"{b}={r[b]}" for b in by)
         print(f"labbrdf fit: group {group} FAILED: {r['message']}", file=sys.stderr)
     return 3 if failed else 0
-
-
-def _all_have_sigma(df: Any) -> bool:
-    import numpy as np
-
-    sig = df["sigma"].to_numpy(float)
-    return bool(sig.size) and bool(np.all(np.isfinite(sig) & (sig > 0)))
 
 
 def _model_from_args(args: argparse.Namespace) -> tuple[Any, dict[str, float]]:

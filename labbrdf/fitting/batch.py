@@ -22,7 +22,7 @@ from .core import METHOD, fit, parse_method, setup_params
 from .data import FitData, FitError, select_rows, several_groups_message
 from .result import FitResult
 
-__all__ = ["fit_many", "fit_many_nk", "fit_records"]
+__all__ = ["auto_weighting", "fit_many", "fit_many_nk", "fit_records"]
 
 
 def _sort_key(key: Any) -> tuple[Any, ...]:
@@ -226,6 +226,27 @@ def fit_many(
     num += ["rmse", "rmse_pct", "chisqr", "redchi", "elapsed_s"] + param_names
     out[num] = out[num].astype(float)
     return (out, results) if return_results else out
+
+
+def auto_weighting(data: Measurement | pd.DataFrame) -> str | None:
+    """The weighting of a batch when none is asked for: the data's sigmas, if all have one.
+
+    Parameters
+    ----------
+    data : Measurement or DataFrame
+        The rows to be fitted.
+
+    Returns
+    -------
+    None or "relative"
+        None (``1/sigma^2``, :func:`fit`'s default) when every row has a finite sigma
+        > 0; else ``"relative"`` (sigma_i = max(|y_i|, floor x max|y|)): rows without
+        sigma (a ``.bsdf`` has none) are fitted with relative weights, not uniform ones.
+    """
+    df = data.data if isinstance(data, Measurement) else data
+    sig = df["sigma"].to_numpy(float)
+    every = bool(sig.size) and bool(np.all(np.isfinite(sig) & (sig > 0)))
+    return None if every else "relative"
 
 
 def _metas(data: Measurement) -> list[dict[str, Any]]:
