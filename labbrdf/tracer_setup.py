@@ -1,13 +1,13 @@
 """A tracer run from what a user has: index values or files, roughness values or height maps.
 
 The objects layer over :mod:`labbrdf.tracer` (which reads no file):
-:func:`trace_config_from_inputs` assembles the :class:`~labbrdf.tracer.Substrate` and the
-:class:`~labbrdf.tracer.Coating` of a :class:`~labbrdf.tracer.TraceConfig` from
+:func:`trace_config_from_inputs` assembles the :class:`~labbrdf.Substrate` and the
+:class:`~labbrdf.Coating` of a :class:`~labbrdf.TraceConfig` from
 
 - the substrate index: a value, or the bulk n, k of an ellipsometer file at the traced
   wavelength (:func:`labbrdf.nk.read_nk`, :func:`labbrdf.nk.bulk_index_at`);
 - the substrate roughness: a GGX or Beckmann alpha, or the slope table of a measured
-  areal height map (:meth:`labbrdf.tracer.Substrate.from_surface`);
+  areal height map (:meth:`labbrdf.Substrate.from_surface`);
 - an optional coating: index and thickness values, or the one layer of a film fit at the
   traced wavelength (:func:`labbrdf.nk.coating_from_fit`), with its top's roughness as an
   alpha (default: the substrate's) or a measured map.
@@ -27,7 +27,7 @@ from typing import Any, Literal
 from .adapters.topography import HeightMap, read_height_map
 from .errors import SetupError, escaped
 from .nk import NkError, bulk_index_at, coating_from_fit, read_nk
-from .tracer import Coating, Substrate, TraceConfig
+from .tracer.config import Coating, Substrate, TraceConfig
 from .tracer.sampling import TabulatedNDF
 
 __all__ = ["trace_config_from_inputs"]
@@ -183,7 +183,7 @@ def trace_config_from_inputs(
     warn: Callable[[str], None] = _warn,
     **run: Any,
 ) -> TraceConfig:
-    """The :class:`~labbrdf.tracer.TraceConfig` of a substrate, a coating and a run.
+    """The :class:`~labbrdf.TraceConfig` of a substrate, a coating and a run.
 
     Parameters
     ----------
@@ -200,7 +200,7 @@ def trace_config_from_inputs(
         Substrate roughness [1] (GGX or Beckmann alpha, see ``distribution``) ...
     surface : path-like or HeightMap, optional
         ... or a measured areal height map: the substrate's facets follow its slope table
-        (:meth:`labbrdf.tracer.Substrate.from_surface`). ``surface`` wins over ``alpha``.
+        (:meth:`labbrdf.Substrate.from_surface`). ``surface`` wins over ``alpha``.
     coating_index : complex, optional
         Coating index [1], with ``thickness_nm`` ...
     coating_from : path-like, optional
@@ -223,7 +223,7 @@ def trace_config_from_inputs(
         Called with each doubt about a height map's geometry (default
         :func:`warnings.warn`).
     **run
-        Any other :class:`~labbrdf.tracer.TraceConfig` field (``rays``, ``seed``,
+        Any other :class:`~labbrdf.TraceConfig` field (``rays``, ``seed``,
         ``scattering``, ``coherent``, ``estimator``, ``scalar`` ...).
 
     Returns
@@ -236,7 +236,7 @@ def trace_config_from_inputs(
         Arguments missing or given twice, or a file that cannot give what is asked of it
         (the message names the keyword and the file).
     ValueError
-        A value the tracer refuses (:class:`~labbrdf.tracer.TraceConfig`'s checks).
+        A value the tracer refuses (:class:`~labbrdf.TraceConfig`'s checks).
     """
 
     def read(source: PathLike | HeightMap, keyword: str) -> HeightMap:
