@@ -120,3 +120,18 @@ def test_nk_from_a_file_without_psi_delta_names_option_and_file(capsys) -> None:
     assert main([*argv, "--wavelength", "500", "--param", "alpha=0.2"]) == 2
     err = capsys.readouterr().err
     assert f"--nk-from {SCAN}: no psi/delta rows" in err
+
+
+def test_report_passes_the_row_range_to_the_library(monkeypatch, tmp_path: Path) -> None:
+    import labbrdf.report
+
+    seen = {}
+
+    def fake_report(files, model, out, **kw):
+        seen.update(kw["selection"])
+        return 0
+
+    monkeypatch.setattr(labbrdf.report, "user_report", fake_report)
+    argv = ["report", str(SCAN), "-o", str(tmp_path / "r"), "--scheduler", "serial"]
+    assert main([*argv, "--wavelength-range", "400:700", "--theta-i", "45"]) == 0
+    assert seen == {"wavelength": "400:700", "theta_i": "45"}
