@@ -43,19 +43,24 @@ import pandas as pd
 
 from . import ellipsometry as ell
 from .dataset import Measurement
+from .errors import LabbrdfError
 
 __all__ = [
     "POSITION_TOL_MM",
     "AngleVerdict",
+    "NkError",
     "angle_verdict",
+    "bulk_index_at",
     "coating_from_fit",
     "combined_table",
     "compare_reflectance",
     "microfacet_hemispherical",
+    "model_with_nk",
     "nk_at",
     "nk_json",
     "nk_table",
     "ordinary_psi_delta",
+    "read_nk",
 ]
 
 #: Stage positions closer than this (chained, per coordinate) are the same spot [mm].
@@ -607,6 +612,133 @@ def nk_at(
         if bad.any():
             raise ValueError(_angle_dependent_message(x[bad]))
     return out
+
+
+class NkError(LabbrdfError, ValueError):
+    """n, k that a file cannot give: no psi/Delta, outside its range, not a bulk index.
+
+    The message starts with the file it is about.
+    """
+
+
+def read_nk(path: str | os.PathLike[str]) -> pd.DataFrame:
+    """The per-wavelength combined n, k of an ellipsometer file (its psi/Delta inverted).
+
+    Parameters
+    ----------
+    path : path-like
+        Any export :func:`labbrdf.read` reads that holds ordinary psi/Delta rows.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The file's :func:`combined_table`, for :func:`bulk_index_at` or :func:`nk_at`.
+
+    Raises
+    ------
+    labbrdf.AdapterError
+        The file cannot be read.
+    NkError
+        It holds no psi/Delta to invert (the message names the file).
+    """
+    from . import adapters  # the readers, imported where needed
+
+    m = adapters.read(path)
+    try:
+        return combined_table(m)
+    except ValueError as exc:
+        raise NkError(f"{path}: {exc}") from None
+
+
+def bulk_index_at(
+    table: pd.DataFrame, wavelength_nm: float, *, source: str | os.PathLike[str] = "n, k"
+) -> tuple[float, float]:
+    """The bulk index ``(n, k)`` of a combined table at one wavelength, checked physical.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A :func:`combined_table` (e.g. of :func:`read_nk`) of one sample.
+    wavelength_nm : float
+        Vacuum wavelength [nm] inside the measured range (linear interpolation,
+        :func:`nk_at`).
+    source : str or path-like, optional
+        What the table came from (its file), the start of every error message.
+
+    Returns
+    -------
+    n, k : float
+        Refractive index and extinction coefficient [1], ``n > 0`` and ``k >= 0``.
+
+    Raises
+    ------
+    NkError
+        The wavelength lies outside the table, the sample's angles disagree there (a
+        stack), or the two-phase pseudo-index is not a material's (``n <= 0`` or
+        ``k < 0``: a film on the sample, whose pseudo-index can leave the physical
+        half-plane).
+    """
+    try:
+        at = nk_at(table, wavelength_nm)
+    except ValueError as exc:
+        raise NkError(f"{source}: {exc}") from None
+    n, k = float(at["n"]), float(at["k"])
+    if not (n > 0 and k >= 0):
+        raise NkError(
+            f"{source}: the pseudo-index at {wavelength_nm:g} nm is n={n:.4g}, "
+            f"k={k:.4g}, not a physical bulk index (a film on the sample?)"
+        )
+    return n, k
+
+
+def model_with_nk(
+    name: str,
+    nk_from: str | os.PathLike[str] | pd.DataFrame,
+    wavelength_nm: float,
+    *,
+    source: str | os.PathLike[str] | None = None,
+    **options: Any,
+) -> Any:
+    """A registry model whose index is a sample's bulk n, k at one wavelength.
+
+    Parameters
+    ----------
+    name : str
+        A model that takes an index ``n``, ``k`` (``microfacet``, see
+        :func:`labbrdf.models.option_names`).
+    nk_from : path-like or pandas.DataFrame
+        An ellipsometer file (:func:`read_nk`) or its combined table.
+    wavelength_nm : float
+        Vacuum wavelength [nm] at which the index is taken (:func:`bulk_index_at`).
+    source : str or path-like, optional
+        What a table came from, for messages (default: the file, or ``"n, k"``).
+    **options
+        The model's other options.
+
+    Returns
+    -------
+    labbrdf.models.Model
+
+    Raises
+    ------
+    labbrdf.errors.SetupError
+        The model takes no index (the message names the keyword ``{nk_from}``).
+    NkError
+        No bulk n, k at that wavelength (the message starts with the file).
+    labbrdf.ModelError
+        An unknown model or a bad option.
+    """
+    from . import models
+    from .errors import SetupError
+
+    if "n" not in models.option_names(name):
+        raise SetupError(f"{{nk_from}}: model {name!r} takes no index n, k")
+    if isinstance(nk_from, pd.DataFrame):
+        table, where = nk_from, source if source is not None else "n, k"
+    else:
+        table, where = read_nk(nk_from), source if source is not None else nk_from
+    n, k = bulk_index_at(table, wavelength_nm, source=where)
+    return models.get(name, **{**options, "n": n, "k": k})
 
 
 def _angle_dependent_message(wavelength_nm: np.ndarray) -> str:
