@@ -642,6 +642,7 @@ def fit(
         ),
         residual=resid,
         best_fit=best,
+        data=fd,
     )
 
 
