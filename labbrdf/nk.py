@@ -886,7 +886,8 @@ def nk_panels(table: pd.DataFrame, *, max_series: int | None = None) -> list[dic
     Returns
     -------
     list of dict
-        Panel descriptions as :func:`labbrdf.report.figures.panels_figure` takes them.
+        Panel descriptions (``title``, ``xlabel``, ``ylabel``, ``series``), as the
+        report's ``panels_figure`` and :func:`plot_table` draw them.
     """
     if not {"wavelength_nm", "n", "k", "n_sigma", "k_sigma"} <= set(table.columns):
         raise ValueError(
