@@ -248,7 +248,7 @@ class FitResult:
             )
         try:
             model = get_model(self.model, **self.options)
-        except (ModelError, TypeError):
+        except ModelError:
             model = None  # not a registry model: draw it through the data points
         ti = np.asarray(d.theta_i_deg, float)
         tr = np.asarray(d.theta_r_deg, float)
