@@ -264,8 +264,12 @@ def trace_config_from_inputs(
         return _height_map(source, keyword, channel, unit, pixel_size, warn)
 
     if base_albedo is not None:
-        metal = {"substrate_index": substrate_index, "nk_from": nk_from, "alpha": alpha}
-        metal["surface"] = surface
+        metal: dict[str, object] = {
+            "substrate_index": substrate_index,
+            "nk_from": nk_from,
+            "alpha": alpha,
+            "surface": surface,
+        }
         coated = coating_index is not None or coating_from is not None
         roughness = coating_alpha is not None or coating_surface is not None
         substrate = _base(base_albedo, metal, coated, roughness)
