@@ -524,7 +524,9 @@ class BrdfPrediction:
                     else "off specular"
                 )
                 if r["consistent"]:
-                    bits.append(f"consistent with the measurement within its Monte Carlo error {where}")
+                    bits.append(
+                        f"consistent with the measurement within its Monte Carlo error {where}"
+                    )
                     continue
                 med = float(r["ratio_median"])
                 spread = max(abs(float(r["ratio_lo"]) - 1.0), abs(float(r["ratio_hi"]) - 1.0))
@@ -555,6 +557,28 @@ def _read_table(bsdf: Any) -> tuple[zemax_bsdf.BsdfTable, str]:
     if isinstance(bsdf, (str, os.PathLike)):
         return zemax_bsdf.read_table(bsdf), str(bsdf)
     return zemax_bsdf._table_of(bsdf), "<table>"
+
+
+def _geometry(ti: NDArray, az: NDArray, rad: NDArray) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+    """theta_r, phi_r, above-horizon and angle from specular [deg] of every grid point."""
+    tr, pr, above = scatter_to_angles(ti[:, None, None], rad[None, None, :], az[None, :, None])
+    d = scatter_to_direction(ti[:, None, None], rad[None, None, :], az[None, :, None])
+    spec = scatter_to_direction(ti[:, None, None], np.zeros((1, 1, 1)), np.zeros((1, 1, 1)))
+    off = np.degrees(np.arccos(np.clip(np.sum(d * spec, axis=0), -1.0, 1.0)))
+    return tr, pr, above, off
+
+
+def _sampled(
+    runs: Sequence[TraceResult], tr: NDArray, pr: NDArray, above: NDArray
+) -> tuple[NDArray, NDArray]:
+    """Each run's S0 and its standard error in the bins of the grid points [sr^-1]."""
+    pred = np.zeros(tr.shape)
+    se = np.zeros(tr.shape)
+    for a, res in enumerate(runs):
+        i, j = _bin(res, np.where(above[a], tr[a], 0.0), pr[a])
+        pred[a] = np.where(above[a], res.s0()[i, j], 0.0)
+        se[a] = np.where(above[a], res.mueller_stderr[..., 0, 0][i, j], 0.0)
+    return pred, se
 
 
 def predict_brdf(
@@ -623,30 +647,18 @@ def predict_brdf(
         alpha, alpha_u = float(roughness), math.nan
     ti = np.asarray(t.theta_i_deg, float)
     az, rad = np.asarray(t.azimuth_deg, float), np.asarray(t.radial_deg, float)
-    tr, pr, above = scatter_to_angles(ti[:, None, None], rad[None, None, :], az[None, :, None])
-    d = scatter_to_direction(ti[:, None, None], rad[None, None, :], az[None, :, None])
-    spec = scatter_to_direction(ti[:, None, None], 0.0 * rad[None, None, :1], az[None, :1, None])
-    cosang = np.clip(np.sum(d * spec, axis=0), -1.0, 1.0)
-    off = np.degrees(np.arccos(cosang))
+    tr, pr, above, off = _geometry(ti, az, rad)
     meas = np.where(above, t.values[0, 0], 0.0)
-    pred = np.zeros_like(meas)
-    se = np.zeros_like(meas)
-    albedo = np.zeros(ti.size)
-    albedo_se = np.zeros(ti.size)
-    results: list[TraceResult] = []
-    seconds = 0.0
     n0, k0 = float(nk["n"][0]), float(nk["k"][0])
-    for a, th in enumerate(ti):
-        res = trace(_config(float(wl), th, n0, k0, alpha, coating, rays, seed, step_deg), map=map)
-        results.append(res)
-        seconds += res.seconds
-        i, j = _bin(res, np.where(above[a], tr[a], 0.0), pr[a])
-        s0 = res.s0()
-        s0_se = res.mueller_stderr[..., 0, 0]
-        pred[a] = np.where(above[a], s0[i, j], 0.0)
-        se[a] = np.where(above[a], s0_se[i, j], 0.0)
-        albedo[a] = res.albedo()
-        albedo_se[a] = res.albedo_stderr()
+    runs = [
+        trace(_config(float(wl), th, n0, k0, alpha, coating, rays, seed, step_deg), map=map)
+        for th in ti
+    ]
+    pred, se = _sampled(runs, tr, pr, above)
+    albedo = np.array([r.albedo() for r in runs])
+    albedo_se = np.array([r.albedo_stderr() for r in runs])
+    seconds = float(sum(r.seconds for r in runs))
+    results = runs
     geo = {"theta_i_deg": ti, "azimuth_deg": az, "radial_deg": rad, "symmetry": t.symmetry}
     gm = grid_integral(meas[None, None], **geo)
     gp = grid_integral(pred[None, None], **geo)
