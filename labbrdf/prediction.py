@@ -459,6 +459,7 @@ class BrdfPrediction:
     rays: int
     seconds: float
     coating: dict[str, Any] | None = None
+    region_table: pd.DataFrame = field(default_factory=pd.DataFrame, repr=False)
     results: list[TraceResult] = field(default_factory=list, repr=False)
 
     @property
@@ -474,70 +475,42 @@ class BrdfPrediction:
         -------
         pandas.DataFrame
             ``theta_i_deg, region ("specular lobe" | "off specular"), points,
-            ratio_median`` (median of predicted / measured over the points with a measured
-            value > 0), ``ratio_lo, ratio_hi`` (its 10 and 90 % quantiles),
-            ``mc_rel_error`` (median relative Monte Carlo error), ``consistent`` (every
-            point within 3 SE + rounding).
+            scatter_measured, scatter_predicted, scatter_predicted_stderr`` (the region's
+            grid integral ``int f cos(theta_r) d omega`` [1] and the prediction's batch
+            error), ``ratio`` = predicted / measured scatter of the region and
+            ``ratio_stderr`` (Monte Carlo 1 sigma), ``ratio_lo, ratio_hi`` (10 and 90 %
+            quantiles of the point ratios), ``consistent`` (``|ratio - 1| <= 3
+            ratio_stderr + 1e-5``).
         """
-        rows = []
-        for a, ti in enumerate(self.theta_i_deg):
-            for region, sel in (
-                ("specular lobe", self.radial_off_deg[a] <= self.lobe_deg),
-                ("off specular", self.radial_off_deg[a] > self.lobe_deg),
-            ):
-                m = sel & self.above[a] & (self.measured[a] > 0)
-                meas, pred = self.measured[a][m], self.predicted[a][m]
-                ratio = pred / meas if m.any() else np.array([np.nan])
-                rel = self.predicted_stderr[a][m] / np.where(pred > 0, pred, np.inf)
-                rows.append(
-                    {
-                        "theta_i_deg": float(ti),
-                        "region": region,
-                        "points": int(m.sum()),
-                        "ratio_median": float(np.median(ratio)),
-                        "ratio_lo": float(np.quantile(ratio, 0.1)),
-                        "ratio_hi": float(np.quantile(ratio, 0.9)),
-                        "mc_rel_error": float(np.median(rel)) if m.any() else math.nan,
-                        "consistent": bool(np.all(self.consistent[a][sel])),
-                    }
-                )
-        return pd.DataFrame(rows)
+        return self.region_table.copy()
 
     def verdict(self) -> str:
         """A plain sentence: where and by how much the prediction misses (or that it does not).
 
-        Per incidence, the median ratio predicted / measured in the specular lobe and off
-        it: "low" / "high" by ``|ratio - 1|`` in percent, "within X %" when the 10-90 %
-        range of the ratio lies within X % of 1, "consistent with the measurement within
-        its Monte Carlo error" when every point passes :attr:`consistent`.
+        Per incidence and region (:meth:`regions`): "on the measurement" when the
+        integrated ratio is 1 within 3 Monte Carlo sigma (and the file's rounding), "within
+        X %" when it misses by less than 10 %, else "N % low" / "N % high".
         """
-        reg = self.regions()
         parts = []
-        for ti, g in reg.groupby("theta_i_deg", sort=True):
+        for ti, g in self.region_table.groupby("theta_i_deg", sort=True):
             bits = []
             for _, r in g.iterrows():
-                if r["points"] == 0:
+                if r["points"] == 0 or not np.isfinite(r["ratio"]):
                     continue
                 where = (
                     f"in the specular lobe (within {self.lobe_deg:.3g} deg of specular)"
                     if r["region"] == "specular lobe"
                     else "off specular"
                 )
+                ratio, se = float(r["ratio"]), float(r["ratio_stderr"])
+                how = f"(integrated ratio {ratio:.3f} +- {se:.3f}, Monte Carlo 1 sigma)"
                 if r["consistent"]:
-                    bits.append(
-                        f"consistent with the measurement within its Monte Carlo error {where}"
-                    )
-                    continue
-                med = float(r["ratio_median"])
-                spread = max(abs(float(r["ratio_lo"]) - 1.0), abs(float(r["ratio_hi"]) - 1.0))
-                if spread <= 0.1:
-                    bits.append(f"within {_pct_ceiling(spread)} % {where}")
+                    bits.append(f"on the measurement {where} {how}")
+                elif abs(ratio - 1.0) < 0.1:
+                    bits.append(f"within {_pct_ceiling(abs(ratio - 1.0))} % {where} {how}")
                 else:
-                    word = "low" if med < 1.0 else "high"
-                    bits.append(
-                        f"{abs(med - 1.0) * 100:.0f} % {word} {where} (median ratio "
-                        f"{med:.3g}, 10-90 % range {r['ratio_lo']:.3g}-{r['ratio_hi']:.3g})"
-                    )
+                    word = "low" if ratio < 1.0 else "high"
+                    bits.append(f"{abs(ratio - 1.0) * 100:.0f} % {word} {where} {how}")
             if bits:
                 parts.append(f"at {float(ti):g} deg the prediction is " + " and ".join(bits))
         if not parts:
@@ -579,6 +552,78 @@ def _sampled(
         pred[a] = np.where(above[a], res.s0()[i, j], 0.0)
         se[a] = np.where(above[a], res.mueller_stderr[..., 0, 0][i, j], 0.0)
     return pred, se
+
+
+def _batch_integrals(
+    res: TraceResult, a: int, tr: NDArray, pr: NDArray, above: NDArray, geo: dict[str, Any]
+) -> tuple[NDArray, NDArray]:
+    """Per tracer batch: S0 on incidence ``a``'s grid points (B, az, rad) and weights (B,)."""
+    i, j = _bin(res, np.where(above[a], tr[a], 0.0), pr[a])
+    if res.batch_mueller is None:
+        return np.where(above[a], res.s0()[i, j], 0.0)[None], np.ones(1)
+    s0_b = res.batch_mueller[:, :, :, 0, 0].astype(float)[:, i, j]
+    return np.where(above[a], s0_b, 0.0), res.block_rays.astype(float)
+
+
+def _integral_and_se(
+    vals_b: NDArray, w: NDArray, mask: NDArray, geo: dict[str, Any], a: int
+) -> tuple[float, float]:
+    """Grid integral of the batch mean over ``mask`` and its batch standard error [1].
+
+    ``sqrt(sum_b N_b (I_b - I)^2 / (N (B - 1)))``, as :meth:`labbrdf.TraceResult.dop_stderr`
+    does for the DOP: the points' errors are correlated (one batch moves a whole lobe), so
+    they are not added in quadrature.
+    """
+    g = {**geo, "theta_i_deg": geo["theta_i_deg"][a : a + 1]}
+    ib = grid_integral(np.where(mask, vals_b, 0.0)[None, :, None], **g)["integral"][0, :, 0]
+    mean = float(np.sum(w * ib) / w.sum())
+    if w.size < 2:
+        return mean, 0.0
+    return mean, math.sqrt(float(np.sum(w * (ib - mean) ** 2)) / w.sum() / (w.size - 1))
+
+
+def _regions(
+    runs: Sequence[TraceResult],
+    arrays: dict[str, NDArray],
+    geo: dict[str, Any],
+    lobe: float,
+) -> tuple[pd.DataFrame, NDArray]:
+    """The region table (:meth:`BrdfPrediction.regions`) and the whole grid's TIS SE."""
+    tr, pr, above = arrays["tr"], arrays["pr"], arrays["above"]
+    meas, pred, off = arrays["meas"], arrays["pred"], arrays["off"]
+    rows, tis_se = [], np.zeros(len(runs))
+    for a, res in enumerate(runs):
+        vals_b, w = _batch_integrals(res, a, tr, pr, above, geo)
+        tis_se[a] = _integral_and_se(vals_b, w, np.ones(vals_b.shape[1:], bool), geo, a)[1]
+        for region, sel in (("specular lobe", off[a] <= lobe), ("off specular", off[a] > lobe)):
+            m = sel & above[a] & (meas[a] > 0)
+            g = {**geo, "theta_i_deg": geo["theta_i_deg"][a : a + 1]}
+            im = float(
+                grid_integral(np.where(m, meas[a], 0.0)[None, None, None], **g)["integral"].item()
+            )
+            se = _integral_and_se(vals_b, w, m, geo, a)[1]
+            ip = float(
+                grid_integral(np.where(m, pred[a], 0.0)[None, None, None], **g)["integral"].item()
+            )
+            pts = pred[a][m] / meas[a][m] if m.any() else np.array([np.nan])
+            ratio = ip / im if im > 0 else math.nan
+            rse = se / im if im > 0 else math.nan
+            rows.append(
+                {
+                    "theta_i_deg": float(geo["theta_i_deg"][a]),
+                    "region": region,
+                    "points": int(m.sum()),
+                    "scatter_measured": im,
+                    "scatter_predicted": ip,
+                    "scatter_predicted_stderr": se,
+                    "ratio": ratio,
+                    "ratio_stderr": rse,
+                    "ratio_lo": float(np.quantile(pts, 0.1)),
+                    "ratio_hi": float(np.quantile(pts, 0.9)),
+                    "consistent": bool(abs(ratio - 1.0) <= 3.0 * rse + FILE_ROUNDING),
+                }
+            )
+    return pd.DataFrame(rows), tis_se
 
 
 def predict_brdf(
@@ -662,10 +707,13 @@ def predict_brdf(
     geo = {"theta_i_deg": ti, "azimuth_deg": az, "radial_deg": rad, "symmetry": t.symmetry}
     gm = grid_integral(meas[None, None], **geo)
     gp = grid_integral(pred[None, None], **geo)
-    # the batch errors of neighbouring points are correlated: the integral of the per-point
-    # SE is an upper bound of the integral's SE
-    gs = grid_integral(se[None, None], **geo)
     lobe = max(MIN_LOBE_DEG, 2.0 * math.degrees(math.atan(alpha)))
+    region_table, tis_se = _regions(
+        runs,
+        {"tr": tr, "pr": pr, "above": above, "meas": meas, "pred": pred, "off": off},
+        geo,
+        lobe,
+    )
     return BrdfPrediction(
         path=path,
         wavelength_nm=float(wl),
@@ -688,7 +736,7 @@ def predict_brdf(
         predicted_stderr=se,
         tis_measured=gm["integral"][0, 0],
         tis_predicted=gp["integral"][0, 0],
-        tis_predicted_stderr=gs["integral"][0, 0],
+        tis_predicted_stderr=tis_se,
         tis_file=np.asarray(t.tis, float)[0, 0],
         albedo=albedo,
         albedo_stderr=albedo_se,
@@ -697,5 +745,6 @@ def predict_brdf(
         rays=int(rays),
         seconds=seconds,
         coating=None if coating is None else coating.to_dict(),
+        region_table=region_table,
         results=results,
     )

@@ -127,7 +127,7 @@ def test_prediction_from_the_same_sample_matches_the_measurement(right) -> None:
     assert right.tis_predicted == pytest.approx(right.tis_measured, rel=1e-5)
     assert right.tis_file == pytest.approx(right.tis_measured, rel=1e-5)
     assert right.regions()["consistent"].all()
-    assert "consistent with the measurement within its Monte Carlo error" in right.verdict()
+    assert right.verdict().count("on the measurement") == 2
 
 
 def test_wrong_index_is_flagged_with_the_fresnel_ratio_in_the_lobe(right, wrong) -> None:
@@ -136,10 +136,10 @@ def test_wrong_index_is_flagged_with_the_fresnel_ratio_in_the_lobe(right, wrong)
     # near specular the facets are near the mean normal: the ratio is that of the
     # unpolarized Fresnel reflectances at 45 deg (to the lobe's spread of local angles)
     want = _reflectance(1.5 + 3.0j, 45.0) / _reflectance(1.2 + 7.26j, 45.0)
-    assert reg.loc["specular lobe", "ratio_median"] == pytest.approx(want, rel=0.02)
+    assert reg.loc["specular lobe", "ratio"] == pytest.approx(want, rel=0.02)
     assert not reg["consistent"].any()
     v = wrong.verdict()
-    pct = round(abs(reg.loc["specular lobe", "ratio_median"] - 1) * 100)
+    pct = round(abs(reg.loc["specular lobe", "ratio"] - 1) * 100)
     assert f"{pct:.0f} % low in the specular lobe" in v
     assert v.startswith("At 45 deg the prediction is")
     assert wrong.tis_predicted[0] < 0.95 * wrong.tis_measured[0]
