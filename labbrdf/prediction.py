@@ -212,7 +212,9 @@ def ellipsometer_dop(data: pd.DataFrame, *, depolarizer: str = "mixed") -> pd.Da
     )
 
 
-def substrate_nk(data: pd.DataFrame, wavelength_nm: float | Sequence[float]) -> dict[str, Any]:
+def substrate_nk(
+    data: pd.DataFrame, wavelength_nm: float | Sequence[float] | NDArray[np.float64]
+) -> dict[str, Any]:
     """The substrate's n, k at given wavelengths from a psi/Delta dataset (all angles).
 
     :func:`labbrdf.nk.nk_at` on :func:`labbrdf.nk.combined_table`: the two-phase inversion
@@ -704,7 +706,12 @@ def predict_brdf(
     albedo_se = np.array([r.albedo_stderr() for r in runs])
     seconds = float(sum(r.seconds for r in runs))
     results = runs
-    geo = {"theta_i_deg": ti, "azimuth_deg": az, "radial_deg": rad, "symmetry": t.symmetry}
+    geo: dict[str, Any] = {
+        "theta_i_deg": ti,
+        "azimuth_deg": az,
+        "radial_deg": rad,
+        "symmetry": t.symmetry,
+    }
     gm = grid_integral(meas[None, None], **geo)
     gp = grid_integral(pred[None, None], **geo)
     lobe = max(MIN_LOBE_DEG, 2.0 * math.degrees(math.atan(alpha)))
