@@ -40,6 +40,7 @@ __all__ = [
     "group_of",
     "pair_samples",
     "sample_file",
+    "split_same_sample",
     "stated_names",
 ]
 
@@ -78,7 +79,7 @@ class SampleGroup:
         The files, in input order.
     reason : str
         Why these files are one sample (``"sample name 'Ta2O5-1' in a.dat and b.dat"``,
-        ``"given with --same-sample a.dat,b.di"``), or, for a file on its own, why it was
+        ``"given with --same-sample (a.dat and b.di)"``), or, for a file on its own, why it was
         not paired with any other.
     """
 
@@ -302,7 +303,7 @@ def pair_samples(
                 f"{gs[1] + 1} ({_names(uniq[i].path for i in b)}) are one sample by the "
                 f"sample names the files state ({evidence}): give them as one group"
             )
-        reasons = [f"{given_as} {','.join(str(uniq[i].path) for i in given[g])}" for g in gs]
+        reasons = [f"{given_as} ({_names(uniq[i].path for i in given[g])})" for g in gs]
         reasons += [
             f"sample name {n!r} in {_names(uniq[i].path for i in holders[n])}" for n in shared
         ]
@@ -343,3 +344,40 @@ def group_of(groups: Sequence[SampleGroup], path: str | os.PathLike[str]) -> Sam
         if any(_key(p) == k for p in g.paths):
             return g
     raise KeyError(f"{os.fspath(path)} is in no sample group")
+
+
+def split_same_sample(
+    text: str, inputs: Sequence[str | os.PathLike[str]]
+) -> list[str | os.PathLike[str]]:
+    """The files of one ``--same-sample`` value: comma-separated, commas in names allowed.
+
+    File names may hold commas (``F4-P3HT 1-10 0,5 mgml.Probe.Raw.asc``), so the value
+    is split at the commas that make every piece one of ``inputs``; when no split does,
+    at every comma (and :func:`pair_samples` then names the piece that is no input).
+
+    Parameters
+    ----------
+    text : str
+        The option's value, e.g. ``"a.dat,b.di"``.
+    inputs : sequence of path-like
+        The command's input files.
+
+    Returns
+    -------
+    list
+        The paths, as the inputs spell them where they match one.
+    """
+    known = {_key(p): p for p in inputs}
+    parts = text.split(",")
+    n = len(parts)
+    # best[i]: the matched pieces of parts[:i], or None when parts[:i] cannot be split
+    best: list[list[str | os.PathLike[str]] | None] = [[]] + [None] * n
+    for end in range(1, n + 1):
+        for start in range(end - 1, -1, -1):
+            prev = best[start]
+            piece = ",".join(parts[start:end])
+            if prev is not None and piece and _key(piece) in known:
+                best[end] = [*prev, known[_key(piece)]]
+                break
+    found = best[n]
+    return found if found is not None else [p for p in parts if p]

@@ -15,6 +15,7 @@ from labbrdf.samples import (
     group_of,
     pair_samples,
     sample_file,
+    split_same_sample,
     stated_names,
 )
 
@@ -76,7 +77,7 @@ def test_given_mapping_pairs_files_without_names(files):
         given_as="given with --same-sample",
     )
     assert groups[0].paths == (files["a.dat"], files["c.di"])
-    assert groups[0].reason == f"given with --same-sample {files['c.di']},{files['a.dat']}"
+    assert groups[0].reason == "given with --same-sample (c.di and a.dat)"
     assert groups[0].name == "a.dat + c.di"
     assert groups[1].paths == (files["e.txt"],)
 
@@ -203,3 +204,20 @@ def test_real_exports_state_their_names_or_not(real_exports):
     groups = pair_samples([f_wv, f_bsdf, f_di], [[di, wv]])
     assert groups[0].paths == (wv, di)
     assert groups[0].name == stated_names(f_wv)[0]
+
+
+def test_split_same_sample_keeps_commas_inside_file_names(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    odd = "F4 1-10 0,5 mgml.asc"
+    inputs = [odd, "b.di", "c,d.dat"]
+    assert split_same_sample(f"{odd},b.di", inputs) == [odd, "b.di"]
+    assert split_same_sample(f"b.di,{odd},c,d.dat", inputs) == ["b.di", odd, "c,d.dat"]
+    assert split_same_sample("./b.di,c,d.dat", inputs) == ["b.di", "c,d.dat"]
+
+
+def test_split_same_sample_falls_back_to_every_comma(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    parts = split_same_sample("b.di,nope.dat,", ["b.di"])
+    assert parts == ["b.di", "nope.dat"]
+    with pytest.raises(PairingError, match="nope.dat is not among the input files"):
+        pair_samples(["b.di"], [parts])
