@@ -602,7 +602,8 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
     ----------
     panels : sequence of mappings
         ``{"label": str, "theta_r": array [deg], "phi_r": array [deg], "measured": array
-        [sr^-1], "model": array [sr^-1], "residual": array [1]}``.
+        [sr^-1], "model": array [sr^-1], "residual": array [1]}``; optional
+        ``"model_label"`` (default "model (per-incidence fit)", e.g. a prediction's).
     title : str
 
     Returns
@@ -624,7 +625,8 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
         vmin = float(np.percentile(pos, 1)) if pos.size else 1e-3
         vmax = float(np.max(pos)) if pos.size else 1.0
         norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 10))
-        for j, (z, name) in enumerate(((meas, "measured"), (mod, "model (per-incidence fit)"))):
+        mod_name = str(p.get("model_label", "model (per-incidence fit)"))
+        for j, (z, name) in enumerate(((meas, "measured"), (mod, mod_name))):
             zz = np.where(z > 0, np.clip(z, vmin, None), np.nan)
             tri, zt = _tri(p, zz)
             ax = axes[i, j]
