@@ -109,7 +109,7 @@ def prediction_section(ctx: Context) -> None:
     b = ctx.b
     ready, lacking = sample_inputs(ctx)
     if not ready:
-        why = "; ".join(f"{r['sample']}: no {r['missing']}" for r in lacking) or "no samples"
+        why = "; ".join(f"{r['sample']} lacks {r['missing']}" for r in lacking) or "no samples"
         raise Unavailable(
             "needs an areal height map, a psi/Delta file and a .bsdf BRDF of ONE sample "
             f"(paired by the sample names in the files or --same-sample); {why}"
@@ -206,7 +206,10 @@ def _dop_part(ctx: Context, sid: str, c: DopComparison) -> None:
         "al. 2022, Fig. 6). Line: from the ellipsometer's psi, DOP = |cos 2psi| (times "
         "1 - depolarization where the file has a depolarization channel at that angle: a "
         "partial depolarizer mixed in), band +-1 sigma from sigma(psi). Points: the tracer's "
-        "DOP in the bin holding the specular direction, with the batch standard error.",
+        "DOP in the bin holding the specular direction, with the batch standard error. For "
+        "a bare substrate in single scattering the specular facets are the mean plane, so the "
+        "tracer gives |cos 2psi| of the same n, k: a difference is the ellipsometer's "
+        "depolarization or the bin average, not the n, k.",
         figures.panels_figure(panels, ncols=min(4, len(panels)), panel_size=(4.0, 3.0)),
     )
     rows = t.to_dict("records")
