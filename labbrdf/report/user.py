@@ -5,7 +5,8 @@ measured quantity per file, optical constants from psi/Delta with the Fresnel re
 compared with measured reflectance, the fits (per sample and
 wavelength, with uncertainties, intervals, flags and RMSE), measured points with the model
 curves and residuals, parameter spectra, energy and reciprocity of every fit, and the sample
-colour when spectrophotometer reflectance is among the files.
+colour when spectrophotometer reflectance is among the files, and, for a sample with a
+height map, psi/Delta and a measured ``.bsdf``, the tracer's prediction beside the BRDF.
 """
 
 from __future__ import annotations
