@@ -246,3 +246,30 @@ def test_unreadable_bsdf_names_the_file(sample_set: dict, tmp_path) -> None:
     p.write_text("Source Measured\nSymmetry Nonsense\n")
     with pytest.raises(AdapterError, match=r"bad\.bsdf"):
         predict_brdf(p, _data(sample_set["psi_delta"]), 0.1)
+
+
+# --------------------------------------------------------------------------- real exports
+
+
+@pytest.mark.shared
+@pytest.mark.parametrize(
+    ("rel", "matched"),
+    [
+        ("woollam-wvase-ascii/wafer_2_01242007.dat", 2028),  # dpolE at every psi point
+        ("woollam-wvase-ascii/wvase_example.dat", 0),  # dpolE at 55-58 deg, psi at 65-75
+        ("filmsense-txt/Filmsense_staticTest.txt", 8),  # 1 - P per wavelength
+    ],
+)
+def test_real_depolarization_is_matched_by_file_wavelength_and_angle(
+    real_exports, rel: str, matched: int
+) -> None:
+    path = real_exports / rel
+    if not path.is_file():
+        pytest.skip(f"{path} absent")
+    df = read(path).data
+    e = ellipsometer_dop(df)
+    assert int(e["depolarization"].notna().sum()) == matched
+    d = np.clip(np.nan_to_num(e["depolarization"].to_numpy(), nan=0.0), 0.0, 1.0)
+    want = (1 - d) * np.abs(np.cos(2 * np.radians(e["psi_deg"].to_numpy())))
+    assert e["dop"].to_numpy() == pytest.approx(want, abs=1e-12)
+    assert ((e["dop"] >= 0) & (e["dop"] <= 1)).all()

@@ -603,7 +603,8 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
     panels : sequence of mappings
         ``{"label": str, "theta_r": array [deg], "phi_r": array [deg], "measured": array
         [sr^-1], "model": array [sr^-1], "residual": array [1]}``; optional
-        ``"model_label"`` (default "model (per-incidence fit)", e.g. a prediction's).
+        ``"model_label"`` (default "model (per-incidence fit)") and ``"residual_label"``
+        (default "(model - measured) / measured"), e.g. for a prediction.
     title : str
 
     Returns
@@ -642,7 +643,8 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
         ax = axes[i, 2]
         mesh = ax.tripcolor(tri, facecolors=zt, cmap="RdBu_r", vmin=-1.0, vmax=1.0)
         _disc(ax, half)
-        ax.set_title(f"{_text(p['label'])}: (model - measured) / measured", fontsize=8)
+        rname = str(p.get("residual_label", "(model - measured) / measured"))
+        ax.set_title(f"{_text(p['label'])}: {rname}", fontsize=8)
         cb = fig.colorbar(mesh, ax=ax, shrink=0.6 if half else 0.8)
         cb.set_label("relative residual [1]", fontsize=7)
         cb.ax.tick_params(which="both", labelsize=6)

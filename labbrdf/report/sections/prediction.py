@@ -205,7 +205,8 @@ def _dop_part(ctx: Context, sid: str, c: DopComparison) -> None:
         "Degree of polarization of the specular reflection for unpolarized light (Dong et "
         "al. 2022, Fig. 6). Line: from the ellipsometer's psi, DOP = |cos 2psi| (times "
         "1 - depolarization where the file has a depolarization channel at that angle: a "
-        "partial depolarizer mixed in), band +-1 sigma from sigma(psi). Points: the tracer's "
+        "partial depolarizer mixed in; a negative depolarization, noise about 0, counts as "
+        "0), band +-1 sigma from sigma(psi). Points: the tracer's "
         "DOP in the bin holding the specular direction, with the batch standard error. For "
         "a bare substrate in single scattering the specular facets are the mean plane, so the "
         "tracer gives |cos 2psi| of the same n, k: a difference is the ellipsometer's "
@@ -292,6 +293,7 @@ def _maps(ctx: Context, sid: str, p: BrdfPrediction) -> None:
                 "measured": meas,
                 "model": pred,
                 "model_label": "tracer prediction (no fit)",
+                "residual_label": "(prediction - measured) / measured",
                 "residual": res,
             }
         )
