@@ -273,3 +273,19 @@ def test_real_depolarization_is_matched_by_file_wavelength_and_angle(
     want = (1 - d) * np.abs(np.cos(2 * np.radians(e["psi_deg"].to_numpy())))
     assert e["dop"].to_numpy() == pytest.approx(want, abs=1e-12)
     assert ((e["dop"] >= 0) & (e["dop"] <= 1)).all()
+
+
+def test_several_rotations_are_refused(sample_set: dict, tmp_path) -> None:
+    from labbrdf.bsdf_export import write_bsdf
+
+    p = write_bsdf(
+        tmp_path / "rot.bsdf",
+        theta_i_deg=[45.0],
+        radial_deg=[0.0, 10.0],
+        azimuth_deg=[0.0, 180.0],
+        values=np.ones((2, 1, 1, 2, 2)),
+        rotation_deg=[0.0, 90.0],
+        symmetry="PlaneSymmetrical",
+    )
+    with pytest.raises(PredictionError, match=r"rot\.bsdf: 2 rotation\(s\) x 1 channel"):
+        predict_brdf(p, _data(sample_set["psi_delta"]), 0.1, wavelength_nm=600.0)
