@@ -33,10 +33,13 @@ the same first-order grid rule (:func:`labbrdf.integrate.grid_integral`) on the 
 grid, so their TIS compare like with like; the tracer's own hemispherical albedo is given
 beside it (it includes the directions the file's grid does not cover).
 
-"Consistent within the Monte Carlo error" means ``|f_pred - f_meas| <= 3 SE + 1e-5 |f_meas|``
-at every point, SE the estimator's batch error and ``1e-5`` the rounding of a six-digit file:
-the measurement's own error is unknown (``.bsdf`` files carry none), so a real measurement
-is judged by the size of the ratio, not by this test.
+"Consistent within the Monte Carlo error" means, per point (:attr:`BrdfPrediction.consistent`),
+``|f_pred - f_meas| <= 3 SE + 1e-5 |f_meas|``, and per region (the specular lobe, the rest;
+:meth:`BrdfPrediction.regions`, which the verdict uses) ``|ratio - 1| <= 3 SE + 1e-5`` for the
+ratio of the region's grid integrals, SE from the batch spread of the integral itself (the
+points' errors are correlated). ``1e-5`` is the rounding of a six-digit file. The
+measurement's own error is unknown (``.bsdf`` files carry none), so a real measurement is
+judged by the size of the ratio, not by this test.
 """
 
 from __future__ import annotations
@@ -635,6 +638,27 @@ def _regions(
     return pd.DataFrame(rows), tis_se
 
 
+def _checked_table(
+    bsdf: Any, wavelength_nm: float | None
+) -> tuple[zemax_bsdf.BsdfTable, str, float]:
+    """The ``.bsdf`` table, its name and wavelength [nm], refused if it cannot be predicted."""
+    t, path = _read_table(bsdf)
+    if t.scatter_type != "BRDF":
+        raise PredictionError(f"{path}: {t.scatter_type} data; the tracer predicts a BRDF")
+    if t.values.shape[0] != 1 or t.values.shape[1] != 1:
+        raise PredictionError(
+            f"{path}: {t.values.shape[0]} rotation(s) x {t.values.shape[1]} channel(s) "
+            f"({t.spectral}); a prediction at one wavelength needs one rotation, Monochrome"
+        )
+    wl = wavelength_nm if wavelength_nm is not None else t.wavelength_nm
+    if wl is None:
+        raise PredictionError(
+            f"{path}: the file states no wavelength (no '#labbrdf wavelength_nm' or "
+            "'#Wavelength (nm) =' comment); give the wavelength of the measurement"
+        )
+    return t, path, float(wl)
+
+
 def predict_brdf(
     bsdf: str | os.PathLike[str] | zemax_bsdf.BsdfTable,
     data: pd.DataFrame,
@@ -680,20 +704,7 @@ def predict_brdf(
     labbrdf.adapters.AdapterError
         A file that is not a readable ``.bsdf``.
     """
-    t, path = _read_table(bsdf)
-    if t.scatter_type != "BRDF":
-        raise PredictionError(f"{path}: {t.scatter_type} data; the tracer predicts a BRDF")
-    if t.values.shape[0] != 1 or t.values.shape[1] != 1:
-        raise PredictionError(
-            f"{path}: {t.values.shape[0]} rotation(s) x {t.values.shape[1]} channel(s) "
-            f"({t.spectral}); a prediction at one wavelength needs one rotation, Monochrome"
-        )
-    wl = wavelength_nm if wavelength_nm is not None else t.wavelength_nm
-    if wl is None:
-        raise PredictionError(
-            f"{path}: the file states no wavelength (no '#labbrdf wavelength_nm' or "
-            "'#Wavelength (nm) =' comment); give the wavelength of the measurement"
-        )
+    t, path, wl = _checked_table(bsdf, wavelength_nm)
     nk = substrate_nk(data, [float(wl)])
     if isinstance(roughness, SlopeFit):
         alpha, alpha_u = float(roughness.alpha), float(roughness.alpha_u)
