@@ -103,6 +103,33 @@ def test_depolarizing_ellipsometer_is_flagged_against_the_tracer(sample_set: dic
     assert (c.table["z"] > 5).all()  # the tracer (no depolarization) sits far above
 
 
+def test_coated_specular_dop_errors_are_honest_between_seeds(sample_set: dict) -> None:
+    # with a varnish over the metal the subsurface walk has Monte Carlo noise: two seeds
+    # must agree within their combined batch errors, and the coating's own reflection
+    # (near Brewster's angle of n = 1.5 at 55 deg) lifts the DOP far above the bare metal's
+    coat = Coating(n=1.5, k=0.0, thickness_nm=300.0, alpha=sample_set["fit"].alpha)
+    df = _data(sample_set["psi_delta"])
+    runs = [
+        specular_dop_comparison(
+            df,
+            sample_set["fit"].alpha,
+            wavelengths_nm=[600.0],
+            coating=coat,
+            rays=16_384,
+            seed=seed,
+            step_deg=2.0,
+        ).table
+        for seed in (0, 1)
+    ]
+    a, b = runs
+    assert (a["dop_tracer_stderr"] > 0).all()
+    z = (a["dop_tracer"] - b["dop_tracer"]) / np.hypot(
+        a["dop_tracer_stderr"], b["dop_tracer_stderr"]
+    )
+    assert np.abs(z).max() < 4
+    assert (a["z"] > 10).all()  # the bare-metal ellipsometer DOP is not the coated sample's
+
+
 # --------------------------------------------------------------------------- BRDF
 
 
