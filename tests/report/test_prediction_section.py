@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -141,3 +142,26 @@ def test_a_stack_psi_delta_gets_notes_not_a_traceback(two_samples: dict, tmp_pat
     res = _run(files, [files])
     notes = [it for it in _section(res)["items"] if it["kind"] == "note"]
     assert len(notes) == 2 and all("stack" in n["text"] for n in notes)
+
+
+def test_extra_files_of_a_sample_are_named_as_not_used(two_samples: dict) -> None:
+    a, b = two_samples["a"], two_samples["b"]
+    files = [a[0], a[1], b[1], a[2]]
+    res = _run(files, [files])
+    assert any(
+        "Not used (the first height map and psi/Delta file are): b_psi.dat" in t
+        for t in _texts(res)
+    )
+    checks = [c for c in res["checks"] if c["id"].startswith("prediction.brdf.")]
+    assert [c["status"] for c in checks] == ["pass"]  # predicted from a_psi.dat, the first
+
+
+def test_two_inputs_of_one_name_are_not_told_apart(two_samples: dict, tmp_path: Path) -> None:
+    a = two_samples["a"]
+    other = tmp_path / "x"
+    other.mkdir()
+    twin = Path(shutil.copy(two_samples["b"][1], other / a[1].name))  # same name, other index
+    files = [a[0], a[1], twin, a[2]]
+    res = _run(files, [files])
+    assert _section(res)["status"] != "ok"
+    assert "lacks a psi/Delta file" in json.dumps(_section(res))

@@ -42,11 +42,13 @@ DOP_Z_MAX = 3.0
 
 
 def _frame_of(ctx: Context, path: Path) -> pd.DataFrame | None:
-    """The ingested rows of one file (by its ``source`` name), or None."""
-    for f in ctx.frames:
-        if len(f) and set(f["source"].astype(str)) == {path.name}:
-            return f
-    return None
+    """The ingested rows of one file (by its ``source`` name); None if none or ambiguous.
+
+    Two inputs of the same name in different folders cannot be told apart by their rows'
+    ``source``, so neither is used rather than the wrong one.
+    """
+    found = [f for f in ctx.frames if len(f) and set(f["source"].astype(str)) == {path.name}]
+    return found[0] if len(found) == 1 else None
 
 
 def sample_inputs(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
@@ -99,6 +101,7 @@ def sample_inputs(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, An
                 "height_map": hms[0],
                 "psi_delta": psi[0],
                 "bsdf": bs,
+                "unused": [Path(h.path).name for h in hms[1:]] + [p.name for p, _ in psi[1:]],
             }
         )
     return ready, lacking
@@ -151,6 +154,11 @@ def _one_sample(ctx: Context, s: dict[str, Any]) -> None:
         f"Files: {Path(hm.path).name} (height map), {psi_path.name} (psi/Delta), "
         f"{', '.join(p.name for p in s['bsdf'])} (measured BRDF); {s['reason']}. GGX alpha "
         f"from the height map: {fit.alpha:.4g} +- {fit.alpha_u:.2g}."
+        + (
+            f" Not used (the first height map and psi/Delta file are): {', '.join(s['unused'])}."
+            if s["unused"]
+            else ""
+        )
     )
     try:
         dop = specular_dop_comparison(frame, fit.alpha, seed=ctx.seed, map=_map(ctx))
