@@ -1236,6 +1236,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
 def cmd_report(args: argparse.Namespace) -> int:
     from .report import user_report
     from .report.sections.film import default_film_model
+    from .samples import split_same_sample
 
     executor = _executor(args, progress=not args.quiet)
     options, start = _split_params(args.model, args.param)
@@ -1251,6 +1252,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             progress=not args.quiet,
             film_model=default_film_model() if args.film_default else args.film_model,
             executor=executor,
+            same_sample=[split_same_sample(v, args.files) for v in args.same_sample or ()],
         )
     )
 
@@ -1685,6 +1687,13 @@ def _report_parser(sub: Any) -> None:
         "--film-default",
         action="store_true",
         help="... or the stated default: one transparent Cauchy layer on c-Si, thickness free",
+    )
+    s.add_argument(
+        "--same-sample",
+        action="append",
+        metavar="FILE,FILE[,...]",
+        help="these input files are one sample (repeatable; files stating one sample name "
+        "are paired anyway)",
     )
     s.add_argument("--quiet", action="store_true", help="no progress lines")
     _add_selection(s)

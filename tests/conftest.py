@@ -99,3 +99,38 @@ def oracles(shared_dir: Path) -> Path:
     if not d.is_dir():
         pytest.skip(f"{d} absent")
     return d
+
+
+@pytest.fixture(scope="session")
+def prediction_sets():
+    """The writers of consistent synthetic one-sample files (``tests/prediction_sets.py``)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "prediction_sets", Path(__file__).with_name("prediction_sets.py")
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="session")
+def sample_set(prediction_sets, tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """One sample's height map, psi/Delta (true and wrong index) and measured ``.bsdf``."""
+    pytest.importorskip("SurfaceTopography")
+    from labbrdf.adapters.topography import read_height_map
+    from labbrdf.prediction import roughness_alpha
+
+    ps = prediction_sets
+    d = tmp_path_factory.mktemp("sample_a")
+    hm = ps.write_height_map(d / "sample_a_heights.nc")
+    fit = roughness_alpha(read_height_map(hm))
+    return {
+        "dir": d,
+        "height_map": hm,
+        "fit": fit,
+        "psi_delta": ps.write_wvase(d / "sample_a_psi.dat", ps.TRUE_NK),
+        "psi_delta_wrong": ps.write_wvase(d / "sample_b_psi.dat", ps.WRONG_NK, "SYNTHETIC B"),
+        "bsdf": ps.write_bsdf(d / "sample_a.bsdf", ps.brdf_config(fit.alpha)),
+    }

@@ -24,6 +24,7 @@ from .._plotting import curve_grid
 from ..adapters.topography import HeightMap
 from ..fitting import METHOD, FitError, FitResult, fit_many
 from ..parallel import Executor
+from ..samples import SampleGroup
 from ..tracer import TraceResult
 from .builder import Builder, Unavailable, num
 
@@ -102,6 +103,8 @@ class Context:
     #: user report: the height maps and profiles :func:`labbrdf.adapters.read_inputs` read
     #: among the inputs (section ``surface``)
     height_maps: list[HeightMap] = field(default_factory=list)
+    #: user report: the input files grouped by sample (:func:`labbrdf.samples.pair_samples`)
+    samples: list[SampleGroup] = field(default_factory=list)
 
     @property
     def data(self) -> pd.DataFrame | None:

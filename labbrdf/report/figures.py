@@ -565,7 +565,9 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
     ----------
     panels : sequence of mappings
         ``{"label": str, "theta_r": array [deg], "phi_r": array [deg], "measured": array
-        [sr^-1], "model": array [sr^-1], "residual": array [1]}``.
+        [sr^-1], "model": array [sr^-1], "residual": array [1]}``; optional
+        ``"model_label"`` (default "model (per-incidence fit)") and ``"residual_label"``
+        (default "(model - measured) / measured"), e.g. for a prediction.
     title : str
 
     Returns
@@ -587,7 +589,8 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
         vmin = float(np.percentile(pos, 1)) if pos.size else 1e-3
         vmax = float(np.max(pos)) if pos.size else 1.0
         norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 10))
-        for j, (z, name) in enumerate(((meas, "measured"), (mod, "model (per-incidence fit)"))):
+        mod_name = str(p.get("model_label", "model (per-incidence fit)"))
+        for j, (z, name) in enumerate(((meas, "measured"), (mod, mod_name))):
             zz = np.where(z > 0, np.clip(z, vmin, None), np.nan)
             tri, zt = _tri(p, zz)
             ax = axes[i, j]
@@ -603,7 +606,8 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
         ax = axes[i, 2]
         mesh = ax.tripcolor(tri, facecolors=zt, cmap="RdBu_r", vmin=-1.0, vmax=1.0)
         _disc(ax, half)
-        ax.set_title(f"{_text(p['label'])}: (model - measured) / measured", fontsize=8)
+        rname = str(p.get("residual_label", "(model - measured) / measured"))
+        ax.set_title(f"{_text(p['label'])}: {rname}", fontsize=8)
         cb = fig.colorbar(mesh, ax=ax, shrink=0.6 if half else 0.8)
         cb.set_label("relative residual [1]", fontsize=7)
         cb.ax.tick_params(which="both", labelsize=6)

@@ -13,7 +13,7 @@ from ..builder import Unavailable
 from ..context import Context
 from ..published import read_published
 
-__all__ = ["fixture_files", "fixtures_section", "ingest_files", "ingest_read"]
+__all__ = ["fixture_files", "fixtures_section", "ingest_files", "ingest_read", "sample_groups"]
 
 
 def fixture_files(folder: Path) -> list[Path]:
@@ -141,7 +141,7 @@ def ingest_read(
             "header": _meta_header(m.meta),
             "error": "",
         }
-        ctx.files.append({**rec, "path": str(p), "meta": m.meta})
+        ctx.files.append({**rec, "path": str(p), "meta": m.meta, "samples": s["sample"]})
         rows.append(rec)
     b.table(
         "ingested_files",
@@ -178,6 +178,62 @@ def ingest_read(
     )
     if not ctx.frames:
         raise Unavailable("no file could be read")
+
+
+def sample_groups(
+    ctx: Context,
+    paths: Sequence[str | os.PathLike[str]],
+    same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
+    given_as: str = "given with --same-sample",
+) -> None:
+    """Group the input files by sample (``ctx.samples``) and show the groups with reasons.
+
+    The names are those the readers found (``ctx.files``; height maps carry none), the
+    mapping is the user's (:func:`labbrdf.samples.pair_samples`). A mapping that the files'
+    own sample names contradict fails the check ``ingest.samples`` and pairs nothing.
+    """
+    from ...samples import PairingError, pair_samples, sample_file
+
+    names = {str(f["path"]): tuple(f.get("samples", ())) for f in ctx.files}
+    maps = {str(hm.path): sample_file(hm.path, hm).names for hm in ctx.height_maps}
+    files = [(p, names.get(str(p), maps.get(str(p), ()))) for p in paths]
+    try:
+        groups = pair_samples(files, same_sample, given_as=given_as)
+    except PairingError as exc:
+        ctx.b.check(
+            "ingest.samples",
+            "the files' sample names agree with the given sample mapping",
+            False,
+            against="the sample names stated in the files",
+            reason=str(exc),
+            substantive=False,
+        )
+        return
+    ctx.samples[:] = groups
+    rows = [
+        {
+            "sample": g.name,
+            "files": ", ".join(Path(p).name for p in g.paths),
+            "n": len(g.paths),
+            "reason": g.reason,
+        }
+        for g in groups
+    ]
+    ctx.b.table(
+        "sample_groups",
+        "Files grouped by sample",
+        [
+            ("sample", "sample", ""),
+            ("files", "files", ""),
+            ("n", "files [n]", "d"),
+            ("reason", "why these files are one sample", ""),
+        ],
+        rows,
+        caption="Files are one sample when they state the same sample name (a name that is "
+        "only the file's own name does not count) or when the user says so (--same-sample); "
+        "never because their wavelengths overlap. Predictions made from one file (e.g. a "
+        "height map's roughness) are set against measurements of the same sample only.",
+    )
 
 
 # --------------------------------------------------------------------------- fits
