@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import Any
 
 from .. import __version__, models
-from ..adapters import read_inputs
 from ..films import FilmModel
 from ..fitting import METHOD
 from ..parallel import Executor, as_executor
@@ -30,14 +29,14 @@ from .sections.brdf import brdf_section
 from .sections.colour import colour_section
 from .sections.film import film_model_of, film_section
 from .sections.fits import fits_section
-from .sections.ingest import ingest_read, sample_groups
+from .sections.ingest import ingest_inputs, sample_groups
 from .sections.measured import measured_section
 from .sections.nk import nk_section
 from .sections.physics import physics_section
 from .sections.prediction import prediction_section
 from .sections.scans import scans_section
 from .sections.spectra import spectra_section
-from .sections.surface import ingest_height_maps, surface_section
+from .sections.surface import surface_section
 
 __all__ = ["user_report"]
 
@@ -229,13 +228,7 @@ def _ingest(
         "optical export into the common dataset, a topography file (height map or profile) "
         "with SurfaceTopography."
     )
-    inputs = read_inputs(paths)
-    ingest_height_maps(ctx, inputs.files)
-    optical = [f for f in inputs.files if f.kind == "optical"]
-    if optical:
-        ingest_read(ctx, optical)
-    elif not ctx.height_maps:
-        raise Unavailable("no file could be read")
+    ingest_inputs(ctx, paths)
     sample_groups(ctx, paths, same_sample)
     if selection:
         from ..selection import SelectionError, select

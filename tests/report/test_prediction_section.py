@@ -10,9 +10,8 @@ import pytest
 
 from labbrdf.report.builder import Builder, Unavailable
 from labbrdf.report.context import Context
-from labbrdf.report.sections.ingest import ingest_files, sample_groups
+from labbrdf.report.sections.ingest import ingest_inputs, sample_groups
 from labbrdf.report.sections.prediction import prediction_section
-from labbrdf.report.sections.surface import ingest_height_maps
 
 pytest.importorskip("SurfaceTopography")
 
@@ -22,7 +21,7 @@ def _run(paths: list[Path], same_sample: list[list[Path]]) -> dict:
     b = Builder("t", progress=False)
     ctx = Context(b)
     with b.section("ingest", "Ingested files"):
-        ingest_files(ctx, ingest_height_maps(ctx, paths))
+        ingest_inputs(ctx, paths)
         sample_groups(ctx, paths, same_sample)
     with b.section("prediction", "Predict, then measure"):
         prediction_section(ctx)
@@ -97,7 +96,7 @@ def test_files_not_paired_are_not_predicted(sample_set: dict) -> None:
         b = Builder("t", progress=False)
         ctx = Context(b)
         with b.section("ingest", "x"):
-            ingest_files(ctx, ingest_height_maps(ctx, paths))
+            ingest_inputs(ctx, paths)
             sample_groups(ctx, paths, [])
         prediction_section(ctx)
 

@@ -13,7 +13,7 @@ from labbrdf.adapters import inputs as inputs_mod
 from labbrdf.adapters import topography
 from labbrdf.report.builder import Builder
 from labbrdf.report.context import Context
-from labbrdf.report.user import _ingest
+from labbrdf.report.sections.ingest import ingest_inputs
 from labbrdf.surface import gaussian_surface
 
 
@@ -51,7 +51,7 @@ def _ingested(paths: list[Path]) -> tuple[Context, dict]:
     b = Builder("t")
     ctx = Context(b)
     with b.section("ingest", "Ingested files"):
-        _ingest(ctx, paths, None)
+        ingest_inputs(ctx, paths)
     return ctx, b.results
 
 

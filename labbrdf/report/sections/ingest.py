@@ -13,7 +13,14 @@ from ..builder import Unavailable
 from ..context import Context
 from ..published import read_published
 
-__all__ = ["fixture_files", "fixtures_section", "ingest_files", "ingest_read", "sample_groups"]
+__all__ = [
+    "fixture_files",
+    "fixtures_section",
+    "ingest_files",
+    "ingest_inputs",
+    "ingest_read",
+    "sample_groups",
+]
 
 
 def fixture_files(folder: Path) -> list[Path]:
@@ -83,6 +90,29 @@ def ingest_files(
     if not paths:
         raise Unavailable("no input files")
     ingest_read(ctx, adapters.read_inputs(paths, kind="optical").files, root, check_id=check_id)
+
+
+def ingest_inputs(ctx: Context, paths: Sequence[str | os.PathLike[str]]) -> None:
+    """Read a user's files once (:func:`labbrdf.adapters.read_inputs`) and list them.
+
+    Height maps go to ``ctx.height_maps`` with their table and check
+    (:func:`~labbrdf.report.sections.surface.ingest_height_maps`), optical exports to
+    ``ctx.frames`` with theirs (:func:`ingest_read`).
+
+    Raises
+    ------
+    Unavailable
+        No file could be read.
+    """
+    from .surface import ingest_height_maps  # the section that shows the height maps
+
+    inputs = adapters.read_inputs(paths)
+    ingest_height_maps(ctx, inputs.files)
+    optical = [f for f in inputs.files if f.kind == "optical"]
+    if optical:
+        ingest_read(ctx, optical)
+    elif not ctx.height_maps:
+        raise Unavailable("no file could be read")
 
 
 def ingest_read(
