@@ -33,6 +33,7 @@ from .sections.measured import measured_section
 from .sections.nk import nk_section
 from .sections.physics import physics_section
 from .sections.scans import scans_section
+from .sections.smoothness import smoothness_section
 from .sections.spectra import spectra_section
 from .sections.surface import ingest_height_maps, surface_section
 
@@ -287,4 +288,9 @@ def _sections(
         ),
         ("colour", "Sample colour from spectrophotometer reflectance", colour_section),
         ("surface", "Measured surface topography", surface_section),
+        (
+            "smoothness",
+            "Roughness against wavelength: Rayleigh criterion and specular loss",
+            smoothness_section,
+        ),
     ]
