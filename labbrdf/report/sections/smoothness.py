@@ -40,8 +40,9 @@ __all__ = ["MAX_WAVELENGTHS", "rayleigh_flags", "smoothness_section"]
 #: most wavelengths per map in the table (evenly picked from the sample's)
 MAX_WAVELENGTHS = 8
 
-#: quantities compared: specular reflectance only (a sphere's total includes the scatter)
-REFLECTANCE = ("reflectance", "specular_intensity")
+#: quantities compared: absolute specular reflectance (not a sphere's total, which holds the
+#: scatter; not a scan's relative specular intensity)
+REFLECTANCE = ("reflectance",)
 
 
 @dataclass
@@ -289,14 +290,22 @@ def _sentence(rows: list[dict[str, Any]], m: MapRoughness, sample: str) -> str:
     ray = sorted({r["rayleigh"] for r in judged})
     fr = sorted({r["fraunhofer"] for r in judged})
     wl = [r["wavelength_nm"] for r in judged]
+    lo, hi = min(r["sigma_nm"] for r in judged), max(r["sigma_nm"] for r in judged)
+    sig = f"{lo:.3g}" if f"{lo:.3g}" == f"{hi:.3g}" else f"{lo:.3g}..{hi:.3g}"
     worst = min(r["loss"] for r in judged)
-    return (
-        f"Sample {sample}: with sigma = {min(r['sigma_nm'] for r in judged):.3g}.."
-        f"{max(r['sigma_nm'] for r in judged):.3g} nm from {m.name}, the surface is "
+    text = (
+        f"Sample {sample}: with sigma = {sig} nm from {m.name}, the surface is "
         f"{' / '.join(ray)} by the Rayleigh criterion and {' / '.join(fr)} by the "
         f"Fraunhofer criterion at {min(wl):.4g}-{max(wl):.4g} nm; the predicted specular "
         f"loss 1 - exp(-g) is at most {100 * (1 - worst):.3g} %."
     )
+    if any(r["coverage"] == "misses short periods" for r in judged):
+        text += (
+            f" The map does not resolve periods below {m.short_nm:.4g} nm (2 pixels), "
+            "so roughness between the shortest scattering period and that is missing "
+            "from sigma: g and the loss are lower bounds."
+        )
+    return text
 
 
 def _tis_rows(
@@ -379,7 +388,9 @@ def smoothness_section(ctx: Context) -> None:
                     r = _judge(m, float(w), t)
                     r.update(_nearest(c, float(w), t))
                     rows.append(r)
-            if rows:
+            if rows and not any("g" in r for r in rows):
+                b.text(_sentence(rows, m, group.name))
+            elif rows:
                 b.table(
                     f"smoothness_{sid}",
                     f"{group.name}: {m.name} against the wavelength",
@@ -389,9 +400,10 @@ def smoothness_section(ctx: Context) -> None:
                     "u = standard uncertainty; verdicts at sigma +- 2u. 'misses short "
                     "periods': the map's pixel is too coarse for the finest roughness that "
                     "scatters, sigma is a lower bound. Spectrophotometer rows without an "
-                    "angle are taken at normal incidence. The ratio needs bulk n, k of the "
-                    "same sample (an ellipsometer file, section nk); a film stack's "
-                    "prediction is not used here.",
+                    "angle are taken at normal incidence, and their reflectance as specular "
+                    "(with an integrating sphere it includes the scatter). The ratio needs "
+                    "bulk n, k of the same sample (an ellipsometer file, section nk); "
+                    "a film stack's prediction is not used here.",
                 )
                 b.text(_sentence(rows, m, group.name))
                 b.figure(
