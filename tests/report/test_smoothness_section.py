@@ -139,3 +139,40 @@ def test_rayleigh_flags_mark_rough_angles_of_the_fits_sample(tmp_path):
     assert rayleigh_flags(ctx, ["other.csv"], 400.0, [30.0]) == []
     smooth = _ctx(tmp_path, 5.0)
     assert rayleigh_flags(smooth, ["scan.csv"], 400.0, [30.0, 60.0]) == []
+
+
+def test_bsdf_tis_of_the_sample_is_set_against_bennett_porteus(tmp_path):
+    ctx = _ctx(tmp_path, 20.0)
+    bsdf = tmp_path / "v.bsdf"
+    ctx.frames.append(
+        make_frame(
+            sample="v",
+            instrument="zemax-bsdf",
+            source="v.bsdf",
+            quantity="brdf",
+            value=[0.1, 0.1],
+            unit="sr-1",
+            wavelength_nm=555.0,
+            theta_i_deg=[15.0, 45.0],
+            theta_r_deg=[15.0, 45.0],
+            phi_r_deg=180.0,
+        )
+    )
+    tis = [{"theta_i_deg": 15.0, "tis": 0.13}, {"theta_i_deg": 45.0, "tis": 0.11}]
+    ctx.files.append({"path": str(bsdf), "samples": ["v"], "meta": {"tis": tis}})
+    groups = pair_samples(
+        [(Path(ctx.height_maps[0].path), ()), (tmp_path / "refl.csv", "S"), (bsdf, "v")],
+        [[ctx.height_maps[0].path, bsdf, tmp_path / "refl.csv"]],
+    )
+    ctx.samples[:] = groups
+    res = _run(ctx)
+    rows = res["tables"]["smoothness_tis_S_map_di"]["rows"]
+    assert [(r["theta_i"], r["tis"]) for r in rows] == [(15.0, 0.13), (45.0, 0.11)]
+    smooth_rows = res["tables"]["smoothness_S_map_di"]["rows"]
+    sigma = smooth_rows[0]["sigma_nm"]  # band-limited at 400 nm; at 555 nm its own band
+    for r in rows:
+        g = r["tis_r0_small"]
+        assert g == pytest.approx(
+            (4 * math.pi * sigma * math.cos(math.radians(r["theta_i"])) / 555.0) ** 2, rel=0.05
+        )
+        assert r["tis_r0"] == pytest.approx(1 - math.exp(-g), rel=1e-12)
