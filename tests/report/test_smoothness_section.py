@@ -176,3 +176,24 @@ def test_bsdf_tis_of_the_sample_is_set_against_bennett_porteus(tmp_path):
             (4 * math.pi * sigma * math.cos(math.radians(r["theta_i"])) / 555.0) ** 2, rel=0.05
         )
         assert r["tis_r0"] == pytest.approx(1 - math.exp(-g), rel=1e-12)
+
+
+def test_smooth3_fit_rows_carry_the_rayleigh_flag_of_their_sample(tmp_path, fixtures_dir):
+    from labbrdf import read
+    from labbrdf.parallel import as_executor
+    from labbrdf.report.sections.fits import fits_section
+
+    # sigma 70 +- 2 x 6.5 nm; at 360 nm the thresholds are 52, 64, 90 nm at 30, 45, 60 deg
+    ctx = _ctx(tmp_path, 70.0)
+    scans = read(fixtures_dir / "specular" / "osr_specular.csv").data
+    scans = scans[scans["wavelength_nm"] == 360.0].assign(source="scan.csv", sample="S")
+    ctx.frames[1] = scans.reset_index(drop=True)
+    ctx.executor = as_executor("serial")
+    with ctx.b.section("fits", "t"):
+        fits_section(ctx, [("smooth3", {})])
+    rows = ctx.b.results["tables"]["fit_smooth3"]["rows"]
+    assert len(rows) == 1
+    flags = rows[0]["flags"]
+    assert "Rayleigh (map.di): rough at 30 deg" in flags
+    assert "Rayleigh (map.di): undecided at 45 deg" in flags
+    assert "at 60 deg" not in flags
