@@ -214,8 +214,7 @@ def _nearest(c: pd.DataFrame | None, wl: float, theta: float) -> dict[str, Any]:
     return {"ratio": float(r["ratio"]), "u_ratio": float(r["u_ratio"]), "nk_file": r["nk_file"]}
 
 
-_COLUMNS = [
-    ("map", "height map", ""),
+_COLUMNS = [  # the map is the table's title (and the rows' "map" key in results.json)
     ("wavelength_nm", "\u03bb [nm]", ".5g"),
     ("theta_i", "\u03b8i [deg]", ".3g"),
     ("shortest_nm", "shortest scattering period [nm]", ".4g"),
