@@ -197,3 +197,28 @@ def test_smooth3_fit_rows_carry_the_rayleigh_flag_of_their_sample(tmp_path, fixt
     assert "Rayleigh (map.di): rough at 30 deg" in flags
     assert "Rayleigh (map.di): undecided at 45 deg" in flags
     assert "at 60 deg" not in flags
+
+
+def test_ratio_falls_back_to_a_fitted_film_stack_of_the_sample(tmp_path):
+    class Stack:  # stands for a FilmFit: its compare_reflectance, as the film section's
+        def compare_reflectance(self, rows: pd.DataFrame) -> pd.DataFrame:
+            return pd.DataFrame(
+                {
+                    "wavelength_nm": rows["wavelength_nm"].to_numpy(float),
+                    "theta_i_deg": 0.0,
+                    "measured": rows["value"].to_numpy(float),
+                    "measured_sigma": np.nan,
+                    "predicted": rows["value"].to_numpy(float) / 0.9,
+                    "predicted_sigma": 0.0,
+                }
+            )
+
+    ctx = _ctx(tmp_path, 20.0)
+    ctx.film_fits["ell.dat"] = Stack()
+    rows = _run(ctx)["tables"]["smoothness_S_map_di"]["rows"]
+    assert [r["ratio"] for r in rows] == pytest.approx([0.9] * 4, rel=1e-12)
+    assert {r["nk_file"] for r in rows} == {"ell.dat (film stack)"}
+    ctx = _ctx(tmp_path, 20.0, nk=True)
+    ctx.film_fits["ell.dat"] = Stack()  # bulk n, k first where both exist
+    rows = _run(ctx)["tables"]["smoothness_S_map_di"]["rows"]
+    assert {r["nk_file"] for r in rows} == {"ell.dat (bulk n, k)"}

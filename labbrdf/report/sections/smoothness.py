@@ -5,7 +5,8 @@ Shown when a height map and reflectance data of one sample are given (files pair
 such map and each (wavelength, angle of incidence) of the sample's reflectance: the
 Rayleigh parameter g, the Rayleigh and Fraunhofer verdicts with sigma's uncertainty, the
 Davies specular loss exp(-g), and, where an ellipsometer file of the same sample gives bulk
-n, k (section ``nk``), the measured specular reflectance divided by the Fresnel prediction;
+n, k (section ``nk``) or a fitted film stack (section ``film``), the measured specular
+reflectance divided by their prediction;
 for a ``.bsdf`` file of the sample, its measured TIS against ``1 - exp(-g)``. Physics:
 :mod:`labbrdf.smoothness`; derivation and the bandwidth caveat: ``docs/smoothness.md``.
 
@@ -179,17 +180,29 @@ def _pick(values: np.ndarray, n: int = MAX_WAVELENGTHS) -> np.ndarray:
 
 
 def _ratios(ctx: Context, group: SampleGroup, rows: pd.DataFrame) -> pd.DataFrame | None:
-    """Measured / Fresnel-predicted reflectance from an ellipsometer file of the group."""
-    tables = ctx.nk_combined
+    """Measured / predicted reflectance, the prediction from an ellipsometer file of the group.
+
+    The bulk n, k of section ``nk`` (Fresnel), else the film stack of section ``film``
+    (transfer matrices); the first that predicts the rows.
+    """
     names = {Path(p).name for p in group.paths}
-    for src, comb in tables.items():
-        if src not in names:
-            continue
+    r = rows[rows["quantity"] == "reflectance"]
+    candidates: list[tuple[str, Any]] = [
+        (f"{src} (bulk n, k)", lambda comb=comb: nkmod.compare_reflectance(comb, r))
+        for src, comb in ctx.nk_combined.items()
+        if src in names
+    ]
+    candidates += [
+        (f"{src} (film stack)", lambda fit=fit: fit.compare_reflectance(r))
+        for src, fit in ctx.film_fits.items()
+        if src in names
+    ]
+    for label, compare in candidates:
         try:
-            c = nkmod.compare_reflectance(comb, rows[rows["quantity"] == "reflectance"])
+            c = compare()
         except ValueError:
             continue
-        c = c.assign(nk_file=src)
+        c = c.assign(nk_file=label)
         with np.errstate(divide="ignore", invalid="ignore"):
             c["ratio"] = c["measured"] / c["predicted"]
             rel = np.hypot(
@@ -230,6 +243,7 @@ _COLUMNS = [  # the map is the table's title (and the rows' "map" key in results
     ("loss", "exp(-g) predicted", ".4g"),
     ("ratio", "R measured / R Fresnel", ".4g"),
     ("u_ratio", "u(ratio)", ".2g"),
+    ("nk_file", "prediction from", ""),
 ]
 
 
@@ -400,9 +414,10 @@ def smoothness_section(ctx: Context) -> None:
                     "periods': the map's pixel is too coarse for the finest roughness that "
                     "scatters, sigma is a lower bound. Spectrophotometer rows without an "
                     "angle are taken at normal incidence, and their reflectance as specular "
-                    "(with an integrating sphere it includes the scatter). The ratio needs "
-                    "bulk n, k of the same sample (an ellipsometer file, section nk); "
-                    "a film stack's prediction is not used here.",
+                    "(with an integrating sphere it includes the scatter). The ratio divides "
+                    "by the reflectance predicted from an ellipsometer file of the same "
+                    "sample: its bulk n, k (section nk, Fresnel) or its fitted film stack "
+                    "(section film).",
                 )
                 b.text(_sentence(rows, m, group.name))
                 b.figure(
@@ -410,15 +425,15 @@ def smoothness_section(ctx: Context) -> None:
                     f"{group.name}: Rayleigh parameter and specular loss against wavelength",
                     "Modelled from the height map: g with the Rayleigh ((pi/2)^2) and "
                     "Fraunhofer ((pi/8)^2) levels, and exp(-g); measured (points): "
-                    "reflectance divided by the Fresnel prediction of the sample's n, k, "
-                    "where the files give them.",
+                    "reflectance divided by the prediction from the sample's bulk n, k or "
+                    "film stack, where the files give them.",
                     _figure(m, np.asarray(wl, float), thetas, c),
                 )
                 if c is None:
                     b.note(
                         "measured ratio",
-                        "no bulk n, k of this sample among the files: the measured "
-                        "reflectance is not divided by a Fresnel prediction",
+                        "no bulk n, k or film stack of this sample among the files: the "
+                        "measured reflectance is not divided by a prediction",
                     )
             tis = _tis_rows(ctx, group, m, data)
             if tis:
