@@ -41,11 +41,11 @@ from . import (
     woollam,
     zemax_bsdf,
 )
-from ._base import AdapterError, Format, check_regular_file
+from ._base import AdapterError, Example, Format, check_regular_file
 from ._ole2 import is_ole2
 from .columns import read_columns as _read_columns
 
-__all__ = ["AdapterError", "Format", "READERS", "formats", "read", "read_many", "sniff"]
+__all__ = ["AdapterError", "Example", "Format", "READERS", "formats", "read", "read_many", "sniff"]
 
 # One module per vendor; each defines FORMATS: tuple[Format, ...]. The order here is the
 # order of formats() and of the candidates named in errors.

@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from .. import models
+from .._plotting import curve_grid
 from ..adapters.topography import HeightMap
 from ..fitting import METHOD, FitError, FitResult, fit_many
 from ..parallel import Executor
@@ -247,13 +248,6 @@ def run_fits(
         ctx.b.log(f"  fitted {name} to {len(table)} groups ({group})")
         out[name] = fit_records(name, options, scans, table, results, BY, group)
     return out
-
-
-def curve_grid(theta_r: np.ndarray) -> np.ndarray:
-    """121 detector angles [deg] spanning the measured ones with a 5 % margin."""
-    lo, hi = float(np.min(theta_r)), float(np.max(theta_r))
-    pad = 0.05 * max(hi - lo, 0.5)
-    return np.linspace(max(0.0, lo - pad), min(89.9, hi + pad), 121)
 
 
 def model_curve(
