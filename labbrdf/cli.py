@@ -1691,8 +1691,9 @@ def _report_parser(sub: Any) -> None:
     s.add_argument(
         "--same-sample",
         action="append",
-        metavar="FILE,FILE[,...]",
-        help="these input files are one sample (repeatable; files stating one sample name "
+        # not an InputPath: every name must be one of the DATA inputs (refused otherwise)
+        metavar="A,B[,...]",
+        help="these DATA inputs are one sample (repeatable; inputs stating one sample name "
         "are paired anyway)",
     )
     s.add_argument("--quiet", action="store_true", help="no progress lines")

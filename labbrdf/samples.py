@@ -73,8 +73,8 @@ class SampleGroup:
     Attributes
     ----------
     name : str
-        The sample's name: the sample name(s) the files share, else the names the files
-        carry, else the file names.
+        The sample's name: the sample name(s) the files share, else the names they state,
+        else the names their readers gave (file stems), else the file names.
     paths : tuple of Path
         The files, in input order.
     reason : str
@@ -310,9 +310,10 @@ def pair_samples(
         paths = tuple(uniq[i].path for i in members)
         if shared:
             name = " / ".join(shared)
-        else:
+        else:  # the names the files state, else those their readers gave, else file names
+            said = list(dict.fromkeys(n for i in members for n in stated[i]))
             carried = list(dict.fromkeys(n for i in members for n in uniq[i].names if n.strip()))
-            name = " / ".join(carried) if carried else " + ".join(p.name for p in paths)
+            name = " / ".join(said or carried) or " + ".join(p.name for p in paths)
         if len(members) == 1:
             f = uniq[members[0]]
             if stated[members[0]]:

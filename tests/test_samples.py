@@ -84,9 +84,14 @@ def test_given_mapping_pairs_files_without_names(files):
 
 def test_given_mapping_names_the_group_after_the_files_names(files):
     groups = pair_samples(
-        [(files["a.dat"], "Al mirror"), (files["c.di"], ())], [[files["a.dat"], files["c.di"]]]
+        [(files["a.dat"], "Al mirror"), (files["c.di"], ()), (files["d.bsdf"], "d")],
+        [[files["a.dat"], files["c.di"], files["d.bsdf"]]],
     )
-    assert groups[0].name == "Al mirror"
+    assert groups[0].name == "Al mirror"  # stated, before the .bsdf's file-stem name
+    groups = pair_samples(
+        [(files["c.di"], ()), (files["d.bsdf"], "d")], [[files["c.di"], files["d.bsdf"]]]
+    )
+    assert groups[0].name == "d"
 
 
 def test_given_mapping_and_stated_names_combine(files):

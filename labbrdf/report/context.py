@@ -105,6 +105,12 @@ class Context:
     height_maps: list[HeightMap] = field(default_factory=list)
     #: user report: the input files grouped by sample (:func:`labbrdf.samples.pair_samples`)
     samples: list[SampleGroup] = field(default_factory=list)
+    #: user report: combined n, k per ellipsometer file (section ``nk``), by file name
+    nk_combined: dict[str, pd.DataFrame] = field(default_factory=dict)
+    #: user report: the film stack fitted per psi/Delta file (section ``film``), by file name
+    film_fits: dict[str, Any] = field(default_factory=dict)
+    #: user report: each height map's sigma and band, by path (section ``smoothness``)
+    map_roughness: dict[str, Any] = field(default_factory=dict)
 
     @property
     def data(self) -> pd.DataFrame | None:

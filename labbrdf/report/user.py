@@ -35,6 +35,7 @@ from .sections.nk import nk_section
 from .sections.physics import physics_section
 from .sections.prediction import prediction_section
 from .sections.scans import scans_section
+from .sections.smoothness import smoothness_section
 from .sections.spectra import spectra_section
 from .sections.surface import surface_section
 
@@ -285,6 +286,11 @@ def _sections(
         ),
         ("colour", "Sample colour from spectrophotometer reflectance", colour_section),
         ("surface", "Measured surface topography", surface_section),
+        (
+            "smoothness",
+            "Roughness against wavelength: Rayleigh criterion and specular loss",
+            smoothness_section,
+        ),
         (
             "prediction",
             "Predict, then measure: the tracer's prediction beside the BRDF",

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -114,3 +115,32 @@ def test_report_groups_the_names_contradict_fail_a_check(three, tmp_path):
     assert check["status"] == "fail"
     assert "'Al-7' in a.parquet and b,2.parquet" in check["reason"]
     assert "sample_groups" not in res["tables"]
+
+
+@pytest.mark.shared
+def test_report_smoothness_section_for_a_real_map_paired_with_real_reflectance(
+    real_exports, tmp_path, capsys
+):
+    pytest.importorskip("SurfaceTopography")
+    profile = real_exports / "topography" / "opdx-3.opdx"  # Dektak, 50 um, 16.7 nm pitch
+    refl = real_exports / "jasco-jws-binary" / "uvvis_refl.jws"  # JASCO V-730 reflectance
+    out = tmp_path / "rep"
+    args = ["report", str(profile), str(refl), "-o", str(out), "--quiet"]
+    assert main([*args, "--same-sample", f"{refl},{profile}"]) == 0
+    res = json.loads((out / "results.json").read_text())
+    sec = {s["id"]: s for s in res["sections"]}
+    assert sec["smoothness"]["status"] == "ok"
+    rows = res["tables"]["smoothness_test_opdx_3_opdx"]["rows"]
+    assert rows and {r["coverage"] for r in rows} == {"band-limited"}
+    for r in rows:
+        lam = r["wavelength_nm"]
+        assert r["g"] == pytest.approx((4 * math.pi * r["sigma_nm"] / lam) ** 2, rel=1e-12)
+        assert r["rayleigh"] in ("smooth", "rough", "undecided")
+    html = (out / "index.html").read_text()
+    assert "Roughness against wavelength" in html
+    # without the mapping nothing pairs the two files: the section says how to pair them
+    out2 = tmp_path / "rep2"
+    assert main(["report", str(profile), str(refl), "-o", str(out2), "--quiet"]) == 0
+    res2 = json.loads((out2 / "results.json").read_text())
+    sec2 = {s["id"]: s for s in res2["sections"]}["smoothness"]
+    assert sec2["status"] == "not available" and "--same-sample" in sec2["reason"]

@@ -503,6 +503,7 @@ def nk_section(ctx: Context) -> None:
         done = _file_section(ctx, i, src, g, cmp_rows)
         if done is not None:
             combined[src], row = done
+            ctx.nk_combined[src] = combined[src]
             summary.append(row)
     b.heading("Summary and reflectance predictions", anchor="nk_summary")
     _summary_table(ctx, summary)
