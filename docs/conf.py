@@ -64,6 +64,18 @@ html_theme_options = {
 smartquotes = False  # option names stay as typed (--format, not an en dash)
 
 
+def _package_reexports(module: str, obj: object) -> bool:
+    """Whether the package above ``module`` offers ``obj`` under the module's own name.
+
+    ``labbrdf.report.validate`` (function) shadows its module; ``labbrdf.specular_dop``
+    stays the module, so the function of that name is documented on the module's page.
+    """
+    import importlib
+
+    parent, _, name = module.rpartition(".")
+    return getattr(importlib.import_module(parent), name, None) is obj
+
+
 def _top_level() -> dict[str, object]:
     import labbrdf
 
@@ -81,7 +93,7 @@ def _skip_shadowed(app, what, name, obj, skip, options):  # noqa: ANN001, ANN202
     if isinstance(obj, types.GenericAlias):
         return True  # a type alias (``Section``): autodoc cannot sign it; its #: comment stays
     module = getattr(obj, "__module__", None) or ""
-    if what == "module" and module.endswith("." + name):
+    if what == "module" and module.endswith("." + name) and _package_reexports(module, obj):
         return True
     if what == "module" and isinstance(obj, type) and _top_level().get(name) is obj:
         return True  # a class labbrdf offers at the top is documented once, there
