@@ -6,6 +6,7 @@ import copy
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import nlopt
@@ -442,66 +443,38 @@ def fit(
     fix : mapping, optional
         name -> value to hold fixed (the CLI's ``--fix NAME=VALUE``).
     profile : bool, optional
-        Solve the model's linear amplitudes (``Model.linear``) by bounded linear least
-        squares at every step. None (default): whenever the model provides linear components
-        and one of them varies.
+        Solve the linear amplitudes (``Model.linear``) by bounded linear least squares at
+        every step. None: whenever the model has linear components and one of them varies.
     energy_constraint : bool or callable
-        Keep the directional-hemispherical reflectance rho(theta_i) <= 1 over the measured
-        incidence range (docs/models.md 1.4). True uses
-        :func:`labbrdf.integrate.hemispherical_reflectance`; a callable
-        ``rho(values, theta_i_deg) -> array`` replaces it. rho is checked on the measured
-        incidence angles plus 7 equally spaced ones from the smallest to the largest. With
-        one profiled amplitude (smooth3's k1) rho is linear in it and the constraint is an
-        upper bound on it, exact and usable with any algorithm; otherwise every stage must
-        take constraints (:data:`CONSTRAINED`, e.g. ``"GN_ISRES+LN_COBYLA"``).
+        Keep rho(theta_i) <= 1 over the measured incidence range (docs/models.md 5.5): True
+        (:func:`labbrdf.integrate.hemispherical_reflectance`) or ``rho(values, theta_i_deg)``.
+        Unless it bounds one profiled amplitude, every stage must be in :data:`CONSTRAINED`.
     maxeval : int or sequence, optional
-        Total evaluation budget per stage (one number for all stages, or one per stage).
-        Default: ``30 (n + 1)`` for a global stage that starts from the model's guess
-        (:meth:`~labbrdf.models.Model.guess`),
-        ``100 (n + 1)`` without one, and ``LOCAL_ROUNDS x 400 n`` (2000 n) for a local
-        stage, where ``n`` is the number of searched (non-profiled) parameters (tuned with
-        benchmarks/bench_fit.py). A local stage runs in rounds of at most ``400 n``
-        evaluations: a round that stops at its maxeval is restarted from its best point
-        until nlopt's tolerances are met, a whole round lowers chi-square by less than
-        :data:`CHI2_TOL` noise units (converged in chi-square along a flat valley, a
-        success whose parameters the flags mark as not identifiable), or the total is
-        spent (``success`` False, "maxeval reached"). A local last stage that converged is
-        then polished (see Notes); its evaluations are counted in ``nfev`` and listed as
-        a stage of its own, outside ``maxeval``.
+        Evaluation budget per stage (one for all, or one per stage). Default ``30 (n + 1)``
+        for a global stage from the model's guess, ``100 (n + 1)`` without one,
+        ``LOCAL_ROUNDS x 400 n`` for a local stage run in restarted rounds (n searched
+        parameters; docs/models.md 5.1). The polish is not counted in it.
     quantity, unit : str, optional
         Which rows to fit when the data mix quantities or units.
     use_sigma : bool, optional
-        Weight by ``1/sigma^2``. None: when every point has a finite sigma > 0; a table with
-        sigma on some rows only is refused.
+        Weight by ``1/sigma^2``. None: when every point has a finite sigma > 0.
     nan_policy : {"raise", "omit"}
         Points with NaN/inf values or angles raise, or are dropped and counted in
         ``FitResult.ndropped``.
     guess : bool
-        Start from the model's data-driven guess (smooth3: a parabola through
-        log R) for the varying parameters not given in ``params``; the global stage keeps
-        that point in its population, so it can only improve on it.
+        Start the varying parameters not given in ``params`` from the model's data-driven
+        guess (kept in the global stage's population).
     ci : {"wald", "profile"}
-        95% intervals from the covariance (``wald``: value +- t stderr, fast) or from the
-        profile of chi-square (``profile``: where the minimum of chi-square over the other
-        parameters rises by ``t^2`` (times ``redchi`` without sigma); about 20 local fits
-        per parameter, better coverage when parameters are strongly correlated). Not
-        combined with ``energy_constraint``.
+        95% intervals from the covariance (value +- t stderr) or from the profile of
+        chi-square (docs/models.md 5.3). Not combined with ``energy_constraint``.
     weighting : {None, "sigma", "relative", "uniform"}
-        How points are weighted. None: as ``use_sigma`` says (1/sigma^2 where every point
-        has a sigma, else uniform). ``"relative"``: for data without sigma that span orders
-        of magnitude (a BRDF lobe over a diffuse floor): sigma_i = max(|y_i|, floor) with
-        ``floor = relative_floor x max|y|``, i.e. a constant relative error above the floor;
-        the covariance is rescaled by ``redchi`` (the scatter estimates that relative
-        error, reported as ``redchi``).
+        None: as ``use_sigma`` says. ``"relative"``: sigma_i = max(|y_i|, floor), floor =
+        ``relative_floor x max|y|``, covariance rescaled by ``redchi`` (docs/models.md 5.4).
     relative_floor : float
-        The floor of ``weighting="relative"`` as a fraction of the largest value
-        (default :data:`RELATIVE_FLOOR`): points far below the peak do not get weights
-        beyond what an instrument's dynamic range supports.
+        The floor of ``weighting="relative"`` as a fraction of the largest value.
     mask_zeros : bool
-        Exclude points whose value is exactly 0, counted in ``FitResult.nmasked`` and named
-        in ``warnings``. BRDF instruments write 0 where a direction was masked (next to
-        the horizon or the source port); a measured BRDF of a real surface is not exactly 0
-        at the printed precision, so the rule removes masked points and nothing else.
+        Exclude points whose value is exactly 0 (instrument-masked directions), counted in
+        ``FitResult.nmasked`` and named in ``warnings``.
 
     Returns
     -------
@@ -517,31 +490,88 @@ def fit(
 
     Notes
     -----
-    Uncertainties come from the Jacobian of the weighted residuals at the optimum (central
-    differences in the parameters' natural scale): ``covar = inv(J^T W J)``, multiplied by
-    ``redchi`` when the data have no sigma (the scatter of the residuals then estimates the
-    noise, as lmfit's ``scale_covar``); not multiplied when sigma is given, so an honest
-    sigma gives honest intervals. 95% intervals use Student's t with ``nfree`` degrees of
-    freedom and are clipped to the bounds. Profiling the linear amplitudes makes smooth3 a
-    2-D search (k2, k3) with k1 exact.
-
-    A derivative-free local stage judges convergence by its last steps, and along a flat
-    valley it can stop far from the minimum (five_param at OSR 860 nm: chi-square 118.58
-    instead of 118.4853, for some seeds only). When the last stage is local, converged and
-    unconstrained, the fit therefore ends with a polish: scipy's bounded trust-region
-    least squares (``trf``, Branch, Coleman and Li 1999) on the weighted residuals from the
-    best point, which stops at a first-order stationary point (scaled gradient, step or
-    chi-square change below 1e-12 relative). It keeps the nlopt stages as the search and
-    only finishes their descent; the reached chi-square then agrees across seeds and
-    machines to about 1e-11 relative on the fixtures (benchmarks/bench_fit.py
-    ``--only-convergence``). A polish that runs out of its budget makes the fit
-    unsuccessful.
-
-    When every point of a smooth3 fit lies on the specular line (theta_r == theta_i) the fit
-    is refused unless k2 and k3 are fixed: there only k1 exp(-k2^2/k3^2) is identifiable
-    (docs/models.md 1.1), and fixing k2 = 0 alone would leave k3 without any effect.
+    Stages and budgets, the polish ending a converged local stage, uncertainties, weights,
+    the energy constraint and the refused specular-only design: docs/models.md 5 (Fitting).
     """
     t0 = time.perf_counter()
+    pb = _problem(
+        model,
+        data,
+        method=method,
+        params=params,
+        fix=fix,
+        profile=profile,
+        energy_constraint=energy_constraint,
+        maxeval=maxeval,
+        quantity=quantity,
+        unit=unit,
+        use_sigma=use_sigma,
+        nan_policy=nan_policy,
+        guess=guess,
+        ci=ci,
+        weighting=weighting,
+        relative_floor=relative_floor,
+        mask_zeros=mask_zeros,
+    )
+    x, stage_info, last_code, message = _search(
+        pb.obj, pb.x0, pb.stages, pb.budgets, int(seed), pb.cons, pb.nfree, pb.use_sigma
+    )
+    return _finish(pb, x, stage_info, last_code, message, seed=seed, ci=ci, t0=t0)
+
+
+@dataclass
+class _Problem:
+    """What :func:`fit` searches: the points, the parameters, the weights and the objective."""
+
+    model: Model
+    stages: list[str]
+    fd: FitData
+    ndropped: int
+    nmasked: int
+    p: Parameters
+    weights: NDArray
+    use_sigma: bool
+    weighting: str
+    varying: list[str]
+    prof: list[str]
+    rho_fn: Callable[[dict[str, float], NDArray], NDArray] | None
+    th_grid: NDArray
+    obj: Objective
+    cons: Callable[[NDArray], float] | None
+    budgets: list[int]
+
+    @property
+    def x0(self) -> NDArray:
+        """The starting search vector."""
+        return self.obj.to_vector(self.p.values())
+
+    @property
+    def nfree(self) -> int:
+        """Degrees of freedom: points less varying parameters."""
+        return len(self.fd) - len(self.varying)
+
+
+def _problem(
+    model: Model | str,
+    data: Measurement | pd.DataFrame | FitData,
+    *,
+    method: str,
+    params: Parameters | Mapping[str, Any] | None,
+    fix: Mapping[str, float] | None,
+    profile: bool | None,
+    energy_constraint: bool | Callable[..., ArrayLike],
+    maxeval: int | Sequence[int | None] | None,
+    quantity: str | None,
+    unit: str | None,
+    use_sigma: bool | None,
+    nan_policy: str,
+    guess: bool,
+    ci: str,
+    weighting: str | None,
+    relative_floor: float,
+    mask_zeros: bool,
+) -> _Problem:
+    """Check :func:`fit`'s arguments and set up its search (arguments as there)."""
     if isinstance(model, str):
         model = get_model(model)
     if not isinstance(model, Model):
@@ -554,10 +584,9 @@ def fit(
     fd, ndropped, nmasked = _select_points(data, quantity, unit, nan_policy, mask_zeros)
     p = setup_params(model, params, fix)
     guessed = guess and _apply_guess(model, fd, p, set(params or ()))
-    weights, use_sigma, weighting = _weighting(fd, use_sigma, weighting, relative_floor)
+    weights, sigma, how = _weighting(fd, use_sigma, weighting, relative_floor)
     varying = p.varying()
     _check_design(model, fd, varying)
-    n_pts, nvarys = len(fd), len(varying)
     lin = [k for k in model.linear if k in varying]
     prof, rho_fn, th_grid = _profiling(model, fd, lin, profile, energy_constraint)
     linear_upper = _energy_bound(rho_fn, prof[0], th_grid) if rho_fn and prof else None
@@ -569,11 +598,41 @@ def fit(
         )
     cons = _energy_cons(obj, rho_fn, th_grid) if rho_fn is not None and not prof else None
     budgets = _budgets(obj, stages, maxeval, cons is not None, lin, guessed)
-    x, stage_info, last_code, message = _search(
-        obj, obj.to_vector(p.values()), stages, budgets, int(seed), cons, n_pts - nvarys, use_sigma
+    return _Problem(
+        model=model,
+        stages=stages,
+        fd=fd,
+        ndropped=ndropped,
+        nmasked=nmasked,
+        p=p,
+        weights=weights,
+        use_sigma=sigma,
+        weighting=how,
+        varying=varying,
+        prof=prof,
+        rho_fn=rho_fn,
+        th_grid=th_grid,
+        obj=obj,
+        cons=cons,
+        budgets=budgets,
     )
 
-    # ---- final values and statistics
+
+def _finish(
+    pb: _Problem,
+    x: NDArray,
+    stage_info: list[dict[str, Any]],
+    last_code: int,
+    message: str,
+    *,
+    seed: int,
+    ci: str,
+    t0: float,
+) -> FitResult:
+    """The final values and statistics at the best search vector ``x``, as a FitResult."""
+    model, obj, fd, p, varying, prof = pb.model, pb.obj, pb.fd, pb.p, pb.varying, pb.prof
+    use_sigma, rho_fn, th_grid = pb.use_sigma, pb.rho_fn, pb.th_grid
+    n_pts, nvarys = len(fd), len(varying)
     with np.errstate(all="ignore"):
         vals, chisqr = obj.solve(obj.from_vector(x) if obj.n else dict(obj.base))
         best = obj.model_values(vals)
@@ -586,15 +645,15 @@ def fit(
         J, varying, vals, 1.0 if use_sigma else redchi, nfree
     )
     out, flags = _fitted_params(p, vals, stderr, correl, reasons, nfree)
-    warn = [f"{ndropped} point(s) with NaN/inf values dropped (nan_policy='omit')"] * (
-        ndropped > 0
-    ) + [f"{nmasked} point(s) with value 0 excluded as instrument-masked (mask_zeros)"] * (
-        nmasked > 0
+    warn = [f"{pb.ndropped} point(s) with NaN/inf values dropped (nan_policy='omit')"] * (
+        pb.ndropped > 0
+    ) + [f"{pb.nmasked} point(s) with value 0 excluded as instrument-masked (mask_zeros)"] * (
+        pb.nmasked > 0
     )
     if ci == "profile" and finite:
         delta = float(special.stdtrit(nfree, 0.975)) ** 2 * (1.0 if use_sigma else redchi)
-        warn += _profile_intervals(model, fd, out, weights, prof, varying, chisqr, delta, seed)
-    success, message = _verdict(finite, last_code, stages, obj.n, message)
+        warn += _profile_intervals(model, fd, out, pb.weights, prof, varying, chisqr, delta, seed)
+    success, message = _verdict(finite, last_code, pb.stages, obj.n, message)
     energy_info = None
     if rho_fn is not None:
         energy_info, success, message = _energy_check(rho_fn, vals, th_grid, success, message)
@@ -604,7 +663,7 @@ def fit(
     return FitResult(
         model=model.name,
         options=dict(model.describe()["options"]),
-        method="+".join(stages),
+        method="+".join(pb.stages),
         seed=int(seed),
         params=out,
         init_values=p.values(),
@@ -624,14 +683,14 @@ def fit(
         rmse=float(np.sqrt(np.mean(resid**2))),
         rmse_pct=rmse_pct,
         weighted=bool(use_sigma),
-        weighting=weighting,
-        nmasked=nmasked,
+        weighting=pb.weighting,
+        nmasked=pb.nmasked,
         success=bool(success),
         message=message,
         elapsed_s=time.perf_counter() - t0,
         quantity=fd.quantity,
         unit=fd.unit,
-        ndropped=ndropped,
+        ndropped=pb.ndropped,
         stages=stage_info,
         energy=energy_info,
         warnings=warn,
@@ -716,7 +775,7 @@ def _search(
     nfree: int,
     use_sigma: bool,
 ) -> tuple[NDArray, list[dict[str, Any]], int, str]:
-    """Run the nlopt stages in turn from ``x``, then the polish (see :func:`fit`, Notes).
+    """Run the nlopt stages in turn from ``x``, then the polish (docs/models.md 5.2).
 
     Returns the best search vector, the per-stage records, the last stop code and the
     message.

@@ -51,7 +51,7 @@ intensity of the unpolarized-input Stokes vector (M00).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -229,10 +229,87 @@ class _Setup:
         return refl, tr, cos_t, eta
 
 
+@dataclass
+class _Rays:
+    """The live rays of a block, one column each (the state of the module docstring)."""
+
+    k: NDArray[np.float64]  # (3, n) direction
+    s: NDArray[np.float64]  # (3, n) Stokes frame x axis
+    M: NDArray[np.float64]  # (4, 4, n) Mueller matrix
+    iface: NDArray[np.int8]  # TOP or SUB
+    below: NDArray[np.bool_]  # under the top interface, inside the coating
+    h: NDArray[np.float64]  # height on the microsurface (+inf: arriving from the bulk)
+    fresh: NDArray[np.bool_]  # single scattering: not yet hit at this interface
+    bounces: NDArray[np.int32]  # facet events so far
+    rid: NDArray[np.int64]  # global ray index
+
+    @classmethod
+    def launch(cls, cfg: TraceConfig, su: _Setup, block: int, n: int) -> _Rays:
+        """The ``n`` incident rays of block ``block``, on the first interface."""
+        k, s, M = _launch(cfg.theta_i_deg, n)
+        return cls(
+            k=k,
+            s=s,
+            M=M,
+            iface=np.full(n, TOP if su.layered else SUB, dtype=np.int8),
+            below=np.zeros(n, dtype=bool),
+            h=np.full(n, np.inf),
+            fresh=np.ones(n, dtype=bool),
+            bounces=np.zeros(n, dtype=np.int32),
+            rid=cfg.block_rays * block + np.arange(n, dtype=np.int64),
+        )
+
+    def keep(self, alive: NDArray[np.bool_]) -> None:
+        """Drop the rays that are not ``alive``."""
+        if not alive.all():
+            self.k, self.s, self.M = self.k[:, alive], self.s[:, alive], self.M[:, :, alive]
+            self.iface, self.below, self.h = self.iface[alive], self.below[alive], self.h[alive]
+            self.fresh, self.bounces = self.fresh[alive], self.bounces[alive]
+            self.rid = self.rid[alive]
+
+
+@dataclass
+class _Ledger:
+    """A block's running sums: the energy ledger, the exiting rays and the deposits."""
+
+    booked: float = 0.0  # evaluated: the sampled weight of the branches not followed
+    absorbed: float = 0.0
+    terminated: float = 0.0
+    events: int = 0
+    ex_k: list[NDArray] = field(default_factory=list)
+    ex_s: list[NDArray] = field(default_factory=list)
+    ex_M: list[NDArray] = field(default_factory=list)
+    dep_key: list[NDArray] = field(default_factory=list)
+    dep_rows: list[NDArray] = field(default_factory=list)
+
+    def exit(self, k: NDArray, s: NDArray, M: NDArray) -> None:
+        """Keep exiting rays for the binning."""
+        self.ex_k.append(k)
+        self.ex_s.append(s)
+        self.ex_M.append(M)
+
+
+@dataclass
+class _Hit:
+    """Step 3's facet event of every live ray, before the Fresnel weights."""
+
+    m: NDArray[np.float64]  # (3, n) facet normal
+    cos_i: NDArray[np.float64]  # cosine of incidence on the facet
+    kr: NDArray[np.float64]  # (3, n) mirror direction
+    s_loc: NDArray[np.float64]  # (3, n) the facet's s axis, the ray's new frame
+    on_top: NDArray[np.bool_]
+    alpha: NDArray[np.float64]  # GGX alpha of the interface hit
+    u: NDArray[np.float64]  # the uniform draw of the reflect/refract choice
+
+
 def trace_block(
     cfg: TraceConfig, block: int, *, raw: list[tuple[NDArray, NDArray, NDArray]] | None = None
 ) -> BlockTally:
     """Trace the rays of block ``block`` with generator ``SeedSequence([seed, block])``.
+
+    The steps are those of the module docstring, one function each: :func:`_leave_or_hit`,
+    :func:`_route`, :func:`_scatter` (with :func:`_substrate_event` or
+    :func:`_layered_event`) and :func:`_weight_cut`.
 
     Parameters
     ----------
@@ -254,200 +331,261 @@ def trace_block(
     grid = _grid(cfg)
     n = cfg.block_size(block)
     rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, block]))
-    k, s, M = _launch(cfg.theta_i_deg, n)
-    iface = np.full(n, TOP if su.layered else SUB, dtype=np.int8)
-    below = np.zeros(n, dtype=bool)
-    h = np.full(n, np.inf)
-    fresh = np.ones(n, dtype=bool)
-    bounces = np.zeros(n, dtype=np.int32)
-    rid = cfg.block_rays * block + np.arange(n, dtype=np.int64)  # global ray index
-    booked = 0.0  # evaluated: the sampled weight of the branches not followed
-    dep_key: list[NDArray] = []
-    dep_rows: list[NDArray] = []
-    absorbed = 0.0
-    terminated = 0.0
-    events = 0
-    ex_k: list[NDArray] = []
-    ex_s: list[NDArray] = []
-    ex_M: list[NDArray] = []
+    rays = _Rays.launch(cfg, su, block, n)
+    led = _Ledger()
     if su.albedo is not None and not su.layered:
-        # a bare Lambertian base: one base event, then every ray leaves
-        absorbed += _base_event(su.albedo, rng, np.arange(n), k, s, M)
-        events += n
-        if su.evaluated:
-            booked += float(M[0, 0].sum())  # its BRDF albedo / pi is the closed form
-        else:
-            ex_k.append(k)
-            ex_s.append(s)
-            ex_M.append(M)
-        k = k[:, :0]
-
-    while k.shape[1]:
-        m_ = int(k.shape[1])
-        alive = np.ones(m_, dtype=bool)
-        kz_loc = np.where(below, -k[2], k[2])
-        alpha = np.where(iface == TOP, su.alpha_top, su.alpha_sub)
-
-        # 1. leave or hit
-        if su.single:
-            leave = ~fresh
-            if leave.any():
-                back = leave & (kz_loc <= 0)
-                terminated += float(M[0, 0, back].sum())
-                alive &= ~back
-                go = leave & ~back
-                g = np.where(go, su.g1_of(k, kz_loc, iface == SUB, alpha, below), 1.0)
-                terminated += float((M[0, 0] * (1.0 - g))[go].sum())
-                M *= g
-                leave = go
-        else:
-            lam = su.lambda_of(k, kz_loc, iface == SUB, alpha, below)
-            leave, h_new = sample_height(kz_loc, lam, h, rng.random(m_))
-            h = np.where(leave, h, h_new)
-
-        # 2. route leaving rays: exit, or cross the coating to the other interface
-        if leave.any():
-            out = leave & (((iface == TOP) & ~below) | ((iface == SUB) & (not su.layered)))
-            if out.any():
-                ex_k.append(k[:, out])
-                ex_s.append(s[:, out])
-                ex_M.append(M[:, :, out])
-                alive &= ~out
-            if su.layered:
-                cross_ = leave & ~out
-                if cross_.any():
-                    ab, ev = _cross(su, rng, np.nonzero(cross_)[0], k, s, M, iface, below, h)
-                    absorbed += ab
-                    events += ev.size
-                    bounces[ev] += 1
-                    fresh[cross_] = True
-
+        _bare_base(su.albedo, su.evaluated, rng, rays, led)
+    while rays.k.shape[1]:
+        leave, alive = _leave_or_hit(su, rng, rays, led)
+        _route(su, rng, rays, led, leave, alive)
         # max bounces: a ray that would need one more event is terminated
-        over = alive & (bounces >= cfg.max_bounces)
+        over = alive & (rays.bounces >= cfg.max_bounces)
         if over.any():
-            terminated += float(M[0, 0, over].sum())
+            led.terminated += float(rays.M[0, 0, over].sum())
             alive &= ~over
-
-        if not alive.all():
-            k, s, M = k[:, alive], s[:, alive], M[:, :, alive]
-            iface, below, h = iface[alive], below[alive], h[alive]
-            fresh, bounces, rid = fresh[alive], bounces[alive], rid[alive]
-        m_ = k.shape[1]
-        if m_ == 0:
+        rays.keep(alive)
+        if rays.k.shape[1] == 0:
             break
+        if _scatter(su, cfg, grid, rng, rays, led, raw):
+            break
+        alive, led.terminated = _weight_cut(cfg, rng, rays.M, led.terminated)
+        rays.keep(alive)
+    return _block_tally(cfg, grid, block, n, led, su.evaluated)
 
-        # 3. scatter every remaining ray (all are on a microsurface and hit a facet)
-        u = rng.random((3, m_))
-        events += m_
-        on_top = iface == TOP
-        a = np.where(on_top, su.alpha_top, su.alpha_sub)
-        wi = -k
-        wi[2] = np.where(below, k[2], wi[2])
-        m = sample_vndf(wi, a, u[0], u[1])
-        if su.ndf_sub is not None and not on_top.all():
-            on_sub = ~on_top
-            m[:, on_sub] = su.ndf_sub.sample_visible(wi[:, on_sub], rng)
-        m[2] = np.where(below, -m[2], m[2])
-        if su.ndf_top is not None and on_top.any():
-            # from below: the point reflection of the table's visible normals for k
-            sign = np.where(below[on_top], -1.0, 1.0)
-            m[:, on_top] = sign * su.ndf_top.sample_visible(-k[:, on_top] * sign, rng)
-        cos_i = np.clip(-(k[0] * m[0] + k[1] * m[1] + k[2] * m[2]), 0.0, 1.0)
-        s_loc = s_axis(k, m, s)
-        rotate_frame(M, k, s, s_loc)
-        m00 = M[0, 0].copy()
-        kr = k + 2.0 * cos_i * m
-        trans = None
-        kill_all = False
-        if not su.layered:
-            A, B, C, S = su.substrate_abcs(cos_i)
-            apply_fresnel(M, A, B, C, S)
-            if su.scalar:
-                M[1:] = 0.0
-            knew = kr
-            if su.evaluated:
-                # the first (and only followed) event: its reflection is evaluated in
-                # closed form; the sampled weight only closes the energy ledger
-                krn = kr / np.sqrt((kr * kr).sum(axis=0))
-                g = su.g1_of(krn, krn[2], ~on_top, a)
-                booked += float((M[0, 0] * g).sum())
-                terminated += float((M[0, 0] * (1.0 - g)).sum())
-                kill_all = True
-        else:
-            refl, tr, cos_t, eta = su.layered_abcs(cos_i, on_top, below)
-            s0 = M[0, 0]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                pr = np.where(s0 > 0, (refl[0] * s0 + refl[1] * M[1, 0]) / s0, refl[0])
-                pr = np.where(on_top, np.clip(pr, 0.0, 1.0), 1.0)  # opaque substrate
-                if su.evaluated:
-                    # no random branch: refract into the coating from air (the
-                    # reflection is evaluated), reflect at the top from below (the
-                    # transmission is applied by the exit operator), both with their
-                    # Mueller weights
-                    trans = on_top & ~below
-                    wr = np.where(trans, 0.0, 1.0)
-                    wt = np.where(trans, 1.0, 0.0)
-                    up_ = on_top & below
-                    if up_.any():
-                        _deposit(grid, cfg.batches, k, s_loc, M, up_, rid, dep_key, dep_rows, raw)
-                else:
-                    trans = u[2] >= pr
-                    wr = np.where(trans, 0.0, 1.0 / np.where(trans, 1.0, pr))
-                    wt = np.where(trans, 1.0 / np.where(trans, 1.0 - pr, 1.0), 0.0)
-            if su.evaluated:
-                w_o, g = _other_branch(
-                    su, k, m, kr, M, cos_i, (refl, tr, cos_t, eta), on_top, below
-                )
-                booked += float((w_o * g).sum())
-                terminated += float((w_o * (1.0 - g)).sum())
-                m00 = m00 - w_o
-            apply_fresnel(
-                M,
-                refl[0] * wr + tr[0] * wt,
-                refl[1] * wr + tr[1] * wt,
-                refl[2] * wr + tr[2] * wt,
-                refl[3] * wr + tr[3] * wt,
+
+def _bare_base(
+    albedo: float, evaluated: bool, rng: np.random.Generator, rays: _Rays, led: _Ledger
+) -> None:
+    """A bare Lambertian base: one base event, then every ray leaves."""
+    k, s, M = rays.k, rays.s, rays.M
+    led.absorbed += _base_event(albedo, rng, np.arange(k.shape[1]), k, s, M)
+    led.events += k.shape[1]
+    if evaluated:
+        led.booked += float(M[0, 0].sum())  # its BRDF albedo / pi is the closed form
+    else:
+        led.exit(k, s, M)
+    rays.k = k[:, :0]
+
+
+def _leave_or_hit(
+    su: _Setup, rng: np.random.Generator, rays: _Rays, led: _Ledger
+) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+    """Step 1: which rays leave their microsurface; returns (leave, alive)."""
+    k, M, iface, below = rays.k, rays.M, rays.iface, rays.below
+    m_ = int(k.shape[1])
+    alive = np.ones(m_, dtype=bool)
+    kz_loc = np.where(below, -k[2], k[2])
+    alpha = np.where(iface == TOP, su.alpha_top, su.alpha_sub)
+    if su.single:
+        leave = ~rays.fresh
+        if leave.any():
+            back = leave & (kz_loc <= 0)
+            led.terminated += float(M[0, 0, back].sum())
+            alive &= ~back
+            go = leave & ~back
+            g = np.where(go, su.g1_of(k, kz_loc, iface == SUB, alpha, below), 1.0)
+            led.terminated += float((M[0, 0] * (1.0 - g))[go].sum())
+            M *= g
+            leave = go
+    else:
+        lam = su.lambda_of(k, kz_loc, iface == SUB, alpha, below)
+        leave, h_new = sample_height(kz_loc, lam, rays.h, rng.random(m_))
+        rays.h = np.where(leave, rays.h, h_new)
+    return leave, alive
+
+
+def _route(
+    su: _Setup,
+    rng: np.random.Generator,
+    rays: _Rays,
+    led: _Ledger,
+    leave: NDArray[np.bool_],
+    alive: NDArray[np.bool_],
+) -> None:
+    """Step 2: leaving rays exit, or cross the coating to the other interface (in place)."""
+    if not leave.any():
+        return
+    iface, below = rays.iface, rays.below
+    out = leave & (((iface == TOP) & ~below) | ((iface == SUB) & (not su.layered)))
+    if out.any():
+        led.exit(rays.k[:, out], rays.s[:, out], rays.M[:, :, out])
+        alive &= ~out
+    if su.layered:
+        cross_ = leave & ~out
+        if cross_.any():
+            ab, ev = _cross(
+                su, rng, np.nonzero(cross_)[0], rays.k, rays.s, rays.M, iface, below, rays.h
             )
-            if su.scalar:
-                M[1:] = 0.0
-            if trans.any():
-                kt = eta * k + (eta * cos_i - cos_t) * m
-                knew = np.where(trans, kt, kr)
-            else:
-                knew = kr
-        k = knew / np.sqrt(knew[0] * knew[0] + knew[1] * knew[1] + knew[2] * knew[2])
-        s = s_loc
-        absorbed += float((m00 - M[0, 0]).sum())
-        bounces += 1
-        if kill_all:
-            break
-        fresh[:] = False
-        if trans is not None and trans.any():
-            below = below ^ trans
-            h = np.where(trans, -h, h)
+            led.absorbed += ab
+            led.events += ev.size
+            rays.bounces[ev] += 1
+            rays.fresh[cross_] = True
 
-        # 4. weight threshold / roulette
-        alive, terminated = _weight_cut(cfg, rng, M, terminated)
-        if not alive.all():
-            k, s, M = k[:, alive], s[:, alive], M[:, :, alive]
-            iface, below, h = iface[alive], below[alive], h[alive]
-            fresh, bounces, rid = fresh[alive], bounces[alive], rid[alive]
 
-    cell_keys = cell_sums = batch_rays = None
+def _facet_hit(su: _Setup, rng: np.random.Generator, rays: _Rays) -> _Hit:
+    """Step 3, first half: a visible facet normal for every ray, its frame rotated to it."""
+    k, s, M, below = rays.k, rays.s, rays.M, rays.below
+    u = rng.random((3, k.shape[1]))
+    on_top = rays.iface == TOP
+    a = np.where(on_top, su.alpha_top, su.alpha_sub)
+    wi = -k
+    wi[2] = np.where(below, k[2], wi[2])
+    m = sample_vndf(wi, a, u[0], u[1])
+    if su.ndf_sub is not None and not on_top.all():
+        on_sub = ~on_top
+        m[:, on_sub] = su.ndf_sub.sample_visible(wi[:, on_sub], rng)
+    m[2] = np.where(below, -m[2], m[2])
+    if su.ndf_top is not None and on_top.any():
+        # from below: the point reflection of the table's visible normals for k
+        sign = np.where(below[on_top], -1.0, 1.0)
+        m[:, on_top] = sign * su.ndf_top.sample_visible(-k[:, on_top] * sign, rng)
+    cos_i = np.clip(-(k[0] * m[0] + k[1] * m[1] + k[2] * m[2]), 0.0, 1.0)
+    s_loc = s_axis(k, m, s)
+    rotate_frame(M, k, s, s_loc)
+    kr = k + 2.0 * cos_i * m
+    return _Hit(m=m, cos_i=cos_i, kr=kr, s_loc=s_loc, on_top=on_top, alpha=a, u=u[2])
+
+
+def _scatter(
+    su: _Setup,
+    cfg: TraceConfig,
+    grid: Grid,
+    rng: np.random.Generator,
+    rays: _Rays,
+    led: _Ledger,
+    raw: list[tuple[NDArray, NDArray, NDArray]] | None,
+) -> bool:
+    """Step 3: scatter every live ray at its facet (in place); True ends the walk."""
+    led.events += rays.k.shape[1]
+    hit = _facet_hit(su, rng, rays)
+    M = rays.M
+    m00 = M[0, 0].copy()
+    trans: NDArray[np.bool_] | None = None
+    kill_all = False
+    if not su.layered:
+        kill_all = _substrate_event(su, M, hit, led)
+        knew = hit.kr
+    else:
+        knew, trans, m00 = _layered_event(su, cfg, grid, rays, led, raw, hit, m00)
+    rays.k = knew / np.sqrt(knew[0] * knew[0] + knew[1] * knew[1] + knew[2] * knew[2])
+    rays.s = hit.s_loc
+    led.absorbed += float((m00 - M[0, 0]).sum())
+    rays.bounces += 1
+    if kill_all:
+        return True
+    rays.fresh[:] = False
+    if trans is not None and trans.any():
+        rays.below = rays.below ^ trans
+        rays.h = np.where(trans, -rays.h, rays.h)
+    return False
+
+
+def _substrate_event(su: _Setup, M: NDArray[np.float64], hit: _Hit, led: _Ledger) -> bool:
+    """Step 3 on a bare substrate: Fresnel reflection (in place); True ends the walk."""
+    A, B, C, S = su.substrate_abcs(hit.cos_i)
+    apply_fresnel(M, A, B, C, S)
+    if su.scalar:
+        M[1:] = 0.0
+    if not su.evaluated:
+        return False
+    # the first (and only followed) event: its reflection is evaluated in closed form;
+    # the sampled weight only closes the energy ledger
+    krn = hit.kr / np.sqrt((hit.kr * hit.kr).sum(axis=0))
+    g = su.g1_of(krn, krn[2], ~hit.on_top, hit.alpha)
+    led.booked += float((M[0, 0] * g).sum())
+    led.terminated += float((M[0, 0] * (1.0 - g)).sum())
+    return True
+
+
+def _layered_event(
+    su: _Setup,
+    cfg: TraceConfig,
+    grid: Grid,
+    rays: _Rays,
+    led: _Ledger,
+    raw: list[tuple[NDArray, NDArray, NDArray]] | None,
+    hit: _Hit,
+    m00: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+    """Step 3 under or on a coating: reflect or refract (in place on M).
+
+    Returns the new (unnormalised) directions, the refracted rays and ``m00`` less the
+    weight of the evaluated walk's branch not followed.
+    """
+    k, M, below, on_top, cos_i = rays.k, rays.M, rays.below, hit.on_top, hit.cos_i
+    refl, tr, cos_t, eta = su.layered_abcs(cos_i, on_top, below)
+    s0 = M[0, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        pr = np.where(s0 > 0, (refl[0] * s0 + refl[1] * M[1, 0]) / s0, refl[0])
+        pr = np.where(on_top, np.clip(pr, 0.0, 1.0), 1.0)  # opaque substrate
+        if su.evaluated:
+            # no random branch: refract into the coating from air (the reflection is
+            # evaluated), reflect at the top from below (the transmission is applied by
+            # the exit operator), both with their Mueller weights
+            trans = on_top & ~below
+            wr = np.where(trans, 0.0, 1.0)
+            wt = np.where(trans, 1.0, 0.0)
+            up_ = on_top & below
+            if up_.any():
+                _deposit(
+                    grid,
+                    cfg.batches,
+                    k,
+                    hit.s_loc,
+                    M,
+                    up_,
+                    rays.rid,
+                    led.dep_key,
+                    led.dep_rows,
+                    raw,
+                )
+        else:
+            trans = hit.u >= pr
+            wr = np.where(trans, 0.0, 1.0 / np.where(trans, 1.0, pr))
+            wt = np.where(trans, 1.0 / np.where(trans, 1.0 - pr, 1.0), 0.0)
     if su.evaluated:
-        cell_keys, cell_sums, batch_rays = _cell_tally(cfg, grid, block, n, dep_key, dep_rows)
-    sums, sumsq, counts, hemi = _bin_exit_rays(grid, ex_k, ex_s, ex_M)
+        w_o, g = _other_branch(
+            su, k, hit.m, hit.kr, M, cos_i, (refl, tr, cos_t, eta), on_top, below
+        )
+        led.booked += float((w_o * g).sum())
+        led.terminated += float((w_o * (1.0 - g)).sum())
+        m00 = m00 - w_o
+    apply_fresnel(
+        M,
+        refl[0] * wr + tr[0] * wt,
+        refl[1] * wr + tr[1] * wt,
+        refl[2] * wr + tr[2] * wt,
+        refl[3] * wr + tr[3] * wt,
+    )
+    if su.scalar:
+        M[1:] = 0.0
+    if not trans.any():
+        return hit.kr, trans, m00
+    kt = eta * k + (eta * cos_i - cos_t) * hit.m
+    return np.where(trans, kt, hit.kr), trans, m00
+
+
+def _block_tally(
+    cfg: TraceConfig, grid: Grid, block: int, n: int, led: _Ledger, evaluated: bool
+) -> BlockTally:
+    """Bin the exits (and fold the deposits of the evaluated walk) into the block's tally."""
+    cell_keys = cell_sums = batch_rays = None
+    if evaluated:
+        cell_keys, cell_sums, batch_rays = _cell_tally(
+            cfg, grid, block, n, led.dep_key, led.dep_rows
+        )
+    sums, sumsq, counts, hemi = _bin_exit_rays(grid, led.ex_k, led.ex_s, led.ex_M)
     return BlockTally(
         block=block,
         rays=n,
         sums=sums,
         sumsq=sumsq,
         counts=counts,
-        exited=float(hemi[0]) + booked,
-        absorbed=absorbed,
-        terminated=terminated,
+        exited=float(hemi[0]) + led.booked,
+        absorbed=led.absorbed,
+        terminated=led.terminated,
         hemi=hemi,
-        events=events,
+        events=led.events,
         cell_keys=cell_keys,
         cell_sums=cell_sums,
         batch_rays=batch_rays,
