@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import time
 from pathlib import Path
 
 import numpy as np
@@ -134,9 +133,7 @@ def test_all_real_exports_in_one_report(real_exports: Path, tmp_path: Path) -> N
         and p.suffix != ".md"
         and "topography" not in p.relative_to(real_exports).parts
     )
-    t0 = time.perf_counter()
     res = _report(files, tmp_path / "rep")
-    assert time.perf_counter() - t0 < 90
     read = [r["file"] for r in res["tables"]["ingested_files"]["rows"] if r["status"] == "read"]
     assert read
     for name in read:
