@@ -211,7 +211,7 @@ def _run_stage(
     opt.set_min_objective(obj)
     opt.set_maxeval(budget)
     if not _is_global(name):
-        opt.set_xtol_rel(_LOCAL_XTOL_REL)
+        opt.set_xtol_rel(max(_LOCAL_XTOL_REL, obj.model.fd_rel_step or 0.0))
         opt.set_ftol_rel(_LOCAL_FTOL_REL)
     if "MLSL" in name or "AUGLAG" in name:
         sub = nlopt.opt(nlopt.LD_LBFGS if _needs_grad(name) else nlopt.LN_BOBYQA, n)
@@ -290,6 +290,7 @@ def _polish(obj: Objective, x: NDArray, nfree: int, weighted: bool) -> tuple[NDA
     x0 = np.clip(np.asarray(x, float), lo, hi)
     f0 = obj.solve(obj.from_vector(x0))[1]
     budget = _POLISH_MAXEVAL_PER_DIM * obj.n
+    tol = max(_POLISH_TOL, obj.model.fd_rel_step or 0.0)  # a Monte Carlo model's resolution
     try:
         res = optimize.least_squares(
             obj.residual_vector,
@@ -297,10 +298,11 @@ def _polish(obj: Objective, x: NDArray, nfree: int, weighted: bool) -> tuple[NDA
             bounds=(lo, hi),
             method="trf",
             x_scale="jac",
-            ftol=_POLISH_TOL,
-            xtol=_POLISH_TOL,
-            gtol=_POLISH_TOL,
+            ftol=tol,
+            xtol=tol,
+            gtol=tol,
             max_nfev=budget,
+            diff_step=obj.model.fd_rel_step,
         )
         status, why = int(res.status), str(res.message)
     except (ValueError, np.linalg.LinAlgError) as exc:  # non-finite start, singular step
@@ -585,7 +587,7 @@ def fit(
         profile = profile and len(lin) == 1  # rho <= 1 is a box only for one amplitude
     prof = lin if profile else []
     linear_upper = _energy_bound(rho_fn, prof[0], th_grid) if rho_fn and prof else None
-    obj = Objective(model, fd, p, weights, prof, linear_upper)
+    obj = Objective(model, fd, p, weights, prof, linear_upper, absolute=use_sigma)
     if prof and obj.linear_basis_missing():
         raise FitError(
             f"model {model.name!r} declares linear parameters but gives no "
@@ -698,7 +700,7 @@ def fit(
         rmse=float(np.sqrt(np.mean(resid**2))),
         rmse_pct=rmse_pct,
         weighted=bool(use_sigma),
-        weighting=weighting,
+        weighting=obj.describe_weighting(weighting),
         nmasked=nmasked,
         success=bool(success),
         message=message,

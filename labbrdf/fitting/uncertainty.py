@@ -36,16 +36,22 @@ def jacobian(obj: Objective, vals: dict[str, float], names: list[str]) -> NDArra
     """Weighted residual Jacobian d(sw * (y - f))/dp in the parameters' natural scale.
 
     Central differences, step ``6e-6 * max(|p|, 1e-3 * span)`` (6e-6 ~ eps^(1/3), the
-    step that balances truncation and round-off); one-sided inward at a bound so the model
-    is never evaluated outside the parameter box.
+    step that balances truncation and round-off), or the model's ``fd_rel_step`` of the
+    span where that is larger (a Monte Carlo model); one-sided inward at a bound so the
+    model is never evaluated outside the parameter box. The weights are those at ``vals``
+    (:meth:`Objective.point_sw`).
     """
     J = np.empty((obj.y.size, len(names)))
     f0 = obj.model_values(vals)
+    sw = obj.point_sw(vals)
+    rel = obj.model.fd_rel_step
     for j, k in enumerate(names):
         p = obj.params[k]
         v = vals[k]
         span = p.max - p.min
         h = 6e-6 * max(abs(v), 1e-3 * span if math.isfinite(span) else 1e-3)
+        if rel is not None and math.isfinite(span):
+            h = max(h, rel * span)
         up, dn = v + h <= p.max, v - h >= p.min
         vp, vm = dict(vals), dict(vals)
         if up and dn:
@@ -57,7 +63,7 @@ def jacobian(obj: Objective, vals: dict[str, float], names: list[str]) -> NDArra
         else:
             vm[k] = v - h
             d = (f0 - obj.model_values(vm)) / h
-        J[:, j] = -obj.sw * d
+        J[:, j] = -sw * d
     return J
 
 

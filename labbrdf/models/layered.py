@@ -1,0 +1,472 @@
+"""A rough dielectric coating over a rough conductor, evaluated by the Monte Carlo tracer.
+
+Objects layer: the BRDF is the M00 element of :func:`labbrdf.tracer.trace` in single
+scattering with the evaluated estimator (Dong et al. 2022 sec. 2.3, ``docs/tracer.md``),
+one trace per distinct incidence (and wavelength) of the points asked for, on a coarse
+grid, interpolated to the points. Every trace uses the same seed whatever the parameters
+(common random numbers), so the BRDF is a deterministic and nearly smooth function of the
+parameters and a fit can use it like a closed-form model; its Monte Carlo error enters the
+fit through :meth:`Layered.point_variance` (``docs/models.md``, "The layered model").
+
+References
+----------
+.. [1] Dong Y. et al., "Monte Carlo polarization ray tracing of coated rough surfaces",
+   2022, sec. 2.3 (the layered walk); see :mod:`labbrdf.tracer`.
+.. [2] Walter B., Marschner S. R., Li H., Torrance K. E., "Microfacet models for refraction
+   through rough surfaces", Proc. EGSR 2007, eqs. (20), (21), (33), (34).
+   doi:10.2312/EGWR/EGSR07/195-206
+"""
+
+from __future__ import annotations
+
+import math
+from collections import OrderedDict
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .base import Model, ModelError, Parameters
+
+__all__ = ["Layered"]
+
+_BASES = ("conductor",)
+#: traces kept per model instance (two small maps each): a fit's Jacobian and polish come
+#: back to the same parameter values several times
+_CACHE_SIZE = 64
+#: grid steps [deg] the tracer accepts (divisors of 90 and of 360)
+_THETA_STEPS = (1.0, 2.0, 3.0, 5.0, 6.0)
+_PHI_STEPS = (2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0)
+
+
+def _auto_step(spacing: float, steps: tuple[float, ...]) -> float:
+    """The largest allowed step not above half the data's angular spacing [deg]."""
+    ok = [s for s in steps if s <= spacing / 2.0]
+    return max(ok) if ok else steps[0]
+
+
+class Layered(Model):
+    """Rough dielectric coating over a rough conductor, by the tracer (single scattering).
+
+    Other Parameters
+    ----------------
+    n, k : float
+        Complex index N = n + ik of the conductor substrate [1] (``--nk-from FILE`` sets
+        them at the file's wavelength).
+    base : {"conductor"}, default "conductor"
+        What lies under the coating.
+    coherent : bool, default False
+        The tracer's coherent mode (:mod:`labbrdf.tracer`): coating and substrate as one
+        rough interface whose facets carry a conformal film, reflecting with the Airy
+        amplitudes; adds the parameter ``thickness_nm`` and drops ``alpha_sub`` (the facets
+        use ``alpha_top``). Without it the coating is a separate rough layer whose
+        thickness enters only through Beer-Lambert absorption (``coating_k``).
+    coating_k : float, default 0
+        Extinction coefficient of the coating [1].
+    thickness_nm : float, default 1000
+        Coating thickness [nm] of the incoherent model (a parameter in coherent mode).
+    floor : bool, default False
+        Add a Lambertian floor ``kd / pi`` [sr^-1] (linear; profiled by the fit).
+    rays : int, default 20000
+        Rays per trace. On a 3 x 6 degree grid 2e4 rays give a relative standard error of
+        about 1 % of the BRDF over the lobe (``docs/models.md``).
+    seed : int, default 0
+        Seed of every trace (common random numbers: the same for all parameter values).
+    grid : "auto" or (float, float), default "auto"
+        Tracer bin steps (theta, phi) [deg]; "auto" derives them from the number of points
+        per incidence of the first evaluation (:meth:`_set_grid`; at most 6 x 12 degrees).
+    wavelength_nm : float, default 550
+        Wavelength [nm] for points that carry none.
+
+    Parameters: ``n_coat`` [1] in [1.2, 2.2], fixed at 1.5 by default (``--free n_coat``);
+    ``alpha_top`` [1] in [0.02, 1] (log), GGX roughness of the coating's top;
+    ``alpha_sub`` [1] in [0.02, 1] (log), GGX roughness of the conductor (incoherent);
+    ``thickness_nm`` [nm] in [0, 2000] (coherent only); ``kd`` [1] in [0, 1] with ``floor``.
+
+    Notes
+    -----
+    The tracer bins the exit directions; the model's value at a point is the bilinear
+    interpolation (in theta_r and periodic phi_r) of the cos-weighted bin averages at the
+    bin centres. Against the point value of the BRDF this has a bias of order
+    ``h^2 f'' / 8``, which is why "auto" keeps the bins at most half the data's spacing.
+    Single scattering (the separable Smith G1 G1 per interface) loses energy for rough
+    interfaces; the multiple-scattering walk would count rays, whose noise no fit can
+    use (``docs/tracer.md``).
+    """
+
+    name = "layered"
+    reference = (
+        "Dong Y. et al. 2022 (layered Monte Carlo polarization walk, sec. 2.3); Walter B. "
+        "et al., EGSR 2007 (GGX, Smith G1, rough-dielectric BTDF); evaluated estimator with "
+        "common random numbers"
+    )
+    doi = "10.2312/EGWR/EGSR07/195-206"
+    reciprocity_note = (
+        "layered is reciprocal up to its Monte Carlo error in the incoherent mode (the "
+        "walk's interfaces are reciprocal, the estimate of each direction pair is not "
+        "symmetrised); the coherent film and the Lambertian floor are reciprocal."
+    )
+    linear: tuple[str, ...] = ()
+    #: common random numbers make the traced BRDF smooth on scales above ~1e-3 of a
+    #: parameter's range (below it, single rays changing bins show as small jumps)
+    fd_rel_step = 3e-3
+
+    def __init__(
+        self,
+        n: float | None = None,
+        k: float | None = None,
+        base: str = "conductor",
+        coherent: bool = False,
+        coating_k: float = 0.0,
+        thickness_nm: float = 1000.0,
+        floor: bool = False,
+        rays: int = 20_000,
+        seed: int = 0,
+        grid: str | tuple[float, float] = "auto",
+        wavelength_nm: float = 550.0,
+        **options: Any,
+    ) -> None:
+        if options:
+            raise ModelError(
+                f"model 'layered' got unknown options {sorted(options)}; options are "
+                "['n', 'k', 'base', 'coherent', 'coating_k', 'thickness_nm', 'floor', "
+                "'rays', 'seed', 'grid', 'wavelength_nm']"
+            )
+        if base not in _BASES:
+            raise ModelError(f"layered option 'base' must be one of {list(_BASES)}; got {base!r}")
+        self._base = base
+        self._coherent = _flag(coherent, "coherent")
+        self._floor = _flag(floor, "floor")
+        if base == "conductor":
+            if n is None:
+                raise ModelError(
+                    "layered with base='conductor' needs the substrate index n= (and k=), "
+                    "e.g. --nk-from FILE or --param n=1.55 --param k=7.71"
+                )
+            kk = 0.0 if k is None else k
+            if not (_real(n) and _real(kk) and n >= 0 and kk >= 0 and (n > 0 or kk > 0)):
+                raise ModelError(
+                    f"layered options n, k must be finite, >= 0 and not both 0; got "
+                    f"n={n!r}, k={kk!r}"
+                )
+            self._nk = (float(n), float(kk))
+        if not (_real(coating_k) and coating_k >= 0):
+            raise ModelError(f"layered option 'coating_k' must be >= 0; got {coating_k!r}")
+        if not (_real(thickness_nm) and thickness_nm > 0):
+            raise ModelError(f"layered option 'thickness_nm' must be > 0; got {thickness_nm!r}")
+        if not (_real(rays) and float(rays).is_integer() and 1000 <= rays <= 10_000_000):
+            raise ModelError(
+                f"layered option 'rays' must be an integer in [1000, 1e7]; got {rays!r}"
+            )
+        if not (_real(seed) and float(seed).is_integer() and seed >= 0):
+            raise ModelError(f"layered option 'seed' must be an integer >= 0; got {seed!r}")
+        if not (_real(wavelength_nm) and wavelength_nm > 0):
+            raise ModelError(f"layered option 'wavelength_nm' must be > 0; got {wavelength_nm!r}")
+        self._grid: tuple[float, float] | None = None
+        if grid != "auto":
+            try:
+                dt, dp = (float(v) for v in grid)
+            except (TypeError, ValueError):
+                raise ModelError(
+                    f"layered option 'grid' must be 'auto' or (theta_step, phi_step) [deg]; "
+                    f"got {grid!r}"
+                ) from None
+            if dt not in _THETA_STEPS or dp not in _PHI_STEPS:
+                raise ModelError(
+                    f"layered option 'grid': theta step must be one of {list(_THETA_STEPS)} "
+                    f"and phi step one of {list(_PHI_STEPS)} [deg]; got {grid!r}"
+                )
+            self._grid = (dt, dp)
+        self._coating_k = float(coating_k)
+        self._thickness = float(thickness_nm)
+        self._rays = int(rays)
+        self._seed = int(seed)
+        self._wl_default = float(wavelength_nm)
+        self._cache: OrderedDict[tuple, tuple[NDArray, NDArray]] = OrderedDict()
+        self._operators: OrderedDict[str, Any] = OrderedDict()  # exit operators in memory
+        self.traces = 0  # traces run (cache misses), for benchmarks
+        opts: dict[str, Any] = {"base": base, "rays": self._rays, "seed": self._seed}
+        if base == "conductor":
+            opts.update(n=self._nk[0], k=self._nk[1])
+        if self._coherent:
+            opts["coherent"] = True
+        else:
+            opts["thickness_nm"] = self._thickness
+        if self._coating_k:
+            opts["coating_k"] = self._coating_k
+        if self._floor:
+            opts["floor"] = True
+            self.linear = ("kd",)
+        opts["grid"] = "auto" if self._grid is None else f"{self._grid[0]:g}x{self._grid[1]:g}"
+        super().__init__(**opts)
+
+    def default_params(self) -> Parameters:
+        """n_coat 1.5 (fixed), alpha_top 0.2, alpha_sub 0.2 or thickness_nm 500, kd 0."""
+        p = Parameters()
+        p.add(
+            "n_coat",
+            1.5,
+            1.2,
+            2.2,
+            vary=False,
+            units="1",
+            description="refractive index of the coating",
+        )
+        p.add(
+            "alpha_top",
+            0.2,
+            0.02,
+            1.0,
+            units="1",
+            log=True,
+            description="GGX roughness of the coating's top",
+        )
+        if self._coherent:
+            p.add("thickness_nm", 500.0, 0.0, 2000.0, units="nm", description="film thickness")
+        elif self._base == "conductor":
+            p.add(
+                "alpha_sub",
+                0.2,
+                0.02,
+                1.0,
+                units="1",
+                log=True,
+                description="GGX roughness of the conductor",
+            )
+        if self._floor:
+            p.add("kd", 0.0, 0.0, 1.0, units="1", description="Lambertian floor albedo")
+        return p
+
+    def lobe_width(self, p: Mapping[str, float]) -> float:
+        """Angular scale of the lobe in theta_r [rad] (a quadrature hint): ``2 alpha_top``."""
+        return 2.0 * float(p["alpha_top"])
+
+    def guess(self, theta_i: NDArray, theta_r: NDArray, value: NDArray) -> dict[str, float]:
+        """``kd`` from the lowest quarter of the data (with a floor), else nothing."""
+        if not self._floor or value.size == 0:
+            return {}
+        return {"kd": float(np.clip(math.pi * np.percentile(value, 10), 1e-3, 0.9))}
+
+    # ------------------------------------------------------------------ tracing
+    def _config(self, p: Mapping[str, float], theta_i_deg: float, wl: float) -> Any:
+        from ..tracer import Coating, Substrate, TraceConfig
+
+        n_coat, a_top = float(p["n_coat"]), float(p["alpha_top"])
+        for name, v, lo in (("n_coat", n_coat, 0.0), ("alpha_top", a_top, 0.0)):
+            if not (math.isfinite(v) and v > lo):
+                raise ModelError(f"layered parameter {name!r} must be > {lo:g}; got {v!r}")
+        thick = float(p["thickness_nm"]) if self._coherent else self._thickness
+        coat = Coating(n=n_coat, k=self._coating_k, thickness_nm=thick, alpha=a_top)
+        a_sub = a_top if self._coherent else float(p["alpha_sub"])
+        sub = Substrate(n=self._nk[0], k=self._nk[1], alpha=a_sub)
+        assert self._grid is not None
+        return TraceConfig(
+            wavelength_nm=wl,
+            theta_i_deg=theta_i_deg,
+            substrate=sub,
+            coating=coat,
+            rays=self._rays,
+            seed=self._seed,
+            scattering="single",
+            estimator="evaluated",
+            coherent=self._coherent,
+            theta_step_deg=self._grid[0],
+            phi_step_deg=self._grid[1],
+        )
+
+    def _key_params(self, p: Mapping[str, float]) -> tuple[float, ...]:
+        names = ("n_coat", "alpha_top", "alpha_sub", "thickness_nm")
+        return tuple(float(p[k]) for k in names if k in self.params)
+
+    def trace_maps(
+        self, p: Mapping[str, float], theta_i_deg: float, wavelength_nm: float
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """S0 BRDF map and its standard error, each (n_theta, n_phi) [sr^-1], cached.
+
+        Unpolarized incidence; the tracer's grid (:attr:`grid_deg`); the floor not added.
+        """
+        from ..tracer import trace
+        from ..tracer.operator import memory_cache
+
+        key = (self._key_params(p), round(float(theta_i_deg), 9), float(wavelength_nm))
+        hit = self._cache.get(key)
+        if hit is not None:
+            self._cache.move_to_end(key)
+            return hit
+        try:
+            cfg = self._config(p, float(theta_i_deg), float(wavelength_nm))
+        except ValueError as exc:
+            raise ModelError(f"layered: {exc}") from None
+        with memory_cache(self._operators):
+            res = trace(cfg)
+        self.traces += 1
+        se = res.mueller_stderr
+        out = (np.asarray(res.mueller[..., 0, 0], float), np.asarray(se[..., 0, 0], float))
+        self._cache[key] = out
+        if len(self._cache) > _CACHE_SIZE:
+            self._cache.popitem(last=False)
+        return out
+
+    @property
+    def grid_deg(self) -> tuple[float, float] | None:
+        """Tracer bin steps (theta, phi) [deg]; None until "auto" has seen data."""
+        return self._grid
+
+    def _set_grid(self, theta_i_deg: NDArray) -> None:
+        """Tracer steps from the data's density (once, at the first evaluation).
+
+        M points per incidence sample 2 pi sr at a spacing of about ``sqrt(2 pi / M)``;
+        theta gets half of it, phi all of it (an azimuth degree is shorter than a polar one
+        by sin theta).
+        """
+        if self._grid is not None:
+            return
+        n_inc = max(np.unique(np.round(theta_i_deg, 9)).size, 1)
+        per = max(theta_i_deg.size / n_inc, 1.0)
+        spacing = math.degrees(math.sqrt(2.0 * math.pi / per))
+        dt = _auto_step(spacing, _THETA_STEPS)
+        dp = _auto_step(2.0 * spacing, _PHI_STEPS)
+        self._grid = (dt, dp)
+        self.options["grid"] = f"{dt:g}x{dp:g}"
+
+    def _maps_at(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> tuple[NDArray, NDArray]:
+        """(value, standard error) of the traced part at every point [sr^-1]."""
+        ti_deg = np.degrees(theta_i)
+        tr_deg = np.degrees(theta_r)
+        pr_deg = np.mod(np.degrees(phi_r), 360.0)
+        self._set_grid(np.broadcast_to(ti_deg, tr_deg.shape).ravel())
+        assert self._grid is not None
+        wl = (
+            np.full(ti_deg.shape, self._wl_default)
+            if wavelength is None
+            else np.broadcast_to(np.asarray(wavelength, float), ti_deg.shape)
+        )
+        wl = np.where(np.isfinite(wl), wl, self._wl_default)
+        if not np.all((ti_deg >= 0) & (ti_deg < 90)):
+            raise ModelError("layered: the tracer needs incidence angles in [0, 90) deg")
+        val = np.zeros(ti_deg.shape)
+        err = np.zeros(ti_deg.shape)
+        up = (tr_deg >= 0) & (tr_deg <= 90)
+        dt, dp = self._grid
+        pairs = np.unique(np.stack([np.round(ti_deg, 9).ravel(), wl.ravel()], axis=1), axis=0)
+        for t, w in pairs:
+            sel = up & (np.round(ti_deg, 9) == t) & (wl == w)
+            if not sel.any():
+                continue
+            f, se = self.trace_maps(p, float(t), float(w))
+            val[sel], err[sel] = _bilinear(f, se, tr_deg[sel] / dt, pr_deg[sel] / dp)
+        return val, err
+
+    # ------------------------------------------------------------------ model API
+    def _evaluate(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> NDArray:
+        val, _ = self._maps_at(p, theta_i, theta_r, phi_r, wavelength)
+        if self._floor:
+            val = val + p["kd"] * _lambert(theta_i, theta_r)
+        return val
+
+    def linear_components(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> dict[str, NDArray] | None:
+        """``{"kd": 1 / pi}`` with ``floor`` (the traced part is not linear in anything)."""
+        if not self._floor:
+            return None
+        return {"kd": np.broadcast_to(_lambert(theta_i, theta_r), np.shape(theta_r)).copy()}
+
+    def point_variance(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> NDArray[np.float64]:
+        """Monte Carlo variance of :meth:`evaluate` at every point [sr^-2].
+
+        The square of the bilinear interpolation of the tracer's per-bin standard errors
+        (batch spread, ``docs/tracer.md``): exact when neighbouring bins' errors are fully
+        correlated, an upper bound otherwise.
+        """
+        _, err = self._maps_at(p, theta_i, theta_r, phi_r, wavelength)
+        return err * err
+
+    def hemispherical(
+        self, theta_i_deg: ArrayLike, params: Mapping[str, float] | None = None
+    ) -> NDArray[np.float64] | None:
+        """The traced albedo [1] (S0 map integrated over the hemisphere) plus ``kd``."""
+        from ..tracer import trace
+        from ..tracer.operator import memory_cache
+
+        p = self.values(params)
+        if self._grid is None:
+            self._grid = (2.0, 4.0)
+            self.options["grid"] = "2x4"
+        out = []
+        for t in np.atleast_1d(np.asarray(theta_i_deg, float)):
+            with memory_cache(self._operators):
+                res = trace(self._config(p, float(t), self._wl_default))
+            out.append(res.albedo() + (p["kd"] if self._floor else 0.0))
+        return np.asarray(out, float).reshape(np.shape(theta_i_deg))
+
+
+def _flag(v: Any, name: str) -> bool:
+    if isinstance(v, bool):
+        return v
+    if isinstance(v, str) and v.lower() in ("true", "false"):
+        return v.lower() == "true"
+    raise ModelError(f"layered option {name!r} must be true or false; got {v!r}")
+
+
+def _real(v: Any) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _lambert(theta_i: NDArray, theta_r: NDArray) -> NDArray:
+    """``1 / pi`` [sr^-1] where both directions are above the surface, else 0."""
+    up = (np.cos(theta_i) > 0) & (np.cos(theta_r) > 0)
+    return np.where(up, 1.0 / np.pi, 0.0)
+
+
+def _bilinear(
+    f: NDArray, se: NDArray, u: NDArray, v: NDArray
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Bilinear interpolation of two (n_theta, n_phi) maps at fractional bin indices.
+
+    ``u`` = theta / step, clipped to the polar range; ``v`` = phi / step, periodic.
+    """
+    nt, nph = f.shape
+    u = np.clip(u, 0.0, nt - 1.0)
+    i0 = np.minimum(np.floor(u).astype(int), nt - 2)
+    a = u - i0
+    j0 = np.floor(v).astype(int) % nph
+    b = v - np.floor(v)
+    j1 = (j0 + 1) % nph
+
+    def at(m: NDArray) -> NDArray:
+        return (
+            (1 - a) * (1 - b) * m[i0, j0]
+            + (1 - a) * b * m[i0, j1]
+            + a * (1 - b) * m[i0 + 1, j0]
+            + a * b * m[i0 + 1, j1]
+        )
+
+    return at(f), at(se)
