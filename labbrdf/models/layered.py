@@ -73,9 +73,10 @@ class Layered(Model):
         about 1 % of the BRDF over the lobe (``docs/models.md``).
     seed : int, default 0
         Seed of every trace (common random numbers: the same for all parameter values).
-    grid : "auto" or (float, float), default "auto"
-        Tracer bin steps (theta, phi) [deg]; "auto" derives them from the number of points
-        per incidence of the first evaluation (:meth:`_set_grid`; at most 6 x 12 degrees).
+    grid : "auto", "THETAxPHI" or (float, float), default "auto"
+        Tracer bin steps (theta, phi) [deg], e.g. "3x6"; "auto" derives them from the
+        number of points per incidence of the first evaluation (:meth:`_set_grid`; at
+        most 6 x 12 degrees).
     wavelength_nm : float, default 550
         Wavelength [nm] for points that carry none.
 
@@ -165,11 +166,13 @@ class Layered(Model):
             raise ModelError(f"layered option 'wavelength_nm' must be > 0; got {wavelength_nm!r}")
         self._grid: tuple[float, float] | None = None
         if grid != "auto":
+            parts = grid.lower().split("x") if isinstance(grid, str) else grid
             try:
-                dt, dp = (float(v) for v in grid)
+                dt, dp = (float(v) for v in parts)
             except (TypeError, ValueError):
                 raise ModelError(
-                    f"layered option 'grid' must be 'auto' or (theta_step, phi_step) [deg]; "
+                    "layered option 'grid' must be 'auto', 'THETAxPHI' or (theta_step, "
+                    "phi_step) [deg]; "
                     f"got {grid!r}"
                 ) from None
             if dt not in _THETA_STEPS or dp not in _PHI_STEPS:
@@ -406,7 +409,11 @@ class Layered(Model):
         (batch spread, ``docs/tracer.md``): exact when neighbouring bins' errors are fully
         correlated, an upper bound otherwise.
         """
-        _, err = self._maps_at(p, theta_i, theta_r, phi_r, wavelength)
+        q = self.values(p)  # missing names take the current values
+        ti, tr, pr = np.broadcast_arrays(
+            np.asarray(theta_i, float), np.asarray(theta_r, float), np.asarray(phi_r, float)
+        )
+        _, err = self._maps_at(q, ti, tr, pr, wavelength)
         return err * err
 
     def hemispherical(
