@@ -700,7 +700,7 @@ def fit(
         rmse=float(np.sqrt(np.mean(resid**2))),
         rmse_pct=rmse_pct,
         weighted=bool(use_sigma),
-        weighting=obj.describe_weighting(weighting),
+        weighting=obj.describe_weighting(weighting, vals),
         nmasked=nmasked,
         success=bool(success),
         message=message,

@@ -210,11 +210,25 @@ class Objective:
         var = self.model.point_variance(vals, self.ti, self.tr, self.pr, self.wl)
         return 1.0 / np.sqrt(1.0 / self.w + np.asarray(var, float))
 
-    def describe_weighting(self, weighting: str) -> str:
-        """``weighting`` (the words of the fit result), plus the model's noise if added."""
-        if not self.model_noise:
+    def describe_weighting(self, weighting: str, vals: Mapping[str, float]) -> str:
+        """``weighting`` (the words of the fit result) and how the model's noise entered.
+
+        With :attr:`model_noise` the variance was added; a model with a variance fitted
+        with uniform or relative weights has its noise in the residual scatter that scales
+        the covariance, and the words give its median size relative to the model.
+        """
+        if self.model_noise:
+            return f"{weighting} + the model's Monte Carlo variance (in quadrature, per point)"
+        var = self.model.point_variance(vals, self.ti, self.tr, self.pr, self.wl)
+        if var is None:
             return weighting
-        return f"{weighting} + the model's Monte Carlo variance (in quadrature, per point)"
+        f = np.abs(self.model_values(vals))
+        ok = f > 0
+        rel = float(np.median(np.sqrt(np.asarray(var, float)[ok]) / f[ok])) if ok.any() else 0.0
+        return (
+            f"{weighting}; the model's Monte Carlo error (median {100 * rel:.2g} % of the "
+            "model) is part of the residual scatter that scales the covariance"
+        )
 
     def model_values(self, vals: Mapping[str, float]) -> NDArray[np.float64]:
         """The model at every data point for full parameter values ``vals``.
