@@ -137,9 +137,10 @@ class Objective:
         self.w = np.asarray(weights, float)
         self.sw = np.sqrt(self.w)
         self.base = {k: p.value for k, p in params.items()}
-        wl1 = None if self.wl is None else self.wl[:1]
+        # a model that overrides point_variance has a noise of its own (not evaluated here:
+        # a Monte Carlo model's first evaluation may fix its grid from the points it sees)
         self.model_noise = bool(absolute) and (
-            model.point_variance(self.base, self.ti[:1], self.tr[:1], self.pr[:1], wl1) is not None
+            type(model).point_variance is not Model.point_variance
         )
         ps = [params[k] for k in self.names]
         self._log = np.array([p.log for p in ps], bool)
@@ -208,6 +209,8 @@ class Objective:
         if not self.model_noise:
             return self.sw
         var = self.model.point_variance(vals, self.ti, self.tr, self.pr, self.wl)
+        if var is None:
+            return self.sw
         return 1.0 / np.sqrt(1.0 / self.w + np.asarray(var, float))
 
     def describe_weighting(self, weighting: str, vals: Mapping[str, float]) -> str:
@@ -217,11 +220,11 @@ class Objective:
         with uniform or relative weights has its noise in the residual scatter that scales
         the covariance, and the words give its median size relative to the model.
         """
-        if self.model_noise:
-            return f"{weighting} + the model's Monte Carlo variance (in quadrature, per point)"
         var = self.model.point_variance(vals, self.ti, self.tr, self.pr, self.wl)
         if var is None:
             return weighting
+        if self.model_noise:
+            return f"{weighting} + the model's Monte Carlo variance (in quadrature, per point)"
         f = np.abs(self.model_values(vals))
         ok = f > 0
         rel = float(np.median(np.sqrt(np.asarray(var, float)[ok]) / f[ok])) if ok.any() else 0.0

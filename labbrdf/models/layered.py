@@ -1,7 +1,7 @@
 """A rough dielectric coating over a rough conductor, evaluated by the Monte Carlo tracer.
 
 Objects layer: the BRDF is the M00 element of :func:`labbrdf.tracer.trace` in single
-scattering with the evaluated estimator (Dong et al. 2022 sec. 2.3, ``docs/tracer.md``),
+scattering with the evaluated estimator ([1]_ sec. 2.3, ``docs/tracer.md``),
 one trace per distinct incidence (and wavelength) of the points asked for, on a coarse
 grid, interpolated to the points. Every trace uses the same seed whatever the parameters
 (common random numbers), so the BRDF is a deterministic and nearly smooth function of the
@@ -10,8 +10,10 @@ fit through :meth:`Layered.point_variance` (``docs/models.md``, "The layered mod
 
 References
 ----------
-.. [1] Dong Y. et al., "Monte Carlo polarization ray tracing of coated rough surfaces",
-   2022, sec. 2.3 (the layered walk); see :mod:`labbrdf.tracer`.
+.. [1] Dong Z., Bai P., Xu W., Liu Y., Sun X., "Modeling and characteristic analysis
+   methods for reflection polarization on coated surfaces", Acta Optica Sinica 42(22),
+   2224001 (2022), sec. 2.3 (the layered walk; see :mod:`labbrdf.tracer`).
+   doi:10.3788/AOS202242.2224001
 .. [2] Walter B., Marschner S. R., Li H., Torrance K. E., "Microfacet models for refraction
    through rough surfaces", Proc. EGSR 2007, eqs. (20), (21), (33), (34).
    doi:10.2312/EGWR/EGSR07/195-206
@@ -103,7 +105,8 @@ class Layered(Model):
 
     name = "layered"
     reference = (
-        "Dong Y. et al. 2022 (layered Monte Carlo polarization walk, sec. 2.3); Walter B. "
+        "Dong Z. et al., Acta Optica Sinica 42(22) 2224001, 2022 (layered walk, sec. 2.3); "
+        "Walter B. "
         "et al., EGSR 2007 (GGX, Smith G1, rough-dielectric BTDF); evaluated estimator with "
         "common random numbers"
     )
