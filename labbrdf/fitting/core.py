@@ -20,7 +20,7 @@ from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
 from .objective import Objective
 from .result import FitResult
-from .uncertainty import AT_BOUND_FRAC, jacobian, uncertainties
+from .uncertainty import AT_BOUND_FRAC, jacobian, noise_meat, uncertainties
 
 __all__ = [
     "ALGORITHMS",
@@ -634,8 +634,9 @@ def fit(
     resid = obj.y - best
     nfree = n_pts - nvarys
     redchi = chisqr / nfree
+    meat = noise_meat(obj, vals, J) if finite else None  # a Monte Carlo model's noise
     covar, stderr, correl, reasons, cond = uncertainties(
-        J, varying, vals, 1.0 if use_sigma else redchi, nfree
+        J, varying, vals, 1.0 if use_sigma else redchi, nfree, meat
     )
     out, flags = _fitted_params(p, vals, stderr, correl, reasons, nfree)
     warn = [f"{ndropped} point(s) with NaN/inf values dropped (nan_policy='omit')"] * (

@@ -16,6 +16,7 @@ __all__ = [
     "REL_STDERR_MAX",
     "REL_STDERR_POOR",
     "jacobian",
+    "noise_meat",
     "uncertainties",
 ]
 
@@ -67,8 +68,37 @@ def jacobian(obj: Objective, vals: dict[str, float], names: list[str]) -> NDArra
     return J
 
 
+def noise_meat(obj: Objective, vals: dict[str, float], J: NDArray) -> NDArray | None:
+    """``J^T S C S J`` of the sandwich covariance, for a model with correlated noise.
+
+    ``S = diag(sqrt(w_eff))`` are the residual weights actually used (data sigma and the
+    model's variance in quadrature, :meth:`Objective.point_sw`) and
+    ``C = diag(sigma^2) + sum_k n_k n_k^T`` the true covariance of data minus model, with
+    the model's noise components ``n_k`` (:meth:`labbrdf.models.Model.point_noise`).
+    Weighted least squares with weights that are not ``C^-1`` has the parameter covariance
+    ``H^-1 (J^T S C S J) H^-1``, ``H = J^T J`` (the sandwich, e.g. White 1980): the
+    quadrature weights treat the noise of neighbouring points as independent, the
+    sandwich does not. None where the weights are not the data's sigma or the model has
+    no noise components.
+    """
+    if not obj.model_noise:
+        return None
+    comps = obj.model.point_noise(vals, obj.ti, obj.tr, obj.pr, obj.wl)
+    if comps is None:
+        return None
+    sw = obj.point_sw(vals)
+    data_part = sw * sw / obj.w  # sigma^2 w_eff
+    g = J.T @ (np.asarray(comps, float) * sw).T  # (n, K)
+    return np.asarray((J * data_part[:, None]).T @ J + g @ g.T, float)
+
+
 def uncertainties(
-    J: NDArray, names: list[str], values: dict[str, float], scale: float, nfree: int
+    J: NDArray,
+    names: list[str],
+    values: dict[str, float],
+    scale: float,
+    nfree: int,
+    meat: NDArray | None = None,
 ) -> tuple[
     NDArray | None,
     dict[str, float | None],
@@ -76,7 +106,11 @@ def uncertainties(
     dict[str, list[str]],
     float | None,
 ]:
-    """Covariance, stderr, correlations and identifiability reasons from J."""
+    """Covariance, stderr, correlations and identifiability reasons from J.
+
+    With ``meat`` (:func:`noise_meat`) the covariance is the sandwich
+    ``H^-1 meat H^-1`` instead of ``scale H^-1``.
+    """
     n = len(names)
     reasons: dict[str, list[str]] = {k: [] for k in names}
     stderr: dict[str, float | None] = {k: None for k in names}
@@ -109,6 +143,8 @@ def uncertainties(
                         )
         Ci = np.linalg.pinv(C, rcond=1.0 / COND_MAX, hermitian=True)
         sub = Ci / np.outer(d[idx], d[idx]) * scale
+        if meat is not None:
+            sub = sub @ meat[np.ix_(idx, idx)] @ sub / (scale * scale)
         covar[np.ix_(idx, idx)] = sub
     for j, k in enumerate(names):
         if not ok[j] or not covar[j, j] > 0 or any("singular" in r for r in reasons[k]):

@@ -216,6 +216,23 @@ class Model(ABC):
         """
         return None
 
+    def point_noise(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> NDArray | None:
+        """Components n_k (K, ...) of the model's own noise [sr^-1], or None.
+
+        The noise covariance between points is ``sum_k n_k n_k^T`` (its diagonal is
+        :meth:`point_variance`). A fit weighted by the data's sigma uses it for the
+        parameters' covariance (``labbrdf.fitting.uncertainty.noise_meat``). The default
+        (a closed-form model) has none.
+        """
+        return None
+
     def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:
         """Whether f(i, r) == f(r, i) for these parameter values."""
         return False

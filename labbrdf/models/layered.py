@@ -319,9 +319,10 @@ class Layered(Model):
     def trace_maps(
         self, p: Mapping[str, float], theta_i_deg: float, wavelength_nm: float
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """S0 BRDF map and its standard error, each (n_theta, n_phi) [sr^-1], cached.
+        """S0 BRDF map (n_theta, n_phi) and its batch deviations (B, n_theta, n_phi) [sr^-1].
 
-        Unpolarized incidence; the tracer's grid (:attr:`grid_deg`); the floor not added.
+        Unpolarized incidence; the tracer's grid (:attr:`grid_deg`); the floor not added;
+        cached. The deviations' squares sum to the squared standard error of each bin.
         """
         from ..tracer import trace
         from ..tracer.operator import memory_cache
@@ -338,8 +339,14 @@ class Layered(Model):
         with memory_cache(self._operators):
             res = trace(cfg)
         self.traces += 1
-        se = res.mueller_stderr
-        out = (np.asarray(res.mueller[..., 0, 0], float), np.asarray(se[..., 0, 0], float))
+        f = np.asarray(res.mueller[..., 0, 0], float)
+        assert res.batch_mueller is not None  # the evaluated estimator keeps its batches
+        # batch deviations d_b = sqrt(N_b / (N (B - 1))) (f_b - f): sum_b d_b^2 is the
+        # tracer's squared standard error, sum_b d_b(x) d_b(y) the covariance of two bins
+        nb = np.asarray(res.block_rays, float)
+        scale = np.sqrt(nb / (nb.sum() * (nb.size - 1)))[:, None, None]
+        dev = scale * (np.asarray(res.batch_mueller[..., 0, 0], float) - f)
+        out = (f, dev)
         self._cache[key] = out
         if len(self._cache) > _CACHE_SIZE:
             self._cache.popitem(last=False)
@@ -375,7 +382,7 @@ class Layered(Model):
         phi_r: NDArray,
         wavelength: NDArray | None,
     ) -> tuple[NDArray, NDArray]:
-        """(value, standard error) of the traced part at every point [sr^-1]."""
+        """Traced part at every point and its batch deviations (B, ...) [sr^-1]."""
         ti_deg = np.degrees(theta_i)
         tr_deg = np.degrees(theta_r)
         pr_deg = np.mod(np.degrees(phi_r), 360.0)
@@ -390,7 +397,7 @@ class Layered(Model):
         if not np.all((ti_deg >= 0) & (ti_deg < 90)):
             raise ModelError("layered: the tracer needs incidence angles in [0, 90) deg")
         val = np.zeros(ti_deg.shape)
-        err = np.zeros(ti_deg.shape)
+        dev: NDArray | None = None
         up = (tr_deg >= 0) & (tr_deg <= 90)
         dt, dp = self._grid
         pairs = np.unique(np.stack([np.round(ti_deg, 9).ravel(), wl.ravel()], axis=1), axis=0)
@@ -398,9 +405,13 @@ class Layered(Model):
             sel = up & (np.round(ti_deg, 9) == t) & (wl == w)
             if not sel.any():
                 continue
-            f, se = self.trace_maps(p, float(t), float(w))
-            val[sel], err[sel] = _bilinear(f, se, tr_deg[sel] / dt, pr_deg[sel] / dp)
-        return val, err
+            f, d = self.trace_maps(p, float(t), float(w))
+            if dev is None:
+                dev = np.zeros((d.shape[0], *ti_deg.shape))
+            u, v = tr_deg[sel] / dt, pr_deg[sel] / dp
+            val[sel] = _bilinear(f, u, v)
+            dev[:, sel] = _bilinear(d, u, v)
+        return val, np.zeros((1, *ti_deg.shape)) if dev is None else dev
 
     # ------------------------------------------------------------------ model API
     def _evaluate(
@@ -429,6 +440,28 @@ class Layered(Model):
             return None
         return {"kd": np.broadcast_to(_lambert(theta_i, theta_r), np.shape(theta_r)).copy()}
 
+    def point_noise(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> NDArray[np.float64]:
+        """Monte Carlo error components (B, ...) [sr^-1]: covariance ``sum_b n_b n_b^T``.
+
+        The bilinear interpolation of each batch's deviation from the mean map, scaled so
+        that the squares sum to the squared standard error (``docs/tracer.md``, standard
+        errors). Interpolation is linear, so these are exactly the error components of the
+        interpolated values, with the correlations between points that share bins or
+        rays (the exit operator spreads each ray over the top interface's lobe).
+        """
+        q = self.values(p)  # missing names take the current values
+        ti, tr, pr = np.broadcast_arrays(
+            np.asarray(theta_i, float), np.asarray(theta_r, float), np.asarray(phi_r, float)
+        )
+        return self._maps_at(q, ti, tr, pr, wavelength)[1]
+
     def point_variance(
         self,
         p: Mapping[str, float],
@@ -439,16 +472,11 @@ class Layered(Model):
     ) -> NDArray[np.float64]:
         """Monte Carlo variance of :meth:`evaluate` at every point [sr^-2].
 
-        The square of the bilinear interpolation of the tracer's per-bin standard errors
-        (batch spread, ``docs/tracer.md``): exact when neighbouring bins' errors are fully
-        correlated, an upper bound otherwise.
+        The sum of squares of :meth:`point_noise` (the squared standard error from the
+        spread of the tracer's independent ray batches).
         """
-        q = self.values(p)  # missing names take the current values
-        ti, tr, pr = np.broadcast_arrays(
-            np.asarray(theta_i, float), np.asarray(theta_r, float), np.asarray(phi_r, float)
-        )
-        _, err = self._maps_at(q, ti, tr, pr, wavelength)
-        return err * err
+        n = self.point_noise(p, theta_i, theta_r, phi_r, wavelength)
+        return np.asarray(np.sum(n * n, axis=0), float)
 
     def hemispherical(
         self, theta_i_deg: ArrayLike, params: Mapping[str, float] | None = None
@@ -487,27 +515,22 @@ def _lambert(theta_i: NDArray, theta_r: NDArray) -> NDArray:
     return np.where(up, 1.0 / np.pi, 0.0)
 
 
-def _bilinear(
-    f: NDArray, se: NDArray, u: NDArray, v: NDArray
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Bilinear interpolation of two (n_theta, n_phi) maps at fractional bin indices.
+def _bilinear(m: NDArray, u: NDArray, v: NDArray) -> NDArray[np.float64]:
+    """Bilinear interpolation of maps (..., n_theta, n_phi) at fractional bin indices.
 
     ``u`` = theta / step, clipped to the polar range; ``v`` = phi / step, periodic.
     """
-    nt, nph = f.shape
+    nt, nph = m.shape[-2:]
     u = np.clip(u, 0.0, nt - 1.0)
     i0 = np.minimum(np.floor(u).astype(int), nt - 2)
     a = u - i0
     j0 = np.floor(v).astype(int) % nph
     b = v - np.floor(v)
     j1 = (j0 + 1) % nph
-
-    def at(m: NDArray) -> NDArray:
-        return (
-            (1 - a) * (1 - b) * m[i0, j0]
-            + (1 - a) * b * m[i0, j1]
-            + a * (1 - b) * m[i0 + 1, j0]
-            + a * b * m[i0 + 1, j1]
-        )
-
-    return at(f), at(se)
+    return np.asarray(
+        (1 - a) * (1 - b) * m[..., i0, j0]
+        + (1 - a) * b * m[..., i0, j1]
+        + a * (1 - b) * m[..., i0 + 1, j0]
+        + a * b * m[..., i0 + 1, j1],
+        float,
+    )

@@ -68,3 +68,30 @@ def test_model_variance_is_not_added_without_the_data_sigma():
     assert res.weighting.startswith("uniform; the model's Monte Carlo error (median ")
     ref = fit(_NoisyLine(None), d, method="LN_BOBYQA", weighting="uniform")
     assert res.chisqr == pytest.approx(ref.chisqr, rel=1e-10)
+
+
+class _OffsetNoiseLine(_NoisyLine):
+    """f = a x with one fully correlated noise component: a common offset of size ``s``."""
+
+    def point_noise(self, p, theta_i, theta_r, phi_r, wavelength):
+        return np.full((1, *np.shape(theta_r)), math.sqrt(self.var))
+
+    def point_variance(self, p, theta_i, theta_r, phi_r, wavelength):
+        return np.sum(self.point_noise(p, theta_i, theta_r, phi_r, wavelength) ** 2, axis=0)
+
+
+def test_correlated_model_noise_enters_through_the_sandwich_covariance():
+    """A common offset s on every point: var(a) = sigma^2 / Sx2 + s^2 (Sx)^2 / Sx2^2.
+
+    The least-squares slope through the origin moves by Sx delta / Sx2 for an offset
+    delta; treating the offset as independent per point (quadrature only) would give
+    (sigma^2 + s^2) / Sx2 instead, several times smaller here.
+    """
+    sigma, var = 0.01, 3e-4
+    d = _data(sigma)
+    x = np.radians(np.asarray(d.theta_r_deg))
+    sx, sx2 = float(x.sum()), float(x @ x)
+    res = fit(_OffsetNoiseLine(var), d, method="LN_BOBYQA")
+    expected = math.sqrt(sigma**2 / sx2 + var * sx**2 / sx2**2)
+    assert res.params["a"].stderr == pytest.approx(expected, rel=1e-4)
+    assert expected > 2 * math.sqrt((sigma**2 + var) / sx2)
