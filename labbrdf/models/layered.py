@@ -90,7 +90,8 @@ class Layered(Model):
     Parameters: ``n_coat`` [1] in [1.2, 2.2], fixed at 1.5 by default (``--free n_coat``);
     ``alpha_top`` [1] in [0.02, 1] (log), GGX roughness of the coating's top;
     ``alpha_sub`` [1] in [0.02, 1] (log), GGX roughness of the conductor (incoherent);
-    ``thickness_nm`` [nm] in [0, 2000] (coherent only); ``kd`` [1] in [0, 1] with ``floor``.
+    ``thickness_nm`` [nm] in [0, 2000] (coherent only); ``scale`` [1] in [0, 10], fixed at
+    1 (free it for relative data; linear); ``kd`` [1] in [0, 1] with ``floor`` (linear).
 
     Notes
     -----
@@ -118,8 +119,9 @@ class Layered(Model):
     )
     linear: tuple[str, ...] = ()
     #: common random numbers make the traced BRDF smooth on scales above ~1e-3 of a
-    #: parameter's range (below it, single rays changing bins show as small jumps)
-    fd_rel_step = 3e-3
+    #: parameter's range (below it, single rays changing bins show as small jumps); None
+    #: in the coherent mode, whose map is evaluated in closed form
+    fd_rel_step: float | None = 3e-3
 
     def __init__(
         self,
@@ -146,6 +148,8 @@ class Layered(Model):
             raise ModelError(f"layered option 'base' must be one of {list(_BASES)}; got {base!r}")
         self._base = base
         self._coherent = _flag(coherent, "coherent")
+        if self._coherent:
+            self.fd_rel_step = None
         self._floor = _flag(floor, "floor")
         if base == "conductor":
             if n is None:
@@ -206,14 +210,18 @@ class Layered(Model):
             opts["thickness_nm"] = self._thickness
         if self._coating_k:
             opts["coating_k"] = self._coating_k
+        self.linear = ("scale",)
         if self._floor:
             opts["floor"] = True
-            self.linear = ("kd",)
+            self.linear = ("scale", "kd")
         opts["grid"] = "auto" if self._grid is None else f"{self._grid[0]:g}x{self._grid[1]:g}"
         super().__init__(**opts)
 
     def default_params(self) -> Parameters:
-        """n_coat 1.5 (fixed), alpha_top 0.2, alpha_sub 0.2 or thickness_nm 500, kd 0."""
+        """Defaults: n_coat 1.5 (fixed), alpha_top and alpha_sub 0.2, scale 1 (fixed), kd 0.
+
+        Coherent mode: thickness_nm 500 instead of alpha_sub.
+        """
         p = Parameters()
         p.add(
             "n_coat",
@@ -245,6 +253,15 @@ class Layered(Model):
                 log=True,
                 description="GGX roughness of the conductor",
             )
+        p.add(
+            "scale",
+            1.0,
+            0.0,
+            10.0,
+            vary=False,
+            units="1",
+            description="overall factor of the traced part (relative data)",
+        )
         if self._floor:
             p.add("kd", 0.0, 0.0, 1.0, units="1", description="Lambertian floor albedo")
         return p
@@ -423,6 +440,7 @@ class Layered(Model):
         wavelength: NDArray | None,
     ) -> NDArray:
         val, _ = self._maps_at(p, theta_i, theta_r, phi_r, wavelength)
+        val = p["scale"] * val
         if self._floor:
             val = val + p["kd"] * _lambert(theta_i, theta_r)
         return val
@@ -435,10 +453,12 @@ class Layered(Model):
         phi_r: NDArray,
         wavelength: NDArray | None,
     ) -> dict[str, NDArray] | None:
-        """``{"kd": 1 / pi}`` with ``floor`` (the traced part is not linear in anything)."""
-        if not self._floor:
-            return None
-        return {"kd": np.broadcast_to(_lambert(theta_i, theta_r), np.shape(theta_r)).copy()}
+        """``{"scale": traced part, "kd": 1 / pi}`` (``kd`` with ``floor`` only)."""
+        val, _ = self._maps_at(p, theta_i, theta_r, phi_r, wavelength)
+        out = {"scale": np.broadcast_to(val, np.shape(theta_r)).copy()}
+        if self._floor:
+            out["kd"] = np.broadcast_to(_lambert(theta_i, theta_r), np.shape(theta_r)).copy()
+        return out
 
     def point_noise(
         self,
@@ -460,7 +480,7 @@ class Layered(Model):
         ti, tr, pr = np.broadcast_arrays(
             np.asarray(theta_i, float), np.asarray(theta_r, float), np.asarray(phi_r, float)
         )
-        return self._maps_at(q, ti, tr, pr, wavelength)[1]
+        return q["scale"] * self._maps_at(q, ti, tr, pr, wavelength)[1]
 
     def point_variance(
         self,

@@ -19,11 +19,11 @@ def _points(theta_i_deg: float = 45.0, n: int = 40) -> tuple[np.ndarray, ...]:
 def test_layered_is_registered_and_names_its_parameters():
     m = models.get("layered", **AL)
     assert "layered" in models.names()
-    assert list(m.params) == ["n_coat", "alpha_top", "alpha_sub"]
+    assert list(m.params) == ["n_coat", "alpha_top", "alpha_sub", "scale"]
     assert not m.params["n_coat"].vary
     coh = models.get("layered", coherent=True, floor=True, **AL)
-    assert list(coh.params) == ["n_coat", "alpha_top", "thickness_nm", "kd"]
-    assert coh.linear == ("kd",)
+    assert list(coh.params) == ["n_coat", "alpha_top", "thickness_nm", "scale", "kd"]
+    assert coh.linear == ("scale", "kd")
 
 
 @pytest.mark.parametrize(
