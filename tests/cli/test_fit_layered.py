@@ -81,3 +81,22 @@ def test_fit_layered_errors_exit_2_with_the_reason(microfacet_bsdf, capsys, extr
     err = capsys.readouterr().err
     assert words in err
     assert "Traceback" not in err
+
+
+def test_residual_maps_are_drawn_for_the_fitted_group(microfacet_bsdf, tmp_path, capsys):
+    """--residual-maps writes a PNG of measured, model and residual per incidence."""
+    png = tmp_path / "maps.png"
+    argv = ["fit", str(microfacet_bsdf), "--model", "layered", *AL, "--param", "coherent=true"]
+    argv += ["--fix", "thickness_nm=0", "--residual-maps", str(png)]
+    assert main(argv) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert png.stat().st_size > 10_000
+
+
+def test_residual_maps_refuse_several_groups(microfacet_bsdf, tmp_path, capsys):
+    png = tmp_path / "maps.png"
+    argv = ["fit", str(microfacet_bsdf), "--model", "microfacet", *AL, "--by", "theta_i_deg"]
+    argv += ["--residual-maps", str(png)]
+    assert main(argv) == 2
+    assert "--residual-maps draws one fitted group; 2 were fitted" in capsys.readouterr().err
+    assert not png.exists()
