@@ -118,6 +118,10 @@ class Layered(Model):
         "symmetrised); the coherent film and the Lambertian floor are reciprocal."
     )
     linear: tuple[str, ...] = ()
+    #: none: on the specular line each roughness still sets the peak's height (the GGX
+    #: D(0) = 1 / (pi alpha^2) of its interface), so specular-only data constrain both,
+    #: if weakly and correlated; the fitting core's correlation flags show it
+    specular_line_shape: tuple[str, ...] = ()
     #: common random numbers make the traced BRDF smooth on scales above ~1e-3 of a
     #: parameter's range (below it, single rays changing bins show as small jumps); None
     #: in the coherent mode, whose map is evaluated in closed form
