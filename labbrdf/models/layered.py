@@ -367,6 +367,10 @@ class Layered(Model):
         nb = np.asarray(res.block_rays, float)
         scale = np.sqrt(nb / (nb.sum() * (nb.size - 1)))[:, None, None]
         dev = scale * (np.asarray(res.batch_mueller[..., 0, 0], float) - f)
+        if not np.any(res.mueller_stderr[..., 0, 0]):
+            # no Monte Carlo part (a bare or coherent first surface): the batch maps are
+            # the same map, and only their float32 storage differs from f
+            dev = np.zeros_like(dev)
         out = (f, dev)
         self._cache[key] = out
         if len(self._cache) > _CACHE_SIZE:
