@@ -595,7 +595,11 @@ def _tri(panel: Mapping[str, Any], z: np.ndarray) -> tuple[Any, np.ndarray]:
     return tri, np.where(bad, 0.0, zt)
 
 
-def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
+def brdf_maps_figure(
+    panels: Sequence[Mapping[str, Any]],
+    title: str = "",
+    model_label: str = "model (per-incidence fit)",
+) -> str:
     """Measured BRDF, fitted model and relative residual per angle of incidence (one row each).
 
     Parameters
@@ -604,6 +608,8 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
         ``{"label": str, "theta_r": array [deg], "phi_r": array [deg], "measured": array
         [sr^-1], "model": array [sr^-1], "residual": array [1]}``.
     title : str
+    model_label : str
+        Heading of the model column.
 
     Returns
     -------
@@ -624,7 +630,7 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
         vmin = float(np.percentile(pos, 1)) if pos.size else 1e-3
         vmax = float(np.max(pos)) if pos.size else 1.0
         norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 10))
-        for j, (z, name) in enumerate(((meas, "measured"), (mod, "model (per-incidence fit)"))):
+        for j, (z, name) in enumerate(((meas, "measured"), (mod, model_label))):
             zz = np.where(z > 0, np.clip(z, vmin, None), np.nan)
             tri, zt = _tri(p, zz)
             ax = axes[i, j]
@@ -953,4 +959,4 @@ def fit_maps_figure(model: Any, params: Mapping[str, float], rows: Any, title: s
                 "residual": res,
             }
         )
-    return brdf_maps_figure(panels, title=title)
+    return brdf_maps_figure(panels, title=title, model_label="model (one fit, all incidences)")
