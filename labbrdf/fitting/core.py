@@ -634,9 +634,8 @@ def fit(
     resid = obj.y - best
     nfree = n_pts - nvarys
     redchi = chisqr / nfree
-    meat = noise_meat(obj, vals, J) if finite else None  # a Monte Carlo model's noise
     covar, stderr, correl, reasons, cond = uncertainties(
-        J, varying, vals, 1.0 if use_sigma else redchi, nfree, meat
+        J, varying, vals, 1.0 if use_sigma else redchi, nfree, noise_meat(obj, vals, J)
     )
     out, flags = _fitted_params(p, vals, stderr, correl, reasons, nfree)
     warn = [f"{ndropped} point(s) with NaN/inf values dropped (nan_policy='omit')"] * (

@@ -78,10 +78,10 @@ def noise_meat(obj: Objective, vals: dict[str, float], J: NDArray) -> NDArray | 
     Weighted least squares with weights that are not ``C^-1`` has the parameter covariance
     ``H^-1 (J^T S C S J) H^-1``, ``H = J^T J`` (the sandwich, e.g. White 1980): the
     quadrature weights treat the noise of neighbouring points as independent, the
-    sandwich does not. None where the weights are not the data's sigma or the model has
-    no noise components.
+    sandwich does not. None where the weights are not the data's sigma, the model has
+    no noise components or J is not finite.
     """
-    if not obj.model_noise:
+    if not obj.model_noise or not np.all(np.isfinite(J)):
         return None
     comps = obj.model.point_noise(vals, obj.ti, obj.tr, obj.pr, obj.wl)
     if comps is None:
