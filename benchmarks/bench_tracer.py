@@ -17,9 +17,12 @@ Prints:
    (S0 > 10 % of its maximum) estimated from two seeds, seconds per run including start-up
    (the exit operator built once, then read from the cache, both quoted), one process;
    the DOP standard error over the lobe; a full 91 x 360 map with its peak memory.
+6. the Lambertian base against the conductor under the same varnish (alpha 0.2, 60 deg,
+   multiple scattering, counting): rays/s and facet events per ray, one process.
 
-Usage: ``python benchmarks/bench_tracer.py [--quick] [--estimators]`` (``--quick`` uses
-1e6 rays for item 3; ``--estimators`` runs item 5 only).
+Usage: ``python benchmarks/bench_tracer.py [--quick] [--estimators] [--base]``
+(``--quick`` uses 1e6 rays for item 3; ``--estimators`` runs item 5 only, ``--base``
+item 6 only).
 """
 
 from __future__ import annotations
@@ -122,10 +125,30 @@ def estimators() -> None:
     )
 
 
+def base() -> None:
+    """Item 6: the Lambertian base's cost against the conductor's, same coating."""
+    print("6. Lambertian base (albedo 0.8) vs Al under varnish, 60 deg, multiple, counting")
+    for name, cfg in (
+        ("coated Al", COATED.replace(estimator="counting")),
+        ("coated base", COATED.replace(substrate=Substrate.lambertian(0.8))),
+        ("bare Al", ROUGH_MULTI),
+        ("bare base", ROUGH_MULTI.replace(substrate=Substrate.lambertian(0.8))),
+    ):
+        rate, t = _best_rate(cfg, 200_000)
+        res = trace(cfg.replace(rays=200_000))
+        print(
+            f"   {name:12s} {rate:12,.0f} rays/s; {res.events / res.rays:5.2f} events/ray; "
+            f"albedo {res.albedo():.4f}"
+        )
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if "--estimators" in argv:
         estimators()
+        return 0
+    if "--base" in argv:
+        base()
         return 0
     quick = "--quick" in argv
     pmap = functools.partial(parallel.imap, scheduler="processes", workers=2)
@@ -165,6 +188,7 @@ def main(argv: list[str] | None = None) -> int:
             f"speed-up {rates[name] / loop:6.0f}x (one core each)"
         )
     estimators()
+    base()
     return 0
 
 

@@ -1189,33 +1189,59 @@ def _complex(text: str, what: str) -> complex:
         raise UsageError(f"{what} {text!r}: expected a complex index like 1.55+7.71j") from None
 
 
+def _base_substrate(args: argparse.Namespace, tracer: Any) -> Any:
+    """``--base-albedo``: a Lambertian base, refusing the conductor's options."""
+    metal = {
+        "--substrate": args.substrate,
+        "--nk-from": args.nk_from,
+        "--alpha": args.alpha,
+        "--surface": args.surface,
+    }
+    given = [name for name, value in metal.items() if value is not None]
+    if given:
+        raise UsageError(f"--base-albedo replaces the metal substrate: drop {', '.join(given)}")
+    coated = args.coating is not None or args.coating_from is not None
+    if coated and args.coating_alpha is None and args.coating_surface is None:
+        raise UsageError(
+            "--base-albedo with a coating needs its roughness: --coating-alpha A or "
+            "--coating-surface FILE (there is no substrate alpha to default to)"
+        )
+    try:
+        return tracer.Substrate.lambertian(args.base_albedo)
+    except ValueError as exc:
+        raise UsageError(f"--base-albedo: {exc}") from None
+
+
 @_executor_errors
 def cmd_trace(args: argparse.Namespace) -> int:
 
     from . import tracer
 
     executor = _executor(args, progress=not args.json)  # outputs checked by _checked_outputs
-    if (args.substrate is None) == (args.nk_from is None):
-        raise UsageError("give the substrate index with --substrate N+Kj or --nk-from FILE")
-    if args.nk_from is not None:
-        n, k = _nk_at(_nk_combined(args.nk_from), args.wavelength, args.nk_from)
-        sub = complex(n, k)
+    if args.base_albedo is not None:
+        substrate = _base_substrate(args, tracer)
     else:
-        sub = _complex(args.substrate, "--substrate")
-    if args.surface is not None:
-        hm = _height_map(args.surface, args.channel, args)
-        try:
-            substrate = tracer.Substrate.from_surface(
-                hm.heights, hm.pixel_size, n=sub.real, k=sub.imag
+        if (args.substrate is None) == (args.nk_from is None):
+            raise UsageError("give the substrate index with --substrate N+Kj or --nk-from FILE")
+        if args.nk_from is not None:
+            n, k = _nk_at(_nk_combined(args.nk_from), args.wavelength, args.nk_from)
+            sub = complex(n, k)
+        else:
+            sub = _complex(args.substrate, "--substrate")
+        if args.surface is not None:
+            hm = _height_map(args.surface, args.channel, args)
+            try:
+                substrate = tracer.Substrate.from_surface(
+                    hm.heights, hm.pixel_size, n=sub.real, k=sub.imag
+                )
+            except ValueError as exc:
+                raise UsageError(f"{args.surface}: {exc}") from None
+        elif args.alpha is None:
+            raise UsageError("give the substrate roughness with --alpha A or --surface FILE")
+        else:
+            substrate = tracer.Substrate(
+                n=sub.real, k=sub.imag, alpha=args.alpha, ndf=_analytic_table(args, args.alpha)
             )
-        except ValueError as exc:
-            raise UsageError(f"{args.surface}: {exc}") from None
-    elif args.alpha is None:
-        raise UsageError("give the substrate roughness with --alpha A or --surface FILE")
-    else:
-        substrate = tracer.Substrate(
-            n=sub.real, k=sub.imag, alpha=args.alpha, ndf=_analytic_table(args, args.alpha)
-        )
     kw: dict[str, Any] = {
         "wavelength_nm": args.wavelength,
         "theta_i_deg": args.theta_i,
@@ -1632,6 +1658,14 @@ def _trace_parser(sub: Any) -> None:
         help="measured height map: its slope table",
     )
     s.add_argument("--channel", default=None, help="height channel of --surface")
+    s.add_argument(
+        "--base-albedo",
+        type=float,
+        default=None,
+        metavar="A",
+        help="a Lambertian base of albedo A in [0, 1] instead of the metal substrate "
+        "(paints, plastics: with --coating and --coating-alpha)",
+    )
     _add_geometry(s)
     s.add_argument("--coating", default=None, help="coating index, e.g. 1.5")
     s.add_argument(

@@ -27,6 +27,10 @@ implemented):
 * bins centred on the 91 x 360 one-degree grid, bin-averaged BRDF normalised by the
   cos-weighted solid angle (:mod:`.binning`).
 
+Beyond the paper: the substrate may be a Lambertian base instead of the conductor
+(:meth:`Substrate.lambertian`; paints and plastics under a clear layer), a depolarizing
+diffuse reflector re-emitting with the cosine law (``docs/tracer.md``).
+
 Determinism: the rays are split into blocks of ``config.block_rays``; block b draws from
 ``numpy.random.SeedSequence([seed, b])``. Consecutive blocks form fold groups of
 ``config.fold_blocks``; a group's tally is the sum of its blocks' tallies in block order,

@@ -31,7 +31,12 @@ def _finite(x: Any) -> bool:
 
 @dataclass(frozen=True)
 class Substrate:
-    """Opaque substrate: complex index N = n + ik and GGX roughness (or a tabulated NDF).
+    """Opaque substrate: a rough conductor (N = n + ik, GGX or tabulated NDF) or a diffuse base.
+
+    Two kinds (:attr:`kind`): ``"conductor"`` (the default; ``"mirror"`` with
+    ``mirror=True``), whose facets reflect with the Fresnel matrix of ``n + ik``, and
+    ``"lambertian"`` (``albedo`` given, see :meth:`lambertian`): a flat, depolarizing,
+    diffusely reflecting base, as under a paint's or a plastic's clear layer.
 
     Parameters
     ----------
@@ -47,6 +52,12 @@ class Substrate:
         Tabulated slope distribution replacing GGX on the substrate (its D, Smith Lambda
         and visible-normal sampling); None = GGX with ``alpha`` (the original path, bit for
         bit). Not combinable with ``TraceConfig(coherent=True)``.
+    albedo : float or None
+        Lambertian base of this albedo [1], in [0, 1]; None = the conductor. A ray reaching
+        the base leaves it with its Mueller matrix multiplied by ``albedo * diag(1, 0, 0,
+        0)`` in a cosine-distributed direction (``docs/tracer.md``); ``n``, ``k`` and
+        ``alpha`` are then unused (``alpha`` = 0, ``n``, ``k`` at their defaults), and
+        ``mirror``, ``ndf`` and ``TraceConfig(coherent=True)`` are refused.
     """
 
     n: float = 1.55
@@ -54,6 +65,31 @@ class Substrate:
     alpha: float = 0.2
     mirror: bool = False
     ndf: TabulatedNDF | None = None
+    albedo: float | None = None
+
+    @classmethod
+    def lambertian(cls, albedo: float) -> Substrate:
+        """A Lambertian (diffuse, depolarizing) base of albedo ``albedo`` [1] in [0, 1].
+
+        Bare (no coating) its BRDF is ``albedo / pi`` [sr^-1] in every direction.
+        """
+        return cls(alpha=0.0, albedo=albedo)
+
+    @property
+    def kind(self) -> str:
+        """``"lambertian"``, ``"mirror"`` or ``"conductor"``."""
+        if self.albedo is not None:
+            return "lambertian"
+        return "mirror" if self.mirror else "conductor"
+
+    def describe(self) -> str:
+        """One line for people: the kind and its parameters."""
+        if self.albedo is not None:
+            return f"Lambertian base, albedo {self.albedo:g}"
+        if self.mirror:
+            return f"ideal mirror, alpha {self.alpha:g}"
+        table = ", slope table" if self.ndf is not None else ""
+        return f"N = {self.n:g}+{self.k:g}i, alpha {self.alpha:g}{table}"
 
     @classmethod
     def from_surface(
@@ -111,11 +147,14 @@ class Substrate:
             "alpha": self.alpha,
             "mirror": self.mirror,
             "ndf": None if self.ndf is None else self.ndf.to_dict(),
+            "albedo": self.albedo,
         }
 
     def __post_init__(self) -> None:
         if isinstance(self.ndf, dict):
             object.__setattr__(self, "ndf", TabulatedNDF.from_dict(self.ndf))
+        if self.albedo is not None:
+            self._check_base()
         _check(
             self.ndf is None or isinstance(self.ndf, TabulatedNDF),
             "substrate.ndf",
@@ -131,10 +170,31 @@ class Substrate:
             self.alpha,
         )
         _check(
-            self.mirror or complex(self.n, self.k) != 0,
+            self.mirror or self.albedo is not None or complex(self.n, self.k) != 0,
             "substrate n + ik",
             "non-zero (or mirror=True)",
             (self.n, self.k),
+        )
+
+    def _check_base(self) -> None:
+        """Validation of the Lambertian kind (its own fields and what it excludes)."""
+        _check(
+            _finite(self.albedo) and 0 <= self.albedo <= 1,  # type: ignore[operator]
+            "substrate.albedo",
+            "a finite number in [0, 1] (or None for the conductor)",
+            self.albedo,
+        )
+        _check(
+            not self.mirror,
+            "substrate.mirror",
+            "False with a Lambertian base (albedo given)",
+            self.mirror,
+        )
+        _check(
+            self.ndf is None,
+            "substrate.ndf",
+            "None with a Lambertian base (albedo given: the base is flat)",
+            type(self.ndf).__name__,
         )
 
 
@@ -377,16 +437,10 @@ class TraceConfig:
             self.estimator != "evaluated" or self.evaluated_applies,
             "estimator",
             "'counting' or 'auto' here: 'evaluated' needs scattering='single' and a rough "
-            "first interface (alpha > 0; a GGX coating top, not a table)",
+            "first interface (alpha > 0; a GGX coating top, not a table), or a bare "
+            "Lambertian base",
             self.estimator,
         )
-        _check(
-            not self.coherent or self.coating is not None,
-            "coherent",
-            "False when there is no coating",
-            self.coherent,
-        )
-
         # the incoherent walk treats the coating as a separate rough layer between two
         # interfaces, which never reduces to the bare substrate; a 0 nm layer is no layer
         _check(
@@ -397,24 +451,26 @@ class TraceConfig:
             "substrate)",
             None if self.coating is None else self.coating.thickness_nm,
         )
-        _check(
-            not (self.coherent and self.substrate.ndf is not None),
-            "coherent",
-            "False with a tabulated substrate NDF (the coherent facets use the coating's alpha)",
-            self.coherent,
+        if self.coherent:
+            self._check_coherent()
+
+    def _check_coherent(self) -> None:
+        """What ``coherent=True`` needs: a coating on a conductor's GGX facets."""
+        _check(self.coating is not None, "coherent", "False when there is no coating", True)
+        why = (
+            (self.substrate.albedo is not None, "a Lambertian base (it has no film amplitudes)"),
+            (
+                self.substrate.ndf is not None,
+                "a tabulated substrate NDF (the coherent facets use the coating's alpha)",
+            ),
+            (
+                self.coating is not None and self.coating.ndf is not None,
+                "a tabulated coating NDF (the coherent facets are GGX)",
+            ),
+            (self.substrate.mirror, "an ideal-mirror substrate (the film needs n + ik)"),
         )
-        _check(
-            not (self.coherent and self.coating is not None and self.coating.ndf is not None),
-            "coherent",
-            "False with a tabulated coating NDF (the coherent facets are GGX)",
-            self.coherent,
-        )
-        _check(
-            not (self.coherent and self.substrate.mirror),
-            "coherent",
-            "False with an ideal-mirror substrate (the film needs n + ik)",
-            self.coherent,
-        )
+        for bad, what in why:
+            _check(not bad, "coherent", f"False with {what}", True)
 
     @property
     def evaluated_applies(self) -> bool:
@@ -422,8 +478,11 @@ class TraceConfig:
 
         It needs single scattering (the multiple-scattering walk's exits are counted) and a
         rough first interface (the coating's top, or the substrate, or the coherent facets),
-        whose reflection has a closed form; a coating's top must be GGX.
+        whose reflection has a closed form; a coating's top must be GGX. A bare Lambertian
+        base is its own closed form (``albedo / pi``) in either scattering mode.
         """
+        if self.coating is None and self.substrate.albedo is not None:
+            return True
         if self.scattering != "single":
             return False
         if self.coating is not None:

@@ -85,9 +85,11 @@ def first_surface_point(
     -------
     ndarray, shape (n, 4, 4)
     """
+    t, p = np.radians(np.asarray(theta_r_deg, float)), np.radians(np.asarray(phi_r_deg, float))
+    if _bare_base(cfg):
+        return _lambert(cfg, t.shape)
     abcs, d_of, g1_of, _ = _first_surface(cfg)
     th = np.radians(cfg.theta_i_deg)
-    t, p = np.radians(np.asarray(theta_r_deg, float)), np.radians(np.asarray(phi_r_deg, float))
     wo = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)])
     M = reflection_mueller(
         np.array([-np.sin(th), 0.0, -np.cos(th)]), np.array([0.0, 1.0, 0.0]), wo, abcs, d_of, g1_of
@@ -109,6 +111,8 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
     """
     su = _Setup(cfg)
     grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
+    if _bare_base(cfg):
+        return _lambert(cfg, (grid.n_theta, grid.n_phi))
     th = np.radians(cfg.theta_i_deg)
     k_in = np.array([-np.sin(th), 0.0, -np.cos(th)])
     s_in = np.array([0.0, 1.0, 0.0])
@@ -147,6 +151,21 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
         m00 = f[..., 0, 0].copy()
         f[...] = 0.0
         f[..., 0, 0] = m00
+    return f
+
+
+def _bare_base(cfg: TraceConfig) -> bool:
+    return cfg.coating is None and cfg.substrate.albedo is not None
+
+
+def _lambert(cfg: TraceConfig, shape: tuple[int, ...]) -> NDArray[np.float64]:
+    """A bare Lambertian base: ``albedo / pi * diag(1, 0, 0, 0)`` [sr^-1], exactly.
+
+    A constant's cos-weighted bin average is the constant, so bins and points agree.
+    """
+    assert cfg.substrate.albedo is not None
+    f = np.zeros((*shape, 4, 4))
+    f[..., 0, 0] = cfg.substrate.albedo / np.pi
     return f
 
 

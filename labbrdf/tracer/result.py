@@ -129,10 +129,7 @@ class TraceResult:
         c = self.config
         facts = [
             ("wavelength [nm], theta_i [deg]", f"{c.wavelength_nm:g}, {c.theta_i_deg:g}"),
-            (
-                "substrate",
-                f"N = {c.substrate.n:g}+{c.substrate.k:g}i, alpha {c.substrate.alpha:g}",
-            ),
+            ("substrate", c.substrate.describe()),
             (
                 "coating",
                 "none"

@@ -17,7 +17,10 @@ One step, for every live ray:
    exit and binning; down out of the top interface -> across the coating to the substrate;
    up out of the substrate under a coating -> across the coating to the top interface from
    below. Crossing the coating multiplies M by the Beer-Lambert factor
-   ``exp(-4 pi k_c d / (lambda |cos theta|))``.
+   ``exp(-4 pi k_c d / (lambda |cos theta|))``. A Lambertian base (``Substrate.lambertian``)
+   has no microsurface: a ray reaching it is re-emitted at once (``albedo * diag(1, 0, 0,
+   0)``, cosine-distributed direction) and crosses back up in the same step; a bare base
+   sends every ray straight out.
 3. *Scatter* a hitting ray: a visible GGX normal (Heitz 2018 / Dupuy & Benyoub 2023), the
    frame rotated to the facet's s axis, Fresnel reflection (conductor; ideal mirror; or
    coherent film) or, at the dielectric top interface, reflection or refraction chosen with
@@ -112,6 +115,8 @@ class _Setup:
         self.ndf_top = coat.ndf if (coat is not None and self.layered) else None
         self.evaluated = cfg.resolved_estimator == "evaluated"
         self.scalar = bool(cfg.scalar)
+        # Lambertian base instead of the conductor's microsurface (None: the conductor)
+        self.albedo = sub.albedo
 
     def lambda_of(
         self,
@@ -249,15 +254,7 @@ def trace_block(
     grid = _grid(cfg)
     n = cfg.block_size(block)
     rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, block]))
-    th = np.radians(cfg.theta_i_deg)
-    k = np.zeros((3, n))
-    k[0] = -np.sin(th)
-    k[2] = -np.cos(th)
-    s = np.zeros((3, n))
-    s[1] = 1.0  # phi_hat(phi_i = 0)
-    M = np.zeros((4, 4, n))
-    for i in range(4):
-        M[i, i] = 1.0
+    k, s, M = _launch(cfg.theta_i_deg, n)
     iface = np.full(n, TOP if su.layered else SUB, dtype=np.int8)
     below = np.zeros(n, dtype=bool)
     h = np.full(n, np.inf)
@@ -273,9 +270,20 @@ def trace_block(
     ex_k: list[NDArray] = []
     ex_s: list[NDArray] = []
     ex_M: list[NDArray] = []
+    if su.albedo is not None and not su.layered:
+        # a bare Lambertian base: one base event, then every ray leaves
+        absorbed += _base_event(su.albedo, rng, np.arange(n), k, s, M)
+        events += n
+        if su.evaluated:
+            booked += float(M[0, 0].sum())  # its BRDF albedo / pi is the closed form
+        else:
+            ex_k.append(k)
+            ex_s.append(s)
+            ex_M.append(M)
+        k = k[:, :0]
 
     while k.shape[1]:
-        m_ = k.shape[1]
+        m_ = int(k.shape[1])
         alive = np.ones(m_, dtype=bool)
         kz_loc = np.where(below, -k[2], k[2])
         alpha = np.where(iface == TOP, su.alpha_top, su.alpha_sub)
@@ -308,24 +316,11 @@ def trace_block(
             if su.layered:
                 cross_ = leave & ~out
                 if cross_.any():
-                    ci = np.nonzero(cross_)[0]
-                    att = su.beer_lambert(k[2, ci])
-                    if att is not None:
-                        absorbed += float((M[0, 0, ci] * (1.0 - att)).sum())
-                        M[:, :, ci] *= att
-                    up = iface[ci] == SUB
-                    iface[ci] = np.where(up, TOP, SUB)
-                    below[ci] = up
-                    fresh[ci] = True
-                    if not su.single:
-                        # arrival height on the next microsurface (always a hit: the ray
-                        # travels towards it)
-                        kz_new = np.where(up, -k[2, ci], k[2, ci])
-                        a_new = np.where(up, su.alpha_top, su.alpha_sub)
-                        lam_new = su.lambda_of(k[:, ci], kz_new, ~up, a_new, up)
-                        _, h[ci] = sample_height(
-                            kz_new, lam_new, np.full(ci.size, np.inf), rng.random(ci.size)
-                        )
+                    ab, ev = _cross(su, rng, np.nonzero(cross_)[0], k, s, M, iface, below, h)
+                    absorbed += ab
+                    events += ev.size
+                    bounces[ev] += 1
+                    fresh[cross_] = True
 
         # max bounces: a ray that would need one more event is terminated
         over = alive & (bounces >= cfg.max_bounces)
@@ -400,22 +395,8 @@ def trace_block(
                     wr = np.where(trans, 0.0, 1.0 / np.where(trans, 1.0, pr))
                     wt = np.where(trans, 1.0 / np.where(trans, 1.0 - pr, 1.0), 0.0)
             if su.evaluated:
-                # the branch not followed, sampled, for the ledger only: the reflected
-                # ray of the entry, the transmitted ray of an internal event; both leave
-                # into the air with Smith G1 of their direction
-                entry = on_top & ~below
-                up_ = on_top & below
-                other = np.where(entry, 1.0, 0.0), np.where(up_, 1.0, 0.0)
-                w_o = (refl[0] * other[0] + tr[0] * other[1]) * M[0, 0] + (
-                    refl[1] * other[0] + tr[1] * other[1]
-                ) * M[1, 0]
-                kt_ = eta * k + (eta * cos_i - cos_t) * m
-                k_o = np.where(entry, kr, kt_)
-                k_o = k_o / np.sqrt((k_o * k_o).sum(axis=0))
-                g = np.where(
-                    entry | up_,
-                    su.g1_of(k_o, k_o[2], np.zeros_like(on_top), np.full(m_, su.alpha_top)),
-                    0.0,
+                w_o, g = _other_branch(
+                    su, k, m, kr, M, cos_i, (refl, tr, cos_t, eta), on_top, below
                 )
                 booked += float((w_o * g).sum())
                 terminated += float((w_o * (1.0 - g)).sum())
@@ -446,30 +427,7 @@ def trace_block(
             h = np.where(trans, -h, h)
 
         # 4. weight threshold / roulette
-        alive = np.ones(m_, dtype=bool)
-        if cfg.tau > 0:
-            low = M[0, 0] < cfg.tau
-            if low.any():
-                if cfg.termination == "threshold":
-                    terminated += float(M[0, 0, low].sum())
-                    alive &= ~low
-                else:
-                    idx = np.nonzero(low)[0]
-                    p = M[0, 0, idx] / cfg.tau
-                    survive = rng.random(idx.size) < p
-                    dead = idx[~survive]
-                    live = idx[survive]
-                    terminated += float(M[0, 0, dead].sum())
-                    before = M[0, 0, live].copy()
-                    M[:, :, live] /= p[survive]
-                    terminated += float((before - M[0, 0, live]).sum())
-                    alive[dead] = False
-        else:
-            dead = ~(M[0, 0] > 0)
-            if dead.any():
-                terminated += float(M[0, 0, dead].sum())
-                alive &= ~dead
-
+        alive, terminated = _weight_cut(cfg, rng, M, terminated)
         if not alive.all():
             k, s, M = k[:, alive], s[:, alive], M[:, :, alive]
             iface, below, h = iface[alive], below[alive], h[alive]
@@ -477,38 +435,8 @@ def trace_block(
 
     cell_keys = cell_sums = batch_rays = None
     if su.evaluated:
-        batch_rays = np.bincount(
-            (cfg.block_rays * block + np.arange(n)) % cfg.batches, minlength=cfg.batches
-        ).astype(np.int64)
-        if dep_key:
-            key = np.concatenate(dep_key)
-            rows_d = np.concatenate(dep_rows, axis=1)
-            nkeys = cfg.batches * grid.n_bins
-            cnt = np.bincount(key, minlength=nkeys)
-            cell_keys = np.flatnonzero(cnt)
-            dense = np.empty((16, nkeys))
-            for e in range(16):
-                dense[e] = np.bincount(key, weights=rows_d[e], minlength=nkeys)
-            cell_sums = dense[:, cell_keys].T.copy()
-        else:
-            cell_keys = np.zeros(0, dtype=np.int64)
-            cell_sums = np.zeros((0, 16))
-    # binning of the exits, in the LB exit frames phi_hat(phi)
-    if ex_k:
-        ke = np.concatenate(ex_k, axis=1)
-        se = np.concatenate(ex_s, axis=1)
-        Me = np.concatenate(ex_M, axis=2)
-        idx, phi = grid.index(ke)
-        s_det = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
-        rotate_frame(Me, ke, se, s_det)
-        rows = Me.reshape(16, -1)
-        sums, sumsq, counts = bin_exits(grid, idx, rows)
-        hemi = rows.sum(axis=1)
-    else:
-        nb = grid.n_bins
-        sums, sumsq = np.zeros((nb, 16)), np.zeros((nb, 16))
-        counts = np.zeros(nb, dtype=np.int64)
-        hemi = np.zeros(16)
+        cell_keys, cell_sums, batch_rays = _cell_tally(cfg, grid, block, n, dep_key, dep_rows)
+    sums, sumsq, counts, hemi = _bin_exit_rays(grid, ex_k, ex_s, ex_M)
     return BlockTally(
         block=block,
         rays=n,
@@ -524,6 +452,221 @@ def trace_block(
         cell_sums=cell_sums,
         batch_rays=batch_rays,
     )
+
+
+def _launch(
+    theta_i_deg: float, n: int
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Incident rays: direction, Stokes frame ``phi_hat(phi_i = 0)``, identity Mueller."""
+    th = np.radians(theta_i_deg)
+    k = np.zeros((3, n))
+    k[0] = -np.sin(th)
+    k[2] = -np.cos(th)
+    s = np.zeros((3, n))
+    s[1] = 1.0
+    M = np.zeros((4, 4, n))
+    for i in range(4):
+        M[i, i] = 1.0
+    return k, s, M
+
+
+def _other_branch(
+    su: _Setup,
+    k: NDArray[np.float64],
+    m: NDArray[np.float64],
+    kr: NDArray[np.float64],
+    M: NDArray[np.float64],
+    cos_i: NDArray[np.float64],
+    fresnel: tuple,
+    on_top: NDArray[np.bool_],
+    below: NDArray[np.bool_],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Evaluated walk: the branch not followed, sampled, for the ledger only.
+
+    The reflected ray of the entry, the transmitted ray of an internal top event; both
+    leave into the air with Smith G1 of their direction. Returns its M00 weight (before
+    masking; 0 for substrate events) and that G1 (0 where there is no such branch).
+    """
+    refl, tr, cos_t, eta = fresnel
+    entry = on_top & ~below
+    up_ = on_top & below
+    other = np.where(entry, 1.0, 0.0), np.where(up_, 1.0, 0.0)
+    w_o = (refl[0] * other[0] + tr[0] * other[1]) * M[0, 0] + (
+        refl[1] * other[0] + tr[1] * other[1]
+    ) * M[1, 0]
+    kt_ = eta * k + (eta * cos_i - cos_t) * m
+    k_o = np.where(entry, kr, kt_)
+    k_o = k_o / np.sqrt((k_o * k_o).sum(axis=0))
+    g = np.where(
+        entry | up_,
+        su.g1_of(k_o, k_o[2], np.zeros_like(on_top), np.full(k.shape[1], su.alpha_top)),
+        0.0,
+    )
+    return w_o, g
+
+
+def _weight_cut(
+    cfg: TraceConfig, rng: np.random.Generator, M: NDArray[np.float64], terminated: float
+) -> tuple[NDArray[np.bool_], float]:
+    """Step 4: the weight threshold ``tau`` or Russian roulette (in place on M).
+
+    Returns the rays that live on and ``terminated`` with the killed weight (and a
+    roulette survivor's boost, negative) added.
+    """
+    alive = np.ones(M.shape[2], dtype=bool)
+    if cfg.tau > 0:
+        low = M[0, 0] < cfg.tau
+        if low.any():
+            if cfg.termination == "threshold":
+                terminated += float(M[0, 0, low].sum())
+                alive &= ~low
+            else:
+                idx = np.nonzero(low)[0]
+                p = M[0, 0, idx] / cfg.tau
+                survive = rng.random(idx.size) < p
+                dead = idx[~survive]
+                live = idx[survive]
+                terminated += float(M[0, 0, dead].sum())
+                before = M[0, 0, live].copy()
+                M[:, :, live] /= p[survive]
+                terminated += float((before - M[0, 0, live]).sum())
+                alive[dead] = False
+    else:
+        dead = ~(M[0, 0] > 0)
+        if dead.any():
+            terminated += float(M[0, 0, dead].sum())
+            alive &= ~dead
+    return alive, terminated
+
+
+def _cell_tally(
+    cfg: TraceConfig,
+    grid: Grid,
+    block: int,
+    n: int,
+    dep_key: list[NDArray],
+    dep_rows: list[NDArray],
+) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]]:
+    """Evaluated estimator: the recorded up-going rays summed per (batch, cell).
+
+    Returns the occupied keys, their (n_keys, 16) Mueller sums and the rays per batch.
+    """
+    batch_rays = np.bincount(
+        (cfg.block_rays * block + np.arange(n)) % cfg.batches, minlength=cfg.batches
+    ).astype(np.int64)
+    if not dep_key:
+        return np.zeros(0, dtype=np.int64), np.zeros((0, 16)), batch_rays
+    key = np.concatenate(dep_key)
+    rows_d = np.concatenate(dep_rows, axis=1)
+    nkeys = cfg.batches * grid.n_bins
+    cnt = np.bincount(key, minlength=nkeys)
+    cell_keys = np.flatnonzero(cnt)
+    dense = np.empty((16, nkeys))
+    for e in range(16):
+        dense[e] = np.bincount(key, weights=rows_d[e], minlength=nkeys)
+    return cell_keys, dense[:, cell_keys].T.copy(), batch_rays
+
+
+def _bin_exit_rays(
+    grid: Grid, ex_k: list[NDArray], ex_s: list[NDArray], ex_M: list[NDArray]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64], NDArray[np.float64]]:
+    """Bin the exited rays in the LB exit frames ``phi_hat(phi)``.
+
+    Returns the per-bin sums and sums of squares (n_bins, 16), the counts and the
+    hemispherical sum (16,).
+    """
+    if not ex_k:
+        nb = grid.n_bins
+        return np.zeros((nb, 16)), np.zeros((nb, 16)), np.zeros(nb, dtype=np.int64), np.zeros(16)
+    ke = np.concatenate(ex_k, axis=1)
+    se = np.concatenate(ex_s, axis=1)
+    Me = np.concatenate(ex_M, axis=2)
+    idx, phi = grid.index(ke)
+    s_det = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+    rotate_frame(Me, ke, se, s_det)
+    rows = Me.reshape(16, -1)
+    sums, sumsq, counts = bin_exits(grid, idx, rows)
+    return sums, sumsq, counts, rows.sum(axis=1)
+
+
+def _cross(
+    su: _Setup,
+    rng: np.random.Generator,
+    ci: NDArray[np.int64],
+    k: NDArray[np.float64],
+    s: NDArray[np.float64],
+    M: NDArray[np.float64],
+    iface: NDArray[np.int8],
+    below: NDArray[np.bool_],
+    h: NDArray[np.float64],
+) -> tuple[float, NDArray[np.int64]]:
+    """Carry the rays ``ci`` across the coating to the other interface (in place).
+
+    Beer-Lambert along the way; a ray reaching a Lambertian base is re-emitted there
+    (:func:`_base_event`) and crosses back up in the same step, with the attenuation of
+    its new direction, to arrive at the top interface from below. With multiple
+    scattering the arrival height on the next microsurface is drawn (always a hit: the ray
+    travels towards it).
+
+    Returns
+    -------
+    absorbed : float
+        The M00 lost on the way (Beer-Lambert, the base's 1 - albedo).
+    base : ndarray of int
+        The rays that had a base event (one event each).
+    """
+    absorbed = 0.0
+    att = su.beer_lambert(k[2, ci])
+    if att is not None:
+        absorbed += float((M[0, 0, ci] * (1.0 - att)).sum())
+        M[:, :, ci] *= att
+    up = iface[ci] == SUB
+    base = ci[:0]
+    if su.albedo is not None and not up.all():
+        base = ci[~up]
+        absorbed += _base_event(su.albedo, rng, base, k, s, M)
+        att = su.beer_lambert(k[2, base])
+        if att is not None:
+            absorbed += float((M[0, 0, base] * (1.0 - att)).sum())
+            M[:, :, base] *= att
+        up[:] = True
+    iface[ci] = np.where(up, TOP, SUB)
+    below[ci] = up
+    if not su.single:
+        kz_new = np.where(up, -k[2, ci], k[2, ci])
+        a_new = np.where(up, su.alpha_top, su.alpha_sub)
+        lam_new = su.lambda_of(k[:, ci], kz_new, ~up, a_new, up)
+        _, h[ci] = sample_height(kz_new, lam_new, np.full(ci.size, np.inf), rng.random(ci.size))
+    return absorbed, base
+
+
+def _base_event(
+    albedo: float,
+    rng: np.random.Generator,
+    idx: NDArray[np.int64],
+    k: NDArray[np.float64],
+    s: NDArray[np.float64],
+    M: NDArray[np.float64],
+) -> float:
+    """Re-emit the rays ``idx`` from a Lambertian base (in place); returns the M00 absorbed.
+
+    The base is flat and depolarizing: ``M <- albedo * diag(1, 0, 0, 0) M`` (only the
+    intensity row survives, scaled by the albedo) and the new direction is drawn from the
+    cosine (Lambert) distribution over the upper hemisphere, ``cos theta = sqrt(1 - u1)``,
+    ``phi = 2 pi u2`` (Malley's method), so the reflected radiance is isotropic: the BRDF
+    is ``albedo / pi``. The Stokes frame is the meridional ``phi_hat(phi)`` (any frame
+    serves for an unpolarized ray).
+    """
+    u = rng.random((2, idx.size))
+    r = np.sqrt(u[0])
+    phi = 2.0 * np.pi * u[1]
+    absorbed = float(((1.0 - albedo) * M[0, 0, idx]).sum())
+    row = albedo * M[0][:, idx]
+    M[:, :, idx] = 0.0
+    M[0][:, idx] = row
+    k[:, idx] = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1.0 - u[0])])
+    s[:, idx] = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+    return absorbed
 
 
 def _scalar(abcs: tuple) -> tuple:
