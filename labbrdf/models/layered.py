@@ -1,4 +1,4 @@
-"""A rough dielectric coating over a rough conductor, evaluated by the Monte Carlo tracer.
+"""A rough dielectric coating over a rough conductor or a diffuse base, by the tracer.
 
 Objects layer: the BRDF is the M00 element of :func:`labbrdf.tracer.trace` in single
 scattering with the evaluated estimator ([1]_ sec. 2.3, ``docs/tracer.md``),
@@ -33,7 +33,7 @@ from .base import Model, ModelError, Parameters
 
 __all__ = ["Layered"]
 
-_BASES = ("conductor",)
+_BASES = ("conductor", "diffuse")
 #: traces kept per model instance (two small maps each): a fit's Jacobian and polish come
 #: back to the same parameter values several times
 _CACHE_SIZE = 64
@@ -54,15 +54,17 @@ def _auto_step(spacing: float, steps: tuple[float, ...]) -> float:
 
 
 class Layered(Model):
-    """Rough dielectric coating over a rough conductor, by the tracer (single scattering).
+    """Rough dielectric coating over a rough conductor or a Lambertian base, by the tracer.
 
     Other Parameters
     ----------------
     n, k : float
         Complex index N = n + ik of the conductor substrate [1] (``--nk-from FILE`` sets
         them at the file's wavelength).
-    base : {"conductor"}, default "conductor"
-        What lies under the coating.
+    base : {"conductor", "diffuse"}, default "conductor"
+        What lies under the coating: the rough conductor ``n + ik`` (parameter
+        ``alpha_sub``) or a flat Lambertian, depolarizing base (parameter ``albedo``;
+        paints, plastics, vinyls; :meth:`labbrdf.tracer.Substrate.lambertian`).
     coherent : bool, default False
         The tracer's coherent mode (:mod:`labbrdf.tracer`): coating and substrate as one
         rough interface whose facets carry a conformal film, reflecting with the Airy
@@ -90,6 +92,7 @@ class Layered(Model):
     Parameters: ``n_coat`` [1] in [1.2, 2.2], fixed at 1.5 by default (``--free n_coat``);
     ``alpha_top`` [1] in [0.02, 1] (log), GGX roughness of the coating's top;
     ``alpha_sub`` [1] in [0.02, 1] (log), GGX roughness of the conductor (incoherent);
+    ``albedo`` [1] in [0, 1], of the diffuse base;
     ``thickness_nm`` [nm] in [0, 2000] (coherent only); ``scale`` [1] in [0, 10], fixed at
     1 (free it for relative data; linear); ``kd`` [1] in [0, 1] with ``floor`` (linear).
 
@@ -155,6 +158,18 @@ class Layered(Model):
         if self._coherent:
             self.fd_rel_step = None
         self._floor = _flag(floor, "floor")
+        self._nk = (1.0, 0.0)
+        if base == "diffuse":
+            if n is not None or k is not None:
+                raise ModelError(
+                    "layered with base='diffuse' takes no substrate index n, k (they are the "
+                    "conductor's); leave out --nk-from and n=, k="
+                )
+            if self._coherent:
+                raise ModelError(
+                    "layered: coherent=True needs base='conductor' (the film's Airy "
+                    "amplitudes need the substrate's index)"
+                )
         if base == "conductor":
             if n is None:
                 raise ModelError(
@@ -206,6 +221,8 @@ class Layered(Model):
         self._operators: OrderedDict[str, Any] = OrderedDict()  # exit operators in memory
         self.traces = 0  # traces run (cache misses), for benchmarks
         opts: dict[str, Any] = {"base": base, "rays": self._rays, "seed": self._seed}
+        if self._wl_default != 550.0:
+            opts["wavelength_nm"] = self._wl_default
         if base == "conductor":
             opts.update(n=self._nk[0], k=self._nk[1])
         if self._coherent:
@@ -247,6 +264,8 @@ class Layered(Model):
         )
         if self._coherent:
             p.add("thickness_nm", 500.0, 0.0, 2000.0, units="nm", description="film thickness")
+        elif self._base == "diffuse":
+            p.add("albedo", 0.5, 0.0, 1.0, units="1", description="Lambertian base albedo")
         elif self._base == "conductor":
             p.add(
                 "alpha_sub",
@@ -282,9 +301,16 @@ class Layered(Model):
         tilt: the lobe's half width at half maximum above the floor is ``~1.3 alpha`` [rad]
         (near normal incidence). Measured per incidence along theta_r (all azimuths, so a
         lower bound on the width), median over incidences. ``kd`` with ``floor``: pi times
-        the 10th percentile of the data. ``{}`` where no incidence shows a peak.
+        the 10th percentile of the data. ``albedo`` of a diffuse base: ``pi n_coat^2``
+        times that percentile (a coated Lambertian base's floor is about
+        ``albedo T^2 / (pi n^2)``). No roughness where no incidence shows a peak.
         """
         out: dict[str, float] = {}
+        if self._base == "diffuse" and value.size:
+            # the floor of a coated Lambertian base is about albedo T^2 / (pi n^2)
+            n2 = float(self.params["n_coat"].value) ** 2
+            floor = math.pi * n2 * float(np.percentile(value, 10))
+            out["albedo"] = float(np.clip(floor, 0.02, 0.98))
         if self._floor and value.size:
             out["kd"] = float(np.clip(math.pi * np.percentile(value, 10), 1e-3, 0.9))
         widths = []
@@ -316,8 +342,11 @@ class Layered(Model):
                 raise ModelError(f"layered parameter {name!r} must be > {lo:g}; got {v!r}")
         thick = float(p["thickness_nm"]) if self._coherent else self._thickness
         coat = Coating(n=n_coat, k=self._coating_k, thickness_nm=thick, alpha=a_top)
-        a_sub = a_top if self._coherent else float(p["alpha_sub"])
-        sub = Substrate(n=self._nk[0], k=self._nk[1], alpha=a_sub)
+        if self._base == "diffuse":
+            sub = Substrate.lambertian(float(p["albedo"]))
+        else:
+            a_sub = a_top if self._coherent else float(p["alpha_sub"])
+            sub = Substrate(n=self._nk[0], k=self._nk[1], alpha=a_sub)
         assert self._grid is not None
         return TraceConfig(
             wavelength_nm=wl,
@@ -334,7 +363,7 @@ class Layered(Model):
         )
 
     def _key_params(self, p: Mapping[str, float]) -> tuple[float, ...]:
-        names = ("n_coat", "alpha_top", "alpha_sub", "thickness_nm")
+        names = ("n_coat", "alpha_top", "alpha_sub", "thickness_nm", "albedo")
         return tuple(float(p[k]) for k in names if k in self.params)
 
     def trace_maps(
