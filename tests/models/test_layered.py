@@ -24,6 +24,8 @@ def test_layered_is_registered_and_names_its_parameters():
     coh = models.get("layered", coherent=True, floor=True, **AL)
     assert list(coh.params) == ["n_coat", "alpha_top", "thickness_nm", "scale", "kd"]
     assert coh.linear == ("scale", "kd")
+    dif = models.get("layered", base="diffuse")
+    assert list(dif.params) == ["n_coat", "alpha_top", "albedo", "scale"]
 
 
 @pytest.mark.parametrize(
@@ -38,6 +40,8 @@ def test_layered_is_registered_and_names_its_parameters():
         ({"n": 0.0, "k": 0.0}, "not both 0"),
         ({"floor": "maybe", **AL}, "'floor' must be true or false"),
         ({"colour": 1, **AL}, "unknown options ['colour']"),
+        ({"base": "diffuse", **AL}, "takes no substrate index n, k"),
+        ({"base": "diffuse", "coherent": True}, "coherent=True needs base='conductor'"),
     ],
 )
 def test_bad_options_are_refused_by_name(options, words):
@@ -64,6 +68,22 @@ def test_coherent_zero_thickness_equals_the_closed_form_microfacet():
     np.testing.assert_allclose(f[big], g[big], rtol=5e-3)
     # no Monte Carlo in the coherent mode: no variance
     assert np.all(lay.point_variance(lay.values(), ti, tr, pr, None) == 0)
+
+
+def test_a_black_diffuse_base_leaves_the_closed_form_rough_dielectric():
+    """Albedo 0: only the coating's first-surface reflection is left, which is the
+    closed-form GGX microfacet model of the dielectric n = 1.5 (no Monte Carlo noise)."""
+    lay = models.get("layered", base="diffuse", grid="1x2")
+    mf = models.get("microfacet", n=1.5, k=0.0)
+    ti, tr, pr = _points(30.0, 60)
+    f = lay.evaluate(ti, tr, pr, params={"alpha_top": 0.3, "albedo": 0.0})
+    g = mf.evaluate(ti, tr, pr, params={"alpha": 0.3})
+    big = g > 0.05 * g.max()
+    assert big.sum() > 30
+    np.testing.assert_allclose(f[big], g[big], rtol=5e-3)
+    # a white base adds light everywhere, most where the first surface reflects least
+    w = lay.evaluate(ti, tr, pr, params={"alpha_top": 0.3, "albedo": 1.0})
+    assert np.all(w[big] > f[big])
 
 
 def test_common_random_numbers_make_the_brdf_a_deterministic_smooth_function():
