@@ -1419,8 +1419,8 @@ def _fit_parser(sub: Any) -> None:
         "--param",
         action="append",
         metavar="NAME=VALUE",
-        help="a model option (microfacet n=, k=, diffuse=true; five_param shadowing=mb) "
-        "or a parameter's starting value",
+        help="a model option (microfacet n=, k=, diffuse=true; five_param shadowing=mb; "
+        "layered base=diffuse, rays=, floor=true) or a parameter's starting value",
     )
     s.add_argument(
         "--free", action="append", metavar="NAME", help="vary a parameter fixed by default"
