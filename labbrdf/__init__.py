@@ -4,20 +4,25 @@ Everything a user needs is reachable from here; the names are imported lazily, o
 so that ``import labbrdf`` stays cheap, and ``dir(labbrdf)`` lists them all:
 
 - reading: :func:`read`, :func:`read_many`, :class:`Measurement`, :func:`select`,
-  :func:`formats`
+  :func:`formats`; :func:`read_inputs` reads a list of optical exports and height maps
+  (each file once) into :class:`Inputs`
 - optical constants: :func:`nk_table`, :func:`combined_table` (pseudo-constants from
-  psi/Delta with propagated sigmas)
+  psi/Delta with propagated sigmas), :func:`read_nk`, :func:`bulk_index_at` (a file's bulk
+  n, k at one wavelength), :func:`model_with_nk` (a model with that index)
 - models and fits: :mod:`models` (:func:`labbrdf.models.get`), :func:`fit`,
-  :func:`fit_many`, :class:`FitResult`, :func:`hemispherical_reflectance`
+  :func:`fit_many`, :func:`fit_many_nk` (an index per wavelength from an ellipsometer
+  file), :func:`fit_records` (a batch as JSON records), :class:`FitResult`,
+  :func:`hemispherical_reflectance`
 - films: :class:`Stack`, :class:`Layer`, :func:`fit_film`, :class:`FilmFit` (thin-film
   stacks fitted to psi/Delta and reflectance)
 - roughness: :func:`read_height_map`, :func:`roughness_statistics`
 - the tracer: :func:`trace`, :class:`TraceConfig`, :class:`Substrate`, :class:`Coating`,
-  :class:`TraceResult`
+  :class:`TraceResult`, :func:`trace_config_from_inputs` (a run from values and files)
 - reports: :func:`user_report` (the validation report: :func:`labbrdf.report.validate`)
 - errors: :class:`LabbrdfError`, the base of every labbrdf error, and the errors of each
   layer (:class:`AdapterError`, :class:`DatasetError`, :class:`FitError`,
-  :class:`ModelError`)
+  :class:`ModelError`, :class:`NkError`), and :class:`SetupError` (arguments that do not fit
+  together, named in the message)
 
 The subpackages and modules (``labbrdf.optics``, ``labbrdf.nk``, ...) are attributes too.
 """
@@ -33,13 +38,20 @@ __version__ = "0.1.0.dev0"
 _LAZY: dict[str, tuple[str, str]] = {
     "read": ("labbrdf.adapters", "read"),
     "read_many": ("labbrdf.adapters", "read_many"),
+    "read_inputs": ("labbrdf.adapters", "read_inputs"),
+    "Inputs": ("labbrdf.adapters", "Inputs"),
     "formats": ("labbrdf.adapters", "formats"),
     "Measurement": ("labbrdf.dataset", "Measurement"),
     "select": ("labbrdf.selection", "select"),
     "nk_table": ("labbrdf.nk", "nk_table"),
     "combined_table": ("labbrdf.nk", "combined_table"),
+    "read_nk": ("labbrdf.nk", "read_nk"),
+    "bulk_index_at": ("labbrdf.nk", "bulk_index_at"),
+    "model_with_nk": ("labbrdf.nk", "model_with_nk"),
     "fit": ("labbrdf.fitting", "fit"),
     "fit_many": ("labbrdf.fitting", "fit_many"),
+    "fit_many_nk": ("labbrdf.fitting", "fit_many_nk"),
+    "fit_records": ("labbrdf.fitting", "fit_records"),
     "FitResult": ("labbrdf.fitting", "FitResult"),
     "hemispherical_reflectance": ("labbrdf.integrate", "hemispherical_reflectance"),
     "Stack": ("labbrdf.films", "Stack"),
@@ -53,12 +65,15 @@ _LAZY: dict[str, tuple[str, str]] = {
     "TraceResult": ("labbrdf.tracer", "TraceResult"),
     "Substrate": ("labbrdf.tracer", "Substrate"),
     "Coating": ("labbrdf.tracer", "Coating"),
+    "trace_config_from_inputs": ("labbrdf.tracer_setup", "trace_config_from_inputs"),
     "user_report": ("labbrdf.report", "user_report"),
     "LabbrdfError": ("labbrdf.errors", "LabbrdfError"),
     "AdapterError": ("labbrdf.adapters", "AdapterError"),
     "DatasetError": ("labbrdf.dataset", "DatasetError"),
     "FitError": ("labbrdf.fitting", "FitError"),
     "ModelError": ("labbrdf.models", "ModelError"),
+    "NkError": ("labbrdf.nk", "NkError"),
+    "SetupError": ("labbrdf.errors", "SetupError"),
 }
 
 #: subpackages and modules reachable as attributes of the package
@@ -80,14 +95,19 @@ _MODULES = (
     "optics",
     "outputs",
     "parallel",
+    "prediction",
     "provenance",
     "report",
     "richrepr",
+    "samples",
     "selection",
+    "smoothness",
+    "specular_dop",
     "stack",
     "surface",
     "topography",
     "tracer",
+    "tracer_setup",
 )
 
 __all__ = ["__version__", *_LAZY, *_MODULES]
@@ -111,29 +131,35 @@ if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__
         optics,
         outputs,
         parallel,
+        prediction,
         provenance,
         report,
         richrepr,
+        samples,
         selection,
+        smoothness,
+        specular_dop,
         stack,
         surface,
         topography,
         tracer,
+        tracer_setup,
     )
-    from .adapters import AdapterError, formats, read, read_many
+    from .adapters import AdapterError, Inputs, formats, read, read_inputs, read_many
     from .adapters.topography import read_height_map
     from .dataset import DatasetError, Measurement
-    from .errors import LabbrdfError
+    from .errors import LabbrdfError, SetupError
     from .films import Layer, Stack, fit_film
-    from .fitting import FitError, FitResult, fit, fit_many
+    from .fitting import FitError, FitResult, fit, fit_many, fit_many_nk, fit_records
     from .fitting.film import FilmFit
     from .integrate import hemispherical_reflectance
     from .models import ModelError
-    from .nk import combined_table, nk_table
+    from .nk import NkError, bulk_index_at, combined_table, model_with_nk, nk_table, read_nk
     from .report import user_report
     from .selection import select
     from .topography import roughness_statistics
     from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
+    from .tracer_setup import trace_config_from_inputs
 
 
 def __getattr__(name: str) -> Any:

@@ -8,6 +8,13 @@ written, ...), 3 ``fit``: some groups could not be fitted or did not converge (l
 ``success`` false and the reason), 141 the reader of our output went away; the error is on
 stderr. Every output path goes through :mod:`labbrdf.outputs`.
 
+One name, one meaning, in every subcommand: ``--wavelength NM`` is one wavelength [nm],
+``--wavelength-range MIN:MAX`` a range of rows; options are taken by their full names only
+(``allow_abbrev=False``), and older spellings are refused naming the new one. The library
+does the work: the commands parse text into values and call it once (e.g.
+:func:`labbrdf.tracer_setup.trace_config_from_inputs`); a
+:class:`labbrdf.errors.SetupError` is said with the options' names (:data:`OPTION_NAMES`).
+
 Arguments that name files are declared as :class:`InputPath` or :class:`OutputPath`; before
 a command runs, :func:`_checked_outputs` checks all its outputs against all its inputs and
 runs it under one rule (:func:`labbrdf.outputs.write_policy`): an existing output is
@@ -181,27 +188,13 @@ def _value(text: str) -> float | bool | str:
     return x
 
 
-def _model_options(name: str) -> set[str]:
-    """Option names the model's constructor takes (its signature is the contract)."""
-    import inspect
-
-    from . import models
-
-    if name not in models.MODELS:
-        raise UsageError(f"unknown model {name!r}; models are {models.names()}")
-    sig = inspect.signature(models.MODELS[name].__init__)
-    return {
-        k
-        for k, v in sig.parameters.items()
-        if k != "self" and v.kind not in (v.VAR_KEYWORD, v.VAR_POSITIONAL)
-    }
-
-
 def _split_params(
     model: str, items: Sequence[str] | None
 ) -> tuple[dict[str, Any], dict[str, float]]:
     """``--param NAME=VALUE``: model options (e.g. microfacet's n, k) and parameter values."""
-    opts_names = _model_options(model)
+    from .models import option_names
+
+    opts_names = option_names(model)
     options: dict[str, Any] = {}
     values: dict[str, float] = {}
     for item in items or ():
@@ -219,9 +212,71 @@ def _split_params(
     return options, values
 
 
-def _add_selection(p: argparse.ArgumentParser) -> None:
+def _range(text: str) -> str:
+    """The argparse type of a ``MIN:MAX`` option: one word with a colon (checked later)."""
+    if ":" not in text:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected MIN:MAX in one word, e.g. 400:700 (either end may be "
+            "left open: 400: or :700)"
+        )
+    return text
+
+
+def _wavelength_value(text: str) -> float:
+    """The argparse type of ``--wavelength NM``: one wavelength [nm]."""
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not (text.strip().isascii() and math.isfinite(x) and x > 0):
+        hint = "; a range of rows is --wavelength-range MIN:MAX" if ":" in text else ""
+        raise argparse.ArgumentTypeError(f"{text!r}: expected one wavelength [nm] > 0{hint}")
+    return x
+
+
+class _Renamed(argparse.Action):
+    """An old option spelling: refused, naming the new one."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, *, new: str, **kw: Any) -> None:
+        super().__init__(
+            option_strings,
+            dest,
+            nargs="?",
+            default=argparse.SUPPRESS,
+            help=argparse.SUPPRESS,
+            **kw,
+        )
+        self.new = new
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        parser.error(f"{option_string} is not an option of this command: {self.new}")
+
+
+#: what ``--wavelength`` says in a command that selects rows (it has no single wavelength)
+_WAVELENGTH_IS_ONE = (
+    "--wavelength NM is one wavelength (export, hemispherical, trace, fit --nk-from); "
+    "select a range of rows with --wavelength-range MIN:MAX"
+)
+
+
+def _add_selection(p: argparse.ArgumentParser, *, wavelength_taken: bool = False) -> None:
+    """The row-selection options; ``--wavelength`` is refused unless the command has one."""
     g = p.add_argument_group("selection")
-    g.add_argument("--wavelength", default=None, metavar="MIN:MAX", help="[nm], e.g. 400:700")
+    g.add_argument(
+        "--wavelength-range",
+        type=_range,
+        default=None,
+        metavar="MIN:MAX",
+        help="[nm], e.g. 400:700",
+    )
+    if not wavelength_taken:
+        g.add_argument("--wavelength", action=_Renamed, new=_WAVELENGTH_IS_ONE)
     g.add_argument("--theta-i", default=None, metavar="MIN:MAX", help="[deg], e.g. 40:60")
     g.add_argument("--theta-r", default=None, metavar="MIN:MAX", help="[deg], e.g. :70")
     g.add_argument("--quantity", default=None, help="comma-separated quantities")
@@ -233,15 +288,29 @@ def _selected(args: argparse.Namespace, m: Any) -> Any:
     from .dataset import Measurement
     from .selection import select
 
-    chosen = {k: getattr(args, k, None) for k in SELECTION_KEYS}
-    chosen = {k: v for k, v in chosen.items() if v is not None}
+    chosen = _selection(args)
     if not chosen:
         return m
     return Measurement(select(m, **chosen), m.meta)
 
 
-#: the selection options (argparse destinations = :func:`labbrdf.selection.select` keywords)
-SELECTION_KEYS = ("wavelength", "theta_i", "theta_r", "quantity", "sample")
+#: the selection options: argparse destination -> :func:`labbrdf.selection.select` keyword
+SELECTION_KEYS = {
+    "wavelength_range": "wavelength",
+    "theta_i": "theta_i",
+    "theta_r": "theta_r",
+    "quantity": "quantity",
+    "sample": "sample",
+}
+
+
+def _selection(args: argparse.Namespace) -> dict[str, Any]:
+    """The given selection options as :func:`labbrdf.selection.select` keywords."""
+    return {
+        kw: getattr(args, dest)
+        for dest, kw in SELECTION_KEYS.items()
+        if getattr(args, dest, None) is not None
+    }
 
 
 def _add_scheduler(p: argparse.ArgumentParser) -> None:
@@ -365,25 +434,34 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     measurements = []
     failures: list[dict[str, str]] = []
     unselected: list[str] = []
-    for f in args.files:
-        try:
-            m = adapters.read(f, args.format, columns=args.columns)
-        except (ValueError, NotImplementedError) as exc:
-            if not args.keep_going:
-                print(f"labbrdf ingest: {exc}", file=sys.stderr)
-                return 2
-            failures.append({"file": str(f), "error": str(exc)})
+    try:
+        inputs = adapters.read_inputs(
+            args.files,
+            args.format,
+            columns=args.columns,
+            on_error="collect" if args.keep_going else "raise",
+        )
+    except (ValueError, NotImplementedError, OSError, ImportError) as exc:
+        print(f"labbrdf ingest: {exc}", file=sys.stderr)
+        return 2
+    maps = [(i.path, i.height_map) for i in inputs.files if i.height_map is not None]
+    for i in inputs.files:
+        path, m = i.path, i.measurement
+        if i.error:
+            failures.append({"file": path, "error": i.error})
+            continue
+        if m is None:  # a height map: reported below, not part of the dataset
             continue
         try:
             m = _selected(args, m)
         except SelectionError as exc:
-            unselected.append(f"{f}: {exc}")
+            unselected.append(f"{path}: {exc}")
             continue
         s = m.summary()
         measurements.append(m)
         rows.append(
             {
-                "file": str(f),
+                "file": path,
                 "format": m.meta.get("format", args.format),
                 "sample": s["sample"][0] if len(s["sample"]) == 1 else s["sample"],
                 "rows": s["rows"],
@@ -400,14 +478,19 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     if out is not None and measurements:
         write(concat(measurements), out)
     if args.json:
-        payload: Any = rows
+        payload: Any = rows + [{"file": p, "height_map": hm.summary()} for p, hm in maps]
         if failures:
-            payload = rows + [{"file": f["file"], "error": f["error"]} for f in failures]
+            payload = payload + [{"file": f["file"], "error": f["error"]} for f in failures]
         _emit_json(payload)
     else:
-        _print_ingest_table(rows)
+        if rows or not maps:
+            _print_ingest_table(rows)
+        for p, hm in maps:
+            print(f"{p}: height map, not optical data: {hm.summary_line()}")
         if out is not None and measurements:
             print(f"wrote {out} ({sum(r['rows'] for r in rows)} rows)")
+    if out is not None and maps and not measurements:
+        print(f"labbrdf ingest: no optical data, {out} not written", file=sys.stderr)
     for f in failures:
         print(f"labbrdf ingest: FAILED {f['error']}", file=sys.stderr)
     for u in unselected:
@@ -508,12 +591,41 @@ def cmd_formats(args: argparse.Namespace) -> int:
 # ------------------------------------------------------------------------------- fit
 
 
+#: the keywords of the library's builders, as the command line spells them
+OPTION_NAMES = {
+    "nk_from": "--nk-from",
+    "wavelength_nm": "--wavelength",
+    "substrate_index": "--substrate",
+    "alpha": "--alpha",
+    "surface": "--surface",
+    "coating_index": "--coating",
+    "coating_from": "--coating-from",
+    "thickness_nm": "--thickness",
+    "coating_alpha": "--coating-alpha",
+    "coating_surface": "--coating-surface",
+    "distribution": "--distribution",
+    "base_albedo": "--base-albedo",
+}
+
+
+@contextlib.contextmanager
+def _option_errors() -> Iterator[None]:
+    """Library errors about arguments, said with the options' names (exit 2)."""
+    from .errors import SetupError
+    from .nk import NkError
+
+    try:
+        yield
+    except SetupError as exc:
+        raise UsageError(exc.spelled(OPTION_NAMES)) from None
+    except NkError as exc:
+        raise UsageError(f"--nk-from {exc}") from None
+
+
 @_executor_errors
 def cmd_fit(args: argparse.Namespace) -> int:
-    import pandas as pd
-
     from . import adapters, models
-    from .fitting import fit_many
+    from .fitting import auto_weighting, fit_many, fit_many_nk, fit_records
 
     executor = _executor(args, progress=not args.json)
     data = _selected(args, adapters.read_many(args.files))
@@ -534,42 +646,25 @@ def cmd_fit(args: argparse.Namespace) -> int:
         "mask_zeros": not args.keep_zeros,
         "relative_floor": args.relative_floor,
     }
-    if args.weighting != "auto":
-        kw["weighting"] = args.weighting
-    elif not _all_have_sigma(data.data):
-        kw["weighting"] = "relative"
+    weighting = args.weighting if args.weighting != "auto" else auto_weighting(data)
+    if weighting is not None:
+        kw["weighting"] = weighting
     if args.nk_from:
-        if "n" not in _model_options(args.model):
-            raise UsageError(f"--nk-from: model {args.model!r} takes no index n, k")
-        nk = _nk_combined(args.nk_from)
-        unstated = [
-            str(m.get("source", "?")) for m in _metas(data) if m.get("wavelength_stated") is False
-        ]
-        if unstated and args.nk_wavelength is None:
-            raise UsageError(
-                f"--nk-from: {', '.join(unstated)} state(s) no wavelength (the format has "
-                "no field for it); say at which wavelength to take n, k with --nk-wavelength NM"
+        with _option_errors():
+            table, results = fit_many_nk(
+                data,
+                args.model,
+                args.nk_from,
+                options=options,
+                wavelength_nm=args.wavelength,
+                **{**kw, "by": by},
             )
-        # one batch, a model per wavelength (the index at that wavelength), wavelength
-        # first: the table lists each wavelength's groups together
-        index_at = {
-            wl: _nk_at(nk, float(args.nk_wavelength or wl), args.nk_from)
-            for wl in data.data["wavelength_nm"].unique()
-        }
-
-        def model_at(key: dict[str, Any]) -> Any:
-            n, k = index_at[key["wavelength_nm"]]
-            return models.get(args.model, **{**options, "n": n, "k": k})
-
-        by_wl = ["wavelength_nm", *(b for b in by if b != "wavelength_nm")]
-        table, results = fit_many(data, model_at, **{**kw, "by": by_wl})
-        nk_cols = pd.DataFrame([index_at[w] for w in table["wavelength_nm"]], columns=["n", "k"])
-        table = pd.concat([table, nk_cols], axis=1)
-        if "wavelength_nm" not in by:
-            table = table.drop(columns="wavelength_nm")
-            results = [({b: g[b] for b in by}, r) for g, r in results]
-        table = table[[*by, *(c for c in table.columns if c not in by)]]
     else:
+        if args.wavelength is not None:
+            raise UsageError(
+                "--wavelength NM is the wavelength of --nk-from's n, k; select a range of "
+                "rows with --wavelength-range MIN:MAX"
+            )
         try:
             model = models.get(args.model, **options)
         except models.ModelError as exc:
@@ -584,7 +679,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
         _residual_maps(args, data, results)
     failed = [r for r in table.to_dict("records") if not r["success"]]
     if args.json:
-        _emit_json(_fit_json(table, results, by))
+        _emit_json(fit_records(table, results, by))
     else:
         import pandas as pd
 
@@ -618,123 +713,21 @@ def _residual_maps(args: argparse.Namespace, data: Any, results: list) -> None:
     save_png(fit_maps_figure(model, res.values, rows, title=title), args.residual_maps)
 
 
-def _same_key(a: dict[str, Any], b: dict[str, Any]) -> bool:
-    def eq(x: Any, y: Any) -> bool:
-        return x == y or (x != x and y != y)  # NaN group keys are equal
-
-    return a.keys() == b.keys() and all(eq(a[k], b[k]) for k in a)
-
-
-def _fit_json(table: Any, results: list[tuple[dict[str, Any], Any]], by: list[str]) -> list:
-    """One JSON object per row of the fit table, failed groups included.
-
-    A failed group has ``success`` false and the reason in ``message``; ``results`` holds
-    the fitted groups in table order.
-    """
-    out = []
-    j = 0
-    for row in table.to_dict("records"):
-        key = {b: row[b] for b in by}
-        if j < len(results) and _same_key(results[j][0], key):
-            s = results[j][1].summary()
-            j += 1
-            out.append(
-                {
-                    "group": results[j - 1][0],
-                    "params": {
-                        name: {
-                            "value": p["value"],
-                            "stderr": p.get("stderr"),
-                            "ci95": p.get("ci95"),
-                            "at_bound": p.get("at_bound", False),
-                        }
-                        for name, p in s["params"].items()
-                    },
-                    "rmse": s["rmse"],
-                    "redchi": s["redchi"],
-                    "aic": s["aic"],
-                    "bic": s["bic"],
-                    "ndata": s["ndata"],
-                    "weighting": s["weighting"],
-                    "nmasked": s["nmasked"],
-                    "flags": {k: v["flags"] for k, v in s["params"].items() if v["flags"]},
-                    "nfev": s["nfev"],
-                    "success": s["success"],
-                    "message": row.get("message", ""),
-                }
-            )
-        else:
-            out.append(
-                {
-                    "group": key,
-                    "params": {},
-                    "rmse": None,
-                    "nfev": None,
-                    "success": False,
-                    "message": row.get("message", ""),
-                }
-            )
-    return out
-
-
-def _metas(m: Any) -> list[dict[str, Any]]:
-    """The per-file metas of a (concatenated) Measurement, each with its ``source``."""
-    parts = m.meta.get("parts")
-    if not parts:
-        return [m.meta]
-    return [{**p.get("meta", {}), "source": p.get("source")} for p in parts]
-
-
-def _all_have_sigma(df: Any) -> bool:
-    import numpy as np
-
-    sig = df["sigma"].to_numpy(float)
-    return bool(sig.size) and bool(np.all(np.isfinite(sig) & (sig > 0)))
-
-
-def _nk_combined(path: str) -> Any:
-    """Per-wavelength combined n, k of an ellipsometer file (``--nk-from``)."""
-    from . import adapters
-    from .nk import combined_table
-
-    m = adapters.read(path)
-    try:
-        return combined_table(m)
-    except ValueError as exc:
-        raise UsageError(f"--nk-from {path}: {exc}") from None
-
-
-def _nk_at(table: Any, wavelength_nm: float, path: str) -> tuple[float, float]:
-    from .nk import nk_at
-
-    try:
-        at = nk_at(table, wavelength_nm)
-    except ValueError as exc:
-        raise UsageError(f"--nk-from {path}: {exc}") from None
-    n, k = float(at["n"]), float(at["k"])
-    if not (n > 0 and k >= 0):
-        raise UsageError(
-            f"--nk-from {path}: the pseudo-index at {wavelength_nm:g} nm is n={n:.4g}, "
-            f"k={k:.4g}, not a physical bulk index (a film on the sample?)"
-        )
-    return n, k
-
-
 def _model_from_args(args: argparse.Namespace) -> tuple[Any, dict[str, float]]:
     """Build the model of ``--model`` and return it with the ``--param`` parameter values.
 
     Model options come from ``--param`` (and ``--nk-from``'s n, k at ``--wavelength``).
     """
     from . import models
+    from .nk import model_with_nk
 
     options, values = _split_params(args.model, args.param)
-    if args.nk_from:
-        if args.wavelength is None:
-            raise UsageError("--nk-from needs --wavelength NM")
-        options["n"], options["k"] = _nk_at(
-            _nk_combined(args.nk_from), args.wavelength, args.nk_from
-        )
     try:
+        if args.nk_from:
+            if args.wavelength is None:
+                raise UsageError("--nk-from needs --wavelength NM")
+            with _option_errors():
+                return model_with_nk(args.model, args.nk_from, args.wavelength, **options), values
         return models.get(args.model, **options), values
     except models.ModelError as exc:
         raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
@@ -797,7 +790,7 @@ def _film_value(text: str, what: str) -> tuple[float, tuple[float, float] | None
 def _film_model(args: argparse.Namespace) -> Any:
     """The FilmModel of --model FILE, or of --substrate and --layer, or the default."""
     from . import films
-    from .dispersion import Tabulated
+    from .nk import tabulated_from_file
 
     if args.model is not None:
         if args.layer or args.substrate:
@@ -812,7 +805,7 @@ def _film_model(args: argparse.Namespace) -> Any:
         sub = (
             films.as_material(sub_text)
             if not os.path.exists(sub_text)
-            else Tabulated.from_file(sub_text)
+            else tabulated_from_file(sub_text)
         )
     except ValueError as exc:
         raise UsageError(f"--substrate {sub_text}: {exc}") from None
@@ -827,7 +820,7 @@ def _film_model(args: argparse.Namespace) -> Any:
         name, mat, thick = fields[0] or f"layer{j}", fields[1], fields[2]
         d, dbox = _film_value(thick, f"--layer {name}: thickness")
         try:
-            m = films.as_material(mat) if not os.path.exists(mat) else Tabulated.from_file(mat)
+            m = films.as_material(mat) if not os.path.exists(mat) else tabulated_from_file(mat)
         except ValueError as exc:
             raise UsageError(f"--layer {name}: {exc}") from None
         values = {}
@@ -909,9 +902,17 @@ def cmd_film(args: argparse.Namespace) -> int:
 
     fm = _film_model(args)
     sigma = _parse_assignments(args.sigma, "--sigma")
-    wl_range = tuple(args.wavelength_range) if args.wavelength_range else None
-    if wl_range is not None and not 0 < wl_range[0] < wl_range[1]:
-        raise UsageError("--wavelength-range: expected MIN MAX with 0 < MIN < MAX [nm]")
+    wl_range = None
+    if args.wavelength_range is not None:  # the rows, and the range that replaces the file's
+        from .selection import parse_range
+
+        r = parse_range(args.wavelength_range, "--wavelength-range")
+        if not 0 <= r.lo < r.hi:
+            raise UsageError(
+                f"--wavelength-range {args.wavelength_range}: expected MIN:MAX with "
+                "0 <= MIN < MAX [nm]"
+            )
+        wl_range = (r.lo, r.hi)
     data = _selected(args, adapters.read_many(args.files))
     res = films.fit_film(
         fm,
@@ -1015,55 +1016,50 @@ def _grid(text: str, option: str) -> Any:
         ) from None
 
 
-def _height_map(path: str, channel: str | None, args: argparse.Namespace | None = None) -> Any:
-    """Read a height map; ``--pixel-size`` / ``--unit`` of ``args`` state its geometry."""
-    from .adapters.topography import length_m, read_height_map
+def _channel(text: str | None) -> int | str | None:
+    """``--channel``: an index (digits) or a name."""
+    return int(text) if text and text.isdigit() else text
 
-    ch: int | str | None = int(channel) if channel and channel.isdigit() else channel
-    unit = getattr(args, "unit", None)
+
+def _pixel_size(args: argparse.Namespace) -> tuple[float, ...] | None:
+    """``--pixel-size LENGTH[,LENGTH]`` in metres (``--unit`` for bare numbers)."""
+    from .adapters.topography import length_m
+
     px_text = getattr(args, "pixel_size", None)
-    pixel = None
-    if px_text is not None:
-        try:
-            pixel = tuple(length_m(v, unit) for v in px_text.split(","))
-        except ValueError as exc:
-            raise UsageError(f"--pixel-size: {exc}") from None
-        if len(pixel) not in (1, 2):
-            raise UsageError(f"--pixel-size {px_text!r}: one pitch or two (dx,dy)")
+    if px_text is None:
+        return None
     try:
-        hm = read_height_map(path, ch, unit=unit, pixel_size=pixel)
+        pixel = tuple(length_m(v, getattr(args, "unit", None)) for v in px_text.split(","))
+    except ValueError as exc:
+        raise UsageError(f"--pixel-size: {exc}") from None
+    if len(pixel) not in (1, 2):
+        raise UsageError(f"--pixel-size {px_text!r}: one pitch or two (dx,dy)")
+    return pixel
+
+
+def _warn(message: str) -> None:
+    print(f"labbrdf: warning: {message}", file=sys.stderr)
+
+
+def _height_map(path: str, channel: str | None, args: argparse.Namespace) -> Any:
+    """Read a height map; ``--pixel-size`` / ``--unit`` of ``args`` state its geometry."""
+    from .adapters import read_inputs
+
+    pixel = _pixel_size(args)
+    try:
+        (hm,) = read_inputs(
+            [path],
+            kind="height_map",
+            channel=_channel(channel),
+            unit=args.unit,
+            pixel_size=pixel,
+            on_error="raise",
+        ).height_maps
     except MemoryError:
         raise UsageError(f"{path}: out of memory while reading the height map") from None
     for w in hm.warnings:
-        print(f"labbrdf: warning: {path}: {w}", file=sys.stderr)
+        _warn(f"{path}: {w}")
     return hm
-
-
-def _slope_table_of(
-    path: str, channel: str | None, args: argparse.Namespace | None = None
-) -> tuple[float, Any]:
-    """(ML GGX alpha, slope table) of a measured areal map, for the coating's top."""
-    from .tracer import Substrate
-
-    hm = _height_map(path, channel, args)
-    if hm.heights.ndim != 2:
-        raise UsageError(f"{path}: a line profile; the coating needs an areal height map")
-    try:
-        s = Substrate.from_surface(hm.heights, hm.pixel_size)
-    except ValueError as exc:
-        raise UsageError(f"{path}: {exc}") from None
-    return float(s.alpha), s.ndf
-
-
-def _analytic_table(args: argparse.Namespace, alpha: float) -> Any:
-    """``--distribution beckmann``: the Beckmann slope table of ``alpha``; GGX: None."""
-    if args.distribution == "ggx":
-        return None
-    from .tracer.sampling import TabulatedNDF
-
-    if not alpha > 0:
-        raise UsageError("--distribution beckmann needs a roughness alpha > 0")
-    return TabulatedNDF.beckmann(alpha)
 
 
 def _progress_printer(label: str, after_s: float = 2.0) -> Any:
@@ -1189,108 +1185,40 @@ def _complex(text: str, what: str) -> complex:
         raise UsageError(f"{what} {text!r}: expected a complex index like 1.55+7.71j") from None
 
 
-def _base_substrate(args: argparse.Namespace, tracer: Any) -> Any:
-    """``--base-albedo``: a Lambertian base, refusing the conductor's options."""
-    metal = {
-        "--substrate": args.substrate,
-        "--nk-from": args.nk_from,
-        "--alpha": args.alpha,
-        "--surface": args.surface,
-    }
-    given = [name for name, value in metal.items() if value is not None]
-    if given:
-        raise UsageError(f"--base-albedo replaces the metal substrate: drop {', '.join(given)}")
-    coated = args.coating is not None or args.coating_from is not None
-    if coated and args.coating_alpha is None and args.coating_surface is None:
-        raise UsageError(
-            "--base-albedo with a coating needs its roughness: --coating-alpha A or "
-            "--coating-surface FILE (there is no substrate alpha to default to)"
-        )
-    try:
-        return tracer.Substrate.lambertian(args.base_albedo)
-    except ValueError as exc:
-        raise UsageError(f"--base-albedo: {exc}") from None
-
-
 @_executor_errors
 def cmd_trace(args: argparse.Namespace) -> int:
-
     from . import tracer
+    from .tracer_setup import trace_config_from_inputs
 
     executor = _executor(args, progress=not args.json)  # outputs checked by _checked_outputs
-    if args.base_albedo is not None:
-        substrate = _base_substrate(args, tracer)
-    else:
-        if (args.substrate is None) == (args.nk_from is None):
-            raise UsageError("give the substrate index with --substrate N+Kj or --nk-from FILE")
-        if args.nk_from is not None:
-            n, k = _nk_at(_nk_combined(args.nk_from), args.wavelength, args.nk_from)
-            sub = complex(n, k)
-        else:
-            sub = _complex(args.substrate, "--substrate")
-        if args.surface is not None:
-            hm = _height_map(args.surface, args.channel, args)
-            try:
-                substrate = tracer.Substrate.from_surface(
-                    hm.heights, hm.pixel_size, n=sub.real, k=sub.imag
-                )
-            except ValueError as exc:
-                raise UsageError(f"{args.surface}: {exc}") from None
-        elif args.alpha is None:
-            raise UsageError("give the substrate roughness with --alpha A or --surface FILE")
-        else:
-            substrate = tracer.Substrate(
-                n=sub.real, k=sub.imag, alpha=args.alpha, ndf=_analytic_table(args, args.alpha)
-            )
-    kw: dict[str, Any] = {
-        "wavelength_nm": args.wavelength,
-        "theta_i_deg": args.theta_i,
-        "substrate": substrate,
-        "rays": args.rays,
-        "seed": args.seed,
-        "scattering": "single" if args.single_scattering else "multiple",
-        "coherent": args.coherent,
-        "estimator": args.estimator,
-        "scalar": args.scalar,
-    }
-    coat: complex | None = None
-    thickness = args.thickness
-    if args.coating_from is not None:
-        if args.coating is not None or args.thickness is not None:
-            raise UsageError(
-                "give the coating once: --coating-from FIT.json, or --coating and --thickness"
-            )
-        from .nk import coating_from_fit
-
-        try:
-            coat, thickness = coating_from_fit(args.coating_from, args.wavelength)
-        except ValueError as exc:
-            raise UsageError(f"--coating-from {exc}") from None
-    elif args.coating is not None:
-        coat = _complex(args.coating, "--coating")
-    if coat is not None:
-        if thickness is None:
-            raise UsageError("--coating needs --thickness (nm)")
-        if args.coating_alpha is not None and args.coating_surface is not None:
-            raise UsageError(
-                "give the coating roughness once: --coating-alpha or --coating-surface"
-            )
-        coat_alpha = args.coating_alpha if args.coating_alpha is not None else substrate.alpha
-        coat_ndf = _analytic_table(args, coat_alpha)
-        if args.coating_surface is not None:
-            coat_alpha, coat_ndf = _slope_table_of(args.coating_surface, args.channel, args)
-        kw["coating"] = tracer.Coating(
-            n=coat.real, k=coat.imag, thickness_nm=thickness, alpha=coat_alpha, ndf=coat_ndf
+    with _option_errors():
+        config = trace_config_from_inputs(
+            args.wavelength,
+            args.theta_i,
+            base_albedo=args.base_albedo,
+            substrate_index=None
+            if args.substrate is None
+            else _complex(args.substrate, "--substrate"),
+            nk_from=args.nk_from,
+            alpha=args.alpha,
+            surface=args.surface,
+            coating_index=None if args.coating is None else _complex(args.coating, "--coating"),
+            coating_from=args.coating_from,
+            thickness_nm=args.thickness,
+            coating_alpha=args.coating_alpha,
+            coating_surface=args.coating_surface,
+            distribution=args.distribution,
+            channel=_channel(args.channel),
+            unit=args.unit,
+            pixel_size=_pixel_size(args),
+            warn=_warn,
+            rays=args.rays,
+            seed=args.seed,
+            scattering="single" if args.single_scattering else "multiple",
+            coherent=args.coherent,
+            estimator=args.estimator,
+            scalar=args.scalar,
         )
-    elif (
-        args.thickness is not None
-        or args.coating_alpha is not None
-        or args.coating_surface is not None
-    ):
-        raise UsageError(
-            "--thickness, --coating-alpha and --coating-surface need --coating (or --coating-from)"
-        )
-    config = tracer.TraceConfig(**kw)
     t0 = time.perf_counter()
     result = tracer.trace(config, map=functools.partial(executor.imap, desc="trace"))
     seconds = time.perf_counter() - t0
@@ -1332,10 +1260,11 @@ def cmd_validate(args: argparse.Namespace) -> int:
 def cmd_report(args: argparse.Namespace) -> int:
     from .report import user_report
     from .report.sections.film import default_film_model
+    from .samples import split_same_sample
 
     executor = _executor(args, progress=not args.quiet)
     options, start = _split_params(args.model, args.param)
-    selection = {k: getattr(args, k) for k in SELECTION_KEYS if getattr(args, k) is not None}
+    selection = _selection(args)
     return int(
         user_report(
             args.files,
@@ -1347,6 +1276,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             progress=not args.quiet,
             film_model=default_film_model() if args.film_default else args.film_model,
             executor=executor,
+            same_sample=[split_same_sample(v, args.files) for v in args.same_sample or ()],
         )
     )
 
@@ -1433,12 +1363,14 @@ def _fit_parser(sub: Any) -> None:
         help="n, k from psi/Delta (microfacet)",
     )
     s.add_argument(
-        "--nk-wavelength",
-        type=float,
+        "--wavelength",
+        type=_wavelength_value,
         default=None,
         metavar="NM",
-        help="take --nk-from's n, k at this wavelength (for files that state none)",
+        help="[nm] take --nk-from's n, k at this wavelength for every group (needed for "
+        "files that state none); default: each group's own",
     )
+    s.add_argument("--nk-wavelength", action=_Renamed, new="say --wavelength NM")
     s.add_argument(
         "--weighting",
         choices=["auto", "sigma", "relative", "uniform"],
@@ -1470,7 +1402,7 @@ def _fit_parser(sub: Any) -> None:
     )
     _add_overwrite(s)
     s.add_argument("--json", action="store_true")
-    _add_selection(s)
+    _add_selection(s, wavelength_taken=True)
     _add_scheduler(s)
     s.set_defaults(func=cmd_fit)
 
@@ -1533,7 +1465,6 @@ def _film_parser(sub: Any) -> None:
         help="a layer, top first (repeat); LO..HI values are fitted, e.g. "
         "oxide:cauchy:0..20:A=1.3..1.7:B=0.004 (no --model/--layer: one Cauchy layer on Si)",
     )
-    s.add_argument("--wavelength-range", nargs=2, type=float, default=None, metavar=("MIN", "MAX"))
     s.add_argument(
         "--sigma",
         action="append",
@@ -1615,7 +1546,13 @@ def _export_parser(sub: Any) -> None:
     )
     s.add_argument("--param", action="append", metavar="NAME=VALUE")
     s.add_argument("--nk-from", action=InputPath, default=None, metavar="FILE")
-    s.add_argument("--wavelength", type=float, default=None, help="[nm] for --nk-from")
+    s.add_argument(
+        "--wavelength",
+        type=_wavelength_value,
+        default=None,
+        metavar="NM",
+        help="[nm] for --nk-from",
+    )
     s.add_argument("--theta-i", type=float, nargs="+", default=None, metavar="DEG")
     s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")
     s.add_argument("--azimuth", default="0:180:5", help="START:STOP:STEP [deg]")
@@ -1633,7 +1570,13 @@ def _hemispherical_parser(sub: Any) -> None:
     s.add_argument(
         "--nk-from", action=InputPath, default=None, metavar="FILE", help="n, k from psi/Delta"
     )
-    s.add_argument("--wavelength", type=float, default=None, help="[nm] for --nk-from")
+    s.add_argument(
+        "--wavelength",
+        type=_wavelength_value,
+        default=None,
+        metavar="NM",
+        help="[nm] for --nk-from",
+    )
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_hemispherical)
 
@@ -1693,7 +1636,9 @@ def _trace_parser(sub: Any) -> None:
         "always use their own slope table)",
     )
     s.add_argument("--theta-i", type=float, required=True, help="[deg]")
-    s.add_argument("--wavelength", type=float, required=True, help="[nm]")
+    s.add_argument(
+        "--wavelength", type=_wavelength_value, required=True, metavar="NM", help="[nm]"
+    )
     s.add_argument("--rays", type=int, default=200_000)
     s.add_argument("--seed", type=int, default=1)
     s.add_argument("--single-scattering", action="store_true")
@@ -1775,22 +1720,42 @@ def _report_parser(sub: Any) -> None:
         action="store_true",
         help="... or the stated default: one transparent Cauchy layer on c-Si, thickness free",
     )
+    s.add_argument(
+        "--same-sample",
+        action="append",
+        # not an InputPath: every name must be one of the DATA inputs (refused otherwise)
+        metavar="A,B[,...]",
+        help="these DATA inputs are one sample (repeatable; inputs stating one sample name "
+        "are paired anyway)",
+    )
     s.add_argument("--quiet", action="store_true", help="no progress lines")
     _add_selection(s)
     _add_scheduler(s)
     s.set_defaults(func=cmd_report)
 
 
+class _Parser(argparse.ArgumentParser):
+    """A parser that takes options by their full names only.
+
+    No abbreviations (``allow_abbrev=False``): ``--wavelength`` must never be taken for
+    ``--wavelength-range``, nor a later option's prefix for an earlier one.
+    """
+
+    def __init__(self, *args: Any, **kw: Any) -> None:
+        kw.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kw)
+
+
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
 
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="labbrdf",
         description="Optical-metrology toolkit: read instrument exports, fit BRDF models, "
         "check physics, trace polarized rays, write validation reports.",
     )
     p.add_argument("--version", action="version", version=f"labbrdf {__version__}")
-    sub = p.add_subparsers(dest="command", required=True)
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     _ingest_parser(sub)
     _formats_parser(sub)
     _fit_parser(sub)

@@ -1,7 +1,7 @@
 """Dispersion models: a material's complex index ``N = n + ik`` as a function of wavelength.
 
-Physics layer (NumPy only; :meth:`Tabulated.from_file` alone reaches the dataset layer, to
-read an ellipsometer file, and imports it when called). Each model is a small frozen
+Physics layer: NumPy only, and no file is read here (a table from a file or an ellipsometer
+export is built by :func:`labbrdf.nk.tabulated_from_file`). Each model is a small frozen
 dataclass of named parameters with
 
 * ``.nk(wavelength_nm) -> complex ndarray`` (``n + ik``, ``k >= 0``, vacuum wavelength in
@@ -19,12 +19,10 @@ their papers are conjugated here (each docstring says so).
 from __future__ import annotations
 
 import math
-import os
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from importlib import resources
-from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
@@ -44,6 +42,7 @@ __all__ = [
     "Tabulated",
     "TaucLorentz",
     "from_dict",
+    "parse_nk_table",
 ]
 
 #: h c [eV nm] (CODATA 2018, exact): E [eV] = HC_EV_NM / lambda [nm]
@@ -563,8 +562,27 @@ REFERENCE_TABLES: dict[str, tuple[str, str]] = {
 }
 
 
-def _read_table(text: str, source: str) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Columns wavelength [nm], n, k (k optional) of a comment-#'d, comma/space table."""
+def parse_nk_table(text: str, source: str) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Columns wavelength [nm], n, k (k optional) of a comment-#'d, comma/space table.
+
+    Parameters
+    ----------
+    text : str
+        The table: ``wavelength_nm n [k]`` per line, comma, semicolon or whitespace
+        separated, ``#`` comments, optional header lines before the data.
+    source : str
+        Where the text comes from, named in every error.
+
+    Returns
+    -------
+    (ndarray, ndarray, ndarray)
+        Wavelength [nm] (sorted, increasing), n [1], k [1] (0 where the table has none).
+
+    Raises
+    ------
+    DispersionError
+        Not such a table; names ``source`` and the line.
+    """
     wl: list[float] = []
     n: list[float] = []
     k: list[float] = []
@@ -609,9 +627,9 @@ class Tabulated(Dispersion):
     """Tabulated ``n, k`` interpolated linearly in wavelength.
 
     Build with :meth:`reference` (the shipped tables, :data:`REFERENCE_TABLES`),
-    :meth:`from_file` (a two/three-column ``wavelength_nm n [k]`` text file, or any
-    ellipsometer export whose two-phase pseudo-constants are the material's, e.g. a bare
-    substrate) or directly from arrays. Outside the table's range :meth:`nk` raises
+    :func:`labbrdf.nk.tabulated_from_file` (a two/three-column ``wavelength_nm n [k]`` text
+    file, or any ellipsometer export whose two-phase pseudo-constants are the material's,
+    e.g. a bare substrate) or directly from arrays. Outside the table's range :meth:`nk` raises
     (never extrapolates).
 
     Parameters
@@ -653,7 +671,7 @@ class Tabulated(Dispersion):
         """A model from ``params`` (name -> value); unknown names raise."""
         raise DispersionError(
             "tabulated: has no parameters; build it with Tabulated.reference(name) or "
-            "Tabulated.from_file(path)"
+            "labbrdf.nk.tabulated_from_file(path)"
         )
 
     @property
@@ -707,82 +725,8 @@ class Tabulated(Dispersion):
             )
         fname, cite = REFERENCE_TABLES[key]
         text = resources.files("labbrdf").joinpath("data", "nk", fname).read_text("utf-8")
-        w, n, k = _read_table(text, f"labbrdf/data/nk/{fname}")
+        w, n, k = parse_nk_table(text, f"labbrdf/data/nk/{fname}")
         return cls(w, n, k, source=f"{fname} ({cite})", key=f"reference:{key}")
-
-    @classmethod
-    def from_file(
-        cls, path: str | os.PathLike[str], *, theta_deg: float | None = None
-    ) -> Tabulated:
-        """Read ``n, k`` from a file.
-
-        Parameters
-        ----------
-        path : path-like
-            A text table ``wavelength_nm n [k]`` (comma, semicolon or whitespace separated,
-            ``#`` comments, an optional header line), or any ellipsometer export labbrdf
-            reads: its psi/Delta are inverted to two-phase pseudo-constants
-            (:func:`labbrdf.nk.nk_table`) and averaged over the angles of incidence with
-            the inverse-variance weights of :func:`labbrdf.nk.combined_table` (a bare,
-            smooth substrate: the pseudo-constants are the material's).
-        theta_deg : float, optional
-            Use only this angle of incidence of an ellipsometer file.
-
-        Raises
-        ------
-        DispersionError
-            The file cannot be read as either, names the file and line.
-        """
-        p = Path(path)
-        try:
-            text = p.read_text("utf-8", errors="replace")
-        except OSError as exc:
-            raise DispersionError(f"{p}: cannot read ({exc.strerror})") from None
-        try:
-            w, n, k = _read_table(text, str(p))
-        except DispersionError as table_error:
-            w, n, k = _pseudo_constants(p, theta_deg, table_error)
-        return cls(w, n, k, source=str(p), key=f"file:{p}")
-
-
-def _pseudo_constants(
-    path: Path, theta_deg: float | None, table_error: DispersionError
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Pseudo-constants of an ellipsometer file, combined over angles (dataset layer)."""
-    # imported here: reading files is the dataset layer's job, and this one path needs it
-    from . import adapters
-    from . import nk as nk_mod
-
-    try:
-        meas = adapters.read(path)
-    except ValueError as exc:
-        raise DispersionError(
-            f"{path}: neither an n,k table ({table_error}) nor an ellipsometer file ({exc})"
-        ) from None
-    df = meas.data
-    if theta_deg is not None:
-        keep = (~df["quantity"].isin(["psi", "delta"])) | (
-            np.abs(df["theta_i_deg"] - theta_deg) < 1e-3
-        )
-        df = df[keep]
-    try:
-        table = nk_mod.combined_table(df, on_ill_conditioned="ignore")
-    except ValueError as exc:
-        raise DispersionError(f"{path}: no pseudo-constants ({exc})") from None
-    if "combined" in table and not bool(table["combined"].all()):
-        raise DispersionError(
-            f"{path}: its angles of incidence disagree (pseudo-constants of a stack, not a "
-            "material's constants); fit the stack with `labbrdf film` and use its layers"
-        )
-    table = table.sort_values("wavelength_nm").drop_duplicates("wavelength_nm")
-    n = table["n"].to_numpy(float)
-    k = table["k"].to_numpy(float)
-    if np.any(n < 0) or np.any(k < 0):
-        raise DispersionError(
-            f"{path}: the pseudo-constants have n < 0 or k < 0 at some wavelengths; they "
-            "are not a material's constants (a film or a rough surface)"
-        )
-    return table["wavelength_nm"].to_numpy(float), n, k
 
 
 #: registry name -> class
@@ -807,7 +751,10 @@ def from_dict(d: Mapping[str, Any]) -> Dispersion:
         if "reference" in d:
             return Tabulated.reference(str(d["reference"]))
         if "file" in d:
-            return Tabulated.from_file(str(d["file"]))
+            raise DispersionError(
+                f"tabulated: {d['file']!r} is a file; read it with "
+                "labbrdf.nk.tabulated_from_file (labbrdf.films.as_material does)"
+            )
         if "wavelength_nm" in d:
             return Tabulated(
                 d["wavelength_nm"],

@@ -11,14 +11,51 @@ error                                            also a
 :class:`labbrdf.DatasetError`                    ``ValueError``
 :class:`labbrdf.ModelError`                      ``ValueError``
 :class:`labbrdf.FitError`                        ``ValueError``
+:class:`labbrdf.NkError`                         ``ValueError``
+:class:`labbrdf.SetupError`                      ``ValueError``
 :class:`labbrdf.parallel.ParallelError`          ``RuntimeError``
 ===============================================  =================
 """
 
 from __future__ import annotations
 
-__all__ = ["LabbrdfError"]
+__all__ = ["LabbrdfError", "SetupError"]
 
 
 class LabbrdfError(Exception):
     """Base class of the errors labbrdf raises on purpose."""
+
+
+class _Spelled(dict[str, str]):
+    """``{argument}`` fields spelled by a mapping, else as the keyword itself."""
+
+    def __missing__(self, key: str) -> str:
+        return key
+
+
+class SetupError(LabbrdfError, ValueError):
+    """Arguments of a builder that do not fit together (or a value one of them refuses).
+
+    The message names the arguments; it is kept as a template whose ``{name}`` fields are
+    the builder's keyword arguments, so that a caller with other names for them (the
+    command line's options) can say it in its own words with :meth:`spelled`.
+    ``str(error)`` names the keywords.
+
+    Parameters
+    ----------
+    template : str
+        The message, with ``{keyword}`` fields (other braces doubled).
+    """
+
+    def __init__(self, template: str) -> None:
+        self.template = template
+        super().__init__(self.spelled({}))
+
+    def spelled(self, names: dict[str, str]) -> str:
+        """The message with each ``{keyword}`` replaced by ``names[keyword]`` (or itself)."""
+        return self.template.format_map(_Spelled(names))
+
+
+def escaped(text: object) -> str:
+    """``text`` made safe inside a :class:`SetupError` template (braces doubled)."""
+    return str(text).replace("{", "{{").replace("}", "}}")

@@ -131,10 +131,20 @@ def as_material(m: Any) -> Material:
             "'roughness'"
         )
     if isinstance(m, Mapping):
-        if str(m.get("model", "")).lower() == "roughness":
+        model = str(m.get("model", "")).lower()
+        if model == "roughness":
             return Roughness(float(m.get("fraction", 0.5)))
+        if model == "tabulated" and "file" in m:
+            return _table_file(str(m["file"]))
         return disp.from_dict(m)
     raise FilmError(f"material: expected a dispersion model, a number or a name, got {m!r}")
+
+
+def _table_file(path: str | os.PathLike[str]) -> disp.Tabulated:
+    """A table or ellipsometer file's ``n, k`` (:func:`labbrdf.nk.tabulated_from_file`)."""
+    from .nk import tabulated_from_file  # the dataset layer: pandas and the adapters
+
+    return tabulated_from_file(path)
 
 
 def _with_params(m: Material, values: Mapping[str, float]) -> Material:
@@ -508,7 +518,7 @@ def _material_from_table(
         p = Path(val)
         p = p if p.is_absolute() else base / p
         try:
-            m: Material = disp.Tabulated.from_file(p)
+            m: Material = _table_file(p)
         except disp.DispersionError as exc:
             raise FilmError(f"{at(kind)}: {exc}") from None
     else:

@@ -40,22 +40,34 @@ from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
+from . import adapters
+from . import dispersion as disp
 from . import ellipsometry as ell
 from .dataset import Measurement
+from .errors import LabbrdfError
 
 __all__ = [
     "POSITION_TOL_MM",
     "AngleVerdict",
+    "NkError",
     "angle_verdict",
+    "bulk_index_at",
     "coating_from_fit",
     "combined_table",
     "compare_reflectance",
     "microfacet_hemispherical",
+    "model_with_nk",
     "nk_at",
     "nk_json",
+    "nk_panels",
     "nk_table",
     "ordinary_psi_delta",
+    "tabulated_from_file",
+    "plot_table",
+    "series_members",
+    "read_nk",
 ]
 
 #: Stage positions closer than this (chained, per coordinate) are the same spot [mm].
@@ -609,6 +621,133 @@ def nk_at(
     return out
 
 
+class NkError(LabbrdfError, ValueError):
+    """n, k that a file cannot give: no psi/Delta, outside its range, not a bulk index.
+
+    The message starts with the file it is about.
+    """
+
+
+def read_nk(path: str | os.PathLike[str]) -> pd.DataFrame:
+    """The per-wavelength combined n, k of an ellipsometer file (its psi/Delta inverted).
+
+    Parameters
+    ----------
+    path : path-like
+        Any export :func:`labbrdf.read` reads that holds ordinary psi/Delta rows.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The file's :func:`combined_table`, for :func:`bulk_index_at` or :func:`nk_at`.
+
+    Raises
+    ------
+    labbrdf.AdapterError
+        The file cannot be read.
+    NkError
+        It holds no psi/Delta to invert (the message names the file).
+    """
+    from . import adapters  # the readers, imported where needed
+
+    m = adapters.read(path)
+    try:
+        return combined_table(m)
+    except ValueError as exc:
+        raise NkError(f"{path}: {exc}") from None
+
+
+def bulk_index_at(
+    table: pd.DataFrame, wavelength_nm: float, *, source: str | os.PathLike[str] = "n, k"
+) -> tuple[float, float]:
+    """The bulk index ``(n, k)`` of a combined table at one wavelength, checked physical.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A :func:`combined_table` (e.g. of :func:`read_nk`) of one sample.
+    wavelength_nm : float
+        Vacuum wavelength [nm] inside the measured range (linear interpolation,
+        :func:`nk_at`).
+    source : str or path-like, optional
+        What the table came from (its file), the start of every error message.
+
+    Returns
+    -------
+    n, k : float
+        Refractive index and extinction coefficient [1], ``n > 0`` and ``k >= 0``.
+
+    Raises
+    ------
+    NkError
+        The wavelength lies outside the table, the sample's angles disagree there (a
+        stack), or the two-phase pseudo-index is not a material's (``n <= 0`` or
+        ``k < 0``: a film on the sample, whose pseudo-index can leave the physical
+        half-plane).
+    """
+    try:
+        at = nk_at(table, wavelength_nm)
+    except ValueError as exc:
+        raise NkError(f"{source}: {exc}") from None
+    n, k = float(at["n"]), float(at["k"])
+    if not (n > 0 and k >= 0):
+        raise NkError(
+            f"{source}: the pseudo-index at {wavelength_nm:g} nm is n={n:.4g}, "
+            f"k={k:.4g}, not a physical bulk index (a film on the sample?)"
+        )
+    return n, k
+
+
+def model_with_nk(
+    name: str,
+    nk_from: str | os.PathLike[str] | pd.DataFrame,
+    wavelength_nm: float,
+    *,
+    source: str | os.PathLike[str] | None = None,
+    **options: Any,
+) -> Any:
+    """A registry model whose index is a sample's bulk n, k at one wavelength.
+
+    Parameters
+    ----------
+    name : str
+        A model that takes an index ``n``, ``k`` (``microfacet``, see
+        :func:`labbrdf.models.option_names`).
+    nk_from : path-like or pandas.DataFrame
+        An ellipsometer file (:func:`read_nk`) or its combined table.
+    wavelength_nm : float
+        Vacuum wavelength [nm] at which the index is taken (:func:`bulk_index_at`).
+    source : str or path-like, optional
+        What a table came from, for messages (default: the file, or ``"n, k"``).
+    **options
+        The model's other options.
+
+    Returns
+    -------
+    labbrdf.models.Model
+
+    Raises
+    ------
+    labbrdf.errors.SetupError
+        The model takes no index (the message names the keyword ``{nk_from}``).
+    NkError
+        No bulk n, k at that wavelength (the message starts with the file).
+    labbrdf.ModelError
+        An unknown model or a bad option.
+    """
+    from . import models
+    from .errors import SetupError
+
+    if "n" not in models.option_names(name):
+        raise SetupError(f"{{nk_from}}: model {name!r} takes no index n, k")
+    if isinstance(nk_from, pd.DataFrame):
+        table, where = nk_from, source if source is not None else "n, k"
+    else:
+        table, where = read_nk(nk_from), source if source is not None else nk_from
+    n, k = bulk_index_at(table, wavelength_nm, source=where)
+    return models.get(name, **{**options, "n": n, "k": k})
+
+
 def _angle_dependent_message(wavelength_nm: np.ndarray) -> str:
     w = ", ".join(f"{v:g}" for v in np.unique(wavelength_nm)[:5])
     return (
@@ -847,3 +986,201 @@ def coating_from_fit(path: str | os.PathLike[str], wavelength_nm: float) -> tupl
     layer = stack.layers[0]
     big_n = complex(np.asarray(stack.nk(wl)[layer.name]).ravel()[0])
     return big_n, float(layer.thickness_nm)
+
+
+_SERIES = ("time_s", "x_mm", "y_mm")
+
+
+def series_members(table: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
+    """(label, rows) per member of a series (time or spot) of an n, k table, or the whole.
+
+    The label names the member (``"time 12"``, ``"x 3 y 4"``), empty when the table is no
+    series (module Grouping).
+    """
+    keys = [k for k in _SERIES if k in table.columns]
+    if not keys:
+        return [("", table)]
+    out = []
+    for key, g in table.groupby(keys, sort=True, dropna=False):
+        key = key if isinstance(key, tuple) else (key,)
+        lab = ", ".join(f"{k.split('_')[0]} {v:g}" for k, v in zip(keys, key, strict=True))
+        out.append((lab, g))
+    return out
+
+
+def nk_panels(table: pd.DataFrame, *, max_series: int | None = None) -> list[dict[str, Any]]:
+    """The two panels (n, k against wavelength) that draw an n, k table.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A :func:`combined_table` (one line per series member, shaded +-1 sigma band) or an
+        :func:`nk_table` (one series per angle of incidence, 1-sigma error bars).
+    max_series : int, optional
+        Draw at most this many members or angles (the first ones).
+
+    Returns
+    -------
+    list of dict
+        Panel descriptions (``title``, ``xlabel``, ``ylabel``, ``series``), as the
+        report's ``panels_figure`` and :func:`plot_table` draw them.
+    """
+    if not {"wavelength_nm", "n", "k", "n_sigma", "k_sigma"} <= set(table.columns):
+        raise ValueError(
+            "not an n, k table: expected the columns wavelength_nm, n, k, n_sigma, k_sigma "
+            f"(of nk_table or combined_table), got {list(table.columns)}"
+        )
+    per_angle = "theta_i_deg" in table.columns
+    if per_angle:
+        p = table.assign(theta=table["theta_i_deg"].round(2))
+        groups = [(f"\u03b8i {th:g}\u00b0", g) for th, g in p.groupby("theta", sort=True)]
+    else:
+        groups = series_members(table)
+    groups = groups[:max_series] if max_series is not None else groups
+    by_wl = table["wavelength_nm"].round(6).nunique() > 1
+    panels = []
+    for q in ("n", "k"):
+        series = []
+        for lab, g in groups:
+            s: dict[str, Any] = {
+                "label": lab,
+                "x": g["wavelength_nm"].to_numpy(float),
+                "y": g[q].to_numpy(float),
+            }
+            if per_angle:
+                s["yerr"] = g[f"{q}_sigma"].to_numpy(float)
+                s["style"] = "points" if g["wavelength_nm"].nunique() < 3 else "line"
+            else:
+                s["band"] = g[f"{q}_sigma"].to_numpy(float)
+                s["style"] = "line" if by_wl else "points"
+            series.append(s)
+        panels.append(
+            {
+                "title": f"pseudo-{q} per angle of incidence" if per_angle else f"combined {q}",
+                "xlabel": "wavelength [nm]",
+                "ylabel": f"<{q}> [1]" if per_angle else f"{q} [1]",
+                "series": series,
+            }
+        )
+    return panels
+
+
+def plot_table(table: pd.DataFrame, ax: Any = None) -> Any:
+    """n and k against wavelength with their 1-sigma uncertainties, for notebooks.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A :func:`combined_table` (lines with shaded +-1 sigma bands, one per series member)
+        or an :func:`nk_table` (the pseudo-constants, one series per angle of incidence,
+        with 1-sigma error bars). The report's n, k figures draw the same panels
+        (:func:`nk_panels`).
+    ax : pair of matplotlib Axes, optional
+        Where to draw n and k; default a new figure with two side-by-side axes.
+
+    Returns
+    -------
+    numpy.ndarray of matplotlib Axes
+        The n and the k axes.
+
+    Raises
+    ------
+    ValueError
+        The table lacks the n, k columns.
+
+    Examples
+    --------
+    >>> from labbrdf import nk  # doctest: +SKIP
+    >>> nk.plot_table(nk.combined_table(measurement))  # doctest: +SKIP
+    """
+    from ._plotting import draw_panel  # matplotlib only when drawing
+
+    panels = nk_panels(table)
+    if ax is None:
+        import matplotlib.pyplot as plt
+
+        _, ax = plt.subplots(1, 2, figsize=(9.2, 3.4), layout="constrained")
+    axes = np.asarray(ax, dtype=object).ravel()
+    if axes.size != 2:
+        raise ValueError(f"ax: expected two Axes (n, k), got {axes.size}")
+    for a, panel in zip(axes, panels, strict=True):
+        draw_panel(a, panel)
+    return axes
+
+
+# --------------------------------------------------------------------------- tables from files
+
+
+def tabulated_from_file(
+    path: str | os.PathLike[str], *, theta_deg: float | None = None
+) -> disp.Tabulated:
+    """Tabulated ``n, k`` of a material, read from a file.
+
+    Parameters
+    ----------
+    path : path-like
+        A text table ``wavelength_nm n [k]`` (comma, semicolon or whitespace separated,
+        ``#`` comments, an optional header line; :func:`labbrdf.dispersion.parse_nk_table`),
+        or any ellipsometer export labbrdf reads: its psi/Delta are inverted to two-phase
+        pseudo-constants (:func:`nk_table`) and averaged over the angles of incidence with
+        the inverse-variance weights of :func:`combined_table` (a bare, smooth substrate:
+        the pseudo-constants are the material's).
+    theta_deg : float, optional
+        Use only this angle of incidence of an ellipsometer file.
+
+    Returns
+    -------
+    labbrdf.dispersion.Tabulated
+        Keyed ``file:PATH`` (its ``to_dict`` names the file).
+
+    Raises
+    ------
+    labbrdf.dispersion.DispersionError
+        The file cannot be read as either; names the file (and the line of a table).
+    """
+    p = Path(path)
+    try:
+        text = p.read_text("utf-8", errors="replace")
+    except OSError as exc:
+        raise disp.DispersionError(f"{p}: cannot read ({exc.strerror})") from None
+    try:
+        w, n, k = disp.parse_nk_table(text, str(p))
+    except disp.DispersionError as table_error:
+        w, n, k = _pseudo_constants(p, theta_deg, table_error)
+    return disp.Tabulated(w, n, k, source=str(p), key=f"file:{p}")
+
+
+def _pseudo_constants(
+    path: Path, theta_deg: float | None, table_error: disp.DispersionError
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Pseudo-constants of an ellipsometer file, combined over angles."""
+    try:
+        meas = adapters.read(path)
+    except ValueError as exc:
+        raise disp.DispersionError(
+            f"{path}: neither an n,k table ({table_error}) nor an ellipsometer file ({exc})"
+        ) from None
+    df = meas.data
+    if theta_deg is not None:
+        keep = (~df["quantity"].isin(["psi", "delta"])) | (
+            np.abs(df["theta_i_deg"] - theta_deg) < 1e-3
+        )
+        df = df[keep]
+    try:
+        table = combined_table(df, on_ill_conditioned="ignore")
+    except ValueError as exc:
+        raise disp.DispersionError(f"{path}: no pseudo-constants ({exc})") from None
+    if "combined" in table and not bool(table["combined"].all()):
+        raise disp.DispersionError(
+            f"{path}: its angles of incidence disagree (pseudo-constants of a stack, not a "
+            "material's constants); fit the stack with `labbrdf film` and use its layers"
+        )
+    table = table.sort_values("wavelength_nm").drop_duplicates("wavelength_nm")
+    n = table["n"].to_numpy(float)
+    k = table["k"].to_numpy(float)
+    if np.any(n < 0) or np.any(k < 0):
+        raise disp.DispersionError(
+            f"{path}: the pseudo-constants have n < 0 or k < 0 at some wavelengths; they "
+            "are not a material's constants (a film or a rough surface)"
+        )
+    return table["wavelength_nm"].to_numpy(float), n, k

@@ -935,6 +935,132 @@ def _fmt_len(v: float) -> str:
     return f"{v / 1e-12:.4g} pm"
 
 
+def _eroded(valid: NDArray, erode: int) -> tuple[NDArray, int]:
+    """The valid points after :func:`erode_mask` by ``erode`` pixels, and how many it dropped."""
+    if not valid.any():
+        raise ValueError("heights hold no valid (finite, unmasked) point")
+    if not erode:
+        return valid, 0
+    n_before = int(np.count_nonzero(valid))
+    valid = erode_mask(valid, erode)
+    n_eroded = n_before - int(np.count_nonzero(valid))
+    if not valid.any():
+        raise ValueError(f"eroding the mask by {erode} pixels leaves no valid point")
+    return valid, n_eroded
+
+
+def _jackknife(
+    z: NDArray,
+    valid: NDArray,
+    px: tuple[float, ...],
+    degree: int,
+    tiles: list[tuple[slice, ...]],
+    full: dict[str, Any],
+    progress: Callable[[int, int], None] | None,
+) -> dict[str, float]:
+    """Delete-one-tile jackknife standard errors (bias included) of every finite scalar.
+
+    One replicate per tile, each :func:`_core` with that tile masked, run one after the
+    other (memory: one replicate at a time). Empty without tiles.
+    """
+    if not tiles:
+        return {}
+    scal = [
+        k
+        for k, v in full.items()
+        if not k.startswith("_") and isinstance(v, float) and math.isfinite(v)
+    ]
+    no_dropouts = bool(valid.all())
+    reps: dict[str, list[float]] = {k: [] for k in scal}
+    for i, t in enumerate(tiles):
+        sub = valid.copy()
+        sub[t] = False
+        rep = _core(z, sub, px, degree, hole=t if no_dropouts else None)
+        del sub
+        for k in scal:
+            reps[k].append(rep[k])
+        if progress is not None:
+            progress(i + 2, 1 + len(tiles))
+    nb = len(tiles)
+    unc: dict[str, float] = {}
+    for k in scal:
+        v = np.asarray(reps[k], dtype=float)
+        if not np.all(np.isfinite(v)):
+            unc[k] = _NAN
+            continue
+        var = (nb - 1) / nb * float(np.sum((v - v.mean()) ** 2))
+        bias = (nb - 1) * (float(v.mean()) - full[k])
+        unc[k] = math.sqrt(var + bias * bias)
+    return unc
+
+
+def _stats_notes(
+    z: NDArray,
+    valid: NDArray,
+    px: tuple[float, ...],
+    degree: int,
+    full: dict[str, Any],
+    fits: SlopeFits,
+) -> list[str]:
+    """The warnings of :func:`roughness_statistics`.
+
+    A profile, a poor slope fit, a pixel-scale or undefined correlation length, height
+    variance carried by a few points.
+    """
+    notes = []
+    if z.ndim == 1:
+        notes.append(
+            "profile: alphas and the slope fits use one direction and assume an isotropic surface"
+        )
+    if fits.warning:
+        notes.append(fits.warning)
+    if not math.isfinite(full["c"]):
+        notes.append("the ACF does not fall below 1/e within half the map: c undefined")
+    elif full["c"] < C_MIN_PIXELS * min(px):
+        notes.append(
+            f"correlation length c = {full['c'] / min(px):.2g} pixels (< {C_MIN_PIXELS:g}):"
+            " the ACF is that of pixel-scale noise or spikes, so sqrt(2) sigma / c ="
+            f" {full['alpha_gaussian_acf']:.3g} is no slope; limit the bandwidth"
+            " (short_cutoff, --short-cutoff) or drop dropout rims (erode, --erode-mask)"
+        )
+    share, h2_thr = full["_top_share"]
+    if math.isfinite(share) and share > TOP_VARIANCE_WARN:
+        big = np.zeros(z.shape, dtype=bool)
+        lz = _level(z, valid, degree)
+        with np.errstate(invalid="ignore"):
+            np.greater_equal(lz * lz, h2_thr, out=big, where=valid)
+        del lz
+        n_big = int(np.count_nonzero(big))
+        rim = ""
+        if not valid.all():
+            near = ndimage.binary_dilation(~valid, structure=np.ones((3,) * z.ndim, dtype=bool))
+            rim = f", {int(np.count_nonzero(big & near))} of them next to a dropout"
+        notes.append(
+            f"1 % of the points ({n_big}{rim}) carry {100 * share:.3g} % of the height"
+            " variance: spikes or dropout rims dominate sigma, c and the alphas; erode the"
+            " mask around dropouts (erode, --erode-mask N) or check the data"
+        )
+    return notes
+
+
+def _bandwidth(
+    shape: tuple[int, ...], px: tuple[float, ...], degree: int, short_cutoff: float | None
+) -> tuple[str, str]:
+    """The levelling and the band of surface wavelengths the statistics describe, as text."""
+    lev = {0: "mean removed", 1: "least-squares mean plane removed"}.get(
+        degree, f"least-squares polynomial of total degree {degree} removed"
+    )
+    extent = max(n * p for n, p in zip(shape, px, strict=True))
+    if short_cutoff is not None:
+        lo = (
+            f"short-wavelength cut-off {_fmt_len(float(short_cutoff))}"
+            " (Gaussian S-filter, ISO 16610-61)"
+        )
+    else:
+        lo = f"no S-filter: down to the pixel, {_fmt_len(min(px))}"
+    return lev, f"{lo}; up to the map size {_fmt_len(extent)} ({lev})"
+
+
 def roughness_statistics(
     heights: ArrayLike,
     pixel_size: float | ArrayLike,
@@ -995,105 +1121,29 @@ def roughness_statistics(
     """
     z, valid = _as_heights(heights, mask)
     px = _pixel(pixel_size, z.ndim)
-    if not valid.any():
-        raise ValueError("heights hold no valid (finite, unmasked) point")
-    n_before = int(np.count_nonzero(valid))
-    if erode:
-        valid = erode_mask(valid, erode)
-    n_eroded = n_before - int(np.count_nonzero(valid))
-    if not valid.any():
-        raise ValueError(f"eroding the mask by {erode} pixels leaves no valid point")
+    valid, n_eroded = _eroded(valid, erode)
     if short_cutoff is not None:
         z = _s_filter(_level(z, valid, degree), valid, px, float(short_cutoff))
     if blocks is None:
         blocks = 5 if z.ndim == 2 else 20
     tiles = _tiles(valid, blocks) if blocks and blocks > 1 else []
-    total = 1 + (len(tiles) if len(tiles) > 1 else 0)
+    if len(tiles) < 2:
+        tiles = []
     full = _core(z, valid, px, degree, with_slopes=True)
     if progress is not None:
-        progress(1, total)
-    unc: dict[str, float] = {}
-    scal = [
-        k
-        for k, v in full.items()
-        if not k.startswith("_") and isinstance(v, float) and math.isfinite(v)
-    ]
-    if len(tiles) > 1:
-        no_dropouts = bool(valid.all())
-        reps: dict[str, list[float]] = {k: [] for k in scal}
-        for i, t in enumerate(tiles):
-            sub = valid.copy()
-            sub[t] = False
-            rep = _core(z, sub, px, degree, hole=t if no_dropouts else None)
-            del sub
-            for k in scal:
-                reps[k].append(rep[k])
-            if progress is not None:
-                progress(i + 2, total)
-        nb = len(tiles)
-        for k in scal:
-            v = np.asarray(reps[k], dtype=float)
-            if not np.all(np.isfinite(v)):
-                unc[k] = _NAN
-                continue
-            var = (nb - 1) / nb * float(np.sum((v - v.mean()) ** 2))
-            bias = (nb - 1) * (float(v.mean()) - full[k])
-            unc[k] = math.sqrt(var + bias * bias)
-    fc = full["_fit"]
-    if len(tiles) > 1:
+        progress(1, 1 + len(tiles))
+    unc = _jackknife(z, valid, px, degree, tiles, full, progress)
+    if tiles:
         ug, ub = unc.get("ggx_alpha", _NAN), unc.get("beckmann_alpha", _NAN)
     else:
         ug, ub = full["_fisher"]
-    fits = _make_fits(fc, ug, ub, full["_n_slopes"])
-    notes = []
-    if z.ndim == 1:
-        notes.append(
-            "profile: alphas and the slope fits use one direction and assume an isotropic surface"
-        )
-    if fits.warning:
-        notes.append(fits.warning)
-    if not math.isfinite(full["c"]):
-        notes.append("the ACF does not fall below 1/e within half the map: c undefined")
-    elif full["c"] < C_MIN_PIXELS * min(px):
-        notes.append(
-            f"correlation length c = {full['c'] / min(px):.2g} pixels (< {C_MIN_PIXELS:g}):"
-            " the ACF is that of pixel-scale noise or spikes, so sqrt(2) sigma / c ="
-            f" {full['alpha_gaussian_acf']:.3g} is no slope; limit the bandwidth"
-            " (short_cutoff, --short-cutoff) or drop dropout rims (erode, --erode-mask)"
-        )
-    share, h2_thr = full["_top_share"]
-    if math.isfinite(share) and share > TOP_VARIANCE_WARN:
-        big = np.zeros(z.shape, dtype=bool)
-        lz = _level(z, valid, degree)
-        with np.errstate(invalid="ignore"):
-            np.greater_equal(lz * lz, h2_thr, out=big, where=valid)
-        del lz
-        n_big = int(np.count_nonzero(big))
-        rim = ""
-        if not valid.all():
-            near = ndimage.binary_dilation(~valid, structure=np.ones((3,) * z.ndim, dtype=bool))
-            rim = f", {int(np.count_nonzero(big & near))} of them next to a dropout"
-        notes.append(
-            f"1 % of the points ({n_big}{rim}) carry {100 * share:.3g} % of the height"
-            " variance: spikes or dropout rims dominate sigma, c and the alphas; erode the"
-            " mask around dropouts (erode, --erode-mask N) or check the data"
-        )
+    fits = _make_fits(full["_fit"], ug, ub, full["_n_slopes"])
+    notes = _stats_notes(z, valid, px, degree, full, fits)
     if n_eroded:
         notes.append(f"mask eroded by {erode} pixels around dropouts: {n_eroded} points dropped")
     names = {f for f in RoughnessStats.__dataclass_fields__}
     kw = {k: v for k, v in full.items() if k in names}
-    lev = {0: "mean removed", 1: "least-squares mean plane removed"}.get(
-        degree, f"least-squares polynomial of total degree {degree} removed"
-    )
-    extent = max(n * p for n, p in zip(z.shape, px, strict=True))
-    if short_cutoff is not None:
-        lo = (
-            f"short-wavelength cut-off {_fmt_len(float(short_cutoff))}"
-            " (Gaussian S-filter, ISO 16610-61)"
-        )
-    else:
-        lo = f"no S-filter: down to the pixel, {_fmt_len(min(px))}"
-    band = f"{lo}; up to the map size {_fmt_len(extent)} ({lev})"
+    lev, band = _bandwidth(z.shape, px, degree, short_cutoff)
     return RoughnessStats(
         kind="areal" if z.ndim == 2 else "profile",
         shape=tuple(int(n) for n in z.shape),
@@ -1102,7 +1152,7 @@ def roughness_statistics(
         n_valid=int(np.count_nonzero(valid)),
         slope_fits=fits,
         uncertainty=unc,
-        n_blocks=len(tiles) if len(tiles) > 1 else 0,
+        n_blocks=len(tiles),
         notes=tuple(notes),
         short_cutoff=float(short_cutoff) if short_cutoff is not None else _NAN,
         bandwidth=band,

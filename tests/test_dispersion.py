@@ -17,6 +17,8 @@ from labbrdf.dispersion import (
     Tabulated,
     TaucLorentz,
 )
+from labbrdf.films import as_material
+from labbrdf.nk import tabulated_from_file
 
 EXAMPLES = [
     Cauchy(A=1.9, B=0.02, C=0.001, k_amp=0.01, exponent=2.0, band_edge=4.0),
@@ -144,12 +146,12 @@ def test_tauc_lorentz_matches_pyelli():
 def test_tabulated_from_a_three_and_a_two_column_file(tmp_path):
     p = tmp_path / "film.csv"
     p.write_text("# my film\nwavelength_nm,n,k\n400,2.0,0.1\n800,1.8,0.0\n")
-    t = Tabulated.from_file(p)
+    t = tabulated_from_file(p)
     assert t.nk(600.0) == pytest.approx(1.9 + 0.05j)
     p2 = tmp_path / "glass.txt"
     p2.write_text("500 1.5\n600 1.49\n")
-    assert Tabulated.from_file(p2).nk(550.0) == pytest.approx(1.495 + 0j)
-    assert disp.from_dict(t.to_dict()).nk(600.0) == t.nk(600.0)
+    assert tabulated_from_file(p2).nk(550.0) == pytest.approx(1.495 + 0j)
+    assert as_material(t.to_dict()).nk(600.0) == t.nk(600.0)
 
 
 @pytest.mark.parametrize(
@@ -166,18 +168,18 @@ def test_bad_table_file_names_file_and_line(tmp_path, text, match):
     p = tmp_path / "bad.txt"
     p.write_text(text)
     with pytest.raises(DispersionError, match=match) as exc:
-        Tabulated.from_file(p)
+        tabulated_from_file(p)
     assert "bad.txt" in str(exc.value)
 
 
 def test_missing_file_raises_a_dispersion_error(tmp_path):
     with pytest.raises(DispersionError, match="cannot read"):
-        Tabulated.from_file(tmp_path / "absent.txt")
+        tabulated_from_file(tmp_path / "absent.txt")
 
 
 @pytest.mark.shared
 def test_tabulated_from_a_bare_tantalum_ellipsometer_file(real_exports):
-    t = Tabulated.from_file(real_exports / "woollam-wvase-ascii" / "w2_10102006.dat")
+    t = tabulated_from_file(real_exports / "woollam-wvase-ascii" / "w2_10102006.dat")
     lo, hi = t.range_nm
     assert lo < 300 and hi > 1600
     n633 = t.nk(633.0)
@@ -207,4 +209,4 @@ def test_invalid_parameters_raise_clear_errors(build, match):
 def test_pseudo_constants_of_a_stack_are_refused_as_a_table(real_exports) -> None:
     coated = real_exports / "woollam-wvase-ascii" / "w1_12082006.dat"
     with pytest.raises(DispersionError, match="pseudo-constants of a stack"):
-        Tabulated.from_file(coated)
+        tabulated_from_file(coated)

@@ -482,22 +482,14 @@ def test_leftover_report_folders_of_earlier_labbrdf_versions_are_removed(tmp_pat
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*kept, "rep"])
 
 
-def test_library_reports_refuse_a_foreign_folder_before_any_work(tmp_path, capsys):
+def test_library_reports_refuse_a_foreign_folder_before_any_work(tmp_path, capsys, specular_scan):
     from labbrdf import report
 
     out = tmp_path / "mine"
     out.mkdir()
     (out / "thesis.tex").write_text("x")
-    scan = (
-        Path(__file__).resolve().parents[1]
-        / "labbrdf"
-        / "data"
-        / "fixtures"
-        / "specular"
-        / "osr_specular.csv"
-    )
     with pytest.raises(OutputError, match="not empty"):
-        report.user_report([scan], "smooth3", out, progress=True)
+        report.user_report([specular_scan], "smooth3", out, progress=True)
     with pytest.raises(OutputError, match="not empty"):
         report.validate(out=out, progress=True, quick=True)
     assert "section" not in capsys.readouterr().err  # nothing ran

@@ -529,11 +529,10 @@ def test_dask_scheduler_without_dask_says_how_to_install_it(monkeypatch, schedul
         parallel.run(abs, [1, -2], scheduler=scheduler, workers=2)
 
 
-def test_cli_trace_without_dask_exits_2_with_the_install_hint(monkeypatch, capsys):
+def test_cli_trace_without_dask_exits_2_with_the_install_hint(monkeypatch, capsys, trace_sample):
     parallel.shutdown()
     monkeypatch.setitem(sys.modules, "dask.distributed", None)
-    argv = ["trace", "--substrate", "1.55+7.71j", "--alpha", "0.2", "--theta-i", "45"]
-    code = main([*argv, "--wavelength", "650", "--rays", "1000", "--scheduler", "local"])
+    code = main([*trace_sample, "--rays", "1000", "--scheduler", "local"])
     assert code == 2
     assert "pip install labbrdf[dask]" in capsys.readouterr().err
 
@@ -603,36 +602,23 @@ def spy(monkeypatch) -> Spy:
     return s
 
 
-TRACE_ARGV = [
-    "trace",
-    "--substrate",
-    "1.55+7.71j",
-    "--alpha",
-    "0.2",
-    "--theta-i",
-    "45",
-    "--wavelength",
-    "650",
-    "--rays",
-    "70000",  # 3 blocks of 32768
-    "--seed",
-    "3",
-    "--single-scattering",
-    "--json",
-]
+@pytest.fixture
+def trace_blocks(trace_sample: list[str]) -> list[str]:
+    """A trace of three blocks (70000 rays, blocks of 32768), seeded, JSON summary."""
+    return [*trace_sample, "--rays", "70000", "--seed", "3", "--single-scattering", "--json"]
 
 
-def _trace_json(capsys, *extra: str) -> dict[str, Any]:
-    assert main([*TRACE_ARGV, *extra]) == 0
+def _trace_json(capsys, argv: list[str], *extra: str) -> dict[str, Any]:
+    assert main([*argv, *extra]) == 0
     out = json.loads(capsys.readouterr().out)
     out.pop("seconds")
     return out
 
 
-def test_cli_trace_honours_scheduler_and_workers(spy, capsys):
-    serial = _trace_json(capsys, "--scheduler", "serial")
+def test_cli_trace_honours_scheduler_and_workers(spy, capsys, trace_blocks):
+    serial = _trace_json(capsys, trace_blocks, "--scheduler", "serial")
     assert spy.pools == []  # serial: in this process
-    pool = _trace_json(capsys, "--scheduler", "processes", "--workers", "3")
+    pool = _trace_json(capsys, trace_blocks, "--scheduler", "processes", "--workers", "3")
     assert [(c["scheduler"], c["workers"]) for c in spy.calls] == [
         ("serial", None),
         ("processes", 3),
@@ -642,9 +628,9 @@ def test_cli_trace_honours_scheduler_and_workers(spy, capsys):
 
 
 @pytest.mark.slow
-def test_cli_trace_over_tcp_equals_serial(tcp_cluster, capsys):
-    serial = _trace_json(capsys, "--scheduler", "serial")
-    assert _trace_json(capsys, "--scheduler", tcp_cluster) == serial
+def test_cli_trace_over_tcp_equals_serial(tcp_cluster, capsys, trace_blocks):
+    serial = _trace_json(capsys, trace_blocks, "--scheduler", "serial")
+    assert _trace_json(capsys, trace_blocks, "--scheduler", tcp_cluster) == serial
 
 
 def _write_dataset(frame: pd.DataFrame, tmp_path: Path) -> str:
@@ -760,8 +746,8 @@ def test_validate_runs_its_fits_and_traces_on_the_requested_scheduler(spy, fixtu
 
 
 @pytest.mark.parametrize("bad", [["--scheduler", "gpu"], ["--workers", "0"]])
-def test_cli_rejects_bad_scheduler_or_workers(bad, capsys):
-    assert main([*TRACE_ARGV[:-1], "--rays", "100", *bad]) == 2
+def test_cli_rejects_bad_scheduler_or_workers(bad, capsys, trace_blocks):
+    assert main([*trace_blocks[:-1], "--rays", "100", *bad]) == 2
     err = capsys.readouterr().err
     assert re.search(r"unknown scheduler 'gpu'|workers must be >= 1, got 0", err)
 
@@ -965,9 +951,8 @@ def test_tls_from_the_dask_config_and_a_local_cluster_on_tls(certs, serial):
 
 
 @pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
-def test_cli_tls_options_need_existing_files(tmp_path, capsys):
-    scan = ROOT / "labbrdf" / "data" / "fixtures" / "specular" / "osr_specular.csv"
-    argv = ["fit", str(scan), "--model", "smooth3", "--scheduler", "tls://127.0.0.1:1"]
+def test_cli_tls_options_need_existing_files(tmp_path, capsys, specular_scan):
+    argv = ["fit", str(specular_scan), "--model", "smooth3", "--scheduler", "tls://127.0.0.1:1"]
     assert main([*argv, "--tls-ca", str(tmp_path / "nope.pem"), "--tls-cert", "x"]) == 2
     assert "nope.pem" in capsys.readouterr().err
     assert main([*argv, "--tls-key", str(tmp_path / "k.pem")]) == 2
@@ -1121,9 +1106,8 @@ def test_default_worker_timeout_is_a_minute():
 
 @pytest.mark.parametrize("bad", ["0", "-1", "nan", "inf"])
 @pytest.mark.usefixtures("reset_parallel_options")
-def test_bad_worker_timeout_is_refused(bad, capsys):
-    scan = ROOT / "labbrdf" / "data" / "fixtures" / "specular" / "osr_specular.csv"
-    argv = ["fit", str(scan), "--model", "smooth3", "--scheduler", "serial"]
+def test_bad_worker_timeout_is_refused(bad, capsys, specular_scan):
+    argv = ["fit", str(specular_scan), "--model", "smooth3", "--scheduler", "serial"]
     assert main([*argv, "--worker-timeout", bad]) == 2
     assert "--worker-timeout: expected a finite number of seconds > 0" in capsys.readouterr().err
     with pytest.raises(ValueError, match="worker-timeout"):

@@ -12,6 +12,14 @@ extension that belongs to one format only sends it to that reader, whose error s
 wrong where; otherwise :class:`AdapterError` names the closest candidates: the formats of the
 extension and those whose typical keywords occur in the first bytes. Readers never try each
 other under ``except``: a parse error is reported as is.
+
+Height maps (profilometer, AFM and interferometer files, :mod:`labbrdf.adapters.topography`)
+are an input kind of their own (:data:`~labbrdf.adapters.topography.HEIGHT_MAP_FORMATS`):
+:func:`input_kind` tells them from optical exports before anything is parsed -- an extension
+only height maps have, or, for an extension optical exports share (MetroPro ``.dat``), magic
+bytes a height-map sniffer claims and no optical sniffer does. :func:`read` refuses a height
+map with an :class:`AdapterError` that says so (a height map is not a :class:`Measurement`);
+:func:`read_inputs` reads a list of paths of either kind, each file once.
 """
 
 from __future__ import annotations
@@ -41,11 +49,25 @@ from . import (
     woollam,
     zemax_bsdf,
 )
-from ._base import AdapterError, Format, check_regular_file
+from ._base import AdapterError, Example, Format, check_regular_file
 from ._ole2 import is_ole2
 from .columns import read_columns as _read_columns
+from .topography import height_map_format
 
-__all__ = ["AdapterError", "Format", "READERS", "formats", "read", "read_many", "sniff"]
+__all__ = [
+    "AdapterError",
+    "Example",
+    "Format",
+    "InputFile",
+    "Inputs",
+    "READERS",
+    "formats",
+    "input_kind",
+    "read",
+    "read_inputs",
+    "read_many",
+    "sniff",
+]
 
 # One module per vendor; each defines FORMATS: tuple[Format, ...]. The order here is the
 # order of formats() and of the candidates named in errors.
@@ -123,6 +145,54 @@ def sniff(path: str | os.PathLike[str]) -> list[str]:
     """Names of the formats whose sniffer claims the file."""
     head = _head(path)
     return [n for n, f in READERS.items() if f.sniff(head)]
+
+
+def _kind(p: Path, head: bytes) -> str:
+    """``"height_map"`` or ``"optical"`` from the name and the first bytes."""
+    claim = height_map_format(p, head)
+    if claim is None:
+        return "optical"
+    fmt, own_extension = claim
+    if own_extension:
+        return "height_map"
+    shared = p.name.lower().endswith(fmt.shared_extensions)
+    if not shared and _by_extension(p):  # an optical format's own extension
+        return "optical"
+    return "optical" if any(f.sniff(head) for f in READERS.values()) else "height_map"
+
+
+def input_kind(path: str | os.PathLike[str]) -> str:
+    """Whether a file is an optical export or a height map, before anything is parsed.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+
+    Returns
+    -------
+    str
+        ``"height_map"`` for an extension only topography instruments write
+        (:data:`~labbrdf.adapters.topography.HEIGHT_MAP_FORMATS`), or for a file whose
+        first bytes a height-map sniffer claims and no optical sniffer does, when its
+        extension is one the height-map format shares with optical exports (a MetroPro
+        ``.dat`` beside WVASE ``.dat``) or belongs to no format; ``"optical"`` otherwise.
+
+    Raises
+    ------
+    AdapterError
+        The file is missing, not a regular file, or cannot be read.
+    """
+    p = Path(path)
+    return _kind(p, _head(p))
+
+
+def _height_map_error(path: str | os.PathLike[str]) -> AdapterError:
+    return AdapterError(
+        path,
+        "is a height map (topography file), not an optical export: read it with "
+        "labbrdf.read_height_map, or labbrdf.read_inputs for a mix of both kinds",
+    )
 
 
 def _no_match_message(path: Path, by_ext: list[str], head: bytes) -> str:
@@ -208,7 +278,9 @@ def read(
     Raises
     ------
     AdapterError
-        The file cannot be read, or the format is ambiguous or unknown.
+        The file cannot be read, or the format is ambiguous or unknown; or, with no
+        ``format`` and no ``columns``, it is a height map (:func:`input_kind`): the message
+        says so and names :func:`labbrdf.read_height_map` and :func:`read_inputs`.
     """
     p = Path(path)
     if format is not None and format not in READERS:
@@ -233,8 +305,15 @@ def read(
         return m
     if format is not None:
         return _read_with(format, p)
-    by_ext = _by_extension(p)
     head = _head(p)
+    if _kind(p, head) == "height_map":
+        raise _height_map_error(path)
+    return _dispatch(path, p, head)
+
+
+def _dispatch(path: str | os.PathLike[str], p: Path, head: bytes) -> Measurement:
+    """The reader the extension and the sniffers choose (see the module docstring)."""
+    by_ext = _by_extension(p)
     claimed = [n for n, f in READERS.items() if f.sniff(head)]
     # the extension's formats first; when none of them claims the file, the content decides
     pool = [n for n in claimed if n in by_ext] or claimed
@@ -257,3 +336,7 @@ def read_many(
 ) -> Measurement:
     """Read several files and concatenate them (each row keeps its ``source``)."""
     return concat(read(p, format, columns=columns) for p in paths)
+
+
+# at the end: the inputs module reads through the dispatch above
+from .inputs import InputFile, Inputs, read_inputs  # noqa: E402

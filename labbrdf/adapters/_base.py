@@ -22,6 +22,7 @@ __all__ = [
     "MAX_POINTS",
     "NONFINITE",
     "AdapterError",
+    "Example",
     "Format",
     "check_count",
     "check_regular_file",
@@ -89,6 +90,33 @@ def _rebuild_adapter_error(
 
 
 @dataclass(frozen=True)
+class Example:
+    """A real export of a format: the file a format's generic tests read and damage.
+
+    The files are not part of the package: the test suite finds them in its collection of
+    real exports, one folder per format, and skips where the collection is absent.
+
+    Attributes
+    ----------
+    path : str
+        ``"<folder>/<file name>"`` in the collection of real exports.
+    number : tuple of (str, int), optional
+        A numeric field exactly as written on a data line of the file, and that line
+        (1-based): the field the ASCII-digits test rewrites (full-width digits, ``1_000``,
+        a non-finite spelling) to check the reader refuses it at that line.
+    rows_per_line : int, optional
+        The most dataset rows one text line of the file gives (psi and Delta: 2; a line of
+        three angles: 6; a Mueller matrix: 16). A damaged line may cost at most this many
+        rows, which bounds what the mutation tests of line-oriented formats accept; they
+        damage the examples that state it.
+    """
+
+    path: str
+    number: tuple[str, int] | None = None
+    rows_per_line: int | None = None
+
+
+@dataclass(frozen=True)
 class Format:
     """One supported export format.
 
@@ -113,6 +141,14 @@ class Format:
         A file that no sniffer claims but that contains one of them names this format among
         the closest candidates in the error of :func:`labbrdf.read`. Never used to choose a
         reader.
+    examples : tuple of Example
+        Real exports of the format, the first one its reference file: the generic tests
+        (dispatch, mutation, declared counts under a memory limit, ASCII digits) take
+        their cases for the format from here. Never used to read a file.
+    states_count : bool
+        The files state their point count (or the reader checks the wavelength steps
+        against the stated data interval), so a damaged file is either refused or read
+        with every point: a mutated file never silently loses or gains a point.
     """
 
     name: str
@@ -122,6 +158,8 @@ class Format:
     read: Callable[[str | os.PathLike[str]], Measurement]
     quantities: tuple[str, ...] = field(default=())
     keywords: tuple[bytes, ...] = field(default=())
+    examples: tuple[Example, ...] = field(default=())
+    states_count: bool = False
 
 
 def parse_number(

@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import Measurement, wrap_delta
-from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._base import AdapterError, Example, Format, decode, read_bytes, split_lines
 from ._numblock import (
     Block,
     build_frame,
@@ -382,5 +382,14 @@ FORMATS: tuple[Format, ...] = (
         read=read_accurion,
         quantities=("psi", "delta"),
         keywords=(b"#Lambda\t", b"#ROIidx\t", b"\tAOI\t", b"WVASEformat"),
+        examples=(
+            Example("accurion-ep4-dat/15-1-1.dat", rows_per_line=2),
+            Example("accurion-ep4-dat/corefine_PNIPAM_ellipsometry.dat", rows_per_line=2),
+            Example(
+                "accurion-ep4-dat/Si3N4_on_4inBF33_W02_20240903-150451.ds.dat", rows_per_line=2
+            ),
+            Example("accurion-ep4-dat/testData1_11nm_PNIPAM_on_Si_EP4.dat", rows_per_line=2),
+            Example("accurion-ep4-dat/post synthesis.dat", number=("143.615", 3)),
+        ),
     ),
 )

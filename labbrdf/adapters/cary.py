@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import Measurement
-from ._base import DECIMAL, AdapterError, Format, decode, read_bytes, split_lines
+from ._base import DECIMAL, AdapterError, Example, Format, decode, read_bytes, split_lines
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_cary_csv"]
@@ -375,5 +375,9 @@ FORMATS = (
         read_cary_csv,
         ("absorbance", "transmittance", "reflectance", "hemispherical_reflectance"),
         keywords=(b"Wavelength (nm),",),
+        examples=(
+            Example("agilent-cary-winuv-csv/CuPCtS_H2O_vis.csv", number=("0.0340631865", 5)),
+        ),
+        states_count=True,
     ),
 )

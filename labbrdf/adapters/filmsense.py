@@ -31,7 +31,7 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 
 from ..dataset import Measurement, wrap_delta
-from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._base import AdapterError, Example, Format, decode, read_bytes, split_lines
 from ._numblock import NUMBER, build_frame, group_angles, measurement
 
 __all__ = ["FORMATS", "filmsense_psi_delta", "read_filmsense", "sniff_filmsense"]
@@ -429,5 +429,11 @@ FORMATS: tuple[Format, ...] = (
         read=read_filmsense,
         quantities=("psi", "delta", "depolarization"),
         keywords=(b"Film_Sense",),
+        examples=(
+            Example(
+                "filmsense-txt/Filmsense_staticTest.txt", number=("14.32", 3), rows_per_line=3
+            ),
+            Example("filmsense-txt/Filmsense_kineticTest.txt", rows_per_line=24),
+        ),
     ),
 )

@@ -61,7 +61,7 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, check_count, decode, read_bytes, split_lines
+from ._base import AdapterError, Example, Format, check_count, decode, read_bytes, split_lines
 from ._ole2 import ole_names, open_ole2, read_stream
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
@@ -575,6 +575,10 @@ FORMATS = (
         read_jasco_text,
         ("absorbance", "transmittance", "reflectance", "hemispherical_reflectance"),
         keywords=(b"JASCO", b"\nXYDATA"),
+        examples=(
+            Example("jasco-spectramanager-text/uvvis_abs.txt", number=("-6.38777E-05", 19)),
+        ),
+        states_count=True,
     ),
     Format(
         "jasco-jws",
@@ -583,5 +587,7 @@ FORMATS = (
         _sniff_jws,
         read_jasco_jws,
         ("absorbance", "transmittance", "reflectance", "hemispherical_reflectance"),
+        examples=(Example("jasco-jws-binary/uvvis_abs.jws"),),
+        states_count=True,
     ),
 )

@@ -63,7 +63,16 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import Measurement
-from ._base import MAX_POINTS, AdapterError, Format, check_count, decode, read_bytes, split_lines
+from ._base import (
+    MAX_POINTS,
+    AdapterError,
+    Example,
+    Format,
+    check_count,
+    decode,
+    read_bytes,
+    split_lines,
+)
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_jcamp"]
@@ -629,5 +638,7 @@ FORMATS = (
         read_jcamp,
         ("absorbance", "transmittance", "reflectance", "hemispherical_reflectance"),
         keywords=(b"##TITLE", b"##JCAMP", b"##XYDATA", b"##XYPOINTS"),
+        examples=(Example("jcamp-dx/dupinc1.jdx", number=("2860", 22)),),
+        states_count=True,
     ),
 )

@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, check_count, decode, read_bytes, split_lines
+from ._base import AdapterError, Example, Format, check_count, decode, read_bytes, split_lines
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_perkinelmer_asc"]
@@ -235,5 +235,9 @@ FORMATS = (
         read_perkinelmer_asc,
         ("transmittance", "reflectance", "hemispherical_reflectance", "absorbance"),
         keywords=(b"PE UV", b"PEDS"),
+        examples=(
+            Example("perkinelmer-uvwinlab-asc/KTF-D.Probe.Raw.asc", number=("89.940565", 91)),
+        ),
+        states_count=True,
     ),
 )

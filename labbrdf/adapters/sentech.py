@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement, wrap_delta
-from ._base import AdapterError, Format, decode, read_bytes
+from ._base import AdapterError, Example, Format, decode, read_bytes
 from ._numblock import (
     MUELLER_S1_FLIP,
     NUMBER,
@@ -246,5 +246,13 @@ FORMATS: tuple[Format, ...] = (
         read=read_sentech,
         quantities=("psi", "delta", *(str(q) for q in _MM)),
         keywords=(b"; WAVELENGTH", b"SpectraRay"),
+        examples=(
+            Example(
+                "sentech-spectraray-ascii/Si_SiO2_theta_50_60_70.txt",
+                number=("47.53618", 3),
+                rows_per_line=6,
+            ),
+            Example("sentech-spectraray-ascii/Wafer_MM_70.txt", rows_per_line=16),
+        ),
     ),
 )

@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, check_count, read_bytes
+from ._base import AdapterError, Example, Format, check_count, read_bytes
 from ._ole2 import is_ole2
 from ._spectro import finish, spectrum_frame
 
@@ -419,5 +419,7 @@ FORMATS = (
         _sniff,
         read_spc,
         ("absorbance", "transmittance", "reflectance"),
+        examples=(Example("galactic-spc/HOLMIUM.SPC"),),
+        states_count=True,
     ),
 )

@@ -5,6 +5,11 @@ SurfaceTopography (optional extra ``labbrdf[topography]``) reads the instrument 
 plain XYZ and matrix ASCII, ...); it is imported only when a file is read. Everything is
 converted to metres here, so :mod:`labbrdf.topography` never sees a unit.
 
+Which files are height maps is this module's knowledge too: :data:`HEIGHT_MAP_FORMATS` lists
+the extensions only topography instruments write, the ones shared with optical exports
+(MetroPro ``.dat``) and the magic bytes that decide for those (:func:`height_map_format`);
+:func:`labbrdf.adapters.input_kind` weighs them against the optical sniffers.
+
 Plain XYZ (``x y z`` columns on a grid) and matrix ASCII files are also read by
 SurfaceTopography; a matrix file carries no lateral size, so ``physical_sizes`` (or
 ``pixel_size``) and ``unit`` must then be given.
@@ -31,6 +36,7 @@ linearly onto a uniform grid at their median spacing by SurfaceTopography's
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -40,13 +46,16 @@ from numpy.typing import NDArray
 from labbrdf.adapters._base import AdapterError
 
 __all__ = [
+    "HEIGHT_MAP_FORMATS",
     "MAX_EXTENT_M",
     "MAX_PIXEL_ASPECT",
     "MAX_SLOPE_RMS",
     "MIN_SLOPE_RMS",
     "PITCH_RANGE_M",
     "HeightMap",
+    "HeightMapFormat",
     "check_geometry",
+    "height_map_format",
     "length_m",
     "read_height_map",
     "topography_statistics",
@@ -134,6 +143,142 @@ class HeightMap:
     def physical_sizes(self) -> tuple[float, ...]:
         """Extent per axis [m] (points x spacing, SurfaceTopography's convention)."""
         return tuple(n * p for n, p in zip(self.heights.shape, self.pixel_size, strict=True))
+
+    def summary(self) -> dict[str, Any]:
+        """What the map holds, JSON-safe: kind, reader, channel, points, size, pitch."""
+        return {
+            "kind": "profile" if self.is_profile else "areal map",
+            "reader": self.meta.get("reader", ""),
+            "channel": self.channel,
+            "points": list(self.heights.shape),
+            "size_um": [s * 1e6 for s in self.physical_sizes],
+            "pixel_nm": [s * 1e9 for s in self.pixel_size],
+            "missing": int(self.mask.sum()),
+        }
+
+    def summary_line(self) -> str:
+        """One line: ``areal map, 512 x 512 points, 10 x 10 um, pixel 19.53 nm, ...``."""
+        s = self.summary()
+        size = " x ".join(f"{v:.4g}" for v in s["size_um"])
+        pixel = " x ".join(f"{v:.4g}" for v in s["pixel_nm"])
+        return (
+            f"{s['kind']}, {' x '.join(map(str, s['points']))} points, {size} um, pixel "
+            f"{pixel} nm, channel {s['channel']}, {s['missing']} missing points"
+            f" ({s['reader']})"
+        )
+
+
+#: MetroPro header magic numbers (format 1, 2 and 3), big-endian at byte 0
+_METROPRO_MAGIC = (b"\x88\x1b\x03\x6f", b"\x88\x1b\x03\x70", b"\x88\x1b\x03\x71")
+
+
+def _never(head: bytes) -> bool:
+    return False
+
+
+@dataclass(frozen=True)
+class HeightMapFormat:
+    """One family of topography files (all read by :func:`read_height_map`).
+
+    The registry entry the dispatcher (:func:`labbrdf.adapters.input_kind`) uses to tell a
+    height map from an optical export before anything is parsed.
+
+    Attributes
+    ----------
+    name : str
+        Registry key, e.g. ``"zygo-metropro"``.
+    description : str
+        One line.
+    extensions : tuple of str
+        Lower-case extensions (with the dot) that only this kind of instrument writes: a
+        file with one of them is a height map.
+    shared_extensions : tuple of str
+        Extensions optical exports use too (MetroPro ``.dat`` beside WVASE and Accurion
+        ``.dat``): such a file is a height map only when :attr:`sniff` claims it and no
+        optical sniffer does. A file whose extension belongs to an optical format and is
+        not listed here stays optical whatever its content; one whose extension belongs
+        to no format is a height map when a sniffer here claims it.
+    sniff : callable
+        ``sniff(head: bytes) -> bool`` on the first bytes: cheap, never raises.
+    """
+
+    name: str
+    description: str
+    extensions: tuple[str, ...]
+    shared_extensions: tuple[str, ...] = ()
+    sniff: Callable[[bytes], bool] = _never
+
+
+#: The height-map formats. SurfaceTopography chooses its own reader from the content; the
+#: entries say which files are height maps (extension, or magic bytes for a shared one).
+HEIGHT_MAP_FORMATS: tuple[HeightMapFormat, ...] = (
+    HeightMapFormat(
+        "zygo-metropro",
+        "Zygo MetroPro binary height map",
+        (),
+        (".dat",),
+        lambda head: head[:4] in _METROPRO_MAGIC,
+    ),
+    HeightMapFormat(
+        "nanoscope",
+        "Digital Instruments / Bruker Nanoscope AFM file",
+        (".di", ".spm", ".000", ".001", ".002", ".003", ".004", ".005"),
+        sniff=lambda head: head.startswith(b"\\*File list"),
+    ),
+    HeightMapFormat(
+        "bruker-opdx",
+        "Bruker OPDx optical profiler file",
+        (".opdx",),
+        sniff=lambda head: head.startswith(b"VCA DATA"),
+    ),
+    HeightMapFormat(
+        "bcr-stm",
+        "BCR-STM / BCRF scanning-probe file",
+        (".bcr", ".bcrf"),
+        sniff=lambda head: head.startswith((b"fileformat = bcr", b"fileformat = bcrf")),
+    ),
+    HeightMapFormat(
+        "surfacetopography",
+        "other topography formats SurfaceTopography reads (Gwyddion, X3P, Keyence, "
+        "Olympus LEXT, Wyko OPD, Digital Surf SUR, NT-MDT, ...)",
+        (
+            ".opd", ".sur", ".gwy", ".ibw", ".mi", ".nc", ".plu", ".plux", ".apx", ".x3p",
+            ".datx", ".vk3", ".vk4", ".vk6", ".vk7", ".zmg", ".zon", ".lext", ".os3d", ".frt",
+            ".sdf", ".nid", ".ezd", ".mdt", ".al3d", ".tmd", ".jpk", ".mnt", ".oir", ".poir",
+            ".nms",
+        ),
+    ),
+)  # fmt: skip
+
+
+def height_map_format(
+    path: str | os.PathLike[str], head: bytes
+) -> tuple[HeightMapFormat, bool] | None:
+    """Which height-map format claims a file, and whether by an extension of its own.
+
+    Parameters
+    ----------
+    path : path-like
+        The file (its name decides first).
+    head : bytes
+        Its first bytes (``b""`` to decide by the name alone).
+
+    Returns
+    -------
+    (HeightMapFormat, bool) or None
+        ``(format, True)`` for an extension only height maps have; ``(format, False)`` when
+        a sniffer claims the content (the dispatcher weighs that against the optical
+        formats, :func:`labbrdf.adapters.input_kind`); None when no height-map format claims
+        the file.
+    """
+    name = os.fspath(path).lower()
+    for f in HEIGHT_MAP_FORMATS:
+        if name.endswith(f.extensions):
+            return f, True
+    for f in HEIGHT_MAP_FORMATS:
+        if f.sniff(head):
+            return f, False
+    return None
 
 
 def _json_meta(info: dict[str, Any]) -> dict[str, Any]:
@@ -337,19 +482,52 @@ def read_height_map(
     reader = _open(st, p)
     chans = list(reader.channels)
     names = tuple(str(c.name) for c in chans)
+    index = _channel_index(p, reader, names, channel)
+    ch = chans[index]
+    kw = _topography_kwargs(p, ch, names[index], index, physical_sizes, unit, pixel_size)
+    z, pixel, topo, warnings = _heights_m(p, reader, kw, unit)
+    if pixel_size is not None:
+        pixel = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (z.ndim,)))
+    if not np.isfinite(z).any():
+        raise AdapterError(p, "no defined height in the file")
+    warnings[:0] = check_geometry(p, z, pixel)
+    meta: dict[str, Any] = {"unit_in_file": str(ch.unit), "reader": type(reader).__name__}
+    if unit is not None:
+        meta["unit_stated"] = unit
+    if pixel_size is not None:
+        meta["pixel_size_stated_m"] = list(pixel)
+    meta.update(_json_meta(dict(getattr(topo, "info", {}) or {})))
+    return HeightMap(z, pixel, p, names[index], names, meta, tuple(warnings))
+
+
+def _channel_index(p: str, reader: Any, names: tuple[str, ...], channel: int | str | None) -> int:
+    """Index of the asked channel (by index or name), or of the reader's default one."""
     if channel is None:
         default = getattr(reader, "default_channel", None)
-        index = int(default.index) if default is not None else 0
-    elif isinstance(channel, str):
+        return int(default.index) if default is not None else 0
+    if isinstance(channel, str):
         if channel not in names:
             raise AdapterError(p, f"no channel {channel!r}; channels are {list(names)}")
-        index = names.index(channel)
-    else:
-        if not 0 <= int(channel) < len(chans):
-            raise AdapterError(p, f"channel {channel} out of range 0..{len(chans) - 1}")
-        index = int(channel)
+        return names.index(channel)
+    if not 0 <= int(channel) < len(names):
+        raise AdapterError(p, f"channel {channel} out of range 0..{len(names) - 1}")
+    return int(channel)
+
+
+def _topography_kwargs(
+    p: str,
+    ch: Any,
+    name: str,
+    index: int,
+    physical_sizes: tuple[float, ...] | None,
+    unit: str | None,
+    pixel_size: float | tuple[float, ...] | None,
+) -> dict[str, Any]:
+    """The reader's ``topography()`` keywords: the channel, and what the file lacks.
+
+    The lateral size (from ``physical_sizes`` or ``pixel_size``) and the unit.
+    """
     kw: dict[str, Any] = {"channel_index": index}
-    ch = chans[index]
     if ch.physical_sizes is None:
         if physical_sizes is not None:
             kw["physical_sizes"] = tuple(physical_sizes)
@@ -367,30 +545,42 @@ def read_height_map(
                 "the file has no lateral size: give it with --pixel-size"
                 " (Python: pixel_size= or physical_sizes=)",
             )
-    file_unit = ch.unit if isinstance(ch.unit, str) else None
-    if file_unit is None:
+    if not isinstance(ch.unit, str):
         if unit is None:
             raise AdapterError(
                 p,
-                f"channel {names[index]!r} has no length unit ({ch.unit!r}): give it with"
+                f"channel {name!r} has no length unit ({ch.unit!r}): give it with"
                 " --unit (Python: unit=)",
             )
         kw["unit"] = unit
+    return kw
+
+
+def _uniform(p: str, topo: Any, warnings: list[str]) -> Any:
+    """A non-uniform line scan interpolated onto its median spacing (said in ``warnings``)."""
+    if getattr(topo, "is_uniform", True):
+        return topo
+    x = np.asarray(topo.positions(), dtype=float)
+    step = float(np.median(np.diff(x)))
+    if not step > 0:
+        raise AdapterError(p, "the line scan's x positions do not increase")
+    n_in = x.size
+    topo = topo.to_uniform(pixel_size=step)
+    warnings.append(
+        f"non-uniform line scan ({n_in} points, spacing {np.min(np.diff(x)):.4g}"
+        f"..{np.max(np.diff(x)):.4g} {topo.unit}) interpolated linearly onto"
+        f" {topo.nb_grid_pts[0]} points at its median spacing {step:.4g} {topo.unit}"
+    )
+    return topo
+
+
+def _heights_m(
+    p: str, reader: Any, kw: dict[str, Any], unit: str | None
+) -> tuple[NDArray[np.float64], tuple[float, ...], Any, list[str]]:
+    """(heights [m] with NaN where undefined, pitch [m], the topography, warnings)."""
     warnings: list[str] = []
     try:
-        topo = reader.topography(**kw)
-        if not getattr(topo, "is_uniform", True):
-            x = np.asarray(topo.positions(), dtype=float)
-            step = float(np.median(np.diff(x)))
-            if not step > 0:
-                raise AdapterError(p, "the line scan's x positions do not increase")
-            n_in = x.size
-            topo = topo.to_uniform(pixel_size=step)
-            warnings.append(
-                f"non-uniform line scan ({n_in} points, spacing {np.min(np.diff(x)):.4g}"
-                f"..{np.max(np.diff(x)):.4g} {topo.unit}) interpolated linearly onto"
-                f" {topo.nb_grid_pts[0]} points at its median spacing {step:.4g} {topo.unit}"
-            )
+        topo = _uniform(p, reader.topography(**kw), warnings)
         tunit = unit if unit is not None else topo.unit
         if tunit in _UNITS_M:
             scale = _UNITS_M[tunit]
@@ -410,19 +600,7 @@ def read_height_map(
         z *= scale
     if np.ma.isMaskedArray(h):
         z[np.ma.getmaskarray(h)] = np.nan
-    del h
-    if pixel_size is not None:
-        pixel = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (z.ndim,)))
-    if not np.isfinite(z).any():
-        raise AdapterError(p, "no defined height in the file")
-    warnings[:0] = check_geometry(p, z, pixel)
-    meta: dict[str, Any] = {"unit_in_file": str(ch.unit), "reader": type(reader).__name__}
-    if unit is not None:
-        meta["unit_stated"] = unit
-    if pixel_size is not None:
-        meta["pixel_size_stated_m"] = list(pixel)
-    meta.update(_json_meta(dict(getattr(topo, "info", {}) or {})))
-    return HeightMap(z, pixel, p, names[index], names, meta, tuple(warnings))
+    return z, pixel, topo, warnings
 
 
 def topography_statistics(

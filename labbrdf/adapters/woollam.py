@@ -69,7 +69,7 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import Measurement, wrap_delta
-from ._base import DECIMAL, AdapterError, Format, decode, read_bytes
+from ._base import DECIMAL, AdapterError, Example, Format, decode, read_bytes
 from ._numblock import (
     MUELLER_S1_FLIP,
     Block,
@@ -868,6 +868,15 @@ FORMATS: tuple[Format, ...] = (
             "specular_intensity",
             *_MM.values(),
         ),
+        examples=(
+            Example(
+                "woollam-wvase-ascii/w2_10102006.dat", number=("26.418438", 5), rows_per_line=2
+            ),
+            Example("woollam-wvase-ascii/wafer_2_01242007.dat", rows_per_line=2),
+            Example("woollam-wvase-ascii/ta2o5_02262007_rp.dat", rows_per_line=2),
+            Example("woollam-wvase-ascii/wvase_example.dat", rows_per_line=2),
+            Example("woollam-wvase-ascii/w1_al2o3_20081120_anisotropy.dat", rows_per_line=2),
+        ),
     ),
     Format(
         name="woollam-completeease",
@@ -877,5 +886,14 @@ FORMATS: tuple[Format, ...] = (
         keywords=(b"VASEmethod[", b"CompleteEASE"),
         read=read_woollam,
         quantities=("psi", "delta", "depolarization", "specular_intensity"),
+        examples=(
+            Example("woollam-completeease-ascii/complete_ease_example.dat", rows_per_line=2),
+            Example(
+                "woollam-completeease-ascii/Woolam_staticTest.dat",
+                number=("21.4553", 4),
+                rows_per_line=2,
+            ),
+            Example("woollam-completeease-ascii/Woolam_kineticTest.dat", rows_per_line=2),
+        ),
     ),
 )

@@ -33,7 +33,7 @@ among them in its own ``__all__``. They may change without notice.
 
 from __future__ import annotations
 
-from .batch import fit_many
+from .batch import auto_weighting, fit_many, fit_many_nk, fit_records
 from .core import ALGORITHMS, CONSTRAINED, METHOD, fit, parse_method
 from .data import FITTABLE_QUANTITIES, FitData, FitError
 from .objective import Objective
@@ -54,7 +54,10 @@ __all__ = [
     "FitError",
     "FitResult",
     "Objective",
+    "auto_weighting",
     "fit",
     "fit_many",
+    "fit_many_nk",
+    "fit_records",
     "parse_method",
 ]

@@ -1,11 +1,13 @@
 """Batch fits: one fit per group of a dataset, on an :class:`labbrdf.parallel.Executor`.
 
 The one batch fitter of the package: the ``labbrdf fit`` command (``--nk-from`` included,
-with a model per wavelength) and the reports fit through :func:`fit_many`.
+with a model per wavelength, :func:`fit_many_nk`) and the reports fit through
+:func:`fit_many`; :func:`fit_records` gives its table as JSON-ready records.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -20,7 +22,7 @@ from .core import METHOD, fit, parse_method, setup_params
 from .data import FitData, FitError, select_rows, several_groups_message
 from .result import FitResult
 
-__all__ = ["fit_many"]
+__all__ = ["auto_weighting", "fit_many", "fit_many_nk", "fit_records"]
 
 
 def _sort_key(key: Any) -> tuple[Any, ...]:
@@ -224,3 +226,205 @@ def fit_many(
     num += ["rmse", "rmse_pct", "chisqr", "redchi", "aic", "bic", "elapsed_s"] + param_names
     out[num] = out[num].astype(float)
     return (out, results) if return_results else out
+
+
+def auto_weighting(data: Measurement | pd.DataFrame) -> str | None:
+    """The weighting of a batch when none is asked for: the data's sigmas, if all have one.
+
+    Parameters
+    ----------
+    data : Measurement or DataFrame
+        The rows to be fitted.
+
+    Returns
+    -------
+    None or "relative"
+        None (``1/sigma^2``, :func:`fit`'s default) when every row has a finite sigma
+        > 0; else ``"relative"`` (sigma_i = max(|y_i|, floor x max|y|)): rows without
+        sigma (a ``.bsdf`` has none) are fitted with relative weights, not uniform ones.
+    """
+    df = data.data if isinstance(data, Measurement) else data
+    sig = df["sigma"].to_numpy(float)
+    every = bool(sig.size) and bool(np.all(np.isfinite(sig) & (sig > 0)))
+    return None if every else "relative"
+
+
+def _metas(data: Measurement) -> list[dict[str, Any]]:
+    """The per-file metas of a (concatenated) Measurement, each with its ``source``."""
+    parts = data.meta.get("parts")
+    if not parts:
+        return [data.meta]
+    return [{**p.get("meta", {}), "source": p.get("source")} for p in parts]
+
+
+def fit_many_nk(
+    data: Measurement,
+    model: str,
+    nk_from: str | os.PathLike[str] | pd.DataFrame,
+    *,
+    options: dict[str, Any] | None = None,
+    wavelength_nm: float | None = None,
+    source: str | os.PathLike[str] | None = None,
+    by: Sequence[str] = ("sample", "wavelength_nm"),
+    **kw: Any,
+) -> tuple[pd.DataFrame, list[tuple[dict[str, Any], FitResult]]]:
+    """:func:`fit_many` with a sample's measured index: a model per wavelength.
+
+    Each wavelength's groups are fitted with the registry model ``model`` whose ``n``,
+    ``k`` are the bulk index of ``nk_from`` at that wavelength
+    (:func:`labbrdf.nk.bulk_index_at`), or at ``wavelength_nm`` for every group.
+
+    Parameters
+    ----------
+    data : Measurement
+        The measured rows (its per-file metas say which files state no wavelength).
+    model : str
+        A registry model that takes ``n``, ``k`` (``microfacet``).
+    nk_from : path-like or pandas.DataFrame
+        An ellipsometer file (:func:`labbrdf.nk.read_nk`) or its combined table.
+    options : dict, optional
+        The model's other options.
+    wavelength_nm : float, optional
+        Take n, k at this wavelength [nm] for every group; needed when a file states no
+        wavelength (a Zemax ``.bsdf``: its ``wavelength_nm`` is a label).
+    source : str or path-like, optional
+        What a table came from, for messages.
+    by : sequence of str
+        Grouping columns, as for :func:`fit_many` (the fits run wavelength first).
+    **kw
+        Any other :func:`fit_many` keyword (``return_results`` is always on).
+
+    Returns
+    -------
+    table : pandas.DataFrame
+        :func:`fit_many`'s table with the columns ``n``, ``k`` used by each group, ordered
+        by ``by``.
+    results : list of (dict, FitResult)
+        The fitted groups, keys of ``by``, in table order.
+
+    Raises
+    ------
+    labbrdf.errors.SetupError
+        The model takes no index, or a file states no wavelength and ``wavelength_nm``
+        is not given (the message names the keywords).
+    labbrdf.nk.NkError
+        No bulk n, k at a wavelength (outside the file's range, a stack, a film).
+    """
+    from .. import models
+    from ..errors import SetupError, escaped
+    from ..nk import bulk_index_at, read_nk
+
+    if "n" not in models.option_names(model):
+        raise SetupError(f"{{nk_from}}: model {model!r} takes no index n, k")
+    if isinstance(nk_from, pd.DataFrame):
+        table, where = nk_from, source if source is not None else "n, k"
+    else:
+        table, where = read_nk(nk_from), source if source is not None else nk_from
+    unstated = [
+        str(m.get("source", "?")) for m in _metas(data) if m.get("wavelength_stated") is False
+    ]
+    if unstated and wavelength_nm is None:
+        raise SetupError(
+            f"{{nk_from}}: {escaped(', '.join(unstated))} state(s) no wavelength (the format "
+            "has no field for it); say at which wavelength to take n, k with {wavelength_nm} NM"
+        )
+    by = [by] if isinstance(by, str) else list(by)
+    # one batch, a model per wavelength (the index at that wavelength), wavelength first:
+    # the table lists each wavelength's groups together
+    index_at = {
+        wl: bulk_index_at(table, float(wavelength_nm or wl), source=where)
+        for wl in data.data["wavelength_nm"].unique()
+    }
+
+    def model_at(key: dict[str, Any]) -> Model:
+        n, k = index_at[key["wavelength_nm"]]
+        return get_model(model, **{**(options or {}), "n": n, "k": k})
+
+    by_wl = ["wavelength_nm", *(b for b in by if b != "wavelength_nm")]
+    out, results = fit_many(data, model_at, **{**kw, "by": by_wl, "return_results": True})
+    nk_cols = pd.DataFrame([index_at[w] for w in out["wavelength_nm"]], columns=["n", "k"])
+    out = pd.concat([out, nk_cols], axis=1)
+    if "wavelength_nm" not in by:
+        out = out.drop(columns="wavelength_nm")
+        results = [({b: g[b] for b in by}, r) for g, r in results]
+    out = out[[*by, *(c for c in out.columns if c not in by)]]
+    return out, results
+
+
+def _same_key(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    def eq(x: Any, y: Any) -> bool:
+        return x == y or (x != x and y != y)  # NaN group keys are equal
+
+    return a.keys() == b.keys() and all(eq(a[k], b[k]) for k in a)
+
+
+def fit_records(
+    table: pd.DataFrame, results: list[tuple[dict[str, Any], FitResult]], by: Sequence[str]
+) -> list[dict[str, Any]]:
+    """One JSON-ready record per row of a :func:`fit_many` table, failed groups included.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        The table of :func:`fit_many` (or :func:`fit_many_nk`).
+    results : list of (dict, FitResult)
+        Its fitted groups in table order (``return_results=True``).
+    by : sequence of str
+        The grouping columns of the table.
+
+    Returns
+    -------
+    list of dict
+        Per row: ``group`` (``{column: value}`` of ``by``), ``params`` (per parameter
+        ``value``, ``stderr``, ``ci95``, ``at_bound``), ``rmse``, ``redchi``,
+        ``weighting``, ``nmasked``, ``flags`` (per flagged parameter), ``nfev``,
+        ``success``, ``message``. A group that could not be fitted has ``success`` false,
+        empty ``params``, ``rmse`` and ``nfev`` None and the reason in ``message``.
+        Values are plain Python (NaN stays NaN: :func:`labbrdf.jsonsafe.jsonable` makes
+        it JSON's null).
+    """
+    by = [by] if isinstance(by, str) else list(by)
+    out: list[dict[str, Any]] = []
+    j = 0
+    for row in table.to_dict("records"):
+        key = {b: row[b] for b in by}
+        if j < len(results) and _same_key(results[j][0], key):
+            s = results[j][1].summary()
+            j += 1
+            out.append(
+                {
+                    "group": results[j - 1][0],
+                    "params": {
+                        name: {
+                            "value": p["value"],
+                            "stderr": p.get("stderr"),
+                            "ci95": p.get("ci95"),
+                            "at_bound": p.get("at_bound", False),
+                        }
+                        for name, p in s["params"].items()
+                    },
+                    "rmse": s["rmse"],
+                    "redchi": s["redchi"],
+                    "aic": s["aic"],
+                    "bic": s["bic"],
+                    "ndata": s["ndata"],
+                    "weighting": s["weighting"],
+                    "nmasked": s["nmasked"],
+                    "flags": {k: v["flags"] for k, v in s["params"].items() if v["flags"]},
+                    "nfev": s["nfev"],
+                    "success": s["success"],
+                    "message": row.get("message", ""),
+                }
+            )
+        else:
+            out.append(
+                {
+                    "group": key,
+                    "params": {},
+                    "rmse": None,
+                    "nfev": None,
+                    "success": False,
+                    "message": row.get("message", ""),
+                }
+            )
+    return out

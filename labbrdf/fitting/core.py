@@ -553,39 +553,15 @@ def fit(
         raise FitError(f"ci must be 'wald' or 'profile', got {ci!r}")
     if ci == "profile" and energy_constraint not in (False, None):
         raise FitError("ci='profile' is not combined with energy_constraint; use ci='wald'")
-    fd, ndropped = clean_fit_data(as_fit_data(data, quantity, unit), nan_policy)
-    nmasked = 0
-    if mask_zeros:
-        zero = np.asarray(fd.value) == 0.0
-        nmasked = int(zero.sum())
-        if nmasked == len(fd):
-            raise FitError(f"data: all {nmasked} points are 0 (masked); nothing to fit")
-        if nmasked:
-            fd = fd.take(~zero)
+    fd, ndropped, nmasked = _select_points(data, quantity, unit, nan_policy, mask_zeros)
     p = setup_params(model, params, fix)
     guessed = guess and _apply_guess(model, fd, p, set(params or ()))
     weights, use_sigma, weighting = _weighting(fd, use_sigma, weighting, relative_floor)
     varying = p.varying()
     _check_design(model, fd, varying)
     n_pts, nvarys = len(fd), len(varying)
-
-    # ---- profiling and the energy constraint
     lin = [k for k in model.linear if k in varying]
-    if profile and not lin:
-        raise FitError(
-            f"profile=True but model {model.name!r} has no varying linear "
-            f"parameters (linear: {list(model.linear)})"
-        )
-    profile = bool(lin) if profile is None else profile
-    # rho(theta) <= 1 on th_grid [deg] when the energy constraint is on (rho_fn set)
-    rho_fn: Callable[[dict[str, float], NDArray], NDArray] | None = None
-    th_grid: NDArray = np.empty(0)
-    if energy_constraint is not False and energy_constraint is not None:
-        ti = np.asarray(fd.theta_i_deg, float)
-        th_grid = np.unique(np.concatenate([np.linspace(ti.min(), ti.max(), 7), ti]))
-        rho_fn = _energy_rho(model, energy_constraint)
-        profile = profile and len(lin) == 1  # rho <= 1 is a box only for one amplitude
-    prof = lin if profile else []
+    prof, rho_fn, th_grid = _profiling(model, fd, lin, profile, energy_constraint)
     linear_upper = _energy_bound(rho_fn, prof[0], th_grid) if rho_fn and prof else None
     obj = Objective(model, fd, p, weights, prof, linear_upper, absolute=use_sigma)
     if prof and obj.linear_basis_missing():
@@ -593,37 +569,11 @@ def fit(
             f"model {model.name!r} declares linear parameters but gives no "
             "linear components; pass profile=False"
         )
-    cons = None
-    if rho_fn is not None and not prof:
-
-        def cons(xx: NDArray) -> float:
-            return float(np.max(rho_fn(obj.from_vector(xx), th_grid)) - 1.0)
-
+    cons = _energy_cons(obj, rho_fn, th_grid) if rho_fn is not None and not prof else None
     budgets = _budgets(obj, stages, maxeval, cons is not None, lin, guessed)
-
-    # ---- stages
-    x = obj.to_vector(p.values())
-    stage_info: list[dict[str, Any]] = []
-    last_code, message = nlopt.SUCCESS, "no search needed: only profiled parameters vary"
-    with np.errstate(all="ignore"):
-        for name, budget in zip(stages, budgets, strict=True):
-            if obj.n == 0:
-                break
-            if _is_global(name):
-                x, info = _run_stage(obj, name, budget, x, int(seed), cons)
-            else:
-                x, info = _run_local(
-                    obj, name, budget, x, int(seed), cons, n_pts - nvarys, use_sigma
-                )
-            stage_info.append(info)
-            last_code, message = info["code"], info["message"]
-        converged = last_code in _OK_CODES or last_code == CHI2_CONVERGED
-        if obj.n and cons is None and stages and not _is_global(stages[-1]) and converged:
-            x, info = _polish(obj, x, n_pts - nvarys, use_sigma)
-            stage_info.append(info)
-            message = f"{message}; {info['message']}"
-            if info["code"] == 0:
-                last_code = nlopt.MAXEVAL_REACHED
+    x, stage_info, last_code, message = _search(
+        obj, obj.to_vector(p.values()), stages, budgets, int(seed), cons, n_pts - nvarys, use_sigma
+    )
 
     # ---- final values and statistics
     with np.errstate(all="ignore"):
@@ -645,35 +595,11 @@ def fit(
     )
     if ci == "profile" and finite:
         delta = float(special.stdtrit(nfree, 0.975)) ** 2 * (1.0 if use_sigma else redchi)
-        with np.errstate(all="ignore"):
-            for k in varying:
-                try:
-                    out[k].ci95 = _profile_interval(
-                        model, fd, out, weights, prof, k, chisqr, delta, int(seed)
-                    )
-                except (ValueError, RuntimeError) as exc:  # keep the Wald interval
-                    warn.append(f"{k}: profile interval not found ({exc}); Wald interval kept")
-    if finite:
-        ok = (
-            last_code in _OK_CODES
-            or last_code == CHI2_CONVERGED
-            or (bool(stages) and _is_global(stages[-1]) and last_code == nlopt.MAXEVAL_REACHED)
-        )
-        success = ok or obj.n == 0
-    else:
-        success = False
-        message = "non-finite parameters or chi-square: " + message
+        warn += _profile_intervals(model, fd, out, weights, prof, varying, chisqr, delta, seed)
+    success, message = _verdict(finite, last_code, stages, obj.n, message)
     energy_info = None
     if rho_fn is not None:
-        rho_max = float(np.max(rho_fn(vals, th_grid)))
-        energy_info = {
-            "theta_i_deg": th_grid.tolist(),
-            "max_rho": rho_max,
-            "active": rho_max > 1 - 1e-6,
-        }
-        if rho_max > 1 + 1e-6:
-            success = False
-            message = f"energy constraint violated (max rho {rho_max:.6g}); " + message
+        energy_info, success, message = _energy_check(rho_fn, vals, th_grid, success, message)
     y = obj.y
     rmse_pct = float(100 * np.sqrt(np.mean((resid / y) ** 2))) if np.all(y != 0) else None
     log_l = n_pts * math.log(max(chisqr, 1e-300) / n_pts)
@@ -718,7 +644,167 @@ def fit(
         ),
         residual=resid,
         best_fit=best,
+        data=fd,
     )
+
+
+def _select_points(
+    data: Measurement | pd.DataFrame | FitData,
+    quantity: str | None,
+    unit: str | None,
+    nan_policy: str,
+    mask_zeros: bool,
+) -> tuple[FitData, int, int]:
+    """The points a fit uses, the number dropped as NaN/inf and the number masked as 0."""
+    fd, ndropped = clean_fit_data(as_fit_data(data, quantity, unit), nan_policy)
+    if not mask_zeros:
+        return fd, ndropped, 0
+    zero = np.asarray(fd.value) == 0.0
+    nmasked = int(zero.sum())
+    if nmasked == len(fd):
+        raise FitError(f"data: all {nmasked} points are 0 (masked); nothing to fit")
+    if nmasked:
+        fd = fd.take(~zero)
+    return fd, ndropped, nmasked
+
+
+def _profiling(
+    model: Model,
+    fd: FitData,
+    lin: list[str],
+    profile: bool | None,
+    energy_constraint: bool | Callable[..., ArrayLike],
+) -> tuple[list[str], Callable[[dict[str, float], NDArray], NDArray] | None, NDArray]:
+    """Which linear amplitudes are profiled, and the energy constraint rho(theta) <= 1.
+
+    Returns the profiled names, ``rho(values, theta_i_deg)`` (None without the constraint)
+    and the incidence angles [deg] it is checked on. With the constraint on, profiling is
+    kept only for a single amplitude: rho <= 1 is then an upper bound on it (a box).
+    """
+    if profile and not lin:
+        raise FitError(
+            f"profile=True but model {model.name!r} has no varying linear "
+            f"parameters (linear: {list(model.linear)})"
+        )
+    profile = bool(lin) if profile is None else profile
+    rho_fn: Callable[[dict[str, float], NDArray], NDArray] | None = None
+    th_grid: NDArray = np.empty(0)
+    if energy_constraint is not False and energy_constraint is not None:
+        ti = np.asarray(fd.theta_i_deg, float)
+        th_grid = np.unique(np.concatenate([np.linspace(ti.min(), ti.max(), 7), ti]))
+        rho_fn = _energy_rho(model, energy_constraint)
+        profile = profile and len(lin) == 1
+    return (lin if profile else []), rho_fn, th_grid
+
+
+def _energy_cons(
+    obj: Objective, rho_fn: Callable[[dict[str, float], NDArray], NDArray], th_grid: NDArray
+) -> Callable[[NDArray], float]:
+    """The nlopt inequality constraint ``max rho(theta) - 1 <= 0`` on the search vector."""
+
+    def cons(xx: NDArray) -> float:
+        return float(np.max(rho_fn(obj.from_vector(xx), th_grid)) - 1.0)
+
+    return cons
+
+
+def _search(
+    obj: Objective,
+    x: NDArray,
+    stages: list[str],
+    budgets: list[int],
+    seed: int,
+    cons: Callable[[NDArray], float] | None,
+    nfree: int,
+    use_sigma: bool,
+) -> tuple[NDArray, list[dict[str, Any]], int, str]:
+    """Run the nlopt stages in turn from ``x``, then the polish (see :func:`fit`, Notes).
+
+    Returns the best search vector, the per-stage records, the last stop code and the
+    message.
+    """
+    stage_info: list[dict[str, Any]] = []
+    last_code, message = nlopt.SUCCESS, "no search needed: only profiled parameters vary"
+    with np.errstate(all="ignore"):
+        for name, budget in zip(stages, budgets, strict=True):
+            if obj.n == 0:
+                break
+            if _is_global(name):
+                x, info = _run_stage(obj, name, budget, x, seed, cons)
+            else:
+                x, info = _run_local(obj, name, budget, x, seed, cons, nfree, use_sigma)
+            stage_info.append(info)
+            last_code, message = info["code"], info["message"]
+        converged = last_code in _OK_CODES or last_code == CHI2_CONVERGED
+        if obj.n and cons is None and stages and not _is_global(stages[-1]) and converged:
+            x, info = _polish(obj, x, nfree, use_sigma)
+            stage_info.append(info)
+            message = f"{message}; {info['message']}"
+            if info["code"] == 0:
+                last_code = nlopt.MAXEVAL_REACHED
+    return x, stage_info, last_code, message
+
+
+def _profile_intervals(
+    model: Model,
+    fd: FitData,
+    out: Parameters,
+    weights: NDArray,
+    prof: list[str],
+    varying: list[str],
+    chisqr: float,
+    delta: float,
+    seed: int,
+) -> list[str]:
+    """Replace each varying parameter's Wald interval by its profile interval, in place.
+
+    Returns a warning for each parameter whose profile interval was not found (its Wald
+    interval is kept).
+    """
+    warn = []
+    with np.errstate(all="ignore"):
+        for k in varying:
+            try:
+                out[k].ci95 = _profile_interval(
+                    model, fd, out, weights, prof, k, chisqr, delta, int(seed)
+                )
+            except (ValueError, RuntimeError) as exc:  # keep the Wald interval
+                warn.append(f"{k}: profile interval not found ({exc}); Wald interval kept")
+    return warn
+
+
+def _verdict(
+    finite: bool, last_code: int, stages: list[str], nsearch: int, message: str
+) -> tuple[bool, str]:
+    """Whether the fit succeeded, and its message.
+
+    Converged stop codes succeed; so does a last global stage that spent its budget (a
+    global search has no other stop), and a fit with nothing to search. Non-finite values
+    or chi-square fail.
+    """
+    if not finite:
+        return False, "non-finite parameters or chi-square: " + message
+    ok = (
+        last_code in _OK_CODES
+        or last_code == CHI2_CONVERGED
+        or (bool(stages) and _is_global(stages[-1]) and last_code == nlopt.MAXEVAL_REACHED)
+    )
+    return ok or nsearch == 0, message
+
+
+def _energy_check(
+    rho_fn: Callable[[dict[str, float], NDArray], NDArray],
+    vals: dict[str, float],
+    th_grid: NDArray,
+    success: bool,
+    message: str,
+) -> tuple[dict[str, Any], bool, str]:
+    """The energy record of a constrained fit; a violated constraint makes it fail."""
+    rho_max = float(np.max(rho_fn(vals, th_grid)))
+    info = {"theta_i_deg": th_grid.tolist(), "max_rho": rho_max, "active": rho_max > 1 - 1e-6}
+    if rho_max > 1 + 1e-6:
+        return info, False, f"energy constraint violated (max rho {rho_max:.6g}); " + message
+    return info, success, message
 
 
 def _profile_chi2(

@@ -195,7 +195,7 @@ def _check_coverage(fm: FilmModel, wl: NDArray) -> None:
             raise FilmError(
                 f"{fm.source}: {name} material {m.source} covers {lo:g}-{hi:g} nm but the "
                 f"data span {float(wl.min()):g}-{float(wl.max()):g} nm; restrict the fit "
-                "with wavelength_nm = [min, max] (CLI --wavelength-range MIN MAX) or use a "
+                "with wavelength_nm = [min, max] (CLI --wavelength-range MIN:MAX) or use a "
                 "table that covers the data"
             )
 

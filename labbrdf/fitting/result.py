@@ -7,10 +7,14 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
 from numpy.typing import NDArray
 
+from .._plotting import curve_grid, draw_scan
 from ..jsonsafe import jsonable
-from ..models import Parameters
+from ..models import ModelError, Parameters
+from ..models import get as get_model
+from .data import FitData
 
 __all__ = ["FitResult"]
 
@@ -114,6 +118,8 @@ class FitResult:
         ``y - f`` at the optimum [data units].
     best_fit : ndarray
         The model at the data points [data units].
+    data : FitData or None
+        The points fitted (after dropping and masking), for :meth:`plot`.
 
     Notes
     -----
@@ -161,6 +167,7 @@ class FitResult:
     nlopt_version: str | None = None
     residual: NDArray | None = field(default=None, repr=False)
     best_fit: NDArray | None = field(default=None, repr=False)
+    data: FitData | None = field(default=None, repr=False)
 
     @property
     def G(self) -> Any:
@@ -174,6 +181,118 @@ class FitResult:
     def values(self) -> dict[str, float]:
         """name -> fitted value."""
         return self.params.values()
+
+    def plot(self, ax: Any = None) -> Any:
+        """Data with 1-sigma bars and the fitted model, residuals below, as lmfit's plot.
+
+        One colour and marker per (incidence angle, detector azimuth) scan: the measured
+        points against theta_r with their file sigmas, the fitted model as a line (the
+        report's scan figures draw the same way), and below the residuals ``y - f``
+        (:attr:`residual`) at the points.
+
+        Parameters
+        ----------
+        ax : pair of matplotlib Axes, optional
+            The data axes and the residual axes; default a new figure with the residuals
+            in a short panel below the data.
+
+        Returns
+        -------
+        matplotlib Figure
+
+        Raises
+        ------
+        ValueError
+            The result carries no data (built by hand) or is a film fit (its points
+            mix psi, Delta, R and T, which have no common axis).
+
+        Notes
+        -----
+        The model line is evaluated on 121 detector angles across the measured ones when
+        the model is in the registry (:func:`labbrdf.models.get` with :attr:`options`);
+        a model from outside the registry is drawn through its values at the data points.
+        """
+        series = self._scan_series()
+        if ax is None:
+            import matplotlib.pyplot as plt
+
+            fig, ax = plt.subplots(
+                2,
+                1,
+                sharex=True,
+                figsize=(6.4, 5.2),
+                gridspec_kw={"height_ratios": [3, 1.2]},
+                layout="constrained",
+            )
+        axes = np.asarray(ax, dtype=object).ravel()
+        if axes.size != 2:
+            raise ValueError(f"ax: expected two Axes (data, residuals), got {axes.size}")
+        draw_scan(axes[0], axes[1], series)
+        axes[0].set_ylabel(f"{self.quantity} [{self.unit}]")
+        axes[1].set_ylabel(f"residual [{self.unit}]")
+        axes[0].set_title(f"{self.model}: chisqr {self.chisqr:.6g}, redchi {self.redchi:.4g}")
+        axes[0].legend(fontsize=7, loc="best")
+        return axes[0].figure
+
+    def _scan_series(self) -> list[dict[str, Any]]:
+        """The data, model and residual of each (theta_i, phi_r) scan, for :meth:`plot`."""
+        d = self.data
+        if d is None or self.best_fit is None or self.residual is None:
+            raise ValueError(
+                "this FitResult carries no data to plot (it was not made by labbrdf.fit)"
+            )
+        if d.quantity == "film":
+            raise ValueError(
+                "a film fit mixes psi, Delta, R and T in one residual vector: plot its "
+                "channels from FilmFit.data instead"
+            )
+        try:
+            model = get_model(self.model, **self.options)
+        except ModelError:
+            model = None  # not a registry model: draw it through the data points
+        ti = np.asarray(d.theta_i_deg, float)
+        tr = np.asarray(d.theta_r_deg, float)
+        pr = np.asarray(d.phi_r_deg, float)
+        y = np.asarray(d.value, float)
+        sig = np.asarray(d.sigma, float)
+        wl = None if d.wavelength_nm is None else np.asarray(d.wavelength_nm, float)
+        keys = sorted(set(zip(ti.round(6).tolist(), pr.round(6).tolist(), strict=True)))
+        several_phi = len({k[1] for k in keys}) > 1
+        series = []
+        for t_i, p_r in keys:
+            sel = (ti.round(6) == t_i) & (pr.round(6) == p_r)
+            order = np.argsort(tr[sel], kind="stable")
+            x = tr[sel][order]
+            if model is not None:
+                grid = curve_grid(x)
+                wavelength = None if wl is None else float(np.nanmean(wl[sel]))
+                curve = np.asarray(
+                    model.evaluate(
+                        np.radians(t_i),
+                        np.radians(grid),
+                        np.radians(p_r),
+                        wavelength=wavelength,
+                        params=self.values,
+                    ),
+                    float,
+                )
+            else:
+                grid, curve = x, np.asarray(self.best_fit, float)[sel][order]
+            s = sig[sel][order]
+            label = f"{t_i:g}\u00b0" + (f", \u03c6r {p_r:g}\u00b0" if several_phi else "")
+            series.append(
+                {
+                    "theta_i": t_i,
+                    "label": label,
+                    "theta_r": x,
+                    "value": y[sel][order],
+                    "sigma": s if np.isfinite(s).all() else None,
+                    "curve_theta_r": grid,
+                    "curves": {"model": curve},
+                    "residual": {"y - f": np.asarray(self.residual, float)[sel][order]},
+                }
+            )
+        return series
 
     def summary(self) -> dict[str, Any]:
         """Plain-Python, JSON-safe dict (NaN/inf as None) for reports and the CLI."""

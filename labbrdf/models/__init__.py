@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+import inspect
 from typing import Any
 
 from .base import Model, ModelError, Parameter, Parameters
@@ -15,7 +16,16 @@ from .layered import Layered
 from .microfacet import Microfacet
 from .smooth3 import Smooth3
 
-__all__ = ["MODELS", "Model", "ModelError", "Parameter", "Parameters", "get", "names"]
+__all__ = [
+    "MODELS",
+    "Model",
+    "ModelError",
+    "Parameter",
+    "Parameters",
+    "get",
+    "names",
+    "option_names",
+]
 
 #: name -> Model subclass
 MODELS: dict[str, type[Model]] = {
@@ -38,3 +48,21 @@ def get(name: str, **options: Any) -> Model:
 def names() -> list[str]:
     """The registry names, sorted."""
     return sorted(MODELS)
+
+
+def option_names(name: str) -> set[str]:
+    """The options a registry model takes (its constructor's keywords: the contract).
+
+    Raises
+    ------
+    ModelError
+        Not a registry name.
+    """
+    if name not in MODELS:
+        raise ModelError(f"unknown model {name!r}; models are {names()}")
+    sig = inspect.signature(MODELS[name].__init__)
+    return {
+        k
+        for k, v in sig.parameters.items()
+        if k != "self" and v.kind not in (v.VAR_KEYWORD, v.VAR_POSITIONAL)
+    }

@@ -20,9 +20,11 @@ import numpy as np
 import pandas as pd
 
 from .. import models
+from .._plotting import curve_grid
 from ..adapters.topography import HeightMap
 from ..fitting import METHOD, FitError, FitResult, fit_many
 from ..parallel import Executor
+from ..samples import SampleGroup
 from ..tracer import TraceResult
 from .builder import Builder, Unavailable, num
 
@@ -98,8 +100,17 @@ class Context:
     #: results kept for later sections (and tests): the compare fits, the factor-study runs
     compare_fits: dict[str, list[FitRecord]] = field(default_factory=dict)
     factor_runs: list[tuple[str, str, TraceResult]] = field(default_factory=list)
-    #: user report: height maps and profiles read from topography files (section ``surface``)
+    #: user report: the height maps and profiles :func:`labbrdf.adapters.read_inputs` read
+    #: among the inputs (section ``surface``)
     height_maps: list[HeightMap] = field(default_factory=list)
+    #: user report: the input files grouped by sample (:func:`labbrdf.samples.pair_samples`)
+    samples: list[SampleGroup] = field(default_factory=list)
+    #: user report: combined n, k per ellipsometer file (section ``nk``), by file name
+    nk_combined: dict[str, pd.DataFrame] = field(default_factory=dict)
+    #: user report: the film stack fitted per psi/Delta file (section ``film``), by file name
+    film_fits: dict[str, Any] = field(default_factory=dict)
+    #: user report: each height map's sigma and band, by path (section ``smoothness``)
+    map_roughness: dict[str, Any] = field(default_factory=dict)
 
     @property
     def data(self) -> pd.DataFrame | None:
@@ -238,13 +249,6 @@ def run_fits(
         ctx.b.log(f"  fitted {name} to {len(table)} groups ({group})")
         out[name] = fit_records(name, options, scans, table, results, BY, group)
     return out
-
-
-def curve_grid(theta_r: np.ndarray) -> np.ndarray:
-    """121 detector angles [deg] spanning the measured ones with a 5 % margin."""
-    lo, hi = float(np.min(theta_r)), float(np.max(theta_r))
-    pad = 0.05 * max(hi - lo, 0.5)
-    return np.linspace(max(0.0, lo - pad), min(89.9, hi + pad), 121)
 
 
 def model_curve(

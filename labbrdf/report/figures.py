@@ -20,6 +20,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
+from .._plotting import COLOURS as _COLOURS  # noqa: E402
+from .._plotting import MARKERS as _MARKERS  # noqa: E402
+from .._plotting import draw_panel, draw_polar_map, draw_scan  # noqa: E402
+from .._plotting import text as _text  # noqa: E402
+
 __all__ = [
     "save_trace_maps_png",
     "compare_models_figure",
@@ -34,8 +39,6 @@ __all__ = [
 ]
 
 DPI = 80
-_MARKERS = ("s", "^", "v", "o", "D", "P", "X")
-_COLOURS = ("C0", "C1", "C2", "C3", "C4", "C5", "C6")
 
 
 def to_uri(fig: Figure, dpi: int = DPI) -> str:
@@ -66,11 +69,6 @@ def _finish_grid(fig: Any, title: str | None, fontsize: float = 12.0, dpi: int =
     return to_uri(fig, dpi=dpi)
 
 
-def _text(s: Any) -> str:
-    # matplotlib mathtext interprets $...$: show file text literally
-    return str(s).replace("$", r"\$")
-
-
 def scan_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
     """Measured points and model curves per incidence angle, with residuals (Figs. 2-3 style).
 
@@ -95,45 +93,11 @@ def scan_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
     )
     for j, panel in enumerate(panels):
         ax, axr = axes[0, j], axes[1, j]
-        for k, s in enumerate(panel["series"]):
-            c = _COLOURS[k % len(_COLOURS)]
-            m = _MARKERS[k % len(_MARKERS)]
-            lab = f"{s['theta_i']:g}\u00b0"
-            sig = s.get("sigma")
-            ax.errorbar(
-                s["theta_r"],
-                s["value"],
-                yerr=sig,
-                fmt=m,
-                ms=3.5,
-                color=c,
-                mfc="none",
-                lw=0.8,
-                alpha=0.6,
-                zorder=1,
-                label=f"measured {lab}",
-            )
-            for q, (name, curve) in enumerate(s.get("curves", {}).items()):
-                ax.plot(
-                    s["curve_theta_r"],
-                    curve,
-                    ls=("-", "--", ":")[q % 3],
-                    lw=1.4,
-                    zorder=3,
-                    color="k" if q else c,
-                    label=f"{name} {lab}",
-                )
-            for q, (name, res) in enumerate(s.get("residual", {}).items()):
-                axr.plot(s["theta_r"], res, m, color=c, ms=3, mfc="none" if q else c, label=name)
+        draw_scan(ax, axr, panel["series"])
         ax.set_title(_text(panel["label"]), fontsize=10)
-        ax.set_xlabel(r"$\theta_r$ [deg]")
-        axr.set_xlabel(r"$\theta_r$ [deg]")
-        axr.axhline(0.0, color="0.4", lw=0.6)
         if j == 0:
             ax.set_ylabel(r"BRDF [sr$^{-1}$]")
             axr.set_ylabel("residual [%]")
-        ax.grid(alpha=0.3)
-        axr.grid(alpha=0.3)
     axes[0, 0].legend(fontsize=6.5, loc="best")
     return _finish_grid(fig, title, fontsize=11)
 
@@ -341,27 +305,26 @@ def polar_maps_figure(
     fig, axes = plt.subplots(
         2, n, figsize=(3.3 * n, 6.6), subplot_kw={"projection": "polar"}, squeeze=False
     )
-    ph = np.deg2rad(np.asarray(phi_edges_deg, float))
-    th = np.asarray(theta_edges_deg, float)
-    P, T = np.meshgrid(ph, th)
     for j in range(len(labels)):
         for i, (data, name, cmap, lim) in enumerate(
             (
-                (s0[j], r"$S_0$ [sr$^{-1}$]", "inferno", None),
+                (s0[j], r"$S_0$ [sr$^{-1}$]", "inferno", (None, None)),
                 (dop[j], "DOP [1]", "viridis", (0.0, 1.0)),
             )
         ):
             ax = axes[i, j]
-            z = np.ma.masked_invalid(np.asarray(data, float))
-            kw: dict[str, float | None] = {} if lim is None else {"vmin": lim[0], "vmax": lim[1]}
             if i == 0 and s0_max is not None and s0_max[j] is not None:
-                kw = {"vmin": 0.0, "vmax": s0_max[j]}
-            mesh = ax.pcolormesh(P, T, z, cmap=cmap, shading="flat", **kw)
-            ax.set_ylim(0, th[-1])
-            ax.set_yticks([30, 60, 90])
-            ax.set_yticklabels(["30\u00b0", "60\u00b0", "90\u00b0"], fontsize=6, color="w")
-            ax.tick_params(axis="x", labelsize=6)
-            ax.set_title(f"{_text(labels[j])}\n{name}", fontsize=8)
+                lim = (0.0, s0_max[j])
+            mesh = draw_polar_map(
+                ax,
+                data,
+                theta_edges_deg,
+                phi_edges_deg,
+                title=f"{_text(labels[j])}\n{name}",
+                cmap=cmap,
+                vmin=lim[0],
+                vmax=lim[1],
+            )
             cb = fig.colorbar(mesh, ax=ax, shrink=0.7, pad=0.1)
             cb.ax.tick_params(labelsize=6)
     fig.text(
@@ -595,21 +558,17 @@ def _tri(panel: Mapping[str, Any], z: np.ndarray) -> tuple[Any, np.ndarray]:
     return tri, np.where(bad, 0.0, zt)
 
 
-def brdf_maps_figure(
-    panels: Sequence[Mapping[str, Any]],
-    title: str = "",
-    model_label: str = "model (per-incidence fit)",
-) -> str:
+def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
     """Measured BRDF, fitted model and relative residual per angle of incidence (one row each).
 
     Parameters
     ----------
     panels : sequence of mappings
         ``{"label": str, "theta_r": array [deg], "phi_r": array [deg], "measured": array
-        [sr^-1], "model": array [sr^-1], "residual": array [1]}``.
+        [sr^-1], "model": array [sr^-1], "residual": array [1]}``; optional
+        ``"model_label"`` (default "model (per-incidence fit)") and ``"residual_label"``
+        (default "(model - measured) / measured"), e.g. for a prediction.
     title : str
-    model_label : str
-        Heading of the model column.
 
     Returns
     -------
@@ -630,7 +589,8 @@ def brdf_maps_figure(
         vmin = float(np.percentile(pos, 1)) if pos.size else 1e-3
         vmax = float(np.max(pos)) if pos.size else 1.0
         norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 10))
-        for j, (z, name) in enumerate(((meas, "measured"), (mod, model_label))):
+        mod_name = str(p.get("model_label", "model (per-incidence fit)"))
+        for j, (z, name) in enumerate(((meas, "measured"), (mod, mod_name))):
             zz = np.where(z > 0, np.clip(z, vmin, None), np.nan)
             tri, zt = _tri(p, zz)
             ax = axes[i, j]
@@ -646,7 +606,8 @@ def brdf_maps_figure(
         ax = axes[i, 2]
         mesh = ax.tripcolor(tri, facecolors=zt, cmap="RdBu_r", vmin=-1.0, vmax=1.0)
         _disc(ax, half)
-        ax.set_title(f"{_text(p['label'])}: (model - measured) / measured", fontsize=8)
+        rname = str(p.get("residual_label", "(model - measured) / measured"))
+        ax.set_title(f"{_text(p['label'])}: {rname}", fontsize=8)
         cb = fig.colorbar(mesh, ax=ax, shrink=0.6 if half else 0.8)
         cb.set_label("relative residual [1]", fontsize=7)
         cb.ax.tick_params(which="both", labelsize=6)
@@ -786,50 +747,7 @@ def panels_figure(
         if j >= len(panels):
             ax.set_visible(False)
             continue
-        p = panels[j]
-        series = list(p.get("series", []))
-        for k, s in enumerate(series):
-            c = _COLOURS[k % len(_COLOURS)] if len(series) <= len(_COLOURS) else None
-            c = s.get("colour", c)
-            x = np.asarray(s["x"], float)
-            y = np.asarray(s["y"], float)
-            order = np.argsort(x, kind="stable")
-            x, y = x[order], y[order]
-            yerr = s.get("yerr")
-            band = s.get("band")
-            points = s.get("style") == "points" or len(x) < 3
-            kw: dict[str, Any] = {"label": _text(s.get("label", "")) or None}
-            if c is not None:
-                kw["color"] = c
-            if yerr is not None and np.any(np.isfinite(yerr)):
-                e = np.asarray(yerr, float)[order]
-                every = max(1, len(x) // 60)
-                ax.errorbar(
-                    x,
-                    y,
-                    yerr=np.where(np.isfinite(e), e, 0.0),
-                    fmt="o" if points else "-",
-                    ms=2.5,
-                    lw=0.9,
-                    elinewidth=0.6,
-                    capsize=0,
-                    errorevery=every,
-                    **kw,
-                )
-            else:
-                ax.plot(x, y, "o" if points else "-", ms=2.5, lw=0.9, **kw)
-            if band is not None and np.any(np.isfinite(band)):
-                b = np.asarray(band, float)[order]
-                ax.fill_between(x, y - b, y + b, alpha=0.25, lw=0, color=c)
-        if p.get("logy"):
-            ax.set_yscale("log")
-        ax.set_xlabel(_text(p.get("xlabel", "")), fontsize=8)
-        ax.set_ylabel(_text(p.get("ylabel", "")), fontsize=8)
-        ax.set_title(_text(p.get("title", "")), fontsize=8.5)
-        ax.tick_params(labelsize=7)
-        ax.grid(alpha=0.3)
-        if any(s.get("label") for s in series) and len(series) <= 12:
-            ax.legend(fontsize=6, loc="best")
+        draw_panel(ax, panels[j])
     return _finish_grid(fig, title, fontsize=10)
 
 
@@ -957,6 +875,7 @@ def fit_maps_figure(model: Any, params: Mapping[str, float], rows: Any, title: s
                 "measured": v,
                 "model": f,
                 "residual": res,
+                "model_label": "model (one fit, all incidences)",
             }
         )
-    return brdf_maps_figure(panels, title=title, model_label="model (one fit, all incidences)")
+    return brdf_maps_figure(panels, title=title)

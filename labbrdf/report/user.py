@@ -5,7 +5,8 @@ measured quantity per file, optical constants from psi/Delta with the Fresnel re
 compared with measured reflectance, the fits (per sample and
 wavelength, with uncertainties, intervals, flags and RMSE), measured points with the model
 curves and residuals, parameter spectra, energy and reciprocity of every fit, and the sample
-colour when spectrophotometer reflectance is among the files.
+colour when spectrophotometer reflectance is among the files, and, for a sample with a
+height map, psi/Delta and a measured ``.bsdf``, the tracer's prediction beside the BRDF.
 """
 
 from __future__ import annotations
@@ -28,13 +29,15 @@ from .sections.brdf import brdf_section
 from .sections.colour import colour_section
 from .sections.film import film_model_of, film_section
 from .sections.fits import fits_section
-from .sections.ingest import ingest_files
+from .sections.ingest import ingest_inputs, sample_groups
 from .sections.measured import measured_section
 from .sections.nk import nk_section
 from .sections.physics import physics_section
+from .sections.prediction import prediction_section
 from .sections.scans import scans_section
+from .sections.smoothness import smoothness_section
 from .sections.spectra import spectra_section
-from .sections.surface import ingest_height_maps, surface_section
+from .sections.surface import surface_section
 
 __all__ = ["user_report"]
 
@@ -81,6 +84,7 @@ def user_report(
     start: Mapping[str, float] | None = None,
     selection: Mapping[str, Any] | None = None,
     film_model: str | os.PathLike[str] | FilmModel | None = None,
+    same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
     **kw: Any,
 ) -> int:
     """Build a report for the given files and write it (atomically) to ``out``.
@@ -121,6 +125,10 @@ def user_report(
         Cauchy layer on c-Si with the thickness free,
         :func:`labbrdf.report.sections.film.default_film_model`) fitted to every psi/Delta
         file whose angles of incidence disagree (section ``film``). None: no film fit.
+    same_sample : sequence of sequences of path-like
+        Files that are one sample, one sequence per sample (each file among ``paths``),
+        in addition to the sample names the files state (:func:`labbrdf.samples.pair_samples`);
+        the section ``ingest`` shows the groups and why.
     **kw :
         ``quick`` is accepted for symmetry with :func:`~labbrdf.report.validate` (no effect).
 
@@ -134,27 +142,14 @@ def user_report(
     ------
     ValueError
         No paths, an unknown model name or option, a film model file with an error
-        (naming the file and the line), or an output folder that is refused
+        (naming the file and the line), a ``same_sample`` mapping that cannot hold
+        (:class:`labbrdf.samples.PairingError`), or an output folder that is refused
         (:class:`labbrdf.outputs.OutputError`), all before any work.
     """
     unknown = set(kw) - {"quick"}
     if unknown:
         raise TypeError(f"user_report() got unexpected keyword argument(s) {sorted(unknown)}")
-    paths = [Path(p) for p in ([paths] if isinstance(paths, (str, os.PathLike)) else paths)]
-    if not paths:
-        raise ValueError("paths: expected at least one data file")
-    from ..outputs import check_report_dir
-
-    # the model file is an input too: never inside the replaced folder
-    model_file: list[str | os.PathLike[str]] = (
-        [Path(film_model)] if isinstance(film_model, (str, os.PathLike)) else []
-    )
-    check_report_dir(out, inputs=paths + model_file)  # refused before the fits, not after
-    opts = dict(options or {})
-    try:
-        models.get(model, **opts)
-    except Exception as exc:
-        raise ValueError(f"model: {exc}") from None
+    paths, model_file, opts = _refused_early(paths, model, options, out, film_model, same_sample)
     film, film_how = film_model_of(film_model)
     b = Builder(
         title or f"labbrdf report: {model} fits",
@@ -179,7 +174,7 @@ def user_report(
         fit_options={"params": dict(start)} if start else {},
     )
 
-    sections = _sections(model, opts, film, film_how, paths, selection)
+    sections = _sections(model, opts, film, film_how, paths, selection, same_sample)
     run(ctx, sections)
     if title is None and not _fitted(b.results):
         b.results["title"] = f"labbrdf report: {len(paths)} file(s), nothing fitted"
@@ -190,20 +185,52 @@ def user_report(
     return code
 
 
+def _refused_early(
+    paths: Sequence[str | os.PathLike[str]] | str | os.PathLike[str],
+    model: str,
+    options: Mapping[str, Any] | None,
+    out: str | os.PathLike[str],
+    film_model: str | os.PathLike[str] | FilmModel | None,
+    same_sample: Sequence[Sequence[str | os.PathLike[str]]],
+) -> tuple[list[Path], list[str | os.PathLike[str]], dict[str, Any]]:
+    """Refuse bad arguments before any work: the paths, the model file, the options.
+
+    Returns the paths, the model file as an input (never inside the replaced folder) and
+    the model options; raises ValueError (see :func:`user_report`).
+    """
+    from ..outputs import check_report_dir
+    from ..samples import pair_samples
+
+    files = [Path(p) for p in ([paths] if isinstance(paths, (str, os.PathLike)) else paths)]
+    if not files:
+        raise ValueError("paths: expected at least one data file")
+    model_file: list[str | os.PathLike[str]] = (
+        [Path(film_model)] if isinstance(film_model, (str, os.PathLike)) else []
+    )
+    check_report_dir(out, inputs=[*files, *model_file])  # refused before the fits, not after
+    pair_samples(files, same_sample)  # a mapping that cannot hold
+    opts = dict(options or {})
+    try:
+        models.get(model, **opts)
+    except Exception as exc:
+        raise ValueError(f"model: {exc}") from None
+    return files, model_file, opts
+
+
 def _ingest(
-    ctx: Context, paths: Sequence[str | os.PathLike[str]], selection: Mapping[str, Any] | None
+    ctx: Context,
+    paths: Sequence[str | os.PathLike[str]],
+    selection: Mapping[str, Any] | None,
+    same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
 ) -> None:
     """Read every file (optical data or height maps), then apply the row selection."""
     ctx.b.text(
-        f"{len(paths)} file(s) given; each was read with labbrdf.read into the common "
-        "dataset, or, for topography files (height maps and profiles), with "
-        "SurfaceTopography."
+        f"{len(paths)} file(s) given; each was read once with labbrdf.read_inputs: an "
+        "optical export into the common dataset, a topography file (height map or profile) "
+        "with SurfaceTopography."
     )
-    optical = ingest_height_maps(ctx, paths)
-    if optical:
-        ingest_files(ctx, optical)
-    elif not ctx.height_maps:
-        raise Unavailable("no file could be read")
+    ingest_inputs(ctx, paths)
+    sample_groups(ctx, paths, same_sample)
     if selection:
         from ..selection import SelectionError, select
 
@@ -228,10 +255,11 @@ def _sections(
     film_how: str,
     paths: Sequence[str | os.PathLike[str]],
     selection: Mapping[str, Any] | None,
+    same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
 ) -> list[Section]:
     """The user report's sections, in order, bound to its model, film model and files."""
     return [
-        ("ingest", "Ingested files", lambda ctx: _ingest(ctx, paths, selection)),
+        ("ingest", "Ingested files", lambda ctx: _ingest(ctx, paths, selection, same_sample)),
         ("measured", "Measured data, file by file", measured_section),
         ("nk", "Optical constants and cross-instrument comparison", nk_section),
         (
@@ -258,4 +286,14 @@ def _sections(
         ),
         ("colour", "Sample colour from spectrophotometer reflectance", colour_section),
         ("surface", "Measured surface topography", surface_section),
+        (
+            "smoothness",
+            "Roughness against wavelength: Rayleigh criterion and specular loss",
+            smoothness_section,
+        ),
+        (
+            "prediction",
+            "Predict, then measure: the tracer's prediction beside the BRDF",
+            prediction_section,
+        ),
     ]

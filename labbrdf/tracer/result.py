@@ -13,9 +13,18 @@ from numpy.typing import ArrayLike, NDArray
 from .binning import Grid
 from .config import TraceConfig
 
-__all__ = ["TraceResult", "trace_summary"]
+__all__ = ["DOP_SE_MAX", "MIN_COUNT", "SHOW_COUNT", "TraceResult", "trace_summary"]
 
 UNPOLARIZED = (1.0, 0.0, 0.0, 0.0)
+
+#: counting estimator: peaks and colour scales use bins with at least this many exiting
+#: rays (fewer: the bin value is dominated by one or two rays, e.g. the thin
+#: theta_r = 90 deg edge row)
+MIN_COUNT = 20
+#: counting estimator: the DOP is shown only in bins with at least this many rays
+SHOW_COUNT = 10
+#: evaluated estimator: the DOP is shown where its standard error is at most this [1]
+DOP_SE_MAX = 0.02
 
 
 def _stokes(stokes_in: ArrayLike) -> NDArray[np.float64]:
@@ -202,6 +211,136 @@ class TraceResult:
         nb = w.shape[0]
         var = (w * (d_b - d) ** 2).sum(axis=0) / w.sum() / (nb - 1)
         return np.sqrt(var)
+
+    def readable_dop(self, stokes_in: ArrayLike = UNPOLARIZED) -> NDArray[np.float64]:
+        """:meth:`dop` where it can be read, NaN elsewhere [1].
+
+        Counting estimator: bins with at least :data:`SHOW_COUNT` exiting rays; evaluated:
+        bins whose DOP standard error (:meth:`dop_stderr`) is at most :data:`DOP_SE_MAX`.
+        The report's maps show the DOP the same way.
+        """
+        dop = self.dop(stokes_in)
+        if self.estimator == "evaluated":
+            with np.errstate(invalid="ignore"):
+                return np.where(self.dop_stderr(stokes_in) <= DOP_SE_MAX, dop, np.nan)
+        return np.where(self.counts >= SHOW_COUNT, dop, np.nan)
+
+    def s0_scale_max(self, stokes_in: ArrayLike = UNPOLARIZED) -> float | None:
+        """Top of an S0 colour scale [sr^-1]: the largest S0 among well-populated bins.
+
+        Counting estimator: bins with at least :data:`MIN_COUNT` exiting rays (None if
+        there are none); evaluated: None (every bin is an estimate of its own, the whole
+        range is shown).
+        """
+        if self.estimator == "evaluated":
+            return None
+        ok = self.counts >= MIN_COUNT
+        return float(self.s0(stokes_in)[ok].max()) if ok.any() else None
+
+    def in_plane(self, stokes_in: ArrayLike = UNPOLARIZED) -> dict[str, NDArray[np.float64]]:
+        """S0 and DOP in the plane of incidence, back-scatter half first.
+
+        The bins whose azimuth is nearest phi_r = 0 (back-scatter) and phi_r = 180 deg
+        (specular half-plane), joined into one cut over a signed angle.
+
+        Parameters
+        ----------
+        stokes_in : sequence of 4 floats
+            Input Stokes vector (default unpolarized).
+
+        Returns
+        -------
+        dict of arrays
+            ``theta_deg`` (-theta_r on the back-scatter side, +theta_r on the specular
+            side) [deg], ``s0`` [sr^-1], ``s0_stderr`` (the Monte Carlo error of M00 times
+            S0_in for unpolarized input; NaN otherwise, the per-element errors not carrying
+            the covariances a polarized input needs), ``dop`` [1] (:meth:`readable_dop`:
+            NaN where too noisy to read), ``dop_stderr`` [1]
+            (:meth:`dop_stderr`) and ``phi_r_deg`` (the two azimuths used).
+        """
+        s = _stokes(stokes_in)
+        phi = self.phi_r_deg
+        j0 = int(np.argmin(np.minimum(np.abs(phi), np.abs(360.0 - phi))))
+        j180 = int(np.argmin(np.abs(phi - 180.0)))
+        th = self.theta_r_deg
+        back, fwd = slice(None, None, -1), slice(None)
+        s0, dop, dop_e = self.s0(s), self.readable_dop(s), self.dop_stderr(s)
+        if np.any(s[1:] != 0):
+            s0_e = np.full(s0.shape, np.nan)
+        else:
+            s0_e = self.mueller_stderr[..., 0, 0] * s[0]
+
+        def cut(a: NDArray[np.float64]) -> NDArray[np.float64]:
+            return np.concatenate([a[back, j0], a[fwd, j180]])
+
+        return {
+            "theta_deg": np.concatenate([-th[back], th]),
+            "s0": cut(s0),
+            "s0_stderr": cut(s0_e),
+            "dop": cut(dop),
+            "dop_stderr": cut(dop_e),
+            "phi_r_deg": np.array([phi[j0], phi[j180]]),
+        }
+
+    def plot(self, stokes_in: ArrayLike = UNPOLARIZED, ax: Any = None) -> Any:
+        """Hemisphere maps of S0 and DOP and their cut in the plane of incidence.
+
+        The maps are drawn as the report's tracer maps (polar: azimuth phi_r with the
+        specular half-plane at 180 deg, radius theta_r; the DOP blank where it cannot be
+        read, :meth:`readable_dop`; the S0 scale up to :meth:`s0_scale_max`); the cut is
+        :meth:`in_plane` with 1-sigma error bars (S0) and a band (DOP).
+
+        Parameters
+        ----------
+        stokes_in : sequence of 4 floats
+            Input Stokes vector (default unpolarized).
+        ax : sequence of 3 matplotlib Axes, optional
+            Where to draw: S0 map and DOP map (both with ``projection="polar"``) and the
+            cut. Default a new figure with the three side by side.
+
+        Returns
+        -------
+        matplotlib Figure
+        """
+        from .._plotting import draw_cut, draw_polar_map  # matplotlib only when drawing
+
+        s = _stokes(stokes_in)
+        if ax is None:
+            import matplotlib.pyplot as plt
+
+            fig = plt.figure(figsize=(13.0, 3.9), layout="constrained")
+            ax = [
+                fig.add_subplot(1, 3, 1, projection="polar"),
+                fig.add_subplot(1, 3, 2, projection="polar"),
+                fig.add_subplot(1, 3, 3),
+            ]
+        axes = list(np.asarray(ax, dtype=object).ravel())
+        if len(axes) != 3 or any(a.name != "polar" for a in axes[:2]):
+            raise ValueError("ax: expected three Axes, the first two with projection='polar'")
+        fig = axes[0].figure
+        for a, data, title, cmap, lim in (
+            (axes[0], self.s0(s), r"$S_0$ [sr$^{-1}$]", "inferno", (0.0, self.s0_scale_max(s))),
+            (axes[1], self.readable_dop(s), "DOP [1]", "viridis", (0.0, 1.0)),
+        ):
+            mesh = draw_polar_map(
+                a,
+                data,
+                self.theta_r_edges_deg,
+                self.phi_r_edges_deg,
+                title=title,
+                cmap=cmap,
+                vmin=lim[0],
+                vmax=lim[1],
+            )
+            fig.colorbar(mesh, ax=a, shrink=0.7, pad=0.1)
+        c = self.in_plane(s)
+        draw_cut(axes[2], c["theta_deg"], c["s0"], c["s0_stderr"], c["dop"], c["dop_stderr"])
+        axes[2].set_title(
+            f"plane of incidence (theta_i {self.config.theta_i_deg:g} deg), "
+            f"input Stokes {[float(v) for v in s]}",
+            fontsize=8,
+        )
+        return fig
 
     def albedo(self, stokes_in: ArrayLike = UNPOLARIZED) -> float:
         """Directional-hemispherical reflectance: exited S0 / incident S0 [1]."""

@@ -214,6 +214,101 @@ def _decreasing(x: list[float]) -> bool:
     return all(b < a for a, b in zip(x, x[1:], strict=False))
 
 
+def _middle_max(x: list[float]) -> bool:
+    return len(x) == 3 and x[1] > x[0] and x[1] > x[2]
+
+
+#: the trend claims of each study (paper sec. 4), in the paper's order: (claim, the
+#: per-label number it reads, the test on the numbers in order of increasing factor)
+_TRENDS: dict[str, tuple[tuple[str, str, Callable[[list[float]], bool]], ...]] = {
+    "incidence": (
+        ("with larger theta_i the S0 spot shrinks", "S0_extent_sr", _decreasing),
+        ("with larger theta_i the S0 peak grows", "S0_peak", _increasing),
+        ("with larger theta_i the DOP spot shrinks", "DOP_extent_sr", _decreasing),
+        ("with larger theta_i the DOP peak grows", "DOP_peak", _increasing),
+    ),
+    "roughness": (
+        ("with larger alpha the S0 spot grows", "S0_extent_sr", _increasing),
+        ("with larger alpha the S0 centre intensity falls", "S0_centre", _decreasing),
+        ("with larger alpha the DOP spot grows", "DOP_extent_sr", _increasing),
+        ("with larger alpha the DOP peak grows", "DOP_peak", _increasing),
+    ),
+    "substrate": (
+        (
+            "with larger n/k (Cu < Al < NiFe) the S0 centre intensity falls",
+            "S0_centre",
+            _decreasing,
+        ),
+        ("with larger n/k the DOP spot shrinks", "DOP_extent_sr", _decreasing),
+        ("with larger n/k the DOP peak grows", "DOP_peak", _increasing),
+    ),
+    **{
+        s: (
+            ("the S0 centre intensity is largest for d_c = lambda/4", "S0_centre", _middle_max),
+            ("with larger d_c the DOP spot shrinks", "DOP_extent_sr", _decreasing),
+            ("with larger d_c the DOP peak grows", "DOP_peak", _increasing),
+        )
+        for s in ("thickness", "thickness_coherent")
+    },
+}
+
+
+def _claim(
+    study: str,
+    claim: str,
+    holds: bool,
+    rows: list[tuple[str, dict[str, float]]],
+    keys: Iterable[str],
+) -> dict[str, Any]:
+    """One entry of :func:`evaluate_claims`: the claim, its verdict and the numbers read."""
+    ev = {lab: {k: st[k] for k in keys} for lab, st in rows}
+    return {"study": study, "claim": claim, "holds": bool(holds), "evidence": ev}
+
+
+def _common_claims(
+    study: str, rows: list[tuple[str, dict[str, float]]], tol: float, z_max: float
+) -> list[dict[str, Any]]:
+    """The claims every study makes: mirror symmetry, the specular S0 peak, grazing DOP."""
+    sym_s0 = all(st["S0_symmetry_z"] <= z_max for _, st in rows)
+    sym_dop = all(st["DOP_symmetry_z"] <= z_max for _, st in rows)
+    spec = all(abs(st["S0_plane_argmax_deg"] - st["theta_i_deg"]) <= tol for _, st in rows)
+    grazing = all(
+        st["DOP_peak_theta_deg"] >= 80 and abs(st["DOP_peak_phi_deg"] - 180) <= 10
+        for _, st in rows
+    )
+    return [
+        _claim(study, "S0 is symmetric about phi_r = 180 deg", sym_s0, rows, ("S0_symmetry_z",)),
+        _claim(
+            study, "DOP is symmetric about phi_r = 180 deg", sym_dop, rows, ("DOP_symmetry_z",)
+        ),
+        _claim(
+            study,
+            "S0 is largest at theta_r = theta_i in the plane phi_r = 180 deg",
+            spec,
+            rows,
+            ("S0_plane_argmax_deg", "theta_i_deg"),
+        ),
+        _claim(
+            study,
+            "DOP is largest at (theta_r = 90, phi_r = 180) deg",
+            grazing,
+            rows,
+            ("DOP_peak", "DOP_peak_theta_deg", "DOP_peak_phi_deg"),
+        ),
+    ]
+
+
+def _trend_claims(study: str, rows: list[tuple[str, dict[str, float]]]) -> list[dict[str, Any]]:
+    """The study's own trend claims (:data:`_TRENDS`) on its labels in the paper's order."""
+    out = []
+    for claim, key, test in _TRENDS.get(study, ()):
+        values = [st[key] for _, st in rows]
+        if test is _middle_max and len(values) != 3:
+            continue  # "largest at lambda/4" needs the paper's three thicknesses
+        out.append(_claim(study, claim, test(values), rows, (key,)))
+    return out
+
+
 def evaluate_claims(
     studies: list[tuple[str, str, TraceResult]], *, min_count: int = 20, z_max: float = 5.0
 ) -> list[dict[str, Any]]:
@@ -238,143 +333,11 @@ def evaluate_claims(
     by: dict[str, list[tuple[str, dict[str, float]]]] = {}
     for study, label, res in studies:
         by.setdefault(study, []).append((label, _stats(res, min_count)))
+    tol = 1.0 * max(1.0, float(studies[0][2].config.theta_step_deg)) if studies else 1.0
     out: list[dict[str, Any]] = []
-
-    def add(study: str, claim: str, holds: bool, keys: tuple[str, ...]) -> None:
-        ev = {lab: {k: st[k] for k in keys} for lab, st in by[study]}
-        out.append({"study": study, "claim": claim, "holds": bool(holds), "evidence": ev})
-
-    def col(study: str, key: str) -> list[float]:
-        return [st[key] for _, st in by[study]]
-
-    def spec_peak(study: str, tol: float) -> bool:
-        return all(
-            abs(st["S0_plane_argmax_deg"] - st["theta_i_deg"]) <= tol for _, st in by[study]
-        )
-
-    def sym(study: str, key: str) -> bool:
-        return all(st[key] <= z_max for _, st in by[study])
-
-    def dop_grazing(study: str) -> bool:
-        return all(
-            st["DOP_peak_theta_deg"] >= 80 and abs(st["DOP_peak_phi_deg"] - 180) <= 10
-            for _, st in by[study]
-        )
-
-    for study in by:
-        tol = 1.0 * max(1.0, float(studies[0][2].config.theta_step_deg))
-        add(
-            study,
-            "S0 is symmetric about phi_r = 180 deg",
-            sym(study, "S0_symmetry_z"),
-            ("S0_symmetry_z",),
-        )
-        add(
-            study,
-            "DOP is symmetric about phi_r = 180 deg",
-            sym(study, "DOP_symmetry_z"),
-            ("DOP_symmetry_z",),
-        )
-        add(
-            study,
-            "S0 is largest at theta_r = theta_i in the plane phi_r = 180 deg",
-            spec_peak(study, tol),
-            ("S0_plane_argmax_deg", "theta_i_deg"),
-        )
-        add(
-            study,
-            "DOP is largest at (theta_r = 90, phi_r = 180) deg",
-            dop_grazing(study),
-            ("DOP_peak", "DOP_peak_theta_deg", "DOP_peak_phi_deg"),
-        )
-
-    if "incidence" in by:
-        s = "incidence"
-        add(
-            s,
-            "with larger theta_i the S0 spot shrinks",
-            _decreasing(col(s, "S0_extent_sr")),
-            ("S0_extent_sr",),
-        )
-        add(
-            s,
-            "with larger theta_i the S0 peak grows",
-            _increasing(col(s, "S0_peak")),
-            ("S0_peak",),
-        )
-        add(
-            s,
-            "with larger theta_i the DOP spot shrinks",
-            _decreasing(col(s, "DOP_extent_sr")),
-            ("DOP_extent_sr",),
-        )
-        add(
-            s,
-            "with larger theta_i the DOP peak grows",
-            _increasing(col(s, "DOP_peak")),
-            ("DOP_peak",),
-        )
-    if "roughness" in by:
-        s = "roughness"
-        add(
-            s,
-            "with larger alpha the S0 spot grows",
-            _increasing(col(s, "S0_extent_sr")),
-            ("S0_extent_sr",),
-        )
-        add(
-            s,
-            "with larger alpha the S0 centre intensity falls",
-            _decreasing(col(s, "S0_centre")),
-            ("S0_centre",),
-        )
-        add(
-            s,
-            "with larger alpha the DOP spot grows",
-            _increasing(col(s, "DOP_extent_sr")),
-            ("DOP_extent_sr",),
-        )
-        add(
-            s,
-            "with larger alpha the DOP peak grows",
-            _increasing(col(s, "DOP_peak")),
-            ("DOP_peak",),
-        )
-    if "substrate" in by:
-        s = "substrate"
-        add(
-            s,
-            "with larger n/k (Cu < Al < NiFe) the S0 centre intensity falls",
-            _decreasing(col(s, "S0_centre")),
-            ("S0_centre",),
-        )
-        add(
-            s,
-            "with larger n/k the DOP spot shrinks",
-            _decreasing(col(s, "DOP_extent_sr")),
-            ("DOP_extent_sr",),
-        )
-        add(
-            s, "with larger n/k the DOP peak grows", _increasing(col(s, "DOP_peak")), ("DOP_peak",)
-        )
-    for s in ("thickness", "thickness_coherent"):
-        if s not in by:
-            continue
-        c = col(s, "S0_centre")
-        if len(c) == 3:
-            add(
-                s,
-                "the S0 centre intensity is largest for d_c = lambda/4",
-                c[1] > c[0] and c[1] > c[2],
-                ("S0_centre",),
-            )
-        add(
-            s,
-            "with larger d_c the DOP spot shrinks",
-            _decreasing(col(s, "DOP_extent_sr")),
-            ("DOP_extent_sr",),
-        )
-        add(
-            s, "with larger d_c the DOP peak grows", _increasing(col(s, "DOP_peak")), ("DOP_peak",)
-        )
+    for study, rows in by.items():
+        out += _common_claims(study, rows, tol, z_max)
+    for study in ("incidence", "roughness", "substrate", "thickness", "thickness_coherent"):
+        if study in by:
+            out += _trend_claims(study, by[study])
     return out

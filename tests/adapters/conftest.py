@@ -1,4 +1,9 @@
-"""Fixtures of the adapter tests: a minimal OLE2 compound-document writer.
+"""Fixtures of the adapter tests: reading and error checks shared by the vendors' files, and
+a minimal OLE2 compound-document writer.
+
+The checks (``load``, ``pick``, ``approx``, ``value_at``, ``check_spectrum``, ``write``,
+``raises``) are fixtures that return
+plain functions, so that each vendor's file uses the same ones.
 
 Shimadzu UVProbe ``.spc`` and legacy JASCO ``.jws`` files are OLE2 compound documents. The
 tests build their own from named streams (``olefile`` reads but does not create them), so
@@ -12,8 +17,17 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Callable
+from pathlib import Path
+from typing import Any
 
+import numpy as np
 import pytest
+
+import labbrdf
+from labbrdf.adapters import AdapterError
+
+#: relative tolerance of a value read from a text export against the digits quoted from it
+REL = 1e-12
 
 MAGIC = b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1"
 _FREE, _END, _FATSECT, _NOSTREAM = 0xFFFFFFFF, 0xFFFFFFFE, 0xFFFFFFFD, 0xFFFFFFFF
@@ -137,3 +151,114 @@ def write_ole2(streams: dict[str, bytes]) -> bytes:
 def make_ole2() -> Callable[[dict[str, bytes]], bytes]:
     """The writer: ``make_ole2({"DataInfo": b"...", "Y-Data": b"..."}) -> bytes``."""
     return write_ole2
+
+
+# ----------------------------------------------------------------------------- reading checks
+
+_READ: dict[Path, labbrdf.Measurement] = {}
+
+
+def _load(real_exports: Path, rel: str) -> labbrdf.Measurement:
+    """``labbrdf.read`` of a real export, once per session (tests only look at the result)."""
+    path = real_exports / rel
+    if path not in _READ:
+        _READ[path] = labbrdf.read(path)
+    return _READ[path]
+
+
+def _pick(m: labbrdf.Measurement, quantity: str, wl: float, aoi: float | None = None, **kw):
+    """The single row of ``quantity`` at wavelength ``wl`` (and AOI, channel, time...)."""
+    d = m.data
+    sel = (d["quantity"] == quantity) & np.isclose(d["wavelength_nm"], wl, rtol=1e-9, atol=0)
+    if aoi is not None:
+        sel &= np.isclose(d["theta_i_deg"], aoi, rtol=1e-9, atol=0)
+    for k, v in kw.items():
+        col = d[k]
+        sel &= np.isclose(col, v, rtol=1e-9, atol=0) if isinstance(v, float) else col == v
+    rows = d[sel]
+    assert len(rows) == 1, f"{len(rows)} rows match {quantity} {wl} {aoi} {kw}"
+    return rows.iloc[0]
+
+
+def _value_at(m: labbrdf.Measurement, wavelength: float, sample: str | None = None) -> float:
+    """The value of the single row at ``wavelength`` [nm] (of ``sample``)."""
+    d = m.data
+    sel = np.isclose(d["wavelength_nm"], wavelength, rtol=0, atol=1e-9)
+    if sample is not None:
+        sel &= d["sample"] == sample
+    assert sel.sum() == 1, f"{sel.sum()} rows at {wavelength} nm"
+    return float(d.loc[sel, "value"].iloc[0])
+
+
+def _check_spectrum(m: labbrdf.Measurement, quantity: str, n: int, lo: float, hi: float) -> None:
+    """A spectrophotometer spectrum: ``n`` rows of ``quantity`` from ``lo`` to ``hi`` [nm],
+    fractions (unit "1"), no angle of incidence and no uncertainty."""
+    d = m.data
+    assert len(d) == n
+    assert set(d["quantity"].astype(str)) == {quantity}
+    assert d["wavelength_nm"].min() == pytest.approx(lo, abs=1e-9)
+    assert d["wavelength_nm"].max() == pytest.approx(hi, abs=1e-9)
+    assert (d["unit"] == "1").all()
+    assert d["theta_i_deg"].isna().all() and d["sigma"].isna().all()
+
+
+def _approx(x: float) -> object:
+    return pytest.approx(x, rel=REL, abs=1e-15)
+
+
+def _write(tmp_path: Path, name: str, data: bytes) -> Path:
+    p = tmp_path / name
+    p.write_bytes(data)
+    return p
+
+
+def _raises(path: Path, match: str, line: int | None = None, reader=labbrdf.read, **kw: Any):
+    """The AdapterError of reading ``path``: matches ``match``, names the file (and line)."""
+    with pytest.raises(AdapterError, match=match) as ei:
+        reader(path, **kw)
+    assert str(path) in str(ei.value)
+    if line is not None:
+        assert ei.value.line == line, str(ei.value)
+    return ei.value
+
+
+@pytest.fixture(scope="session")
+def load() -> Callable[[Path, str], labbrdf.Measurement]:
+    """``load(real_exports, "vendor-folder/file")``: the measurement read from a real export."""
+    return _load
+
+
+@pytest.fixture(scope="session")
+def pick() -> Callable[..., Any]:
+    """``pick(m, quantity, wl, aoi=None, **column=value)``: the one row that matches."""
+    return _pick
+
+
+@pytest.fixture(scope="session")
+def approx() -> Callable[[float], object]:
+    """``approx(x)``: ``pytest.approx`` at :data:`REL` (digits quoted from a text export)."""
+    return _approx
+
+
+@pytest.fixture(scope="session")
+def value_at() -> Callable[..., float]:
+    """``value_at(m, wavelength, sample=None)``: the value of the one row there."""
+    return _value_at
+
+
+@pytest.fixture(scope="session")
+def check_spectrum() -> Callable[[labbrdf.Measurement, str, int, float, float], None]:
+    """``check_spectrum(m, quantity, n, lo, hi)``: asserts a spectrum's shape and units."""
+    return _check_spectrum
+
+
+@pytest.fixture(scope="session")
+def write() -> Callable[[Path, str, bytes], Path]:
+    """``write(tmp_path, name, data)``: a file of those bytes."""
+    return _write
+
+
+@pytest.fixture(scope="session")
+def raises() -> Callable[..., AdapterError]:
+    """``raises(path, match, line=None, reader=labbrdf.read, **kw)``: the reader's error."""
+    return _raises

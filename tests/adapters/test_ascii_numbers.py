@@ -16,27 +16,19 @@ from labbrdf.adapters._base import parse_number
 
 FULL = str.maketrans("0123456789", "０１２３４５６７８９")
 
-#: format -> (file, a field as written on a data line, its line number)
+#: format -> (file, a field as written on a data line, its line number): the example of
+#: each text format's registry entry that names such a field (``Example.number``)
 CASES = {
-    "woollam-wvase": ("woollam-wvase-ascii/w2_10102006.dat", "26.418438", 5),
-    "woollam-completeease": ("woollam-completeease-ascii/Woolam_staticTest.dat", "21.4553", 4),
-    "accurion-ep4": ("accurion-ep4-dat/post synthesis.dat", "143.615", 3),
-    "filmsense": ("filmsense-txt/Filmsense_staticTest.txt", "14.32", 3),
-    "sentech-spectraray": ("sentech-spectraray-ascii/Si_SiO2_theta_50_60_70.txt", "47.53618", 3),
-    "jasco-spectramanager-text": ("jasco-spectramanager-text/uvvis_abs.txt", "-6.38777E-05", 19),
-    "perkinelmer-uvwinlab-asc": ("perkinelmer-uvwinlab-asc/KTF-D.Probe.Raw.asc", None, None),
-    "agilent-cary-winuv-csv": ("agilent-cary-winuv-csv/CuPCtS_H2O_vis.csv", "0.0340631865", 5),
-    "jcamp-dx": ("jcamp-dx/dupinc1.jdx", "2860", 22),
+    name: (ex.path, *ex.number)
+    for name, f in READERS.items()
+    for ex in f.examples
+    if ex.number is not None
 }
 
 
 def _case(real_exports: Path, fmt: str) -> tuple[bytes, str, int]:
     rel, field, line = CASES[fmt]
     text = (real_exports / rel).read_bytes().decode("latin-1")
-    if field is None:  # PerkinElmer: the first data row after #DATA
-        lines = text.splitlines()
-        line = next(i for i, s in enumerate(lines, 1) if s.strip() == "#DATA") + 1
-        field = lines[line - 1].split("\t")[1].strip()
     assert field in text.splitlines()[line - 1], (fmt, field, line)
     return text.encode("latin-1"), field, line
 

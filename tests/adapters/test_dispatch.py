@@ -13,11 +13,9 @@ import pytest
 import labbrdf
 from labbrdf.adapters import READERS, AdapterError, sniff
 
-ROOT = Path(__file__).resolve().parents[2]
-
 
 @pytest.mark.parametrize("fmt", sorted(READERS))
-def test_character_device_is_refused_with_and_without_format(fmt: str) -> None:
+def test_character_device_is_refused_with_and_without_format(fmt: str, project_root: Path) -> None:
     # run in a child with a memory limit and a timeout: before the fix /dev/zero was read
     # until memory ran out
     code = (
@@ -34,7 +32,7 @@ def test_character_device_is_refused_with_and_without_format(fmt: str) -> None:
         capture_output=True,
         text=True,
         timeout=60,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        env={**os.environ, "PYTHONPATH": str(project_root)},
     )
     assert out.stdout.strip() == "/dev/zero: is a character device, expected a regular file"
     with pytest.raises(AdapterError, match="character device"):

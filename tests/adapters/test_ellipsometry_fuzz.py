@@ -15,8 +15,9 @@ token at a random byte) and reads the result with the format's reader. Two prope
    Truncation and deletion cannot add data: ``rows <= rows_original``; duplication
    cannot remove any: ``rows >= rows_original``.
 
-Bounded: 60 examples per format, no deadline (the slow line-by-line parser runs on most
-mutated files).
+The files and their rows per line come from each format's registry entry
+(``Format.examples``, ``Example.rows_per_line``). Bounded: 60 examples per format, no
+deadline (the slow line-by-line parser runs on most mutated files).
 """
 
 from __future__ import annotations
@@ -29,42 +30,22 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import labbrdf
-from labbrdf.adapters import AdapterError
+from labbrdf.adapters import READERS, AdapterError
 
+#: format -> the real exports it is fuzzed on: the examples of its registry entry that
+#: state how many rows one text line gives (``Example.rows_per_line``)
 FILES = {
-    "woollam-wvase": [
-        "woollam-wvase-ascii/w2_10102006.dat",
-        "woollam-wvase-ascii/wafer_2_01242007.dat",
-        "woollam-wvase-ascii/ta2o5_02262007_rp.dat",
-        "woollam-wvase-ascii/wvase_example.dat",
-        "woollam-wvase-ascii/w1_al2o3_20081120_anisotropy.dat",
-    ],
-    "woollam-completeease": [
-        "woollam-completeease-ascii/complete_ease_example.dat",
-        "woollam-completeease-ascii/Woolam_staticTest.dat",
-        "woollam-completeease-ascii/Woolam_kineticTest.dat",
-    ],
-    "accurion-ep4": [
-        "accurion-ep4-dat/15-1-1.dat",
-        "accurion-ep4-dat/corefine_PNIPAM_ellipsometry.dat",
-        "accurion-ep4-dat/Si3N4_on_4inBF33_W02_20240903-150451.ds.dat",
-        "accurion-ep4-dat/testData1_11nm_PNIPAM_on_Si_EP4.dat",
-    ],
-    "filmsense": [
-        "filmsense-txt/Filmsense_staticTest.txt",
-        "filmsense-txt/Filmsense_kineticTest.txt",
-    ],
-    "sentech-spectraray": [
-        "sentech-spectraray-ascii/Si_SiO2_theta_50_60_70.txt",
-        "sentech-spectraray-ascii/Wafer_MM_70.txt",
-    ],
+    name: [ex.path for ex in f.examples if ex.rows_per_line is not None]
+    for name, f in READERS.items()
+    if any(ex.rows_per_line is not None for ex in f.examples)
 }
 
+#: file name -> at most this many rows come from one line of it
 ROWS_PER_LINE = {
-    "Filmsense_kineticTest.txt": 24,
-    "Filmsense_staticTest.txt": 3,
-    "Si_SiO2_theta_50_60_70.txt": 6,
-    "Wafer_MM_70.txt": 16,
+    Path(ex.path).name: ex.rows_per_line
+    for f in READERS.values()
+    for ex in f.examples
+    if ex.rows_per_line is not None
 }
 
 GARBAGE = [
@@ -152,7 +133,7 @@ def test_mutated_real_files_raise_adapter_error_or_keep_every_intact_row(real_ex
     src = real_exports / rel
     raw = src.read_bytes()
     n0 = original_rows(src, fmt)
-    per_line = ROWS_PER_LINE.get(src.name, 2)
+    per_line = ROWS_PER_LINE[src.name]
     mutated, kind, touched = mutate(data, raw)
     with tempfile.TemporaryDirectory() as tmp:
         p = Path(tmp) / src.name

@@ -17,9 +17,10 @@ the reader found, kept or dropped as missing; n0 the same for the unmutated file
    struct.error, UnicodeDecodeError, DatasetError, RuntimeWarning ...).
 2. No wrong row count comes back silently:
 
-   * ``COUNTED`` formats, whose files state their point count (JASCO text and binary,
-     PerkinElmer, JCAMP-DX, SPC) or whose reader checks the wavelength steps against the
-     instrument's data interval (Cary): every mutation either raises or gives n == n0.
+   * ``COUNTED`` formats (``Format.states_count`` in the registry), whose files state their
+     point count (JASCO text and binary, PerkinElmer, JCAMP-DX, SPC) or whose reader checks
+     the wavelength steps against the instrument's data interval (Cary): every mutation
+     either raises or gives n == n0.
      One documented exception: deleting the first or last data row of a Cary sample leaves
      a shorter but consistent scan (as real scans stopped early are, ``filters.csv``
      sample 600LP1), so for Cary ``delete`` the bound is n0 - k <= n <= n0 with k the
@@ -49,14 +50,8 @@ from hypothesis import strategies as st  # noqa: E402
 import labbrdf  # noqa: E402
 from labbrdf.adapters import READERS, AdapterError, sniff  # noqa: E402
 
-COUNTED = {
-    "jasco-spectramanager-text",
-    "jasco-jws",
-    "perkinelmer-uvwinlab-asc",
-    "jcamp-dx",
-    "galactic-spc",
-    "agilent-cary-winuv-csv",
-}
+#: the formats whose registry entry says their files state the point count
+COUNTED = {name for name, f in READERS.items() if f.states_count}
 EXAMPLES = 30
 GARBAGE = [
     b"NaN", b"nan", b"inf", b"-inf", b"1e999", b"-", b"+", b".", b",", b";", b"\t", b" ",

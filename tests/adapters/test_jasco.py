@@ -1,4 +1,12 @@
-"""JASCO Spectra Manager text: a UTF-8 BOM or CR-only line ends are recognised."""
+"""JASCO Spectra Manager exports: the text export (V-570, V-730; BOM, CR-only line ends,
+footer) and the binary ``.jws``, both the current layout and the legacy OLE2 one.
+
+Real files come from ../shared/real-exports through the ``real_exports`` fixture (skipped
+when absent); every spot value is quoted from the file line it was checked against. The
+synthetic files are built by the small writers here: each writes a valid file, and the
+error tests break one thing at a time and check the AdapterError names the file and the
+line (text) or byte offset (binary) and what was expected.
+"""
 
 from __future__ import annotations
 
@@ -10,7 +18,10 @@ import pytest
 
 import labbrdf
 from labbrdf.adapters import AdapterError, sniff
-from labbrdf.adapters.jasco import read_jasco_jws
+from labbrdf.adapters.jasco import read_jasco_jws, read_jasco_text
+
+# float32 holds 24 bits: relative round-off of one stored value
+F32 = 2.0**-24
 
 TXT = "jasco-spectramanager-text"
 
@@ -127,3 +138,209 @@ def test_truncated_legacy_jws_is_refused(tmp_path: Path, make_ole2, keep: int) -
     p.write_bytes(make_ole2(legacy_streams())[:keep])
     with pytest.raises(AdapterError, match=r"cut.jws: .*(corrupt|truncated)"):
         read_jasco_jws(p)
+
+
+def test_jasco_text_v730_with_cp932_footer(real_exports: Path, value_at, check_spectrum) -> None:
+    m = read_jasco_text(real_exports / "jasco-spectramanager-text" / "uvvis_abs.txt")
+    check_spectrum(m, "absorbance", 61, 400.0, 700.0)
+    assert value_at(m, 700) == -6.38777e-05  # line 19: "700\t-6.38777E-05"
+    assert value_at(m, 410) == 0.000211082  # line 77: "410\t0.000211082"
+    assert value_at(m, 400) == -0.00019697  # line 79: "400\t-0.00019697"
+    assert m.meta["encoding"] == "cp932"
+    # footer "[コメント情報]" / "試料名\ttest" and "[測定情報]" / "機種名\tV-730"
+    assert set(m.data["sample"]) == {"test"}
+    assert m.meta["footer"]["測定情報"]["機種名"] == "V-730"
+    assert m.meta["footer_en"]["photometric mode"] == "Abs"
+    assert m.meta["footer_en"]["number of points"] == "61"
+    assert m.meta["header"]["SPECTROMETER/DATA SYSTEM"] == "JASCO Corp., V-730, Rev. 1.00"
+
+
+def test_jasco_text_v570_without_footer(real_exports: Path, value_at, check_spectrum) -> None:
+    m = read_jasco_text(real_exports / "jasco-spectramanager-text" / "PbSe batch 1.txt")
+    check_spectrum(m, "absorbance", 1801, 700.0, 2500.0)
+    assert value_at(m, 2500) == 0.10852  # line 19: "2500.0000\t0.10852"
+    assert value_at(m, 700) == 1.58144  # last line: "700.0000\t1.58144"
+    assert set(m.data["sample"]) == {"PbSe batch 1"}  # TITLE is empty: the file stem
+    assert m.meta["footer"] == {} and m.meta["encoding"] == "utf-8"
+
+
+def test_jws_absorbance_matches_its_text_export(real_exports: Path, check_spectrum) -> None:
+    """Same measurement in two files: the binary float32 and the 6-digit text agree."""
+    b = read_jasco_jws(real_exports / "jasco-jws-binary" / "uvvis_abs.jws")
+    t = read_jasco_text(real_exports / "jasco-spectramanager-text" / "uvvis_abs.txt")
+    check_spectrum(b, "absorbance", 61, 400.0, 700.0)
+    yb = b.data.sort_values("wavelength_nm")["value"].to_numpy()
+    yt = t.data.sort_values("wavelength_nm")["value"].to_numpy()
+    # the text prints 6 significant digits: half a unit of the 6th digit, plus float32
+    np.testing.assert_allclose(yb, yt, rtol=5e-6 + F32, atol=0)
+    assert b.meta["model"] == "V-730" and b.meta["serial"] == "H470561798"
+    assert b.meta["time_utc"] == "2026-06-04T07:08:01+00:00"  # text: 26/06/04 16:08 JST
+
+
+def test_jws_reflectance_uses_firstx_and_deltax_not_stale_lastx(
+    real_exports: Path, value_at, check_spectrum
+) -> None:
+    m = read_jasco_jws(real_exports / "jasco-jws-binary" / "uvvis_refl.jws")
+    check_spectrum(m, "reflectance", 11, 650.0, 700.0)
+    assert m.meta["lastx_header_nm"] == 400.0 and not m.meta["lastx_consistent"]
+    # bytes 0x740..0x743 = 9a 1a c8 42 = 100.05195617675781 (%R) at FIRSTX 700 nm
+    assert value_at(m, 700) == pytest.approx(100.05195617675781 / 100, rel=1e-15)
+
+
+def test_jws_transmittance(real_exports: Path, value_at, check_spectrum) -> None:
+    m = read_jasco_jws(real_exports / "jasco-jws-binary" / "uvvis_trans.jws")
+    check_spectrum(m, "transmittance", 61, 400.0, 700.0)
+    # bytes 0x740..0x743 = 32 10 c8 42 = 100.03163146972656 (%T) at 700 nm
+    assert value_at(m, 700) == pytest.approx(100.03163146972656 / 100, rel=1e-15)
+
+
+def jasco_text(
+    rows: str = "700\t50.0\r\n695\t51.0\r\n690\t52.0\r\n",
+    *,
+    yunits: str = "%R",
+    xunits: str = "NANOMETERS",
+    npoints: str = "3",
+    footer: str = "",
+) -> bytes:
+    head = (
+        "TITLE\tmy title\r\nORIGIN\tJASCO\r\nDELTAX\t-5\r\n"
+        f"XUNITS\t{xunits}\r\nYUNITS\t{yunits}\r\nFIRSTX\t700\r\nLASTX\t690\r\n"
+        f"NPOINTS\t{npoints}\r\nXYDATA\r\n"
+    )
+    return (head + rows).encode("ascii") + footer.encode("cp932")
+
+
+def test_jasco_text_percent_reflectance_and_title(tmp_path: Path, write) -> None:
+    m = read_jasco_text(write(tmp_path, "a.txt", jasco_text()))
+    assert list(m.data["value"]) == [0.5, 0.51, 0.52]
+    assert set(m.data["quantity"].astype(str)) == {"reflectance"}
+    assert set(m.data["sample"]) == {"my title"}
+
+
+def test_jasco_text_sphere_accessory_gives_hemispherical(tmp_path: Path, write) -> None:
+    footer = "\r\n\r\n[コメント情報]\r\n試料名\tOSR-1\r\n[付属品情報]\r\n付属品名\tISV-922\r\n"
+    m = read_jasco_text(write(tmp_path, "a.txt", jasco_text(footer=footer)))
+    assert set(m.data["quantity"].astype(str)) == {"hemispherical_reflectance"}
+    assert set(m.data["sample"]) == {"OSR-1"} and m.meta["encoding"] == "cp932"
+
+
+def test_jasco_text_comma_separated_transmittance(tmp_path: Path, write) -> None:
+    data = jasco_text(yunits="TRANSMITTANCE").replace(b"\t", b",").replace(b"XYDATA", b"XYDATA,")
+    m = read_jasco_text(write(tmp_path, "a.csv", data))
+    assert set(m.data["quantity"].astype(str)) == {"transmittance"}
+    assert list(m.data["value"]) == [0.5, 0.51, 0.52]
+
+
+def test_jasco_text_footer_right_after_the_data(tmp_path: Path, write) -> None:
+    footer = "[コメント情報]\r\n試料名\tS\r\n"
+    m = read_jasco_text(write(tmp_path, "a.txt", jasco_text(footer=footer)))
+    assert len(m) == 3 and set(m.data["sample"]) == {"S"}
+
+
+@pytest.mark.parametrize(
+    ("data", "match"),
+    [
+        (b"TITLE\tx\r\nXUNITS\tNANOMETERS\r\n", r"no 'XYDATA' line"),
+        (b"HELLO\r\n", r"line 1: expected a JASCO text export"),
+        (jasco_text(xunits="1/CM"), r"XUNITS '1/CM': only wavelength in NANOMETERS"),
+        (jasco_text(yunits="INTENSITY"), r"YUNITS 'INTENSITY' is not one of"),
+        (jasco_text(npoints="4"), r"line 12: NPOINTS says 4 but the data has 3 rows"),
+        (jasco_text("700\t50.0\r\n695\tx1\r\n"), r"line 11: Y: expected a number, found 'x1'"),
+        (jasco_text("700\t50.0\t1\r\n"), r"line 10: expected 2 cells"),
+        (jasco_text("700\t50\r\n690\t51\r\n685\t52\r\n"), r"line 11: X 690.0 is not on the"),
+        (jasco_text("700\t50\r\n695\t51\r\n690\t52\r\n\r\njunk\r\n"), r"line 14: unexpected"),
+        (jasco_text(""), r"line 9: no data rows after XYDATA"),
+        (b"TITLE\tx\r\nNOSEPARATOR\r\nXYDATA\r\n", r"line 2: expected 'KEY"),
+        (
+            jasco_text() + b"\r\n\r\n[\x81\x5c]\r\n\x85\x40\r\n",
+            r"line 16: byte 0x85 is not valid",
+        ),
+        (jasco_text().replace(b"695", b"6\x0095"), r"binary content \(NUL byte\)"),
+    ],
+)
+def test_jasco_text_errors(tmp_path: Path, data: bytes, match: str, write) -> None:
+    p = write(tmp_path, "bad.txt", data)
+    with pytest.raises(AdapterError, match=match) as exc:
+        read_jasco_text(p)
+    assert str(p) in str(exc.value)
+
+
+def jws(
+    y: list[float] | np.ndarray = (50.0, 51.0, 52.0),
+    *,
+    npoints: int | None = None,
+    block: int | None = None,
+    ymode: int = 0,
+    xcode: int = 3,
+    firstx: float = 700.0,
+    deltax: float = -5.0,
+    accessory: bytes = b"USE-753",
+    extra: int = 0,
+) -> bytes:
+    y = np.asarray(y, dtype="<f4")
+    n = len(y) if npoints is None else npoints
+    h = bytearray(0x740)
+    h[0:4] = b"L~S "
+    h[8:15] = b"SPECMAN"
+    struct.pack_into("<i3d", h, 0x84, n, firstx, firstx + deltax * (n - 1), deltax)
+    h[0xA0], h[0xA4] = xcode, ymode
+    struct.pack_into("<q", h, 0xC8, 4 * n if block is None else block)
+    h[0x140:0x145] = b"V-730"
+    h[0x180:0x186] = b"sample"
+    h[0x484 : 0x484 + len(accessory)] = accessory
+    struct.pack_into("<I", h, 0x2C0, 1_780_556_881)
+    return bytes(h) + y.tobytes() + b"\x00" * extra
+
+
+def test_jws_modes_and_invalid_marker(tmp_path: Path, write) -> None:
+    invalid = np.frombuffer(struct.pack("<I", 0x80800000), "<f4")[0]  # -FLT_MIN
+    m = read_jasco_jws(write(tmp_path, "a.jws", jws([10.0, invalid, np.nan, 20.0], ymode=3)))
+    assert list(m.data["value"]) == [10.0, 20.0]
+    assert list(m.data["wavelength_nm"]) == [700.0, 685.0]
+    assert m.meta["dropped_points"] == 2 and m.meta["invalid_marker_points"] == 1
+    assert set(m.data["quantity"].astype(str)) == {"absorbance"}
+    m = read_jasco_jws(write(tmp_path, "b.jws", jws(ymode=2, accessory=b"ISN-923")))
+    assert set(m.data["quantity"].astype(str)) == {"hemispherical_reflectance"}
+    assert list(m.data["value"]) == [0.5, 0.51, 0.52]
+
+
+@pytest.mark.parametrize(
+    ("data", "match"),
+    [
+        (
+            b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1" + b"\x00" * 600,
+            r"Spectra Manager 1.x .jws: the OLE2 container is corrupt or truncated",
+        ),
+        (b"MZ" + b"\x00" * 2000, r"byte 0: expected the JASCO magic"),
+        (jws()[:0x500], r"byte 1280: file is 1280 bytes, shorter than the 1856-byte header"),
+        (jws()[:-1], r"byte 132: file is 1867 bytes but NPOINTS 3 needs 1868"),
+        (jws(extra=4), r"byte 132: .*truncated or NPOINTS wrong"),
+        (jws(block=8), r"byte 200: data-block length 8 bytes disagrees with NPOINTS 3"),
+        (jws([], npoints=0), r"byte 132: NPOINTS 0: expected a positive count"),
+        (jws(xcode=0), r"byte 160: x-unit code 0: only 3 \(nm\)"),
+        (jws(ymode=9), r"byte 164: y-mode 9 is a single-beam intensity"),
+        (jws(ymode=5), r"byte 164: unknown y-mode code 5"),
+        (jws(deltax=0.0), r"byte 152: DELTAX 0.0"),
+        (jws(firstx=-1.0), r"byte 136: FIRSTX -1.0"),
+        (jws(firstx=10.0), r"byte 152: FIRSTX 10.0 \+ i \* DELTAX -5.0 reaches"),
+        (jws([np.nan, np.nan]), r"no valid data points"),
+    ],
+)
+def test_jws_errors(tmp_path: Path, data: bytes, match: str, write) -> None:
+    p = write(tmp_path, "bad.jws", data)
+    with pytest.raises(AdapterError, match=match) as exc:
+        read_jasco_jws(p)
+    assert str(p) in str(exc.value)
+
+
+def test_utf16_jasco_text_is_refused_as_the_wrong_encoding(tmp_path: Path, write) -> None:
+    p = write(tmp_path, "utf16.txt", jasco_text().decode("latin-1").encode("utf-16"))
+    with pytest.raises(AdapterError, match=r"line 1: binary content \(NUL byte\)"):
+        read_jasco_text(p)
+
+
+def test_jws_string_fields_fall_back_to_latin1(tmp_path: Path, write) -> None:
+    data = bytearray(jws())
+    data[0x180:0x187] = b"\x81\x20abcd\x00"  # neither UTF-8 nor cp932
+    m = read_jasco_jws(write(tmp_path, "a.jws", bytes(data)))
+    assert m.meta["title"] == "\x81 abcd"

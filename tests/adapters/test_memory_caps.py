@@ -15,7 +15,8 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
+from labbrdf.adapters import READERS
+
 LIMIT = 512 << 20
 
 _CHILD = """
@@ -31,8 +32,8 @@ else:
 """
 
 
-def _read_limited(fmt: str, path: Path) -> str:
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1"}
+def _read_limited(fmt: str, path: Path, root: Path) -> str:
+    env = {**os.environ, "PYTHONPATH": str(root), "OPENBLAS_NUM_THREADS": "1"}
     out = subprocess.run(
         [sys.executable, "-c", _CHILD.format(limit=LIMIT), fmt, str(path)],
         capture_output=True,
@@ -44,8 +45,14 @@ def _read_limited(fmt: str, path: Path) -> str:
     return out.stdout.strip()
 
 
+def _reference(fmt: str) -> str:
+    """The reference export of ``fmt``: the first example of its registry entry. The
+    crafted files below change a count at a known place of that file."""
+    return READERS[fmt].examples[0].path
+
+
 def _jcamp_dup(real: Path, tmp: Path) -> Path:
-    raw = (real / "jcamp-dx/dupinc1.jdx").read_bytes()
+    raw = (real / _reference("jcamp-dx")).read_bytes()
     i = raw.index(b"Tk69")
     p = tmp / "dup.jdx"
     p.write_bytes(raw[: i + 1] + b"99999999" + raw[i + 1 :])  # 3e8 repeats, NPOINTS 440
@@ -53,14 +60,14 @@ def _jcamp_dup(real: Path, tmp: Path) -> Path:
 
 
 def _jcamp_npoints(real: Path, tmp: Path) -> Path:
-    raw = (real / "jcamp-dx/dupinc1.jdx").read_bytes()
+    raw = (real / _reference("jcamp-dx")).read_bytes()
     p = tmp / "npoints.jdx"
     p.write_bytes(raw.replace(b"##NPOINTS=  440", b"##NPOINTS=  999999999999"))
     return p
 
 
 def _spc(real: Path, tmp: Path, npts: int, nsub: int | None = None) -> Path:
-    raw = bytearray((real / "galactic-spc/HOLMIUM.SPC").read_bytes())
+    raw = bytearray((real / _reference("galactic-spc")).read_bytes())
     struct.pack_into("<i", raw, 4, npts)
     if nsub is not None:
         raw[0] |= 0x04  # TMULTI
@@ -71,7 +78,7 @@ def _spc(real: Path, tmp: Path, npts: int, nsub: int | None = None) -> Path:
 
 
 def _pe(real: Path, tmp: Path) -> Path:
-    src = real / "perkinelmer-uvwinlab-asc/KTF-D.Probe.Raw.asc"
+    src = real / _reference("perkinelmer-uvwinlab-asc")
     lines = src.read_bytes().split(b"\n")
     k = lines.index(b"#DATA") if b"#DATA" in lines else lines.index(b"#DATA\r")
     # the #GR block ends "... FIRSTX, DELTAX, NPOINTS, ..." : NPOINTS is line gr + 7
@@ -84,7 +91,7 @@ def _pe(real: Path, tmp: Path) -> Path:
 
 
 def _jasco_text(real: Path, tmp: Path) -> Path:
-    raw = (real / "jasco-spectramanager-text/uvvis_abs.txt").read_bytes()
+    raw = (real / _reference("jasco-spectramanager-text")).read_bytes()
     p = tmp / "npoints.txt"
     p.write_bytes(raw.replace(b"NPOINTS\t61", b"NPOINTS\t1999999"))
     assert p.read_bytes() != raw
@@ -92,7 +99,7 @@ def _jasco_text(real: Path, tmp: Path) -> Path:
 
 
 def _jws(real: Path, tmp: Path) -> Path:
-    raw = bytearray((real / "jasco-jws-binary/uvvis_abs.jws").read_bytes())
+    raw = bytearray((real / _reference("jasco-jws")).read_bytes())
     struct.pack_into("<i", raw, 0x84, 2**31 - 1)
     p = tmp / "npoints.jws"
     p.write_bytes(bytes(raw))
@@ -113,11 +120,11 @@ CASES = {
 
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_crafted_huge_count_raises_adaptererror_within_512_mb(
-    real_exports: Path, tmp_path: Path, case: str
+    real_exports: Path, tmp_path: Path, case: str, project_root: Path
 ) -> None:
     fmt, make, expected = CASES[case]
     path = make(real_exports, tmp_path)
-    out = _read_limited(fmt, path)
+    out = _read_limited(fmt, path, project_root)
     assert out.startswith(f"AdapterError: {path}"), out
     assert expected in out, out
 
@@ -152,7 +159,9 @@ print("peak_mb", peak_kib / 1024)
 GIB = 1 << 30
 
 
-def test_five_megabyte_jcamp_title_reads_within_one_gib(tmp_path: Path) -> None:
+def test_five_megabyte_jcamp_title_reads_within_one_gib(
+    tmp_path: Path, project_root: Path
+) -> None:
     """The title is the sample name: kept once (cut in the table), never once per row."""
     title = "T" * 5_000_000
     rows = "".join(f"{400 + 10 * i} {i % 7 + 1}\n" for i in range(440))
@@ -161,7 +170,7 @@ def test_five_megabyte_jcamp_title_reads_within_one_gib(tmp_path: Path) -> None:
         f"##TITLE= {title}\n##JCAMP-DX= 4.24\n##XUNITS= NANOMETERS\n##YUNITS= ABSORBANCE\n"
         f"##NPOINTS= 440\n##XYPOINTS= (XY..XY)\n{rows}##END=\n"
     )
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1"}
+    env = {**os.environ, "PYTHONPATH": str(project_root), "OPENBLAS_NUM_THREADS": "1"}
     out = subprocess.run(
         [sys.executable, "-c", _CHILD_TIMED.format(limit=GIB), str(p)],
         capture_output=True,

@@ -24,6 +24,8 @@ module                    section id(s)
 :mod:`.tracer`            ``tracer_maps``, ``tracer_validation``
 :mod:`.errata`            ``errata``
 :mod:`.surface`           ``surface`` (user: height maps; validation: Gaussian ACF)
+:mod:`.smoothness`        ``smoothness`` (user: a height map against one sample's reflectance)
+:mod:`.prediction`        ``prediction`` (user: tracer prediction beside a measured BRDF)
 ========================  ==============================================================
 """
 

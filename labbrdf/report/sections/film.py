@@ -420,6 +420,7 @@ def _fit_file(
         )
         return
     _fit_shown(ctx, tag, src, verdict, fit)
+    ctx.film_fits[src] = fit
     samples = {str(x).lower() for x in g["sample"]}
     for j, (rs, rg) in enumerate(refl):
         same = rs == src or bool(samples & {str(x).lower() for x in rg["sample"]})

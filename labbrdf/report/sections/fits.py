@@ -15,6 +15,7 @@ from scipy import stats
 from ..builder import num, wl_label
 from ..context import Context, FitRecord, rmse_abs, rmse_paper, run_fits
 from ..published import published_params
+from .smoothness import rayleigh_flags
 
 __all__ = ["fits_section"]
 
@@ -106,6 +107,9 @@ def _row(ctx: Context, r: FitRecord, varying: Sequence[str], has_pub: bool) -> d
             }
         )
         flags += [f"{p}: {f}" for f in q["flags"]]
+    if r.model == "smooth3":  # the model assumes a smooth sample (Zou 2013 sec. 3)
+        src, th = r.data["source"].astype(str).unique(), r.data["theta_i_deg"]
+        flags += rayleigh_flags(ctx, list(src), r.wavelength_nm, th.to_numpy(float))
     row["flags"] = "; ".join(flags)
     row["rmse_paper"] = rmse_paper(r.summary)
     row["rmse_pub"] = pub.get("rmse")

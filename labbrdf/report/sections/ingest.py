@@ -8,11 +8,19 @@ from pathlib import Path
 from typing import Any
 
 from ... import adapters
+from ...adapters.inputs import InputFile
 from ..builder import Unavailable
 from ..context import Context
 from ..published import read_published
 
-__all__ = ["fixture_files", "fixtures_section", "ingest_files"]
+__all__ = [
+    "fixture_files",
+    "fixtures_section",
+    "ingest_files",
+    "ingest_inputs",
+    "ingest_read",
+    "sample_groups",
+]
 
 
 def fixture_files(folder: Path) -> list[Path]:
@@ -78,19 +86,65 @@ def ingest_files(
     *,
     check_id: str = "ingest.read",
 ) -> None:
-    """Read every file; a table of what each holds; a check that all were read."""
+    """Read every file as an optical export (``read_inputs``) and :func:`ingest_read` them."""
+    if not paths:
+        raise Unavailable("no input files")
+    ingest_read(ctx, adapters.read_inputs(paths, kind="optical").files, root, check_id=check_id)
+
+
+def ingest_inputs(ctx: Context, paths: Sequence[str | os.PathLike[str]]) -> None:
+    """Read a user's files once (:func:`labbrdf.adapters.read_inputs`) and list them.
+
+    Height maps go to ``ctx.height_maps`` with their table and check
+    (:func:`~labbrdf.report.sections.surface.ingest_height_maps`), optical exports to
+    ``ctx.frames`` with theirs (:func:`ingest_read`).
+
+    Raises
+    ------
+    Unavailable
+        No file could be read.
+    """
+    from .surface import ingest_height_maps  # the section that shows the height maps
+
+    inputs = adapters.read_inputs(paths)
+    ingest_height_maps(ctx, inputs.files)
+    optical = [f for f in inputs.files if f.kind == "optical"]
+    if optical:
+        ingest_read(ctx, optical)
+    elif not ctx.height_maps:
+        raise Unavailable("no file could be read")
+
+
+def ingest_read(
+    ctx: Context,
+    files: Sequence[InputFile],
+    root: Path | None = None,
+    *,
+    check_id: str = "ingest.read",
+) -> None:
+    """Files already read: a table of what each holds; a check that all were read.
+
+    Parameters
+    ----------
+    ctx : Context
+    files : sequence of InputFile
+        Optical inputs as :func:`labbrdf.adapters.read_inputs` read them (read or failed).
+    root : Path, optional
+        Files under it are named relative to it.
+    check_id : str
+        Id of the check that every file was read.
+    """
     b = ctx.b
-    files = [Path(p) for p in paths]
     if not files:
         raise Unavailable("no input files")
     rows, failures = [], []
-    for p in files:
+    for f in files:
+        p = Path(f.path)
         name = str(p.relative_to(root)) if root is not None and p.is_relative_to(root) else p.name
-        try:
-            m = adapters.read(p)
-        except Exception as exc:  # noqa: BLE001 - each failure is reported
-            failures.append(f"{name}: {exc}")
-            rows.append({"file": name, "status": "error", "error": str(exc)})
+        m = f.measurement
+        if m is None:
+            failures.append(f"{name}: {f.error}")
+            rows.append({"file": name, "status": "error", "error": f.error})
             continue
         fmt_name = m.meta.get("format") or m.meta.get("adapter") or ""
         if not fmt_name:
@@ -117,7 +171,7 @@ def ingest_files(
             "header": _meta_header(m.meta),
             "error": "",
         }
-        ctx.files.append({**rec, "path": str(p), "meta": m.meta})
+        ctx.files.append({**rec, "path": str(p), "meta": m.meta, "samples": s["sample"]})
         rows.append(rec)
     b.table(
         "ingested_files",
@@ -146,14 +200,70 @@ def ingest_files(
         "every input file reads into the common dataset",
         not failures,
         against="labbrdf.read (adapters) and the dataset schema",
-        value=len(paths) - len(failures),
-        tolerance=len(paths),
+        value=len(files) - len(failures),
+        tolerance=len(files),
         justification="value = files read, tolerance = files given; all must read",
         reason="; ".join(failures)[:2000],
         substantive=False,
     )
     if not ctx.frames:
         raise Unavailable("no file could be read")
+
+
+def sample_groups(
+    ctx: Context,
+    paths: Sequence[str | os.PathLike[str]],
+    same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
+    given_as: str = "given with --same-sample",
+) -> None:
+    """Group the input files by sample (``ctx.samples``) and show the groups with reasons.
+
+    The names are those the readers found (``ctx.files``; height maps carry none), the
+    mapping is the user's (:func:`labbrdf.samples.pair_samples`). A mapping that the files'
+    own sample names contradict fails the check ``ingest.samples`` and pairs nothing.
+    """
+    from ...samples import PairingError, pair_samples, sample_file
+
+    names = {str(f["path"]): tuple(f.get("samples", ())) for f in ctx.files}
+    maps = {str(hm.path): sample_file(hm.path, hm).names for hm in ctx.height_maps}
+    files = [(p, names.get(str(p), maps.get(str(p), ()))) for p in paths]
+    try:
+        groups = pair_samples(files, same_sample, given_as=given_as)
+    except PairingError as exc:
+        ctx.b.check(
+            "ingest.samples",
+            "the files' sample names agree with the given sample mapping",
+            False,
+            against="the sample names stated in the files",
+            reason=str(exc),
+            substantive=False,
+        )
+        return
+    ctx.samples[:] = groups
+    rows = [
+        {
+            "sample": g.name,
+            "files": ", ".join(Path(p).name for p in g.paths),
+            "n": len(g.paths),
+            "reason": g.reason,
+        }
+        for g in groups
+    ]
+    ctx.b.table(
+        "sample_groups",
+        "Files grouped by sample",
+        [
+            ("sample", "sample", ""),
+            ("files", "files", ""),
+            ("n", "files [n]", "d"),
+            ("reason", "why these files are one sample", ""),
+        ],
+        rows,
+        caption="Files are one sample when they state the same sample name (a name that is "
+        "only the file's own name does not count) or when the user says so (--same-sample); "
+        "never because their wavelengths overlap. Predictions made from one file (e.g. a "
+        "height map's roughness) are set against measurements of the same sample only.",
+    )
 
 
 # --------------------------------------------------------------------------- fits

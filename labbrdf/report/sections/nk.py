@@ -32,70 +32,16 @@ P_AGREE = 1e-3
 _SERIES = ("time_s", "x_mm", "y_mm")
 
 
-def _members(c: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
-    """(label, rows) per member of a series (time or spot), or the whole table."""
-    keys = [k for k in _SERIES if k in c.columns]
-    if not keys:
-        return [("", c)]
-    out = []
-    for key, g in c.groupby(keys, sort=True, dropna=False):
-        key = key if isinstance(key, tuple) else (key,)
-        lab = ", ".join(f"{k.split('_')[0]} {v:g}" for k, v in zip(keys, key, strict=True))
-        out.append((lab, g))
-    return out
+def _n_members(comb: pd.DataFrame) -> int:
+    return len(nkmod.series_members(comb))
 
 
 def _nk_figure(src: str, c: pd.DataFrame) -> str:
-    members = _members(c)
-    by_wl = c["wavelength_nm"].round(6).nunique() > 1
-    panels = []
-    for q in ("n", "k"):
-        series = []
-        for lab, g in members[:6]:
-            series.append(
-                {
-                    "label": lab,
-                    "x": g["wavelength_nm"].to_numpy(float),
-                    "y": g[q].to_numpy(float),
-                    "band": g[f"{q}_sigma"].to_numpy(float),
-                    "style": "line" if by_wl else "points",
-                }
-            )
-        panels.append(
-            {
-                "title": f"combined {q}",
-                "xlabel": "wavelength [nm]",
-                "ylabel": f"{q} [1]",
-                "series": series,
-            }
-        )
-    return figures.panels_figure(panels, ncols=2)
+    return figures.panels_figure(nkmod.nk_panels(c, max_series=6), ncols=2)
 
 
 def _pseudo_figure(points: pd.DataFrame) -> str:
-    p = points.assign(theta=points["theta_i_deg"].round(2))
-    panels = []
-    for q in ("n", "k"):
-        series = []
-        for th, g in list(p.groupby("theta", sort=True))[:8]:
-            series.append(
-                {
-                    "label": f"\u03b8i {th:g}\u00b0",
-                    "x": g["wavelength_nm"].to_numpy(float),
-                    "y": g[q].to_numpy(float),
-                    "yerr": g[f"{q}_sigma"].to_numpy(float),
-                    "style": "points" if g["wavelength_nm"].nunique() < 3 else "line",
-                }
-            )
-        panels.append(
-            {
-                "title": f"pseudo-{q} per angle of incidence",
-                "xlabel": "wavelength [nm]",
-                "ylabel": f"<{q}> [1]",
-                "series": series,
-            }
-        )
-    return figures.panels_figure(panels, ncols=2)
+    return figures.panels_figure(nkmod.nk_panels(points, max_series=8), ncols=2)
 
 
 def _at(c: pd.DataFrame, wl: float) -> dict[str, float | None]:
@@ -128,7 +74,7 @@ def _compare(
 ) -> None:
     """Fresnel prediction from ``comb`` against the reflectance rows of ``rsrc``."""
     b = ctx.b
-    first = _members(comb)[0][1]
+    first = nkmod.series_members(comb)[0][1]
     try:
         cmp = nkmod.compare_reflectance(first, refl)
     except ValueError as exc:
@@ -222,7 +168,7 @@ def _compare(
 def _r0_figure(ctx: Context, i: int, src: str, comb: pd.DataFrame) -> None:
     """The predicted normal-incidence Fresnel reflectance from the combined n, k."""
     b = ctx.b
-    first = _members(comb)[0][1]
+    first = nkmod.series_members(comb)[0][1]
     ok = _combined_ok(first)
     if not ok.any():
         b.note(
@@ -292,7 +238,7 @@ def _file_text(ctx: Context, pts: pd.DataFrame, comb: pd.DataFrame, verdict: str
     n_ang = int(pts["theta_i_deg"].round(2).nunique())
     ctx.b.text(
         f"{len(pts)} psi/Delta pairs at {n_ang} angle(s), {len(comb)} combined "
-        f"(wavelength{', series member' if len(_members(comb)) > 1 else ''}) rows. "
+        f"(wavelength{', series member' if _n_members(comb) > 1 else ''}) rows. "
         f"Verdict: {verdict}."
         + (
             f" {cond_bad} point(s) are ill-conditioned (condition number above "
@@ -301,9 +247,9 @@ def _file_text(ctx: Context, pts: pd.DataFrame, comb: pd.DataFrame, verdict: str
             else ""
         )
         + (
-            f" The file is a series of {len(_members(comb))} members (times or spots); "
+            f" The file is a series of {_n_members(comb)} members (times or spots); "
             "the figure shows up to six of them."
-            if len(_members(comb)) > 1
+            if _n_members(comb) > 1
             else ""
         )
     )
@@ -557,6 +503,7 @@ def nk_section(ctx: Context) -> None:
         done = _file_section(ctx, i, src, g, cmp_rows)
         if done is not None:
             combined[src], row = done
+            ctx.nk_combined[src] = combined[src]
             summary.append(row)
     b.heading("Summary and reflectance predictions", anchor="nk_summary")
     _summary_table(ctx, summary)

@@ -1,7 +1,8 @@
 r"""Section ``surface``: measured height maps and profiles, and the Gaussian-surface check.
 
 User report (:func:`surface_section`): one part per height map read at ingest
-(:func:`ingest_height_maps`; profilometer, AFM or interferometer files read through
+(:func:`ingest_height_maps`: the profilometer, AFM or interferometer files among the inputs,
+which :func:`labbrdf.adapters.read_inputs` tells from optical exports and reads through
 SurfaceTopography, :mod:`labbrdf.adapters.topography`): the levelled map, its
 autocorrelation and slope histogram with the GGX and Beckmann fits; the roughness
 statistics of :func:`labbrdf.topography.roughness_statistics` with their block-jackknife
@@ -25,7 +26,6 @@ eqs. (1)-(2) and the text after eq. (15) (alpha = sqrt(2) sigma / c).
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -33,13 +33,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from ... import adapters
+from ...adapters.inputs import InputFile
 from ...adapters.topography import HeightMap
 from ...surface import gaussian_surface
 from ...topography import autocorrelation, level, roughness_statistics
 from ...tracer import Substrate, TraceConfig, TraceResult
 from .. import figures
-from ..builder import Unavailable, slug
+from ..builder import Builder, Unavailable, slug
 from ..context import Context
 from .tracer import SHOW_COUNT, _robust_max, _run, maps
 
@@ -47,8 +47,6 @@ __all__ = [
     "ACF_CASES",
     "ACF_TOL_FACTOR",
     "SUBSTRATE_NK",
-    "TOPOGRAPHY_ONLY",
-    "TOPOGRAPHY_OR_OPTICAL",
     "TRACE_RAYS",
     "acf_deviation",
     "gaussian_acf_section",
@@ -56,18 +54,6 @@ __all__ = [
     "printed_psd_surface",
     "surface_section",
 ]
-
-#: extensions only SurfaceTopography reads (read as height maps directly)
-TOPOGRAPHY_ONLY = frozenset(
-    {
-        ".di", ".opdx", ".opd", ".sur", ".spm", ".gwy", ".ibw", ".mi", ".nc", ".plu",
-        ".plux", ".x3p", ".datx", ".vk4", ".vk6", ".vk7", ".zmg", ".zon", ".lext", ".os3d",
-        ".frt", ".sdf", ".nid", ".000", ".001", ".002", ".003",
-    }
-)  # fmt: skip
-#: extensions shared with optical exports (MetroPro ``.dat`` vs WVASE / Accurion ``.dat``):
-#: the optical readers are tried first, the height-map reader only when they all refuse
-TOPOGRAPHY_OR_OPTICAL = frozenset({".dat"})
 
 #: substrate index of the tracer runs: aluminium at 550 nm (n + ik)
 SUBSTRATE_NK = (0.96, 6.69)
@@ -82,107 +68,74 @@ TRACE_STEP_DEG = 2.0
 # --------------------------------------------------------------------------- ingest
 
 
-def _first_line(exc: BaseException) -> str:
-    s = str(exc).strip()
-    return s.splitlines()[0] if s else type(exc).__name__
+def _height_map_row(f: InputFile) -> dict[str, Any]:
+    """The table row of one height-map file: what it holds, or why it was not read."""
+    name = Path(f.path).name
+    if f.height_map is None:
+        return {"file": name, "status": "error", "error": f.error}
+    hm = f.height_map
+    s = hm.summary()
+    return {
+        "file": name,
+        "status": "read",
+        "kind": s["kind"],
+        "reader": s["reader"],
+        "channel": s["channel"],
+        "points": " x ".join(str(n) for n in s["points"]),
+        "size_um": " x ".join(f"{v:.4g}" for v in s["size_um"]),
+        "pixel_nm": " x ".join(f"{v:.4g}" for v in s["pixel_nm"]),
+        "missing": s["missing"],
+        "error": "",
+    }
 
 
-def ingest_height_maps(ctx: Context, paths: Sequence[str | os.PathLike[str]]) -> list[Path]:
-    """Read the height-map files among ``paths``; return the others (optical exports).
-
-    A file with an extension in :data:`TOPOGRAPHY_ONLY` is read as a height map
-    (:func:`labbrdf.adapters.topography.read_height_map`); one in
-    :data:`TOPOGRAPHY_OR_OPTICAL` is read as a height map only when no optical adapter reads
-    it (:func:`labbrdf.read`). Height maps go to ``ctx.height_maps``; a table lists them
-    and a check fails for every such file that could not be read, with the reason.
+def ingest_height_maps(ctx: Context, files: Sequence[InputFile]) -> None:
+    """The height maps among the read input files: to ``ctx.height_maps``, a table, a check.
 
     Parameters
     ----------
     ctx : Context
-    paths : sequence of path-like
-        All input files of the report.
-
-    Returns
-    -------
-    list of Path
-        The files left for the optical ingest (:func:`~.ingest.ingest_files`).
+    files : sequence of InputFile
+        The report's inputs as :func:`labbrdf.adapters.read_inputs` read them; those of kind
+        ``"height_map"`` (read or not) are listed, and a check fails for every one that
+        could not be read, with the reason.
     """
-    from ...adapters.topography import read_height_map
-
-    optical: list[Path] = []
-    rows: list[dict[str, Any]] = []
-    failures: list[str] = []
-    for p in (Path(x) for x in paths):
-        ext = p.suffix.lower()
-        if ext not in TOPOGRAPHY_ONLY and ext not in TOPOGRAPHY_OR_OPTICAL:
-            optical.append(p)
-            continue
-        optical_reason = ""
-        if ext in TOPOGRAPHY_OR_OPTICAL:
-            try:
-                adapters.read(p)
-            except Exception as exc:  # noqa: BLE001 - the reason is kept
-                optical_reason = _first_line(exc)
-            else:
-                optical.append(p)
-                continue
-        try:
-            hm = read_height_map(p)
-        except Exception as exc:  # noqa: BLE001 - each failure is reported
-            reason = f"not a height map SurfaceTopography reads: {_first_line(exc)}"
-            if optical_reason:
-                reason = f"not an optical export ({optical_reason}); {reason}"
-            failures.append(f"{p.name}: {reason}")
-            rows.append({"file": p.name, "status": "error", "error": reason})
-            continue
-        ctx.height_maps.append(hm)
-        size = " x ".join(f"{s * 1e6:.4g}" for s in hm.physical_sizes)
-        rows.append(
-            {
-                "file": p.name,
-                "status": "read",
-                "kind": "profile" if hm.is_profile else "areal map",
-                "reader": hm.meta.get("reader", ""),
-                "channel": hm.channel,
-                "points": " x ".join(str(n) for n in hm.heights.shape),
-                "size_um": size,
-                "pixel_nm": " x ".join(f"{s * 1e9:.4g}" for s in hm.pixel_size),
-                "missing": int(hm.mask.sum()),
-                "error": "",
-            }
-        )
-    if rows:
-        ctx.b.table(
-            "ingested_height_maps",
-            "Ingested height maps and profiles (topography files)",
-            [
-                ("file", "file", ""),
-                ("status", "status", ""),
-                ("kind", "kind", ""),
-                ("reader", "reader (SurfaceTopography)", ""),
-                ("channel", "channel", ""),
-                ("points", "points", ""),
-                ("size_um", "size [\u00b5m]", ""),
-                ("pixel_nm", "pixel [nm]", ""),
-                ("missing", "missing points", "d"),
-                ("error", "error", ""),
-            ],
-            rows,
-            caption="Topography files (profilometer, AFM, interferometer), read with "
-            "SurfaceTopography and converted to metres; they appear in the section "
-            "'Measured surface topography', not in the fits.",
-        )
-        ctx.b.check(
-            "ingest.topography",
-            "every topography file reads as a height map",
-            not failures,
-            against="labbrdf.adapters.topography.read_height_map (SurfaceTopography)",
-            value=len(rows) - len(failures),
-            tolerance=len(rows),
-            justification="value = height maps read, tolerance = topography files given",
-            reason="; ".join(failures)[:2000],
-        )
-    return optical
+    maps = [f for f in files if f.kind == "height_map"]
+    if not maps:
+        return
+    ctx.height_maps.extend(f.height_map for f in maps if f.height_map is not None)
+    rows = [_height_map_row(f) for f in maps]
+    failures = [f"{Path(f.path).name}: {f.error}" for f in maps if f.error]
+    ctx.b.table(
+        "ingested_height_maps",
+        "Ingested height maps and profiles (topography files)",
+        [
+            ("file", "file", ""),
+            ("status", "status", ""),
+            ("kind", "kind", ""),
+            ("reader", "reader (SurfaceTopography)", ""),
+            ("channel", "channel", ""),
+            ("points", "points", ""),
+            ("size_um", "size [\u00b5m]", ""),
+            ("pixel_nm", "pixel [nm]", ""),
+            ("missing", "missing points", "d"),
+            ("error", "error", ""),
+        ],
+        rows,
+        caption="Topography files (profilometer, AFM, interferometer), read with "
+        "SurfaceTopography and converted to metres; they appear in the section "
+        "'Measured surface topography', not in the fits.",
+    )
+    ctx.b.check(
+        "ingest.topography",
+        "every topography file reads as a height map",
+        not failures,
+        against="labbrdf.adapters.topography.read_height_map (SurfaceTopography)",
+        value=len(rows) - len(failures),
+        tolerance=len(rows),
+        justification="value = height maps read, tolerance = topography files given",
+        reason="; ".join(failures)[:2000],
+    )
 
 
 # --------------------------------------------------------------------------- user section
@@ -282,7 +235,6 @@ def surface_section(ctx: Context) -> None:
     b = ctx.b
     if not ctx.height_maps:
         raise Unavailable("no height map or profile among the input files")
-    n, k = SUBSTRATE_NK
     b.text(
         "Each height map is levelled (least-squares mean plane removed) and described by "
         "labbrdf.topography.roughness_statistics: RMS height sigma, RMS slopes, the 1/e "
@@ -295,168 +247,202 @@ def surface_section(ctx: Context) -> None:
     albedo_rows: list[dict[str, Any]] = []
     used: set[str] = set()
     for hm in ctx.height_maps:
-        name = Path(hm.path).name
-        sid = slug(name)
+        sid = slug(Path(hm.path).name)
         while sid in used:
             sid += "_"
         used.add(sid)
-        kind = "profile" if hm.is_profile else "areal map"
-        b.log(f"  surface {name} ({kind})")
+        _map_part(ctx, hm, sid, albedo_rows)
+    _albedo_table(b, albedo_rows)
+
+
+def _map_part(ctx: Context, hm: HeightMap, sid: str, albedo_rows: list[dict[str, Any]]) -> None:
+    """One height map: statistics, figure, tables, notes; tracer maps for an areal map."""
+    b = ctx.b
+    name = Path(hm.path).name
+    kind = "profile" if hm.is_profile else "areal map"
+    b.log(f"  surface {name} ({kind})")
+    b.note(
+        name,
+        f"{kind}, {' x '.join(str(v) for v in hm.heights.shape)} points, channel {hm.channel}",
+    )
+    try:
+        st = roughness_statistics(hm.heights, hm.pixel_size)
+    except ValueError as exc:
+        b.check(
+            f"surface.{sid}.statistics",
+            f"roughness statistics of {name} computed",
+            False,
+            against="labbrdf.topography.roughness_statistics",
+            reason=str(exc),
+        )
+        return
+    _statistics_parts(b, name, sid, hm, st)
+    _statistics_notes(b, hm, st)
+    if hm.is_profile:
         b.note(
-            name,
-            f"{kind}, {' x '.join(str(v) for v in hm.heights.shape)} points, channel {hm.channel}",
+            "profile",
+            "alpha and the slope fits from a profile assume an isotropic surface (one "
+            "direction is measured). No tracer maps (they need the 2-D slope "
+            "distribution of an areal map).",
         )
-        try:
-            st = roughness_statistics(hm.heights, hm.pixel_size)
-        except ValueError as exc:
-            b.check(
-                f"surface.{sid}.statistics",
-                f"roughness statistics of {name} computed",
-                False,
-                against="labbrdf.topography.roughness_statistics",
-                reason=str(exc),
-            )
-            continue
-        z = level(hm.heights, 1)
-        b.figure(
-            f"surface_{sid}",
-            f"{name}: levelled heights, autocorrelation, slope distribution",
-            "Measured. Left: heights after removing the least-squares mean plane (colour "
-            "scale: 0.5 to 99.5 percentiles, arrows = beyond). Middle: "
-            "normalised ACF along the axes, with the 1/e level that defines the "
-            "correlation lengths. Right: the measured slope magnitude |grad z| (areal "
-            "map) or dz/dx (profile) with the densities of the maximum-likelihood GGX "
-            "(solid) and Beckmann (dashed) fits; KS = Kolmogorov-Smirnov distance.",
-            figures.surface_figure(z, hm.pixel_size, st, title=f"{name} ({hm.channel})"),
+        albedo_rows.append(
+            {
+                "file": name,
+                "case": "(none)",
+                "reason": "line profile: no 2-D slope distribution for the tracer",
+            }
         )
-        b.table(
-            f"surface_stats_{sid}",
-            f"{name}: roughness statistics ({st.levelling})",
+        return
+    _tracer_part(ctx, name, sid, hm, st, albedo_rows)
+
+
+def _statistics_parts(b: Builder, name: str, sid: str, hm: HeightMap, st: Any) -> None:
+    """The measured map's figure, its statistics table and its slope-fit table."""
+    z = level(hm.heights, 1)
+    b.figure(
+        f"surface_{sid}",
+        f"{name}: levelled heights, autocorrelation, slope distribution",
+        "Measured. Left: heights after removing the least-squares mean plane (colour "
+        "scale: 0.5 to 99.5 percentiles, arrows = beyond). Middle: "
+        "normalised ACF along the axes, with the 1/e level that defines the "
+        "correlation lengths. Right: the measured slope magnitude |grad z| (areal "
+        "map) or dz/dx (profile) with the densities of the maximum-likelihood GGX "
+        "(solid) and Beckmann (dashed) fits; KS = Kolmogorov-Smirnov distance.",
+        figures.surface_figure(z, hm.pixel_size, st, title=f"{name} ({hm.channel})"),
+    )
+    b.table(
+        f"surface_stats_{sid}",
+        f"{name}: roughness statistics ({st.levelling})",
+        [
+            ("quantity", "quantity", ""),
+            ("value", "value", ".4g"),
+            ("u", "u (jackknife)", ".2g"),
+            ("unit", "unit", ""),
+            ("key", "key (results.json)", ""),
+        ],
+        _stat_rows(st),
+        caption=f"{st.n_valid} valid points, {st.n_blocks} jackknife blocks. "
+        f"Bandwidth of every slope and alpha: {st.bandwidth}. "
+        "Undefined values are blank (e.g. c when the ACF does not fall below 1/e "
+        "within half the map).",
+    )
+    b.table(
+        f"surface_fits_{sid}",
+        f"{name}: GGX and Beckmann fits to the slopes",
+        [
+            ("model", "model", ""),
+            ("alpha", "alpha (ML) [1]", ".4g"),
+            ("u", "u [1]", ".2g"),
+            ("ks", "KS distance [1]", ".3f"),
+            ("aic", "AIC", ".6g"),
+            ("best", "better (smaller AIC)", ""),
+            ("describes", f"KS <= {st.slope_fits.ks_threshold:g}", ""),
+        ],
+        _fit_rows(st),
+        caption="Maximum-likelihood fits of the slope-space densities (2-D for a "
+        "map, the 1-D marginal for a profile). AIC = 2 - 2 log-likelihood: the smaller "
+        "one is the better description; the KS distance says whether it describes "
+        "the slopes at all.",
+    )
+
+
+def _statistics_notes(b: Builder, hm: HeightMap, st: Any) -> None:
+    """Notes on the geometry, the statistics, the correlation length and alpha."""
+    for w in hm.warnings:
+        b.note("geometry", w)
+    for text in st.notes:
+        if text != st.slope_fits.warning and not text.startswith(("profile:", "the ACF does not")):
+            b.note("note", text)
+    if st.slope_fits.warning:
+        b.note("warning", st.slope_fits.warning)
+    if not math.isfinite(st.c):
+        b.note(
+            "correlation length",
+            "undefined: the ACF does not fall below 1/e within half the map (the "
+            "map is not many correlation lengths wide, or long-wavelength form remains "
+            "after levelling), so alpha = sqrt(2) sigma / c is undefined too",
+        )
+    per_axis = st.slope_rms_x if hm.is_profile else st.slope_rms / math.sqrt(2)
+    a_acf = st.alpha_gaussian_acf
+    if math.isfinite(a_acf) and not 2 / 3 <= a_acf / per_axis <= 1.5:
+        b.note(
+            "alpha",
+            f"sqrt(2) sigma / c = {a_acf:.3g} differs from the measured RMS slope per "
+            f"axis ({per_axis:.3g}): the two agree only for a Gaussian ACF sampled finely "
+            "enough. Here the slopes come from roughness on scales much shorter than c "
+            "(or the ACF is not Gaussian), so the ML alphas of the measured slopes, not "
+            "sqrt(2) sigma / c, describe the facets.",
+        )
+
+
+def _tracer_part(
+    ctx: Context,
+    name: str,
+    sid: str,
+    hm: HeightMap,
+    st: Any,
+    albedo_rows: list[dict[str, Any]],
+) -> None:
+    """Tracer S0/DOP maps of the measured slopes beside GGX; their albedo rows."""
+    b = ctx.b
+    n, k = SUBSTRATE_NK
+    r_meas, r_ggx, ggx_alpha = _trace_pair(ctx, hm, st.slope_fits.ggx.alpha)
+    pair = [("measured slopes", r_meas), (f"GGX \u03b1 = {ggx_alpha:.3g}", r_ggx)]
+    mp = [maps(r) for _, r in pair]
+    b.figure(
+        f"surface_tracer_{sid}",
+        f"{name}: tracer S0 and DOP, measured slope distribution vs GGX",
+        f"Modelled from the measured slopes (Monte Carlo polarization tracer, "
+        f"{TRACE_RAYS} rays per case, seed {ctx.seed}, unpolarized input at theta_i = "
+        f"{TRACE_THETA_I_DEG:g} deg, phi_i = 0, {TRACE_WAVELENGTH_NM:g} nm). Substrate: "
+        f"aluminium at 550 nm, N = {n:g} + {k:g}i (a stated default, not measured). Left: "
+        "facets follow the measured slope histogram (tabulated NDF); right: GGX at "
+        "the maximum-likelihood alpha of the same slopes. Top S0 = M00 [sr^-1], "
+        "bottom DOP [1]; azimuth phi_r (specular half-plane at 180 deg), radius "
+        f"theta_r [deg], {TRACE_STEP_DEG:g}-degree bins; DOP blank in bins with fewer "
+        f"than {SHOW_COUNT} rays.",
+        figures.polar_maps_figure(
+            [lab for lab, _ in pair],
+            [m["s0"] for m in mp],
             [
-                ("quantity", "quantity", ""),
-                ("value", "value", ".4g"),
-                ("u", "u (jackknife)", ".2g"),
-                ("unit", "unit", ""),
-                ("key", "key (results.json)", ""),
+                np.where(r.counts >= SHOW_COUNT, m["dop"], np.nan)
+                for (_, r), m in zip(pair, mp, strict=True)
             ],
-            _stat_rows(st),
-            caption=f"{st.n_valid} valid points, {st.n_blocks} jackknife blocks. "
-            f"Bandwidth of every slope and alpha: {st.bandwidth}. "
-            "Undefined values are blank (e.g. c when the ACF does not fall below 1/e "
-            "within half the map).",
+            mp[0]["theta_edges"],
+            mp[0]["phi_edges"],
+            title=name,
+            s0_max=[_robust_max(r, m["s0"]) for (_, r), m in zip(pair, mp, strict=True)],
+        ),
+    )
+    if ggx_alpha < math.tan(math.radians(TRACE_STEP_DEG)):
+        b.note(
+            "tracer maps",
+            f"the slopes are so small (GGX alpha {ggx_alpha:.2g}) that the reflected lobe "
+            f"is narrower than one {TRACE_STEP_DEG:g}-degree bin: the maps show the "
+            "specular bin only; the albedos below are what the runs add.",
         )
-        b.table(
-            f"surface_fits_{sid}",
-            f"{name}: GGX and Beckmann fits to the slopes",
-            [
-                ("model", "model", ""),
-                ("alpha", "alpha (ML) [1]", ".4g"),
-                ("u", "u [1]", ".2g"),
-                ("ks", "KS distance [1]", ".3f"),
-                ("aic", "AIC", ".6g"),
-                ("best", "better (smaller AIC)", ""),
-                ("describes", f"KS <= {st.slope_fits.ks_threshold:g}", ""),
-            ],
-            _fit_rows(st),
-            caption="Maximum-likelihood fits of the slope-space densities (2-D for a "
-            "map, the 1-D marginal for a profile). AIC = 2 - 2 log-likelihood: the smaller "
-            "one is the better description; the KS distance says whether it describes "
-            "the slopes at all.",
+    diff = r_meas.albedo() - r_ggx.albedo()
+    diff_u = math.hypot(r_meas.albedo_stderr(), r_ggx.albedo_stderr())
+    for (lab, r), a in zip(pair, (r_meas.config.substrate.alpha, ggx_alpha), strict=True):
+        albedo_rows.append(
+            {
+                "file": name,
+                "case": "measured" if lab.startswith("measured") else "ggx",
+                "alpha": a,
+                "albedo": r.albedo(),
+                "albedo_u": r.albedo_stderr(),
+                "absorbed": float(r.ledger["absorbed"]),
+                "rays": r.rays,
+                "diff": diff if lab.startswith("measured") else None,
+                "diff_u": diff_u if lab.startswith("measured") else None,
+                "reason": "",
+            }
         )
-        for w in hm.warnings:
-            b.note("geometry", w)
-        for text in st.notes:
-            if text != st.slope_fits.warning and not text.startswith(
-                ("profile:", "the ACF does not")
-            ):
-                b.note("note", text)
-        if st.slope_fits.warning:
-            b.note("warning", st.slope_fits.warning)
-        if not math.isfinite(st.c):
-            b.note(
-                "correlation length",
-                "undefined: the ACF does not fall below 1/e within half the map (the "
-                "map is not many correlation lengths wide, or long-wavelength form remains "
-                "after levelling), so alpha = sqrt(2) sigma / c is undefined too",
-            )
-        per_axis = st.slope_rms_x if hm.is_profile else st.slope_rms / math.sqrt(2)
-        a_acf = st.alpha_gaussian_acf
-        if math.isfinite(a_acf) and not 2 / 3 <= a_acf / per_axis <= 1.5:
-            b.note(
-                "alpha",
-                f"sqrt(2) sigma / c = {a_acf:.3g} differs from the measured RMS slope per "
-                f"axis ({per_axis:.3g}): the two agree only for a Gaussian ACF sampled finely "
-                "enough. Here the slopes come from roughness on scales much shorter than c "
-                "(or the ACF is not Gaussian), so the ML alphas of the measured slopes, not "
-                "sqrt(2) sigma / c, describe the facets.",
-            )
-        if hm.is_profile:
-            b.note(
-                "profile",
-                "alpha and the slope fits from a profile assume an isotropic surface (one "
-                "direction is measured). No tracer maps (they need the 2-D slope "
-                "distribution of an areal map).",
-            )
-            albedo_rows.append(
-                {
-                    "file": name,
-                    "case": "(none)",
-                    "reason": "line profile: no 2-D slope distribution for the tracer",
-                }
-            )
-            continue
-        r_meas, r_ggx, ggx_alpha = _trace_pair(ctx, hm, st.slope_fits.ggx.alpha)
-        pair = [("measured slopes", r_meas), (f"GGX \u03b1 = {ggx_alpha:.3g}", r_ggx)]
-        mp = [maps(r) for _, r in pair]
-        b.figure(
-            f"surface_tracer_{sid}",
-            f"{name}: tracer S0 and DOP, measured slope distribution vs GGX",
-            f"Modelled from the measured slopes (Monte Carlo polarization tracer, "
-            f"{TRACE_RAYS} rays per case, seed {ctx.seed}, unpolarized input at theta_i = "
-            f"{TRACE_THETA_I_DEG:g} deg, phi_i = 0, {TRACE_WAVELENGTH_NM:g} nm). Substrate: "
-            f"aluminium at 550 nm, N = {n:g} + {k:g}i (a stated default, not measured). Left: "
-            "facets follow the measured slope histogram (tabulated NDF); right: GGX at "
-            "the maximum-likelihood alpha of the same slopes. Top S0 = M00 [sr^-1], "
-            "bottom DOP [1]; azimuth phi_r (specular half-plane at 180 deg), radius "
-            f"theta_r [deg], {TRACE_STEP_DEG:g}-degree bins; DOP blank in bins with fewer "
-            f"than {SHOW_COUNT} rays.",
-            figures.polar_maps_figure(
-                [lab for lab, _ in pair],
-                [m["s0"] for m in mp],
-                [
-                    np.where(r.counts >= SHOW_COUNT, m["dop"], np.nan)
-                    for (_, r), m in zip(pair, mp, strict=True)
-                ],
-                mp[0]["theta_edges"],
-                mp[0]["phi_edges"],
-                title=name,
-                s0_max=[_robust_max(r, m["s0"]) for (_, r), m in zip(pair, mp, strict=True)],
-            ),
-        )
-        if ggx_alpha < math.tan(math.radians(TRACE_STEP_DEG)):
-            b.note(
-                "tracer maps",
-                f"the slopes are so small (GGX alpha {ggx_alpha:.2g}) that the reflected lobe "
-                f"is narrower than one {TRACE_STEP_DEG:g}-degree bin: the maps show the "
-                "specular bin only; the albedos below are what the runs add.",
-            )
-        diff = r_meas.albedo() - r_ggx.albedo()
-        diff_u = math.hypot(r_meas.albedo_stderr(), r_ggx.albedo_stderr())
-        for (lab, r), a in zip(pair, (r_meas.config.substrate.alpha, ggx_alpha), strict=True):
-            albedo_rows.append(
-                {
-                    "file": name,
-                    "case": "measured" if lab.startswith("measured") else "ggx",
-                    "alpha": a,
-                    "albedo": r.albedo(),
-                    "albedo_u": r.albedo_stderr(),
-                    "absorbed": float(r.ledger["absorbed"]),
-                    "rays": r.rays,
-                    "diff": diff if lab.startswith("measured") else None,
-                    "diff_u": diff_u if lab.startswith("measured") else None,
-                    "reason": "",
-                }
-            )
+
+
+def _albedo_table(b: Builder, albedo_rows: list[dict[str, Any]]) -> None:
+    """The tracer albedos of every areal map (and why a profile has none)."""
+    n, k = SUBSTRATE_NK
     b.table(
         "surface_tracer_albedo",
         "Tracer albedo: measured slope distribution vs GGX at the fitted alpha",

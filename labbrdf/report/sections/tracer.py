@@ -30,6 +30,7 @@ import pandas as pd
 from ... import optics
 from ...tracer import Substrate, TraceConfig, TraceResult, trace
 from ...tracer import studies as st
+from ...tracer.result import DOP_SE_MAX, MIN_COUNT, SHOW_COUNT
 from .. import figures
 from ..context import Context
 
@@ -39,14 +40,6 @@ __all__ = ["factor_maps_section", "maps", "validation_section"]
 #: values at the bin centres averaged with the same cos-solid-angle weights (midpoint rule
 #: per 1-degree bin, bias ~ f'' (1 deg)^2 / 24, negligible against the noise)
 GROUP = 5
-
-#: peaks are searched among bins with at least this many exiting rays (fewer: the
-#: bin value is dominated by one or two rays, e.g. the thin theta_r = 90 deg edge row)
-MIN_COUNT = 20
-#: DOP is drawn only in bins with at least this many rays
-SHOW_COUNT = 10
-#: evaluated estimator: DOP is drawn where its standard error is at most this [1]
-DOP_SE_MAX = 0.02
 
 
 def _robust_max(res: TraceResult, s0: np.ndarray) -> float | None:

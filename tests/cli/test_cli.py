@@ -162,17 +162,12 @@ def test_every_real_export_reads_through_one_entry_point(real_exports):
         assert m.meta["format"] != "labbrdf-dataset-csv", p
 
 
-FIXTURES_SCAN = (
-    __import__("pathlib").Path(__file__).resolve().parents[1] / "labbrdf/data/fixtures/specular"
-)
-
-
-def test_fit_json_has_one_object_per_group(capsys, tmp_path):
+def test_fit_json_has_one_object_per_group(capsys, tmp_path, specular_scan):
     out = tmp_path / "params.csv"
     code = main(
         [
             "fit",
-            str(FIXTURES_SCAN / "osr_specular.csv"),
+            str(specular_scan),
             "--model",
             "smooth3",
             "--scheduler",
@@ -197,8 +192,8 @@ def test_fit_json_has_one_object_per_group(capsys, tmp_path):
     assert len(pd.read_csv(out)) == 4
 
 
-def test_fit_fix_and_bad_names(capsys):
-    scan = str(FIXTURES_SCAN / "osr_specular.csv")
+def test_fit_fix_and_bad_names(capsys, specular_scan):
+    scan = str(specular_scan)
     assert (
         main(
             ["fit", scan, "--model", "smooth3", "--scheduler", "serial", "--fix", "k2=0", "--json"]
@@ -248,19 +243,11 @@ def test_hemispherical_unknown_parameter(capsys):
     assert "k9" in capsys.readouterr().err
 
 
-def test_trace_json_and_npz(tmp_path, capsys):
+def test_trace_json_and_npz(tmp_path, capsys, trace_sample):
     out = tmp_path / "al.npz"
     code = main(
         [
-            "trace",
-            "--substrate",
-            "1.55+7.71j",
-            "--alpha",
-            "0.2",
-            "--theta-i",
-            "45",
-            "--wavelength",
-            "650",
+            *trace_sample,
             "--rays",
             "20000",
             "--seed",
@@ -298,11 +285,9 @@ def test_trace_bad_index_and_missing_thickness(capsys):
     assert "need --coating" in capsys.readouterr().err
 
 
-def test_report_command_writes_a_page_for_user_files(tmp_path, capsys):
+def test_report_command_writes_a_page_for_user_files(tmp_path, capsys, specular_scan):
     out = tmp_path / "rep"
-    code = main(
-        ["report", str(FIXTURES_SCAN / "osr_specular.csv"), "--model", "smooth3", "-o", str(out)]
-    )
+    code = main(["report", str(specular_scan), "--model", "smooth3", "-o", str(out)])
     assert code == 0
     html = (out / "index.html").read_text()
     assert "data:image/png;base64," in html

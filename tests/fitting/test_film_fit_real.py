@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from labbrdf import adapters
-from labbrdf.dispersion import Cauchy, Tabulated
+from labbrdf.dispersion import Cauchy
 from labbrdf.films import FilmModel, Layer, Stack, fit_film
+from labbrdf.nk import tabulated_from_file
 
 pytestmark = pytest.mark.shared
 
@@ -39,7 +40,7 @@ def test_ta2o5_trio_fits_on_tantalum_and_its_psi_delta_stack_predicts_r_p(real_e
     keep = np.unique(data.wavelength_nm.to_numpy())[::3]
     data = data[data.wavelength_nm.isin(keep)]
     ellipsometry = data[data.quantity.isin(["psi", "delta"])]
-    ta = Tabulated.from_file(d / "w2_10102006.dat")  # the same lab's bare Ta wafer
+    ta = tabulated_from_file(d / "w2_10102006.dat")  # the same lab's bare Ta wafer
     layer = Layer(Cauchy(A=2.1, B=0.02), 200.0, "ta2o5")
     box = {
         "ta2o5.thickness_nm": (100.0, 300.0),

@@ -19,30 +19,11 @@ import pytest
 from labbrdf.cli import main
 from labbrdf.dataset import Measurement, make_frame, write
 
-SCAN = (
-    Path(__file__).resolve().parents[1]
-    / "labbrdf"
-    / "data"
-    / "fixtures"
-    / "specular"
-    / "osr_specular.csv"
-)
-TRACE = [
-    "trace",
-    "--substrate",
-    "1.55+7.71j",
-    "--alpha",
-    "0.2",
-    "--theta-i",
-    "45",
-    "--wavelength",
-    "650",
-    "--rays",
-    "2000",
-    "--scheduler",
-    "serial",
-    "--single-scattering",
-]
+
+@pytest.fixture
+def trace_cmd(trace_argv: list[str]) -> list[str]:
+    """The small shared trace, single scattering (its outputs are what is checked)."""
+    return [*trace_argv, "--single-scattering"]
 
 
 def snapshot(root: Path) -> dict[str, tuple[bytes, int]]:
@@ -88,26 +69,26 @@ def expect_refused(capsys, argv: list[str], *words: str) -> str:
 # --------------------------------------------------------------------------- data loss
 
 
-def test_report_refuses_a_folder_holding_the_input_and_user_files(tmp_path, capsys):
+def test_report_refuses_a_folder_holding_the_input_and_user_files(tmp_path, capsys, specular_scan):
     p = tmp_path / "p"
     p.mkdir()
-    shutil.copy(SCAN, p / "scan.csv")
+    shutil.copy(specular_scan, p / "scan.csv")
     (p / "notes.txt").write_text("x")
     before = snapshot(tmp_path)
     expect_refused(capsys, ["report", str(p / "scan.csv"), "-o", str(p)], str(p), "input")
     assert snapshot(tmp_path) == before
 
 
-def test_report_refuses_an_input_file_as_output(tmp_path, capsys):
+def test_report_refuses_an_input_file_as_output(tmp_path, capsys, specular_scan):
     scan = tmp_path / "scan.csv"
-    shutil.copy(SCAN, scan)
+    shutil.copy(specular_scan, scan)
     before = snapshot(tmp_path)
     expect_refused(capsys, ["report", str(scan), "-o", str(scan)], "existing file")
     assert snapshot(tmp_path) == before and scan.is_file()
 
 
-def test_report_refuses_the_current_folder(tmp_path, capsys, monkeypatch):
-    shutil.copy(SCAN, tmp_path / "scan.csv")
+def test_report_refuses_the_current_folder(tmp_path, capsys, monkeypatch, specular_scan):
+    shutil.copy(specular_scan, tmp_path / "scan.csv")
     (tmp_path / "notes.txt").write_text("x")
     monkeypatch.chdir(tmp_path)
     before = snapshot(tmp_path)
@@ -147,9 +128,9 @@ def test_validate_refuses_a_non_empty_folder_before_running(tmp_path, capsys):
     assert snapshot(tmp_path) == before
 
 
-def test_fit_refuses_to_overwrite_its_input(tmp_path, capsys):
+def test_fit_refuses_to_overwrite_its_input(tmp_path, capsys, specular_scan):
     scan = tmp_path / "scan.csv"
-    shutil.copy(SCAN, scan)
+    shutil.copy(specular_scan, scan)
     before = snapshot(tmp_path)
     argv = ["fit", str(scan), "--model", "smooth3", "--scheduler", "serial", "-o", str(scan)]
     expect_refused(capsys, argv, "one of the input files")
@@ -175,9 +156,9 @@ def test_ingest_dev_zero_is_refused_not_read_forever(capsys):
         (["--png", "{d}"], ["--png", "existing folder"]),
     ],
 )
-def test_trace_output_names_are_checked_before_tracing(tmp_path, capsys, argv, words):
+def test_trace_output_names_are_checked_before_tracing(tmp_path, capsys, argv, words, trace_cmd):
     argv = [a.format(d=tmp_path) for a in argv]
-    expect_refused(capsys, [*TRACE, *argv], *words)
+    expect_refused(capsys, [*trace_cmd, *argv], *words)
     assert list(tmp_path.iterdir()) == []
 
 
@@ -207,7 +188,9 @@ def _deny_writes(monkeypatch):
     monkeypatch.setattr(outputs.tempfile, "mkdtemp", mkdtemp)
 
 
-def test_unwritable_output_folder_is_a_message_and_exit_2(tmp_path, capsys, monkeypatch):
+def test_unwritable_output_folder_is_a_message_and_exit_2(
+    tmp_path, capsys, monkeypatch, trace_cmd
+):
     data = small_dataset(tmp_path / "d.csv")
     ro = tmp_path / "ro"
     ro.mkdir()
@@ -215,15 +198,15 @@ def test_unwritable_output_folder_is_a_message_and_exit_2(tmp_path, capsys, monk
     fit = ["fit", str(data), "--model", "smooth3", "--scheduler", "serial"]
     expect_refused(capsys, [*fit, "-o", str(ro / "p.csv")], str(ro / "p.csv"), "writ")
     expect_refused(capsys, ["ingest", str(data), "-o", str(ro / "x.csv")], "x.csv", "writ")
-    expect_refused(capsys, [*TRACE, "-o", str(ro / "t.npz")], "t.npz", "writ")
-    expect_refused(capsys, [*TRACE, "--png", str(ro / "t.png")], "t.png", "writ")
+    expect_refused(capsys, [*trace_cmd, "-o", str(ro / "t.npz")], "t.npz", "writ")
+    expect_refused(capsys, [*trace_cmd, "--png", str(ro / "t.png")], "t.png", "writ")
     bad = tmp_path / "bad.xyz"
     bad.write_text("x\n")
     expect_refused(capsys, ["report", str(bad), "-o", str(ro / "rep")], "rep", "writ")
 
 
 @pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("setpriv"), reason="needs root")
-def test_read_only_folder_for_another_user():
+def test_read_only_folder_for_another_user(project_root):
     """As user nobody (root runs the tests here, and root may write anywhere): a folder
     nobody may write into is refused before any work, with a message and exit 2."""
     import subprocess
@@ -242,7 +225,7 @@ def test_read_only_folder_for_another_user():
         nobody = ["setpriv", "--reuid=65534", "--regid=65534", "--clear-groups", sys.executable]
         env = {
             **os.environ,
-            "PYTHONPATH": str(Path(__file__).resolve().parents[1]),
+            "PYTHONPATH": str(project_root),
             "MPLCONFIGDIR": str(base / "mpl"),
             "HOME": str(base),
         }
@@ -277,10 +260,13 @@ def test_read_only_folder_for_another_user():
 # --------------------------------------------------------------------------- writers' content
 
 
-def test_trace_writes_the_named_npz_with_umask_permissions(tmp_path, capsys):
+def test_trace_writes_the_named_npz_with_umask_permissions(tmp_path, capsys, trace_cmd):
     old = os.umask(0o027)
     try:
-        assert main([*TRACE, "-o", str(tmp_path / "t.npz"), "--png", str(tmp_path / "m.png")]) == 0
+        assert (
+            main([*trace_cmd, "-o", str(tmp_path / "t.npz"), "--png", str(tmp_path / "m.png")])
+            == 0
+        )
     finally:
         os.umask(old)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.png", "t.npz"]
@@ -312,8 +298,6 @@ def test_fit_lists_failed_groups_and_exits_3(tmp_path, capsys):
 
 # ------------------------------------------------------------------ one rule, every writer
 
-ELLIPSOMETRY = SCAN.parents[1] / "ellipsometry" / "al_bare_wvase.dat"
-
 
 def _fake_height_map(path, channel, args=None):
     from labbrdf.adapters.topography import HeightMap
@@ -332,7 +316,7 @@ def _fake_validate(out="reports/validation", **kw):
 
 
 @pytest.fixture
-def writers(tmp_path, monkeypatch):
+def writers(tmp_path, monkeypatch, fixtures_dir, trace_cmd):
     """Each writer command: its argv without the output, its output option and suffix.
 
     ``surface`` reads a synthetic height map (the readers are tested elsewhere) and
@@ -352,9 +336,9 @@ def writers(tmp_path, monkeypatch):
         "ingest-parquet": (["ingest", str(data)], "-o", ".parquet"),
         "ingest-csv": (["ingest", str(data)], "-o", ".csv"),
         "fit": (["fit", str(data), "--model", "smooth3", "--scheduler", "serial"], "-o", ".csv"),
-        "nk": (["nk", str(ELLIPSOMETRY)], "-o", ".csv"),
-        "trace-o": (TRACE, "-o", ".npz"),
-        "trace-png": (TRACE, "--png", ".png"),
+        "nk": (["nk", str(fixtures_dir / "ellipsometry" / "al_bare_wvase.dat")], "-o", ".csv"),
+        "trace-o": (trace_cmd, "-o", ".npz"),
+        "trace-png": (trace_cmd, "--png", ".png"),
         "surface": (["surface", str(hm), "--blocks", "0"], "--png", ".png"),
         "export": (["export", "--model", "smooth3", "--theta-i", "30"], "-o", ".bsdf"),
         "report": (["report", str(bad)], "-o", ""),

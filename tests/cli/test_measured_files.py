@@ -37,7 +37,7 @@ def test_parse_range_forms():
 @pytest.mark.parametrize("bad", ["700:400", "a:b", "１２:20", "nan", "1e999", "1:2:3"])
 def test_parse_range_refuses(bad):
     with pytest.raises(SelectionError):
-        parse_range(bad, "--wavelength")
+        parse_range(bad, "--wavelength-range")
 
 
 def test_select_empty_result_names_what_the_data_hold(fixtures_dir: Path):
@@ -51,7 +51,7 @@ def test_select_empty_result_names_what_the_data_hold(fixtures_dir: Path):
 
 def test_cli_selection_error_is_exit_2(fixtures_dir: Path, capsys):
     scan = str(fixtures_dir / "specular" / "osr_specular.csv")
-    assert main(["fit", scan, "--model", "smooth3", "--wavelength", "1000:", "--json"]) == 2
+    assert main(["fit", scan, "--model", "smooth3", "--wavelength-range", "1000:", "--json"]) == 2
     assert "no row left" in capsys.readouterr().err
 
 
@@ -123,7 +123,7 @@ def test_fit_with_an_unknown_model_option_is_exit_2(fixtures_dir: Path, capsys):
 
 
 def test_nk_json_on_the_ta_file(real_exports: Path, capsys):
-    assert main(["nk", str(real_exports / TA), "--wavelength", "500:510", "--json"]) == 0
+    assert main(["nk", str(real_exports / TA), "--wavelength-range", "500:510", "--json"]) == 0
     out = _json(capsys)
     keys = ("wavelength_nm", "theta_i_deg", "n", "k", "n_sigma", "k_sigma")
     lengths = {len(out[k]) for k in keys}
@@ -139,7 +139,9 @@ def test_nk_writes_csv_and_refuses_files_without_psi_delta(
     real_exports: Path, fixtures_dir: Path, tmp_path: Path, capsys
 ):
     out = tmp_path / "nk.csv"
-    assert main(["nk", str(real_exports / TA), "--wavelength", "500:510", "-o", str(out)]) == 0
+    assert (
+        main(["nk", str(real_exports / TA), "--wavelength-range", "500:510", "-o", str(out)]) == 0
+    )
     head = out.read_text().splitlines()[0].split(",")
     assert {"wavelength_nm", "theta_i_deg", "n", "k", "n_sigma", "k_sigma"} <= set(head)
     capsys.readouterr()
@@ -170,7 +172,7 @@ def test_fit_nk_from_needs_a_wavelength_for_files_that_state_none(real_exports: 
     argv = ["fit", str(real_exports / BSDF), "--model", "microfacet", "--nk-from",
             str(real_exports / TA), "--scheduler", "serial"]  # fmt: skip
     assert main(argv) == 2
-    assert "--nk-wavelength" in capsys.readouterr().err
+    assert "with --wavelength NM" in capsys.readouterr().err
 
 
 # ------------------------------------------------------------------ pipes
@@ -246,7 +248,8 @@ def test_ingest_selects_rows_and_refuses_an_empty_selection(fixtures_dir: Path, 
     scan = str(fixtures_dir / "specular" / "osr_specular.csv")
     out = tmp_path / "sel.csv"
     assert (
-        main(["ingest", scan, "--wavelength", "500:560", "--theta-i", "45", "-o", str(out)]) == 0
+        main(["ingest", scan, "--wavelength-range", "500:560", "--theta-i", "45", "-o", str(out)])
+        == 0
     )
     d = labbrdf.read(out).data
     assert set(d.wavelength_nm) == {500.0, 550.0} and set(d.theta_i_deg) == {45.0}
@@ -293,12 +296,11 @@ def test_report_takes_model_options_and_a_selection(real_exports: Path, tmp_path
 
 
 @pytest.mark.slow
-def test_trace_exported_as_bsdf_is_read_back_and_fitted(tmp_path: Path, capsys):
+def test_trace_exported_as_bsdf_is_read_back_and_fitted(tmp_path: Path, capsys, trace_sample):
     from labbrdf.tracer import TraceResult
 
     run, out = tmp_path / "al.npz", tmp_path / "al.bsdf"
-    assert main(["trace", "--substrate", "1.55+7.71j", "--alpha", "0.2", "--theta-i", "45",
-                 "--wavelength", "650", "--rays", "400000", "--seed", "1",
+    assert main([*trace_sample, "--rays", "400000", "--seed", "1",
                  "--single-scattering", "-o", str(run), "--scheduler", "serial"]) == 0  # fmt: skip
     assert main(["export", "--trace", str(run), "--radial", "0:60:3", "--azimuth", "0:350:10",
                  "-o", str(out)]) == 0  # fmt: skip

@@ -96,7 +96,8 @@ def test_film_with_a_model_file_writes_json_nk_csv_and_fit_json(film_file, tmp_p
         (["--layer", "film:cauchy:10:Q=1"], "PARAM one of"),
         (["--layer", "film:cauchy:300..0"], "impossible bounds"),
         (["--layer", "film:unobtainium:10"], "unknown material"),
-        (["--layer", "film:cauchy:1..20", "--wavelength-range", "900", "100"], "MIN MAX"),
+        (["--layer", "film:cauchy:1..20", "--wavelength-range", "900:100"], "MIN must not"),
+        (["--layer", "film:cauchy:1..20", "--wavelength-range", "100:100"], "0 <= MIN < MAX"),
         (["--model", "absent.toml"], "cannot read the model file"),
     ],
 )
@@ -129,7 +130,7 @@ def test_native_oxide_on_silicon_from_the_completeease_file(real_exports, capsys
     f = real_exports / "woollam-completeease-ascii" / "complete_ease_example.dat"
     code = main(
         ["film", str(f), "--substrate", "si", "--layer", "oxide:sio2:0..20",
-         "--wavelength-range", "250", "1450", "--json"]
+         "--wavelength-range", "250:1450", "--json"]
     )  # fmt: skip
     assert code == 0
     doc = json.loads(capsys.readouterr().out)

@@ -1,0 +1,297 @@
+"""A tracer run from what a user has: index values or files, roughness values or height maps.
+
+The objects layer over :mod:`labbrdf.tracer` (which reads no file):
+:func:`trace_config_from_inputs` assembles the :class:`~labbrdf.Substrate` and the
+:class:`~labbrdf.Coating` of a :class:`~labbrdf.TraceConfig` from
+
+- the substrate index: a value, or the bulk n, k of an ellipsometer file at the traced
+  wavelength (:func:`labbrdf.nk.read_nk`, :func:`labbrdf.nk.bulk_index_at`);
+- the substrate roughness: a GGX or Beckmann alpha, or the slope table of a measured
+  areal height map (:meth:`labbrdf.Substrate.from_surface`);
+- an optional coating: index and thickness values, or the one layer of a film fit at the
+  traced wavelength (:func:`labbrdf.nk.coating_from_fit`), with its top's roughness as an
+  alpha (default: the substrate's) or a measured map.
+
+``labbrdf trace`` is this function behind its options. Arguments that do not fit together
+raise :class:`labbrdf.errors.SetupError`, whose message names the keywords (the command
+line spells them as its options).
+"""
+
+from __future__ import annotations
+
+import os
+import warnings
+from collections.abc import Callable
+from typing import Any, Literal
+
+from .adapters.topography import HeightMap, read_height_map
+from .errors import SetupError, escaped
+from .nk import NkError, bulk_index_at, coating_from_fit, read_nk
+from .tracer.config import Coating, Substrate, TraceConfig
+from .tracer.sampling import TabulatedNDF
+
+__all__ = ["trace_config_from_inputs"]
+
+PathLike = str | os.PathLike[str]
+
+
+def _warn(message: str) -> None:
+    warnings.warn(message, UserWarning, stacklevel=3)
+
+
+def _height_map(
+    source: PathLike | HeightMap,
+    keyword: str,
+    channel: int | str | None,
+    unit: str | None,
+    pixel_size: float | tuple[float, ...] | None,
+    warn: Callable[[str], None],
+) -> HeightMap:
+    """``source`` read as a height map (its geometry doubts passed to ``warn``)."""
+    if isinstance(source, HeightMap):
+        return source
+    try:
+        hm = read_height_map(source, channel, unit=unit, pixel_size=pixel_size)
+    except MemoryError:
+        raise SetupError(
+            f"{{{keyword}}} {escaped(source)}: out of memory while reading the height map"
+        ) from None
+    for w in hm.warnings:
+        warn(f"{source}: {w}")
+    return hm
+
+
+def _pitch(hm: HeightMap) -> float | tuple[float, float]:
+    """The grid spacing of an areal map [m] (a profile's one pitch as it is)."""
+    px = tuple(float(v) for v in hm.pixel_size)
+    return (px[0], px[1]) if len(px) == 2 else px[0]
+
+
+def _analytic_table(distribution: str, alpha: float) -> TabulatedNDF | None:
+    """The slope table of an analytic distribution: None for GGX (the tracer's own)."""
+    if distribution == "ggx":
+        return None
+    if distribution != "beckmann":
+        raise SetupError(
+            f"{{distribution}} {escaped(repr(distribution))}: expected 'ggx' or 'beckmann'"
+        )
+    if not alpha > 0:
+        raise SetupError("{distribution} beckmann needs a roughness alpha > 0")
+    return TabulatedNDF.beckmann(alpha)
+
+
+def _substrate(
+    wavelength_nm: float,
+    index: complex | None,
+    nk_from: PathLike | None,
+    alpha: float | None,
+    surface: PathLike | HeightMap | None,
+    distribution: str,
+    read: Callable[[PathLike | HeightMap, str], HeightMap],
+) -> Substrate:
+    if (index is None) == (nk_from is None):
+        raise SetupError("give the substrate index with {substrate_index} N+Kj or {nk_from} FILE")
+    if nk_from is not None:
+        try:
+            n, k = bulk_index_at(read_nk(nk_from), wavelength_nm, source=nk_from)
+        except NkError as exc:
+            raise SetupError(f"{{nk_from}} {escaped(exc)}") from None
+        index = complex(n, k)
+    assert index is not None
+    if surface is not None:
+        hm = read(surface, "surface")
+        try:
+            return Substrate.from_surface(hm.heights, _pitch(hm), n=index.real, k=index.imag)
+        except ValueError as exc:
+            raise SetupError(f"{{surface}} {escaped(hm.path)}: {escaped(exc)}") from None
+    if alpha is None:
+        raise SetupError("give the substrate roughness with {alpha} A or {surface} FILE")
+    return Substrate(
+        n=index.real, k=index.imag, alpha=alpha, ndf=_analytic_table(distribution, alpha)
+    )
+
+
+def _base(albedo: float, metal: dict[str, object], coated: bool, roughness: bool) -> Substrate:
+    """A Lambertian base of ``albedo``, refusing the conductor's arguments."""
+    given = [f"{{{name}}}" for name, value in metal.items() if value is not None]
+    if given:
+        raise SetupError(f"{{base_albedo}} replaces the metal substrate: drop {', '.join(given)}")
+    if coated and not roughness:
+        raise SetupError(
+            "{base_albedo} with a coating needs its roughness: {coating_alpha} A or "
+            "{coating_surface} FILE (there is no substrate alpha to default to)"
+        )
+    try:
+        return Substrate.lambertian(albedo)
+    except ValueError as exc:
+        raise SetupError(f"{{base_albedo}}: {escaped(exc)}") from None
+
+
+def _coating(
+    wavelength_nm: float,
+    substrate: Substrate,
+    index: complex | None,
+    coating_from: PathLike | None,
+    thickness_nm: float | None,
+    alpha: float | None,
+    surface: PathLike | HeightMap | None,
+    distribution: str,
+    read: Callable[[PathLike | HeightMap, str], HeightMap],
+) -> Coating | None:
+    if coating_from is not None:
+        if index is not None or thickness_nm is not None:
+            raise SetupError(
+                "give the coating once: {coating_from} FIT.json, or {coating_index} and "
+                "{thickness_nm}"
+            )
+        try:
+            index, thickness_nm = coating_from_fit(coating_from, wavelength_nm)
+        except ValueError as exc:
+            raise SetupError(f"{{coating_from}} {escaped(exc)}") from None
+    if index is None:
+        if thickness_nm is not None or alpha is not None or surface is not None:
+            raise SetupError(
+                "{thickness_nm}, {coating_alpha} and {coating_surface} need {coating_index} "
+                "(or {coating_from})"
+            )
+        return None
+    if thickness_nm is None:
+        raise SetupError("{coating_index} needs {thickness_nm} (nm)")
+    if alpha is not None and surface is not None:
+        raise SetupError("give the coating roughness once: {coating_alpha} or {coating_surface}")
+    if surface is not None:
+        hm = read(surface, "coating_surface")
+        if hm.heights.ndim != 2:
+            raise SetupError(
+                f"{{coating_surface}} {escaped(hm.path)}: a line profile; the coating needs "
+                "an areal height map"
+            )
+        try:
+            top = Substrate.from_surface(hm.heights, _pitch(hm))
+        except ValueError as exc:
+            raise SetupError(f"{{coating_surface}} {escaped(hm.path)}: {escaped(exc)}") from None
+        coat_alpha, coat_ndf = float(top.alpha), top.ndf
+    else:
+        coat_alpha = alpha if alpha is not None else substrate.alpha
+        coat_ndf = _analytic_table(distribution, coat_alpha)
+    return Coating(
+        n=index.real, k=index.imag, thickness_nm=thickness_nm, alpha=coat_alpha, ndf=coat_ndf
+    )
+
+
+def trace_config_from_inputs(
+    wavelength_nm: float,
+    theta_i_deg: float,
+    *,
+    base_albedo: float | None = None,
+    substrate_index: complex | None = None,
+    nk_from: PathLike | None = None,
+    alpha: float | None = None,
+    surface: PathLike | HeightMap | None = None,
+    coating_index: complex | None = None,
+    coating_from: PathLike | None = None,
+    thickness_nm: float | None = None,
+    coating_alpha: float | None = None,
+    coating_surface: PathLike | HeightMap | None = None,
+    distribution: Literal["ggx", "beckmann"] = "ggx",
+    channel: int | str | None = None,
+    unit: str | None = None,
+    pixel_size: float | tuple[float, ...] | None = None,
+    warn: Callable[[str], None] = _warn,
+    **run: Any,
+) -> TraceConfig:
+    """The :class:`~labbrdf.TraceConfig` of a substrate, a coating and a run.
+
+    Parameters
+    ----------
+    wavelength_nm : float
+        Vacuum wavelength [nm]; an index taken from a file is taken here.
+    theta_i_deg : float
+        Angle of incidence [deg].
+    base_albedo : float, optional
+        A Lambertian base of this albedo [1] instead of a metal
+        (:meth:`labbrdf.Substrate.lambertian`); the metal's arguments are then refused and a
+        coating needs its own roughness.
+    substrate_index : complex, optional
+        Substrate index ``n + ik`` [1] ...
+    nk_from : path-like, optional
+        ... or an ellipsometer file: its bulk n, k at ``wavelength_nm``
+        (:func:`labbrdf.nk.bulk_index_at`). Exactly one of the two.
+    alpha : float, optional
+        Substrate roughness [1] (GGX or Beckmann alpha, see ``distribution``) ...
+    surface : path-like or HeightMap, optional
+        ... or a measured areal height map: the substrate's facets follow its slope table
+        (:meth:`labbrdf.Substrate.from_surface`). ``surface`` wins over ``alpha``.
+    coating_index : complex, optional
+        Coating index [1], with ``thickness_nm`` ...
+    coating_from : path-like, optional
+        ... or a one-layer film fit's JSON: the layer's index at ``wavelength_nm`` and
+        its thickness (:func:`labbrdf.nk.coating_from_fit`). At most one of the two; none:
+        no coating.
+    thickness_nm : float, optional
+        Coating thickness [nm] (with ``coating_index``).
+    coating_alpha : float, optional
+        Roughness of the coating's top [1] (default: the substrate's alpha) ...
+    coating_surface : path-like or HeightMap, optional
+        ... or a measured areal height map of the top: its slope table.
+    distribution : {"ggx", "beckmann"}
+        Microfacet distribution of the interfaces given by an alpha (measured maps always
+        use their own slope table).
+    channel, unit, pixel_size :
+        How height-map files are read (:func:`labbrdf.read_height_map`): channel name or
+        index, length unit of the file's numbers, pitch [m] per axis.
+    warn : callable, optional
+        Called with each doubt about a height map's geometry (default
+        :func:`warnings.warn`).
+    **run
+        Any other :class:`~labbrdf.TraceConfig` field (``rays``, ``seed``,
+        ``scattering``, ``coherent``, ``estimator``, ``scalar`` ...).
+
+    Returns
+    -------
+    TraceConfig
+
+    Raises
+    ------
+    labbrdf.errors.SetupError
+        Arguments missing or given twice, or a file that cannot give what is asked of it
+        (the message names the keyword and the file).
+    ValueError
+        A value the tracer refuses (:class:`~labbrdf.TraceConfig`'s checks).
+    """
+
+    def read(source: PathLike | HeightMap, keyword: str) -> HeightMap:
+        return _height_map(source, keyword, channel, unit, pixel_size, warn)
+
+    if base_albedo is not None:
+        metal: dict[str, object] = {
+            "substrate_index": substrate_index,
+            "nk_from": nk_from,
+            "alpha": alpha,
+            "surface": surface,
+        }
+        coated = coating_index is not None or coating_from is not None
+        roughness = coating_alpha is not None or coating_surface is not None
+        substrate = _base(base_albedo, metal, coated, roughness)
+    else:
+        substrate = _substrate(
+            wavelength_nm, substrate_index, nk_from, alpha, surface, distribution, read
+        )
+    coating = _coating(
+        wavelength_nm,
+        substrate,
+        coating_index,
+        coating_from,
+        thickness_nm,
+        coating_alpha,
+        coating_surface,
+        distribution,
+        read,
+    )
+    return TraceConfig(
+        wavelength_nm=wavelength_nm,
+        theta_i_deg=theta_i_deg,
+        substrate=substrate,
+        coating=coating,
+        **run,
+    )
