@@ -675,6 +675,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
         with atomic_output(args.output) as tmp:
             csv_safe_frame(table).to_csv(tmp, index=False)
+    if args.residual_maps:
+        _residual_maps(args, data, results)
     failed = [r for r in table.to_dict("records") if not r["success"]]
     if args.json:
         _emit_json(fit_records(table, results, by))
@@ -687,6 +689,28 @@ def cmd_fit(args: argparse.Namespace) -> int:
         group = ", ".join(f"{b}={r[b]}" for b in by)
         print(f"labbrdf fit: group {group} FAILED: {r['message']}", file=sys.stderr)
     return 3 if failed else 0
+
+
+def _residual_maps(args: argparse.Namespace, data: Any, results: list) -> None:
+    """``--residual-maps PNG``: the maps of the one fitted group (refused for several)."""
+    from . import models
+    from .report.figures import fit_maps_figure, save_png
+
+    if len(results) != 1:
+        raise UsageError(
+            f"--residual-maps draws one fitted group; {len(results)} were fitted "
+            "(select one sample and wavelength, e.g. with --sample and --wavelength)"
+        )
+    key, res = results[0]
+    rows = data.data
+    for col, v in key.items():
+        rows = rows[rows[col] == v]
+    rows = rows[rows["quantity"] == res.quantity]
+    if res.nmasked:
+        rows = rows[rows["value"] != 0]
+    model = models.get(res.model, **res.options)
+    title = f"{res.model}: " + ", ".join(f"{k}={v}" for k, v in key.items())
+    save_png(fit_maps_figure(model, res.values, rows, title=title), args.residual_maps)
 
 
 def _model_from_args(args: argparse.Namespace) -> tuple[Any, dict[str, float]]:
@@ -1325,8 +1349,8 @@ def _fit_parser(sub: Any) -> None:
         "--param",
         action="append",
         metavar="NAME=VALUE",
-        help="a model option (microfacet n=, k=, diffuse=true; five_param shadowing=mb) "
-        "or a parameter's starting value",
+        help="a model option (microfacet n=, k=, diffuse=true; five_param shadowing=mb; "
+        "layered base=diffuse, rays=, floor=true) or a parameter's starting value",
     )
     s.add_argument(
         "--free", action="append", metavar="NAME", help="vary a parameter fixed by default"
@@ -1367,6 +1391,14 @@ def _fit_parser(sub: Any) -> None:
         suffixes=(".csv",),
         default=None,
         help="write the parameter table (CSV)",
+    )
+    s.add_argument(
+        "--residual-maps",
+        action=OutputPath,
+        suffixes=(".png",),
+        default=None,
+        metavar="PNG",
+        help="draw measured, model and relative residual per incidence (one fitted group)",
     )
     _add_overwrite(s)
     s.add_argument("--json", action="store_true")

@@ -88,7 +88,7 @@ def _row(row: dict[str, Any], s: dict[str, Any], param_names: list[str]) -> dict
         row[f"{name}_stderr"] = ps.get("stderr")
         row[f"{name}_ci95_lo"], row[f"{name}_ci95_hi"] = ci
         row[f"{name}_flags"] = ";".join(ps.get("flags", []))
-    for col in ("rmse", "rmse_pct", "chisqr", "redchi", "ndata", "nfev"):
+    for col in ("rmse", "rmse_pct", "chisqr", "redchi", "aic", "bic", "ndata", "nfev"):
         row[col] = s.get(col)
     row["success"] = bool(s.get("success", False))
     row["message"] = s.get("message", "")
@@ -167,9 +167,9 @@ def fit_many(
     pandas.DataFrame, or (DataFrame, list) with ``return_results``
         One row per group: the group keys; per parameter ``<name>``, ``<name>_stderr``,
         ``<name>_ci95_lo``, ``<name>_ci95_hi``, ``<name>_flags`` (``;``-joined); then
-        ``rmse``, ``rmse_pct``, ``chisqr``, ``redchi``, ``ndata``, ``nfev``, ``success``,
-        ``message``, ``elapsed_s``. A group that cannot be fitted (too few points, ...) gets
-        ``success=False`` and the reason in ``message``.
+        ``rmse``, ``rmse_pct``, ``chisqr``, ``redchi``, ``aic``, ``bic``, ``ndata``,
+        ``nfev``, ``success``, ``message``, ``elapsed_s``. A group that cannot be fitted
+        (too few points, ...) gets ``success=False`` and the reason in ``message``.
     """
     if progress is None and not isinstance(executor, parallel.Executor):
         progress = True  # a scheduler name or no executor: a bar, as ``labbrdf fit`` shows
@@ -223,7 +223,7 @@ def fit_many(
         rows.append(_row(row, s, param_names))
     out = pd.DataFrame(rows)
     num = [c for c in out.columns if c.endswith(("_stderr", "_ci95_lo", "_ci95_hi"))]
-    num += ["rmse", "rmse_pct", "chisqr", "redchi", "elapsed_s"] + param_names
+    num += ["rmse", "rmse_pct", "chisqr", "redchi", "aic", "bic", "elapsed_s"] + param_names
     out[num] = out[num].astype(float)
     return (out, results) if return_results else out
 
@@ -405,6 +405,9 @@ def fit_records(
                     },
                     "rmse": s["rmse"],
                     "redchi": s["redchi"],
+                    "aic": s["aic"],
+                    "bic": s["bic"],
+                    "ndata": s["ndata"],
                     "weighting": s["weighting"],
                     "nmasked": s["nmasked"],
                     "flags": {k: v["flags"] for k, v in s["params"].items() if v["flags"]},

@@ -21,7 +21,7 @@ from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
 from .objective import Objective
 from .result import FitResult
-from .uncertainty import AT_BOUND_FRAC, jacobian, uncertainties
+from .uncertainty import AT_BOUND_FRAC, jacobian, noise_meat, uncertainties
 
 __all__ = [
     "ALGORITHMS",
@@ -212,7 +212,7 @@ def _run_stage(
     opt.set_min_objective(obj)
     opt.set_maxeval(budget)
     if not _is_global(name):
-        opt.set_xtol_rel(_LOCAL_XTOL_REL)
+        opt.set_xtol_rel(max(_LOCAL_XTOL_REL, obj.model.fd_rel_step or 0.0))
         opt.set_ftol_rel(_LOCAL_FTOL_REL)
     if "MLSL" in name or "AUGLAG" in name:
         sub = nlopt.opt(nlopt.LD_LBFGS if _needs_grad(name) else nlopt.LN_BOBYQA, n)
@@ -291,6 +291,7 @@ def _polish(obj: Objective, x: NDArray, nfree: int, weighted: bool) -> tuple[NDA
     x0 = np.clip(np.asarray(x, float), lo, hi)
     f0 = obj.solve(obj.from_vector(x0))[1]
     budget = _POLISH_MAXEVAL_PER_DIM * obj.n
+    tol = max(_POLISH_TOL, obj.model.fd_rel_step or 0.0)  # a Monte Carlo model's resolution
     try:
         res = optimize.least_squares(
             obj.residual_vector,
@@ -298,10 +299,11 @@ def _polish(obj: Objective, x: NDArray, nfree: int, weighted: bool) -> tuple[NDA
             bounds=(lo, hi),
             method="trf",
             x_scale="jac",
-            ftol=_POLISH_TOL,
-            xtol=_POLISH_TOL,
-            gtol=_POLISH_TOL,
+            ftol=tol,
+            xtol=tol,
+            gtol=tol,
             max_nfev=budget,
+            diff_step=obj.model.fd_rel_step,
         )
         status, why = int(res.status), str(res.message)
     except (ValueError, np.linalg.LinAlgError) as exc:  # non-finite start, singular step
@@ -590,7 +592,7 @@ def _problem(
     lin = [k for k in model.linear if k in varying]
     prof, rho_fn, th_grid = _profiling(model, fd, lin, profile, energy_constraint)
     linear_upper = _energy_bound(rho_fn, prof[0], th_grid) if rho_fn and prof else None
-    obj = Objective(model, fd, p, weights, prof, linear_upper)
+    obj = Objective(model, fd, p, weights, prof, linear_upper, absolute=sigma)
     if prof and obj.linear_basis_missing():
         raise FitError(
             f"model {model.name!r} declares linear parameters but gives no "
@@ -642,7 +644,7 @@ def _finish(
     nfree = n_pts - nvarys
     redchi = chisqr / nfree
     covar, stderr, correl, reasons, cond = uncertainties(
-        J, varying, vals, 1.0 if use_sigma else redchi, nfree
+        J, varying, vals, 1.0 if use_sigma else redchi, nfree, noise_meat(obj, vals, J)
     )
     out, flags = _fitted_params(p, vals, stderr, correl, reasons, nfree)
     warn = [f"{pb.ndropped} point(s) with NaN/inf values dropped (nan_policy='omit')"] * (
@@ -683,7 +685,7 @@ def _finish(
         rmse=float(np.sqrt(np.mean(resid**2))),
         rmse_pct=rmse_pct,
         weighted=bool(use_sigma),
-        weighting=pb.weighting,
+        weighting=obj.describe_weighting(pb.weighting, vals),
         nmasked=pb.nmasked,
         success=bool(success),
         message=message,

@@ -105,6 +105,12 @@ class Objective:
     linear_upper : callable, optional
         ``linear_upper(values) -> float``: an extra upper bound on the single profiled
         parameter (the energy constraint).
+    absolute : bool
+        The weights are ``1/sigma^2`` of the data's own sigma. Only then is a model's own
+        variance (:meth:`~labbrdf.models.Model.point_variance`, a Monte Carlo model's
+        noise) added to sigma^2: the weights become ``1 / (sigma^2 + var_model(p))`` at
+        the parameters being tried. With uniform or relative weights the noise scale is
+        estimated from the residuals, which then include the model's noise.
     """
 
     def __init__(
@@ -115,6 +121,7 @@ class Objective:
         weights: NDArray,
         profile: Sequence[str] = (),
         linear_upper: Callable[[dict[str, float]], float] | None = None,
+        absolute: bool = False,
     ) -> None:
         self.model = model
         self.data = data
@@ -130,6 +137,11 @@ class Objective:
         self.w = np.asarray(weights, float)
         self.sw = np.sqrt(self.w)
         self.base = {k: p.value for k, p in params.items()}
+        # a model that overrides point_variance has a noise of its own (not evaluated here:
+        # a Monte Carlo model's first evaluation may fix its grid from the points it sees)
+        self.model_noise = bool(absolute) and (
+            type(model).point_variance is not Model.point_variance
+        )
         ps = [params[k] for k in self.names]
         self._log = np.array([p.log for p in ps], bool)
         lo = np.array([p.min for p in ps])
@@ -189,6 +201,38 @@ class Objective:
         return comps is None
 
     # ---- model
+    def point_sw(self, vals: Mapping[str, float]) -> NDArray[np.float64]:
+        """Square roots of the residual weights at parameter values ``vals``.
+
+        ``sqrt(w)``, or with :attr:`model_noise` ``1 / sqrt(1/w + var_model(vals))``.
+        """
+        if not self.model_noise:
+            return self.sw
+        var = self.model.point_variance(vals, self.ti, self.tr, self.pr, self.wl)
+        if var is None:
+            return self.sw
+        return 1.0 / np.sqrt(1.0 / self.w + np.asarray(var, float))
+
+    def describe_weighting(self, weighting: str, vals: Mapping[str, float]) -> str:
+        """``weighting`` (the words of the fit result) and how the model's noise entered.
+
+        With :attr:`model_noise` the variance was added; a model with a variance fitted
+        with uniform or relative weights has its noise in the residual scatter that scales
+        the covariance, and the words give its median size relative to the model.
+        """
+        var = self.model.point_variance(vals, self.ti, self.tr, self.pr, self.wl)
+        if var is None:
+            return weighting
+        if self.model_noise:
+            return f"{weighting} + the model's Monte Carlo variance (in quadrature, per point)"
+        f = np.abs(self.model_values(vals))
+        ok = f > 0
+        rel = float(np.median(np.sqrt(np.asarray(var, float)[ok]) / f[ok])) if ok.any() else 0.0
+        return (
+            f"{weighting}; the model's Monte Carlo error (median {100 * rel:.2g} % of the "
+            "model) is part of the residual scatter that scales the covariance"
+        )
+
     def model_values(self, vals: Mapping[str, float]) -> NDArray[np.float64]:
         """The model at every data point for full parameter values ``vals``.
 
@@ -209,8 +253,9 @@ class Objective:
         (1973): the amplitudes are the exact bounded linear least-squares solution at the
         nonlinear parameters ``vals``.
         """
+        sw = self.point_sw(vals)
         if not self.profile:
-            return vals, self.sw * (self.y - self.model_values(vals))
+            return vals, sw * (self.y - self.model_values(vals))
         comps = self.model.linear_components(vals, self.ti, self.tr, self.pr, self.wl)
         if comps is None:
             raise FitError(f"model {self.model.name!r} gave no linear components to profile")
@@ -218,19 +263,19 @@ class Objective:
         for k, b in comps.items():
             if k not in self.profile:
                 resid = resid - vals[k] * b
-        c = self.sw * resid
+        c = sw * resid
         hi = self._lin_hi
         if self.linear_upper is not None:
             hi = np.minimum(hi, self.linear_upper(vals))
         hi = np.maximum(hi, self._lin_lo)
         if len(self.profile) == 1:  # the common case, kept free of small-array overhead
-            a = self.sw * comps[self.profile[0]]
+            a = sw * comps[self.profile[0]]
             G, g = float(a @ a), float(a @ c)
             p0 = g / G if G > 0 else 0.0
             p0 = min(max(p0, float(self._lin_lo[0])), float(hi[0]))
             vals[self.profile[0]] = p0
             return vals, c - p0 * a
-        A = np.stack([comps[k] for k in self.profile], axis=1) * self.sw[:, None]
+        A = np.stack([comps[k] for k in self.profile], axis=1) * sw[:, None]
         p = _bounded_lsq(A.T @ A, A.T @ c, self._lin_lo, hi)
         for k, v in zip(self.profile, p, strict=True):
             vals[k] = float(v)
@@ -240,7 +285,7 @@ class Objective:
         """chi-square at search vector ``x`` (nlopt signature; finite-difference gradient)."""
         f = self._f(x)
         if grad is not None and grad.size > 0:
-            h = 1e-6  # central differences on the unit-box scale
+            h = max(1e-6, self.model.fd_rel_step or 0.0)  # central, on the unit-box scale
             for j in range(x.size):
                 xp, xm = np.array(x, float), np.array(x, float)
                 xp[j] += h

@@ -16,6 +16,7 @@ __all__ = [
     "REL_STDERR_MAX",
     "REL_STDERR_POOR",
     "jacobian",
+    "noise_meat",
     "uncertainties",
 ]
 
@@ -36,16 +37,22 @@ def jacobian(obj: Objective, vals: dict[str, float], names: list[str]) -> NDArra
     """Weighted residual Jacobian d(sw * (y - f))/dp in the parameters' natural scale.
 
     Central differences, step ``6e-6 * max(|p|, 1e-3 * span)`` (6e-6 ~ eps^(1/3), the
-    step that balances truncation and round-off); one-sided inward at a bound so the model
-    is never evaluated outside the parameter box.
+    step that balances truncation and round-off), or the model's ``fd_rel_step`` of the
+    span where that is larger (a Monte Carlo model); one-sided inward at a bound so the
+    model is never evaluated outside the parameter box. The weights are those at ``vals``
+    (:meth:`Objective.point_sw`).
     """
     J = np.empty((obj.y.size, len(names)))
     f0 = obj.model_values(vals)
+    sw = obj.point_sw(vals)
+    rel = obj.model.fd_rel_step
     for j, k in enumerate(names):
         p = obj.params[k]
         v = vals[k]
         span = p.max - p.min
         h = 6e-6 * max(abs(v), 1e-3 * span if math.isfinite(span) else 1e-3)
+        if rel is not None and math.isfinite(span):
+            h = max(h, rel * span)
         up, dn = v + h <= p.max, v - h >= p.min
         vp, vm = dict(vals), dict(vals)
         if up and dn:
@@ -57,12 +64,41 @@ def jacobian(obj: Objective, vals: dict[str, float], names: list[str]) -> NDArra
         else:
             vm[k] = v - h
             d = (f0 - obj.model_values(vm)) / h
-        J[:, j] = -obj.sw * d
+        J[:, j] = -sw * d
     return J
 
 
+def noise_meat(obj: Objective, vals: dict[str, float], J: NDArray) -> NDArray | None:
+    """``J^T S C S J`` of the sandwich covariance, for a model with correlated noise.
+
+    ``S = diag(sqrt(w_eff))`` are the residual weights actually used (data sigma and the
+    model's variance in quadrature, :meth:`Objective.point_sw`) and
+    ``C = diag(sigma^2) + sum_k n_k n_k^T`` the true covariance of data minus model, with
+    the model's noise components ``n_k`` (:meth:`labbrdf.models.Model.point_noise`).
+    Weighted least squares with weights that are not ``C^-1`` has the parameter covariance
+    ``H^-1 (J^T S C S J) H^-1``, ``H = J^T J`` (the sandwich, e.g. White 1980): the
+    quadrature weights treat the noise of neighbouring points as independent, the
+    sandwich does not. None where the weights are not the data's sigma, the model has
+    no noise components or J is not finite.
+    """
+    if not obj.model_noise or not np.all(np.isfinite(J)):
+        return None
+    comps = obj.model.point_noise(vals, obj.ti, obj.tr, obj.pr, obj.wl)
+    if comps is None:
+        return None
+    sw = obj.point_sw(vals)
+    data_part = sw * sw / obj.w  # sigma^2 w_eff
+    g = J.T @ (np.asarray(comps, float) * sw).T  # (n, K)
+    return np.asarray((J * data_part[:, None]).T @ J + g @ g.T, float)
+
+
 def uncertainties(
-    J: NDArray, names: list[str], values: dict[str, float], scale: float, nfree: int
+    J: NDArray,
+    names: list[str],
+    values: dict[str, float],
+    scale: float,
+    nfree: int,
+    meat: NDArray | None = None,
 ) -> tuple[
     NDArray | None,
     dict[str, float | None],
@@ -70,7 +106,11 @@ def uncertainties(
     dict[str, list[str]],
     float | None,
 ]:
-    """Covariance, stderr, correlations and identifiability reasons from J."""
+    """Covariance, stderr, correlations and identifiability reasons from J.
+
+    With ``meat`` (:func:`noise_meat`) the covariance is the sandwich
+    ``H^-1 meat H^-1`` instead of ``scale H^-1``.
+    """
     n = len(names)
     reasons: dict[str, list[str]] = {k: [] for k in names}
     stderr: dict[str, float | None] = {k: None for k in names}
@@ -103,6 +143,8 @@ def uncertainties(
                         )
         Ci = np.linalg.pinv(C, rcond=1.0 / COND_MAX, hermitian=True)
         sub = Ci / np.outer(d[idx], d[idx]) * scale
+        if meat is not None:
+            sub = sub @ meat[np.ix_(idx, idx)] @ sub / (scale * scale)
         covar[np.ix_(idx, idx)] = sub
     for j, k in enumerate(names):
         if not ok[j] or not covar[j, j] > 0 or any("singular" in r for r in reasons[k]):

@@ -12,6 +12,7 @@ from typing import Any
 
 from .base import Model, ModelError, Parameter, Parameters
 from .five_param import FiveParam
+from .layered import Layered
 from .microfacet import Microfacet
 from .smooth3 import Smooth3
 
@@ -31,6 +32,7 @@ MODELS: dict[str, type[Model]] = {
     "smooth3": Smooth3,
     "five_param": FiveParam,
     "microfacet": Microfacet,
+    "layered": Layered,
 }
 
 

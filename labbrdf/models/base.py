@@ -162,6 +162,12 @@ class Model(ABC):
     specular_line_shape: tuple[str, ...] = ()
     #: what the model's form says about reciprocity, a sentence for reports
     reciprocity_note: str = ""
+    #: smallest step, as a fraction of a parameter's search range, at which finite
+    #: differences of the model are meaningful; None for a smooth (closed-form) model. A
+    #: Monte Carlo model with common random numbers is smooth only on larger scales (a ray
+    #: that changes bin makes a small jump), so the fitter's difference steps and local
+    #: tolerances are kept at or above it
+    fd_rel_step: float | None = None
 
     def __init__(self, **options: Any) -> None:
         self.options: dict[str, Any] = dict(options)
@@ -192,6 +198,39 @@ class Model(ABC):
         wavelength: NDArray | None,
     ) -> dict[str, NDArray] | None:
         """Basis functions b_j with f = sum_j p[j] * b_j over :attr:`linear`, or None."""
+        return None
+
+    def point_variance(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> NDArray | None:
+        """The model's own variance at every point [sr^-2] (Monte Carlo models), or None.
+
+        A fit weighted by the data's sigma adds it to sigma^2 (in quadrature), so the
+        residual weights and the reported uncertainties carry the model's noise. The
+        default (a closed-form model) has none.
+        """
+        return None
+
+    def point_noise(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> NDArray | None:
+        """Components n_k (K, ...) of the model's own noise [sr^-1], or None.
+
+        The noise covariance between points is ``sum_k n_k n_k^T`` (its diagonal is
+        :meth:`point_variance`). A fit weighted by the data's sigma uses it for the
+        parameters' covariance (``labbrdf.fitting.uncertainty.noise_meat``). The default
+        (a closed-form model) has none.
+        """
         return None
 
     def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:

@@ -824,3 +824,58 @@ def reflectance_comparison_figure(
         ncols=2,
         panel_size=panel_size,
     )
+
+
+def fit_maps_figure(model: Any, params: Mapping[str, float], rows: Any, title: str = "") -> str:
+    """Measured BRDF, one fitted model and the relative residual, one row per incidence.
+
+    For a joint fit over several incidences (``labbrdf fit --residual-maps``): the model
+    with ``params`` is evaluated at every row and the panels of :func:`brdf_maps_figure`
+    are drawn (relative residual ``(model - measured) / measured``, blank where the
+    measurement is 0).
+
+    Parameters
+    ----------
+    model : labbrdf.models.Model
+    params : mapping
+        Fitted values (name -> value).
+    rows : pandas.DataFrame
+        ``theta_i_deg``, ``theta_r_deg``, ``phi_r_deg``, ``value`` [sr^-1] and
+        ``wavelength_nm`` (optional).
+    title : str
+
+    Returns
+    -------
+    str
+        PNG data URI.
+    """
+    panels = []
+    for ti, g in rows.groupby("theta_i_deg", sort=True):
+        tr = g["theta_r_deg"].to_numpy(float)
+        pr = g["phi_r_deg"].to_numpy(float)
+        v = g["value"].to_numpy(float)
+        wl = g["wavelength_nm"].to_numpy(float) if "wavelength_nm" in g else None
+        f = np.asarray(
+            model.evaluate(
+                np.radians(np.full(tr.size, float(ti))),
+                np.radians(tr),
+                np.radians(pr),
+                wavelength=wl,
+                params=dict(params),
+            ),
+            float,
+        )
+        with np.errstate(divide="ignore", invalid="ignore"):
+            res = np.where(v > 0, (f - v) / v, np.nan)
+        panels.append(
+            {
+                "label": f"\u03b8i = {float(ti):g}\u00b0",
+                "theta_r": tr,
+                "phi_r": pr,
+                "measured": v,
+                "model": f,
+                "residual": res,
+                "model_label": "model (one fit, all incidences)",
+            }
+        )
+    return brdf_maps_figure(panels, title=title)
