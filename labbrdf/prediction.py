@@ -16,6 +16,12 @@ does that with **no fitted parameter** on a lab's files of one sample:
 * :func:`predict_brdf`: the tracer's S0 (unpolarized incidence) at every point of a measured
   ``.bsdf`` file, with its Monte Carlo error, the grid integral (TIS) of both, and a sentence
   saying where and by how much the prediction misses.
+* :func:`film_coating`: for a coated sample, the coating and the substrate index of its
+  one-layer film fit at the ``.bsdf`` wavelength (``predict_brdf(..., film=fit)``;
+  conformal: the coating's top as rough as the map, incoherent as ``labbrdf trace
+  --coating-from`` builds it);
+* :func:`slope_table`: the map's measured slope table, which ``predict_brdf(..., ndf=)``
+  traces instead of GGX (docs/prediction.md says why GGX is the default).
 
 The workflow layer draws it (:mod:`labbrdf.report.sections.prediction`); nothing here is
 fitted, so a disagreement is a finding about the model (single scattering, GGX, a
