@@ -61,10 +61,15 @@ def same_sample(ctx: Context, a: str, b: str) -> bool:
 def how_to_pair(ctx: Context, files: list[str]) -> str:
     """How a user says that ``files`` (file names) are one sample, in both interfaces.
 
-    The paths are the inputs as given where the report's groups know them.
+    One group holding every file of the groups the files are in now (a file may be in one
+    ``--same-sample`` group only, so groups are merged, not added), spelt as the inputs
+    were given where the report's groups know them.
     """
-    given = {Path(p).name: str(p) for g in ctx.samples for p in g.paths}
-    spelt = [given.get(f, f) for f in files]
+    spelt: list[str] = []
+    for f in files:
+        holding = [g for g in ctx.samples if any(Path(p).name == f for p in g.paths)]
+        members = [str(p) for p in holding[0].paths] if len(holding) == 1 else [f]
+        spelt += [m for m in members if m not in spelt]
     return (
         f"if they are one sample, give the mapping: labbrdf report --same-sample "
         f"{','.join(spelt)} (Python: same_sample=[{spelt!r}])"

@@ -426,20 +426,22 @@ def _fit_file(
     _fit_shown(ctx, tag, src, verdict, fit)
     ctx.film_fits[src] = fit
     own = dict(ellips)
+    apart: list[str] = []
     for j, (rs, rg) in enumerate(refl):
         if not same_sample(ctx, src, rs):
             if len(ellips) == 1 and rs not in own:
-                b.note(
-                    "not compared",
-                    f"reflectance of {rs} with the stack fitted to {src}: no sample name both "
-                    f"files state and no mapping pairs them ({src} being the report's only "
-                    f"psi/Delta file does not make it the same sample); "
-                    f"{how_to_pair(ctx, [src, rs])}",
-                )
+                apart.append(rs)
             continue
         row = _reflectance(ctx, f"{tag}_r{j}_{slug(rs)}", src, fit, rs, rg)
         if row is not None:
             cmp_rows.append(row)
+    if apart:
+        b.note(
+            "not compared",
+            f"reflectance of {', '.join(apart)} with the stack fitted to {src}: no sample "
+            f"name both state and no mapping pairs them ({src} being the report's only "
+            f"psi/Delta file does not make it the same sample); {how_to_pair(ctx, [src, *apart])}",
+        )
 
 
 def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") -> None:

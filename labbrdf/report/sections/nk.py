@@ -439,24 +439,28 @@ def _pairs(
     alone would have paired two files, the note names both and the mapping that pairs them.
     """
     pairs = []
-    for rs, _rg, _ in refl:
+    lone = list(combined) if len(combined) == 1 else []
+    unpaired: list[str] = []
+    for rs, rg, _ in refl:
         # a file with both is compared with its own n, k in its file's part
         match = [s for s in combined if s != rs and same_sample(ctx, s, rs)]
         if not match and rs not in combined:
-            lone = list(combined) if len(combined) == 1 else []
-            ctx.b.note(
-                "not compared",
-                f"reflectance of {rs}: no ellipsometer file of the same sample (no sample name "
-                "both state, no mapping given)"
-                + (
-                    f"; {lone[0]} is the only ellipsometer file of the report, which does not "
-                    f"make it the same sample: {how_to_pair(ctx, [lone[0], rs])}"
-                    if lone
-                    else f"; {how_to_pair(ctx, ['ELLIPSOMETER_FILE', rs])}"
-                ),
-            )
+            unpaired.append(rs)
         for s in match:
-            pairs.append((s, rs, _rg))
+            pairs.append((s, rs, rg))
+    if unpaired:
+        files = ", ".join(unpaired)
+        ctx.b.note(
+            "not compared",
+            f"reflectance of {files}: no ellipsometer file of the same sample (no sample name "
+            "both state, no mapping given)"
+            + (
+                f"; {lone[0]} is the only ellipsometer file of the report, which does not "
+                f"make it the same sample: {how_to_pair(ctx, [lone[0], *unpaired])}"
+                if lone
+                else f"; {how_to_pair(ctx, ['ELLIPSOMETER_FILE', *unpaired])}"
+            ),
+        )
     return pairs
 
 
