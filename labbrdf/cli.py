@@ -1277,6 +1277,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             film_model=default_film_model() if args.film_default else args.film_model,
             executor=executor,
             same_sample=[split_same_sample(v, args.files) for v in args.same_sample or ()],
+            prediction_slopes=args.prediction_slopes,
         )
     )
 
@@ -1727,6 +1728,13 @@ def _report_parser(sub: Any) -> None:
         metavar="A,B[,...]",
         help="these DATA inputs are one sample (repeatable; inputs stating one sample name "
         "are paired anyway)",
+    )
+    s.add_argument(
+        "--prediction-slopes",
+        choices=("ggx", "measured"),
+        default="ggx",
+        help="roughness of the section prediction: the GGX alpha of the height map's slopes "
+        "(default) or their measured table (as trace --surface)",
     )
     s.add_argument("--quiet", action="store_true", help="no progress lines")
     _add_selection(s)

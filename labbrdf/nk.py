@@ -55,6 +55,7 @@ __all__ = [
     "angle_verdict",
     "bulk_index_at",
     "coating_from_fit",
+    "coating_of_stack",
     "combined_table",
     "compare_reflectance",
     "microfacet_hemispherical",
@@ -962,30 +963,85 @@ def coating_from_fit(path: str | os.PathLike[str], wavelength_nm: float) -> tupl
     """
     import json
 
-    from .films import Roughness, Stack  # the film objects, imported where needed
+    from .films import Stack  # the film objects, imported where needed
 
     p = Path(path)
     stack = Stack.from_fit_json(p)
-    names = [lay.name for lay in stack.layers]
-    if len(stack.layers) != 1 or isinstance(stack.layers[0].material, Roughness):
-        raise ValueError(
-            f"{p}: the tracer has one coating over the substrate; this fit's stack has "
-            f"{len(names)} layer(s) {names} (fit one layer, or give --coating and --thickness)"
-        )
-    wl = float(wavelength_nm)
     doc = json.loads(p.read_text("utf-8"))
     rng = doc.get("wavelength_range_nm")
     if not (isinstance(rng, list) and len(rng) == 2):
         raise ValueError(f"{p}: no 'wavelength_range_nm' (not a film fit of labbrdf)")
-    lo, hi = float(rng[0]), float(rng[1])
+    layer_n, thickness, _ = coating_of_stack(
+        stack,
+        wavelength_nm,
+        (float(rng[0]), float(rng[1])),
+        where=str(p),
+        hint="fit one layer, or give --coating and --thickness",
+    )
+    return layer_n, thickness
+
+
+def coating_of_stack(
+    stack: Any,
+    wavelength_nm: float,
+    fitted_range_nm: tuple[float, float],
+    *,
+    where: str,
+    hint: str = "fit one layer",
+) -> tuple[complex, float, complex]:
+    """The tracer's coating and substrate from a fitted one-layer stack, at one wavelength.
+
+    Parameters
+    ----------
+    stack : labbrdf.films.Stack
+        The fitted stack (:attr:`labbrdf.FilmFit.stack`), one layer over the substrate.
+    wavelength_nm : float
+        Vacuum wavelength [nm], inside ``fitted_range_nm``.
+    fitted_range_nm : (float, float)
+        The wavelengths the fit saw [nm]; a dispersion model is not extrapolated beyond
+        the data that fixed it.
+    where : str
+        The fit's origin (a file), named in the errors.
+    hint : str
+        What to do about a stack of another shape, appended to that error.
+
+    Returns
+    -------
+    layer_index : complex
+        The layer's ``n + ik`` at ``wavelength_nm`` [1].
+    thickness_nm : float
+        Its thickness [nm].
+    substrate_index : complex
+        The stack's substrate ``n + ik`` at ``wavelength_nm`` [1].
+
+    Raises
+    ------
+    ValueError
+        No layer, several layers or a roughness layer, or a wavelength outside the fitted
+        range.
+    """
+    from .films import Roughness
+
+    names = [lay.name for lay in stack.layers]
+    if len(stack.layers) != 1 or isinstance(stack.layers[0].material, Roughness):
+        raise ValueError(
+            f"{where}: the tracer has one coating over the substrate; this fit's stack has "
+            f"{len(names)} layer(s) {names} ({hint})"
+        )
+    wl = float(wavelength_nm)
+    lo, hi = float(fitted_range_nm[0]), float(fitted_range_nm[1])
     if not (math.isfinite(wl) and lo <= wl <= hi):
         raise ValueError(
-            f"{p}: {wl:g} nm is outside the fitted range [{lo:g}, {hi:g}] nm; the layer's "
+            f"{where}: {wl:g} nm is outside the fitted range [{lo:g}, {hi:g}] nm; the layer's "
             "dispersion is not extrapolated"
         )
     layer = stack.layers[0]
-    big_n = complex(np.asarray(stack.nk(wl)[layer.name]).ravel()[0])
-    return big_n, float(layer.thickness_nm)
+    at = stack.nk(wl)
+    return (
+        complex(np.asarray(at[layer.name]).ravel()[0]),
+        float(layer.thickness_nm),
+        complex(np.asarray(at["substrate"]).ravel()[0]),
+    )
 
 
 _SERIES = ("time_s", "x_mm", "y_mm")

@@ -16,6 +16,12 @@ does that with **no fitted parameter** on a lab's files of one sample:
 * :func:`predict_brdf`: the tracer's S0 (unpolarized incidence) at every point of a measured
   ``.bsdf`` file, with its Monte Carlo error, the grid integral (TIS) of both, and a sentence
   saying where and by how much the prediction misses.
+* :func:`film_coating`: for a coated sample, the coating and the substrate index of its
+  one-layer film fit at the ``.bsdf`` wavelength (``predict_brdf(..., film=fit)``;
+  conformal: the coating's top as rough as the map, incoherent as ``labbrdf trace
+  --coating-from`` builds it);
+* :func:`slope_table`: the map's measured slope table, which ``predict_brdf(..., ndf=)``
+  traces instead of GGX (docs/prediction.md says why GGX is the default).
 
 The workflow layer draws it (:mod:`labbrdf.report.sections.prediction`); nothing here is
 fitted, so a disagreement is a finding about the model (single scattering, GGX, a
@@ -58,10 +64,11 @@ from numpy.typing import NDArray
 from .adapters import zemax_bsdf
 from .bsdf_geometry import scatter_to_angles, scatter_to_direction
 from .integrate import grid_integral
-from .nk import combined_table, nk_at, ordinary_psi_delta
+from .nk import coating_of_stack, combined_table, nk_at, ordinary_psi_delta
 from .specular_dop import specular_dop
 from .topography import SlopeFit, fit_slope_distribution, level, slopes
 from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
+from .tracer.sampling import TabulatedNDF
 
 __all__ = [
     "DEFAULT_RAYS",
@@ -70,8 +77,10 @@ __all__ = [
     "DopComparison",
     "PredictionError",
     "ellipsometer_dop",
+    "film_coating",
     "predict_brdf",
     "roughness_alpha",
+    "slope_table",
     "specular_dop_comparison",
     "substrate_nk",
 ]
@@ -244,6 +253,113 @@ def substrate_nk(
         raise PredictionError(f"{src}: {exc}") from None
 
 
+def slope_table(heights: Any, pixel_size: float | Sequence[float] | None = None) -> TabulatedNDF:
+    """The measured slope table of an areal height map (what ``labbrdf trace --surface`` uses).
+
+    :meth:`labbrdf.Substrate.from_surface` (mean plane removed, 64 slope cells per axis).
+
+    Raises
+    ------
+    PredictionError
+        A profile, or a map without a pixel size (as :func:`roughness_alpha`).
+    """
+    where = ""
+    if hasattr(heights, "heights") and hasattr(heights, "pixel_size"):
+        where = f"{heights.path}: "
+        pixel_size = heights.pixel_size
+        heights = heights.heights
+    z = np.asarray(heights, dtype=float)
+    if z.ndim != 2:
+        raise PredictionError(
+            f"{where}a line profile; a slope table needs an areal height map (2-D)"
+        )
+    if pixel_size is None:
+        raise PredictionError("pixel_size is needed for a plain height array")
+    px = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (2,)))
+    try:
+        ndf = Substrate.from_surface(z, (px[0], px[1])).ndf
+    except ValueError as exc:
+        raise PredictionError(f"{where}{exc}") from None
+    assert ndf is not None
+    return ndf
+
+
+def film_coating(
+    fit: Any,
+    wavelength_nm: float,
+    roughness: SlopeFit | float,
+    *,
+    ndf: TabulatedNDF | None = None,
+) -> tuple[Coating, complex]:
+    """The tracer's coating and substrate index from a one-layer film fit of the sample.
+
+    The layer's index at ``wavelength_nm`` and its fitted thickness become the
+    :class:`~labbrdf.Coating` (as ``labbrdf trace --coating-from`` does with a saved fit,
+    :func:`labbrdf.nk.coating_of_stack`), the fit's substrate index the substrate's.
+
+    Parameters
+    ----------
+    fit : labbrdf.FilmFit
+        A film fit (:func:`labbrdf.fit_film`) of the sample's psi/Delta, one layer.
+    wavelength_nm : float
+        The wavelength traced [nm], inside the fit's wavelength range.
+    roughness : SlopeFit or float
+        GGX alpha [1] of the height map, given to the coating's top.
+    ndf : TabulatedNDF, optional
+        The height map's measured slope table for the coating's top instead of GGX.
+
+    Returns
+    -------
+    coating : Coating
+    substrate_index : complex
+        The fit's substrate ``n + ik`` at ``wavelength_nm`` [1] (the psi/Delta of a coated
+        sample are the stack's: their two-phase inversion is no substrate's index).
+
+    Raises
+    ------
+    PredictionError
+        A stack of more than one layer (or a roughness layer), a wavelength outside the
+        fitted range, or a layer the tracer cannot hold (0 nm: the incoherent coating
+        needs a thickness).
+
+    Notes
+    -----
+    Conformal coating: the height map is taken as measured on the coating's top, and the
+    substrate below has the same roughness (the tracer's default for ``--coating-from``,
+    the substrate's alpha). The coating is incoherent (intensities, Beer-Lambert in the
+    layer), as :func:`labbrdf.tracer_setup.trace_config_from_inputs` builds it; the film
+    fit itself is coherent, so thin-film interference colours the fit, not the prediction.
+    """
+    d = getattr(fit, "data", None)
+    src = "film fit"
+    if d is not None and "source" in d.columns and len(d):
+        src = "film fit of " + ", ".join(sorted(set(d["source"].astype(str))))[:200]
+    w = np.asarray(d["wavelength_nm"], float) if d is not None else np.array([np.nan])
+    try:
+        layer_n, thickness, sub = coating_of_stack(
+            fit.stack,
+            wavelength_nm,
+            (float(np.nanmin(w)), float(np.nanmax(w))),
+            where=src,
+            hint="the prediction traces one coating; fit a one-layer model",
+        )
+    except ValueError as exc:
+        raise PredictionError(str(exc)) from None
+    alpha = float(roughness.alpha) if isinstance(roughness, SlopeFit) else float(roughness)
+    if not thickness > 0:
+        raise PredictionError(
+            f"{src}: the fitted layer is {thickness:g} nm thick; an incoherent coating needs "
+            "a thickness > 0 (a 0 nm layer is the bare substrate)"
+        )
+    try:
+        coating = Coating(
+            n=layer_n.real, k=layer_n.imag, thickness_nm=thickness, alpha=alpha, ndf=ndf
+        )
+    except ValueError as exc:
+        raise PredictionError(f"{src}: {exc}") from None
+    return coating, sub
+
+
 # --------------------------------------------------------------------------- tracer runs
 
 
@@ -257,16 +373,19 @@ def _config(
     rays: int,
     seed: int,
     step_deg: float,
+    ndf: TabulatedNDF | None = None,
 ) -> TraceConfig:
+    # evaluated wherever it applies (a GGX first interface, or a bare substrate's table);
+    # a measured table on a coating's top is counted
     return TraceConfig(
         wavelength_nm=float(wavelength_nm),
         theta_i_deg=float(theta_i_deg),
-        substrate=Substrate(n=float(n), k=float(k), alpha=float(alpha)),
+        substrate=Substrate(n=float(n), k=float(k), alpha=float(alpha), ndf=ndf),
         coating=coating,
         rays=int(rays),
         seed=int(seed),
         scattering="single",
-        estimator="evaluated",
+        estimator="auto",
         theta_step_deg=float(step_deg),
         phi_step_deg=float(step_deg),
     )
@@ -439,6 +558,11 @@ class BrdfPrediction:
         Rays per incidence and the tracers' total time [s].
     coating : dict or None
         The coating used, if any.
+    slopes : {"ggx", "measured"}
+        The substrate's facets: GGX of ``alpha``, or the height map's measured slope table.
+    index_from : {"psi/Delta", "film fit", "given"}
+        Where the substrate's n, k came from: the two-phase inversion of the psi/Delta, the
+        substrate of a film fit, or the caller.
     """
 
     path: str
@@ -471,6 +595,8 @@ class BrdfPrediction:
     rays: int
     seconds: float
     coating: dict[str, Any] | None = None
+    slopes: str = "ggx"
+    index_from: str = "psi/Delta"
     region_table: pd.DataFrame = field(default_factory=pd.DataFrame, repr=False)
     results: list[TraceResult] = field(default_factory=list, repr=False)
 
@@ -661,11 +787,14 @@ def _checked_table(
 
 def predict_brdf(
     bsdf: str | os.PathLike[str] | zemax_bsdf.BsdfTable,
-    data: pd.DataFrame,
+    data: pd.DataFrame | None,
     roughness: SlopeFit | float,
     *,
     wavelength_nm: float | None = None,
     coating: Coating | None = None,
+    substrate_index: complex | None = None,
+    film: Any = None,
+    ndf: TabulatedNDF | None = None,
     rays: int = DEFAULT_RAYS,
     seed: int = 0,
     step_deg: float = 1.0,
@@ -677,8 +806,9 @@ def predict_brdf(
     ----------
     bsdf : path-like or BsdfTable
         The measured BRDF (one rotation, monochrome, ``BRDF``).
-    data : pandas.DataFrame
-        psi/Delta rows of the same sample (the substrate's n, k, :func:`substrate_nk`).
+    data : pandas.DataFrame or None
+        psi/Delta rows of the same sample (the substrate's n, k, :func:`substrate_nk`);
+        not used (may be None) when ``substrate_index`` is given.
     roughness : SlopeFit or float
         The substrate's GGX alpha [1] (:func:`roughness_alpha` of its height map, whose
         ``alpha_u`` is carried along).
@@ -686,7 +816,18 @@ def predict_brdf(
         Wavelength of the BRDF [nm]; default the one the file states (a ``#labbrdf
         wavelength_nm`` or ``#Wavelength (nm) =`` comment).
     coating : Coating, optional
-        A coating over the substrate.
+        A coating over the substrate (:func:`film_coating`).
+    substrate_index : complex, optional
+        The substrate's ``n + ik`` [1] at the wavelength, e.g. a film fit's substrate
+        (:func:`film_coating`), instead of the two-phase n, k of ``data``.
+    film : labbrdf.FilmFit, optional
+        A one-layer film fit of the sample: the coating and the substrate index at the
+        file's wavelength (:func:`film_coating`, conformal: the coating's top gets the
+        substrate's roughness); instead of ``coating`` and ``substrate_index``.
+    ndf : TabulatedNDF, optional
+        The height map's measured slope table (:func:`slope_table`) on the substrate
+        instead of GGX with ``roughness``'s alpha (which still sets the specular lobe's
+        width).
     rays, seed, step_deg :
         Rays per incidence, seed, tracer bin width [deg].
     map : callable
@@ -700,12 +841,30 @@ def predict_brdf(
     ------
     PredictionError
         A file with several rotations, tristimulus channels or BTDF data; no stated
-        wavelength and none given; n, k not available at the wavelength.
+        wavelength and none given; n, k not available at the wavelength; ``film`` with
+        ``coating`` or ``substrate_index``, or a film fit that gives no coating there
+        (:func:`film_coating`).
     labbrdf.adapters.AdapterError
         A file that is not a readable ``.bsdf``.
     """
     t, path, wl = _checked_table(bsdf, wavelength_nm)
-    nk = substrate_nk(data, [float(wl)])
+    index_from = "psi/Delta"
+    if film is not None:
+        if coating is not None or substrate_index is not None:
+            raise PredictionError(
+                f"{path}: give the coating once: a film fit, or a coating and substrate index"
+            )
+        coating, substrate_index = film_coating(film, float(wl), roughness, ndf=ndf)
+        index_from = "film fit"
+    elif substrate_index is not None:
+        index_from = "given"
+    if substrate_index is not None:
+        nk = {"n": [substrate_index.real], "k": [substrate_index.imag]}
+        nk.update(n_sigma=[math.nan], k_sigma=[math.nan])
+    elif data is None:
+        raise PredictionError(f"{path}: give the psi/Delta rows or the substrate index")
+    else:
+        nk = substrate_nk(data, [float(wl)])
     if isinstance(roughness, SlopeFit):
         alpha, alpha_u = float(roughness.alpha), float(roughness.alpha_u)
     else:
@@ -716,7 +875,7 @@ def predict_brdf(
     meas = np.where(above, t.values[0, 0], 0.0)
     n0, k0 = float(nk["n"][0]), float(nk["k"][0])
     runs = [
-        trace(_config(float(wl), th, n0, k0, alpha, coating, rays, seed, step_deg), map=map)
+        trace(_config(float(wl), th, n0, k0, alpha, coating, rays, seed, step_deg, ndf), map=map)
         for th in ti
     ]
     pred, se = _sampled(runs, tr, pr, above)
@@ -770,6 +929,8 @@ def predict_brdf(
         rays=int(rays),
         seconds=seconds,
         coating=None if coating is None else coating.to_dict(),
+        slopes="ggx" if ndf is None else "measured",
+        index_from=index_from,
         region_table=region_table,
         results=results,
     )

@@ -33,7 +33,7 @@ from .sections.ingest import ingest_inputs, sample_groups
 from .sections.measured import measured_section
 from .sections.nk import nk_section
 from .sections.physics import physics_section
-from .sections.prediction import prediction_section
+from .sections.prediction import SLOPES, prediction_section
 from .sections.scans import scans_section
 from .sections.smoothness import smoothness_section
 from .sections.spectra import spectra_section
@@ -85,6 +85,7 @@ def user_report(
     selection: Mapping[str, Any] | None = None,
     film_model: str | os.PathLike[str] | FilmModel | None = None,
     same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
+    prediction_slopes: str = "ggx",
     **kw: Any,
 ) -> int:
     """Build a report for the given files and write it (atomically) to ``out``.
@@ -129,6 +130,10 @@ def user_report(
         Files that are one sample, one sequence per sample (each file among ``paths``),
         in addition to the sample names the files state (:func:`labbrdf.samples.pair_samples`);
         the section ``ingest`` shows the groups and why.
+    prediction_slopes : {"ggx", "measured"}
+        The roughness the section ``prediction`` traces: the GGX alpha of the height map's
+        slopes (default), or their measured table
+        (:mod:`labbrdf.report.sections.prediction` says why GGX is the default).
     **kw :
         ``quick`` is accepted for symmetry with :func:`~labbrdf.report.validate` (no effect).
 
@@ -143,12 +148,17 @@ def user_report(
     ValueError
         No paths, an unknown model name or option, a film model file with an error
         (naming the file and the line), a ``same_sample`` mapping that cannot hold
-        (:class:`labbrdf.samples.PairingError`), or an output folder that is refused
+        (:class:`labbrdf.samples.PairingError`), an unknown ``prediction_slopes``, or an
+        output folder that is refused
         (:class:`labbrdf.outputs.OutputError`), all before any work.
     """
     unknown = set(kw) - {"quick"}
     if unknown:
         raise TypeError(f"user_report() got unexpected keyword argument(s) {sorted(unknown)}")
+    if prediction_slopes not in SLOPES:
+        raise ValueError(
+            f"prediction_slopes: expected one of {', '.join(SLOPES)}, got {prediction_slopes!r}"
+        )
     paths, model_file, opts = _refused_early(paths, model, options, out, film_model, same_sample)
     film, film_how = film_model_of(film_model)
     b = Builder(
@@ -163,6 +173,7 @@ def user_report(
             "seed": seed,
             "files": [str(p) for p in paths],
             "film_model": film_how or None,
+            "prediction_slopes": prediction_slopes,
             "environment": versions(),
         },
     )
@@ -174,7 +185,9 @@ def user_report(
         fit_options={"params": dict(start)} if start else {},
     )
 
-    sections = _sections(model, opts, film, film_how, paths, selection, same_sample)
+    sections = _sections(
+        model, opts, film, film_how, paths, selection, same_sample, prediction_slopes
+    )
     run(ctx, sections)
     if title is None and not _fitted(b.results):
         b.results["title"] = f"labbrdf report: {len(paths)} file(s), nothing fitted"
@@ -256,6 +269,7 @@ def _sections(
     paths: Sequence[str | os.PathLike[str]],
     selection: Mapping[str, Any] | None,
     same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
+    prediction_slopes: str = "ggx",
 ) -> list[Section]:
     """The user report's sections, in order, bound to its model, film model and files."""
     return [
@@ -294,6 +308,6 @@ def _sections(
         (
             "prediction",
             "Predict, then measure: the tracer's prediction beside the BRDF",
-            prediction_section,
+            lambda ctx: prediction_section(ctx, slopes=prediction_slopes),
         ),
     ]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -21,8 +22,8 @@ RP = "woollam-wvase-ascii/ta2o5_02262007_rp.dat"
 MAP = "accurion-ep4-dat/post synthesis.dat"
 
 
-def _report(paths: list[Path], out: Path) -> dict:
-    code = user_report(paths, "smooth3", out, progress=False)
+def _report(paths: list[Path], out: Path, **kw: Any) -> dict:
+    code = user_report(paths, "smooth3", out, progress=False, **kw)
     res = json.loads((out / "results.json").read_text())
     assert code == res["summary"]["exit_code"]
     return res
@@ -99,7 +100,9 @@ def test_reflectance_comparison_with_a_spectrophotometer(
     )
     spectro = tmp_path / "ta_spectro.csv"
     write_csv(Measurement(frame, {}), spectro)
-    res = _report([real_exports / TA, spectro], tmp_path / "rep")
+    # the two files state different sample names: paired by the mapping
+    pair = [real_exports / TA, spectro]
+    res = _report(pair, tmp_path / "rep", same_sample=[pair])
     rows = res["tables"]["nk_reflectance_comparison"]["rows"]
     assert len(rows) == 1 and rows[0]["refl_file"] == "ta_spectro.csv"
     assert rows[0]["points"] == len(wl)

@@ -18,7 +18,8 @@ W1_RS = "woollam-wvase-ascii/w1_12082006_s-pol_refl.dat"
 def trio(real_exports: Path, tmp_path_factory: pytest.TempPathFactory) -> dict:
     out = tmp_path_factory.mktemp("trio") / "rep"
     paths = [real_exports / p for p in (W1, W1_RP, W1_RS)]
-    code = user_report(paths, "smooth3", out, progress=False)
+    # three files of one wafer that state three different names: paired by the mapping
+    code = user_report(paths, "smooth3", out, progress=False, same_sample=[paths])
     res = json.loads((out / "results.json").read_text())
     res["_code"] = code
     res["_page"] = (out / "index.html").read_text()

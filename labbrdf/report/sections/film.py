@@ -8,7 +8,7 @@ this section fits it to the file's psi/Delta at every angle (:func:`labbrdf.fit_
 and shows the model, the parameters with their intervals, psi and Delta against wavelength
 per angle with the fit and the residuals, each layer's n, k with its uncertainty band, and
 the reflectance comparison redone with the fitted stack: the measured reflectance of the
-same sample (not used by the fit) against the stack's R_s, R_p
+same sample (:mod:`labbrdf.report.pairing`; not used by the fit) against the stack's R_s, R_p
 (:meth:`labbrdf.FilmFit.compare_reflectance`), inside the fitted wavelength range.
 
 Uncertainties of derived curves (n, k of a layer, predicted R) are first-order: central
@@ -32,6 +32,7 @@ from ... import nk as nkmod
 from .. import figures
 from ..builder import Unavailable, slug
 from ..context import Context
+from ..pairing import how_to_pair, same_sample
 from .measured import file_frames
 from .nk import P_AGREE
 
@@ -400,9 +401,12 @@ def _fit_file(
 ) -> None:
     """Fit ``model`` to one file, show it, and compare the stack with measured reflectance.
 
-    Reflectance of the same file or sample, or any when the report has one psi/Delta file;
-    the comparison rows are added to ``cmp_rows``. A model that cannot be fitted is a
-    failed check.
+    Reflectance of the same file or of the same sample
+    (:func:`labbrdf.report.pairing.same_sample`: a sample name both files state, or the
+    user's mapping); the comparison rows are added to ``cmp_rows``. A reflectance file of
+    no sample of a fitted file gets a note saying how to pair it (one psi/Delta file in a
+    report does not make its reflectance files the same sample). A model that cannot be
+    fitted is a failed check.
     """
     b = ctx.b
     tag = f"{i}_{slug(src)}"
@@ -421,14 +425,23 @@ def _fit_file(
         return
     _fit_shown(ctx, tag, src, verdict, fit)
     ctx.film_fits[src] = fit
-    samples = {str(x).lower() for x in g["sample"]}
+    own = dict(ellips)
+    apart: list[str] = []
     for j, (rs, rg) in enumerate(refl):
-        same = rs == src or bool(samples & {str(x).lower() for x in rg["sample"]})
-        if not same and not (len(ellips) == 1 and rs not in dict(ellips)):
+        if not same_sample(ctx, src, rs):
+            if len(ellips) == 1 and rs not in own:
+                apart.append(rs)
             continue
         row = _reflectance(ctx, f"{tag}_r{j}_{slug(rs)}", src, fit, rs, rg)
         if row is not None:
             cmp_rows.append(row)
+    if apart:
+        b.note(
+            "not compared",
+            f"reflectance of {', '.join(apart)} with the stack fitted to {src}: no sample "
+            f"name both state and no mapping pairs them ({src} being the report's only "
+            f"psi/Delta file does not make it the same sample); {how_to_pair(ctx, [src, *apart])}",
+        )
 
 
 def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") -> None:

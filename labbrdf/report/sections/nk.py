@@ -5,8 +5,8 @@ Per file with psi/Delta rows: the two-phase pseudo-constants of every point
 with the angle-to-angle consistency test (:func:`labbrdf.nk.combined_table`), and a plain
 flag where the angles disagree. From the combined ``n, k``: the Fresnel reflectances
 ``R_s, R_p`` and their mean at normal incidence, compared with measured reflectance rows
-(:func:`labbrdf.nk.compare_reflectance`) of the same file, of the same sample, or of the one
-spectrophotometer file in the report when there is exactly one ellipsometer file.
+(:func:`labbrdf.nk.compare_reflectance`) of the same file or of the same sample
+(:mod:`labbrdf.report.pairing`: a sample name the files state, or the user's mapping).
 """
 
 from __future__ import annotations
@@ -22,6 +22,7 @@ from ... import nk as nkmod
 from .. import figures
 from ..builder import Unavailable, slug
 from ..context import Context
+from ..pairing import how_to_pair, same_sample
 from .measured import file_frames
 
 __all__ = ["P_AGREE", "nk_section"]
@@ -427,27 +428,39 @@ def _pairs(
 ) -> list[tuple[str, str, pd.DataFrame]]:
     """(n, k file, reflectance file, its rows) of the cross-instrument comparisons.
 
-    An ellipsometer file of the same sample, or the only one in the report; a note for a
-    reflectance file with neither.
+    An ellipsometer file of the same sample (:func:`labbrdf.report.pairing.same_sample`:
+    a sample name both files state, or the user's mapping); a note for a reflectance file
+    with none, saying how to pair it.
+
+    Notes
+    -----
+    Files are never paired because the report holds one ellipsometer file: a spectrophotometer
+    file of another sample would then be judged against the wrong n, k. Where that count
+    alone would have paired two files, the note names both and the mapping that pairs them.
     """
     pairs = []
+    lone = list(combined) if len(combined) == 1 else []
+    unpaired: list[str] = []
     for rs, rg, _ in refl:
-        rsamples = {str(s).lower() for s in rg["sample"]}
-        match = [
-            s
-            for s, _g, _m in ellips
-            if s != rs and s in combined and rsamples & {str(x).lower() for x in _g["sample"]}
-        ]
-        if not match and len(combined) == 1 and rs not in combined:
-            match = list(combined)
+        # a file with both is compared with its own n, k in its file's part
+        match = [s for s in combined if s != rs and same_sample(ctx, s, rs)]
         if not match and rs not in combined:
-            ctx.b.note(
-                "not compared",
-                f"reflectance of {rs}: no ellipsometer file of the same sample (and not exactly "
-                "one ellipsometer file in the report) - give the two files together to compare",
-            )
+            unpaired.append(rs)
         for s in match:
             pairs.append((s, rs, rg))
+    if unpaired:
+        files = ", ".join(unpaired)
+        ctx.b.note(
+            "not compared",
+            f"reflectance of {files}: no ellipsometer file of the same sample (no sample name "
+            "both state, no mapping given)"
+            + (
+                f"; {lone[0]} is the only ellipsometer file of the report, which does not "
+                f"make it the same sample: {how_to_pair(ctx, [lone[0], *unpaired])}"
+                if lone
+                else f"; {how_to_pair(ctx, ['ELLIPSOMETER_FILE', *unpaired])}"
+            ),
+        )
     return pairs
 
 

@@ -2,8 +2,25 @@
 
 For every sample (files grouped by :mod:`labbrdf.samples`: the sample names the files state,
 or ``--same-sample``) that has an areal height map, a psi/Delta file and a measured ``.bsdf``,
-the tracer predicts with NO fitted parameter (:mod:`labbrdf.prediction`): the substrate's
-GGX alpha from the height map, its n, k from the psi/Delta. The section draws
+the tracer predicts with NO parameter fitted to the BRDF (:mod:`labbrdf.prediction`): the
+roughness from the height map, the substrate's n, k from the psi/Delta. Where section
+``film`` fitted a one-layer stack to the sample's psi/Delta (:attr:`Context.film_fits`), that
+layer is the tracer's coating (its index at the ``.bsdf`` wavelength and its thickness,
+incoherent as ``labbrdf trace --coating-from`` builds it) and the fit's substrate the
+substrate: the two-phase n, k of a coated sample's psi/Delta are no material's. The height
+map is taken as measured on the coating's top and the coating as conformal (the substrate
+below has the same roughness).
+
+The roughness is, by default, the GGX alpha of the map's slopes (maximum likelihood); with
+``slopes="measured"`` (``--prediction-slopes measured``) the map's own slope table
+(:meth:`labbrdf.Substrate.from_surface`, as ``labbrdf trace --surface``). GGX is the default
+because the section is a test of a model with stated parameters: the alpha comes with its
+uncertainty and a smooth tail, while the table of a finite map is its pixel-scale slopes,
+with an empty tail beyond the steepest sampled slope and, on a coating's top, only the
+noisier counting estimator (the evaluated one needs a GGX top). The measured table is the
+check of GGX itself: where the two predictions differ, the slope distribution matters.
+
+The section draws
 
 * the specular DOP for unpolarized light, ellipsometer (|cos 2psi|, with its depolarization
   channel) beside the tracer's specular bin with its batch error, per wavelength against
@@ -28,6 +45,7 @@ from ...prediction import (
     PredictionError,
     predict_brdf,
     roughness_alpha,
+    slope_table,
     specular_dop_comparison,
 )
 from .. import figures
@@ -35,10 +53,12 @@ from ..builder import Unavailable, slug
 from ..context import Context
 from .tracer import _map
 
-__all__ = ["prediction_section", "sample_inputs"]
+__all__ = ["SLOPES", "prediction_section", "sample_inputs"]
 
 #: |z| above which a tracer DOP is called inconsistent with the ellipsometer's
 DOP_Z_MAX = 3.0
+#: the roughness models the section offers (module docstring)
+SLOPES = ("ggx", "measured")
 
 
 def _frame_of(ctx: Context, path: Path) -> pd.DataFrame | None:
@@ -58,7 +78,8 @@ def sample_inputs(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, An
     -------
     (ready, lacking)
         ``ready``: ``{"name", "reason", "height_map", "psi_delta" (path, frame),
-        "bsdf" [paths]}``; ``lacking``: ``{"sample", "files", "missing"}``.
+        "film" (its film fit or None), "bsdf" [paths]}``; ``lacking``: ``{"sample",
+        "files", "missing"}``.
     """
     maps = {str(Path(h.path)): h for h in ctx.height_maps if not h.is_profile}
     bsdf = {
@@ -75,6 +96,8 @@ def sample_inputs(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, An
             fr = _frame_of(ctx, p)
             if fr is not None and (fr["quantity"].astype(str) == "psi").any():
                 psi.append((p, fr))
+        # a psi/Delta file with a film fit first: its stack is the sample's
+        psi.sort(key=lambda pf: pf[0].name not in ctx.film_fits)
         bs = [p for p in paths if str(p) in bsdf]
         missing = [
             what
@@ -100,6 +123,7 @@ def sample_inputs(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, An
                 "reason": g.reason,
                 "height_map": hms[0],
                 "psi_delta": psi[0],
+                "film": ctx.film_fits.get(psi[0][0].name),
                 "bsdf": bs,
                 "unused": [Path(h.path).name for h in hms[1:]] + [p.name for p, _ in psi[1:]],
             }
@@ -107,8 +131,23 @@ def sample_inputs(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, An
     return ready, lacking
 
 
-def prediction_section(ctx: Context) -> None:
-    """One part per sample with a height map, psi/Delta and a measured BRDF."""
+def prediction_section(ctx: Context, *, slopes: str = "ggx") -> None:
+    """One part per sample with a height map, psi/Delta and a measured BRDF.
+
+    Parameters
+    ----------
+    ctx : Context
+    slopes : {"ggx", "measured"}
+        The roughness traced: the GGX alpha of the height map's slopes, or their measured
+        table (module docstring).
+
+    Raises
+    ------
+    ValueError
+        ``slopes`` of another value.
+    """
+    if slopes not in SLOPES:
+        raise ValueError(f"slopes: expected one of {', '.join(SLOPES)}, got {slopes!r}")
     b = ctx.b
     ready, lacking = sample_inputs(ctx)
     if not ready:
@@ -117,16 +156,26 @@ def prediction_section(ctx: Context) -> None:
             "needs an areal height map, a psi/Delta file and a .bsdf BRDF of ONE sample "
             f"(paired by the sample names in the files or --same-sample); {why}"
         )
+    rough = (
+        "the GGX roughness alpha of the maximum-likelihood fit of the height map's slopes "
+        "(the measured slope table: --prediction-slopes measured)"
+        if slopes == "ggx"
+        else "the height map's measured slope table (its GGX alpha, the maximum-likelihood "
+        "fit, only sets the width of the specular lobe in the tables)"
+    )
     b.text(
-        "Predict, then measure: the Monte Carlo polarization tracer (single scattering, "
-        "evaluated estimator) predicts the sample's BRDF and specular DOP with no fitted "
-        "parameter. The substrate's GGX roughness alpha is the maximum-likelihood fit of the "
-        "height map's slopes; its n, k are the two-phase inversion of the psi/Delta, combined "
-        "over the angles of incidence. A disagreement is therefore a finding about the model "
-        "(single scattering, a GGX slope distribution, a bare substrate) or the samples, not "
-        "a fit residual. Monte Carlo errors are the spread of the tracer's 8 independent "
-        f"batches ({DEFAULT_RAYS} rays per run; a bare substrate's single scattering is "
-        "closed form and has none)."
+        "Predict, then measure: the Monte Carlo polarization tracer (single scattering; "
+        "evaluated estimator, counted where a coating's top is a measured table) predicts "
+        "the sample's BRDF and specular DOP with no parameter fitted to them. The roughness "
+        f"is {rough}; the substrate's n, k are the two-phase inversion of the psi/Delta, "
+        "combined over the angles of incidence, or, where section film fitted a one-layer "
+        "stack to the sample's psi/Delta, the stack's substrate, with its layer as an "
+        "incoherent coating (conformal: the height map is taken as measured on the "
+        "coating's top, the substrate below as equally rough). A disagreement is therefore "
+        "a finding about the model (single scattering, the slope distribution, the stack) "
+        "or the samples, not a fit residual. Monte Carlo errors are the spread of the "
+        f"tracer's 8 independent batches ({DEFAULT_RAYS} rays per run; a bare substrate's "
+        "single scattering is closed form and has none)."
     )
     if lacking:
         b.table(
@@ -136,39 +185,54 @@ def prediction_section(ctx: Context) -> None:
             lacking,
         )
     for s in ready:
-        _one_sample(ctx, s)
+        _one_sample(ctx, s, slopes)
 
 
-def _one_sample(ctx: Context, s: dict[str, Any]) -> None:
+def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
     b = ctx.b
     sid = slug(s["name"])
     hm = s["height_map"]
     psi_path, frame = s["psi_delta"]
+    film = s.get("film")
     b.heading(f"Sample {s['name']}", anchor=f"prediction-{sid}")
     try:
         fit = roughness_alpha(hm)
+        ndf = slope_table(hm) if slopes == "measured" else None
     except PredictionError as exc:
         b.note("not predicted", str(exc))
         return
     b.text(
         f"Files: {Path(hm.path).name} (height map), {psi_path.name} (psi/Delta), "
         f"{', '.join(p.name for p in s['bsdf'])} (measured BRDF); {s['reason']}. GGX alpha "
-        f"from the height map: {fit.alpha:.4g} +- {fit.alpha_u:.2g}."
+        f"from the height map: {fit.alpha:.4g} +- {fit.alpha_u:.2g}"
+        + ("; traced: the map's measured slope table." if ndf is not None else ".")
         + (
             f" Not used (the first height map and psi/Delta file are): {', '.join(s['unused'])}."
             if s["unused"]
             else ""
         )
     )
-    try:
-        dop = specular_dop_comparison(frame, fit.alpha, seed=ctx.seed, map=_map(ctx))
-    except PredictionError as exc:
-        b.note("specular DOP not predicted", str(exc))
+    if film is not None:
+        b.text(
+            f"{psi_path.name} has a film fit (section film): the substrate is the fit's, the "
+            "coating its layer (per .bsdf file below)."
+        )
+        b.note(
+            "specular DOP not compared",
+            f"{psi_path.name} is the psi/Delta of a coated sample: the ellipsometer's "
+            "|cos 2psi| is the coherent film's, while the tracer's coating is incoherent "
+            "(intensities add, which depolarizes), so the two DOPs differ by construction.",
+        )
     else:
-        _dop_part(ctx, sid, dop)
+        try:
+            dop = specular_dop_comparison(frame, fit.alpha, seed=ctx.seed, map=_map(ctx))
+        except PredictionError as exc:
+            b.note("specular DOP not predicted", str(exc))
+        else:
+            _dop_part(ctx, sid, dop)
     for path in s["bsdf"]:
         try:
-            pred = predict_brdf(path, frame, fit, seed=ctx.seed, map=_map(ctx))
+            pred = predict_brdf(path, frame, fit, film=film, ndf=ndf, seed=ctx.seed, map=_map(ctx))
         except (PredictionError, ValueError) as exc:
             b.note(f"{path.name} not predicted", str(exc))
             continue
@@ -259,11 +323,7 @@ def _dop_part(ctx: Context, sid: str, c: DopComparison) -> None:
 def _brdf_part(ctx: Context, sid: str, p: BrdfPrediction) -> None:
     b = ctx.b
     name = Path(p.path).name
-    b.text(
-        f"{name} at {p.wavelength_nm:g} nm: n + ik = {p.n:.4g} + {p.k:.4g}i "
-        f"(+- {p.n_sigma:.2g}, {p.k_sigma:.2g}) from the psi/Delta, alpha = {p.alpha:.4g}; "
-        f"{p.rays} rays per angle of incidence, {p.seconds:.1f} s of tracing."
-    )
+    b.text(f"{name} at {p.wavelength_nm:g} nm: {_inputs_text(p)}")
     b.text(p.verdict())
     _maps(ctx, sid, p)
     _cuts(ctx, sid, p)
@@ -279,6 +339,29 @@ def _brdf_part(ctx: Context, sid: str, p: BrdfPrediction) -> None:
         tolerance="3 SE + 1e-5",
         justification="integrated scatter of the specular lobe and of the rest, per angle "
         "of incidence: |ratio - 1| <= 3 Monte Carlo SE + the file's rounding",
+    )
+
+
+def _inputs_text(p: BrdfPrediction) -> str:
+    """Which substrate, coating and roughness went into a prediction, in words."""
+    rough = (
+        f"the height map's measured slope table (GGX alpha {p.alpha:.4g})"
+        if p.slopes == "measured"
+        else f"GGX alpha = {p.alpha:.4g}"
+    )
+    if p.index_from == "film fit" and p.coating is not None:
+        c = p.coating
+        return (
+            f"substrate n + ik = {p.n:.4g} + {p.k:.4g}i (the film fit's substrate); coating "
+            f"n + ik = {c['n']:.4g} + {c['k']:.4g}i, {c['thickness_nm']:.4g} nm thick (the "
+            "film fit's layer, incoherent); both interfaces rough as the height map "
+            f"(conformal coating, the map taken as measured on its top): {rough}; "
+            f"{p.rays} rays per angle of incidence, {p.seconds:.1f} s of tracing."
+        )
+    return (
+        f"bare substrate n + ik = {p.n:.4g} + {p.k:.4g}i (+- {p.n_sigma:.2g}, "
+        f"{p.k_sigma:.2g}) from the psi/Delta, {rough}; {p.rays} rays per angle of "
+        f"incidence, {p.seconds:.1f} s of tracing."
     )
 
 
