@@ -16,8 +16,12 @@ __all__ = ["fixture_files", "fixtures_section", "ingest_files", "sample_groups"]
 
 
 def fixture_files(folder: Path) -> list[Path]:
-    """Every data file under ``folder`` except ``published/``, docs and the generator."""
-    skip_dirs = {"published", "__pycache__"}
+    """Every data file under ``folder`` except ``published/``, docs and the generator.
+
+    ``predict_measure/`` is left out too: that set is one sample for the section
+    ``model_measurement``, which reads it itself (its .bsdf is not a specular scan to fit).
+    """
+    skip_dirs = {"published", "predict_measure", "__pycache__"}
     out = []
     for p in sorted(folder.rglob("*")):
         rel = p.relative_to(folder)
@@ -77,8 +81,13 @@ def ingest_files(
     root: Path | None = None,
     *,
     check_id: str = "ingest.read",
+    table_id: str = "ingested_files",
 ) -> None:
-    """Read every file; a table of what each holds; a check that all were read."""
+    """Read every file; a table of what each holds; a check that all were read.
+
+    ``check_id`` and ``table_id`` name the check and the table (a second ingest on one
+    page, e.g. the validation report's model-against-measurement set, needs its own).
+    """
     b = ctx.b
     files = [Path(p) for p in paths]
     if not files:
@@ -120,7 +129,7 @@ def ingest_files(
         ctx.files.append({**rec, "path": str(p), "meta": m.meta, "samples": s["sample"]})
         rows.append(rec)
     b.table(
-        "ingested_files",
+        table_id,
         "Ingested files",
         [
             ("file", "file", ""),

@@ -35,10 +35,15 @@ from ..builder import Unavailable, slug
 from ..context import Context
 from .tracer import _map
 
-__all__ = ["prediction_section", "sample_inputs"]
+__all__ = ["prediction_section", "rays_of", "sample_inputs"]
 
 #: |z| above which a tracer DOP is called inconsistent with the ellipsometer's
 DOP_Z_MAX = 3.0
+
+
+def rays_of(ctx: Context) -> int:
+    """Tracer rays per run: the report's ``scale["prediction"]`` (validation), else the default."""
+    return int(ctx.scale.get("prediction", DEFAULT_RAYS))
 
 
 def _frame_of(ctx: Context, path: Path) -> pd.DataFrame | None:
@@ -125,7 +130,7 @@ def prediction_section(ctx: Context) -> None:
         "over the angles of incidence. A disagreement is therefore a finding about the model "
         "(single scattering, a GGX slope distribution, a bare substrate) or the samples, not "
         "a fit residual. Monte Carlo errors are the spread of the tracer's 8 independent "
-        f"batches ({DEFAULT_RAYS} rays per run; a bare substrate's single scattering is "
+        f"batches ({rays_of(ctx)} rays per run; a bare substrate's single scattering is "
         "closed form and has none)."
     )
     if lacking:
@@ -161,14 +166,16 @@ def _one_sample(ctx: Context, s: dict[str, Any]) -> None:
         )
     )
     try:
-        dop = specular_dop_comparison(frame, fit.alpha, seed=ctx.seed, map=_map(ctx))
+        dop = specular_dop_comparison(
+            frame, fit.alpha, rays=rays_of(ctx), seed=ctx.seed, map=_map(ctx)
+        )
     except PredictionError as exc:
         b.note("specular DOP not predicted", str(exc))
     else:
         _dop_part(ctx, sid, dop)
     for path in s["bsdf"]:
         try:
-            pred = predict_brdf(path, frame, fit, seed=ctx.seed, map=_map(ctx))
+            pred = predict_brdf(path, frame, fit, rays=rays_of(ctx), seed=ctx.seed, map=_map(ctx))
         except (PredictionError, ValueError) as exc:
             b.note(f"{path.name} not predicted", str(exc))
             continue
