@@ -264,7 +264,7 @@ def _control(ctx: Context, d: Path) -> None:
     p = predict_brdf(bsdf, control, fit, rays=rays_of(ctx), seed=ctx.seed, map=_map(ctx))
     b.text(
         f"The same height map and {bsdf.name}, but n + ik = {p.n:.4g} + {p.k:.4g}i from "
-        f"{CONTROL_FILE} (written for 1.5 + 3i, a poorer metal): {p.verdict()}"
+        f"{CONTROL_FILE} (written for 1.5 + 3i, a poorer metal). {p.verdict()}"
     )
     reg = p.regions()
     b.table(
