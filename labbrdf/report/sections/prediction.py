@@ -218,10 +218,10 @@ def _dop_part(ctx: Context, sid: str, c: DopComparison) -> None:
         f"prediction_dop_{sid}",
         "Specular DOP: ellipsometer against the tracer's prediction",
         "Degree of polarization of the specular reflection for unpolarized light (Dong et "
-        "al. 2022, Fig. 6). Line: from the ellipsometer's psi, DOP = |cos 2psi| (times "
+        "al. 2022, Fig. 6). Line (measured): from the ellipsometer's psi, DOP = |cos 2psi| (times "
         "1 - depolarization where the file has a depolarization channel at that angle: a "
         "partial depolarizer mixed in; a negative depolarization, noise about 0, counts as "
-        "0), band +-1 sigma from sigma(psi). Points: the tracer's "
+        "0), band +-1 sigma from sigma(psi). Points (modelled): the tracer's "
         "DOP in the bin holding the specular direction, with the batch standard error. For "
         "a bare substrate in single scattering the specular facets are the mean plane, so the "
         "tracer gives |cos 2psi| of the same n, k: a difference is the ellipsometer's "
