@@ -5,6 +5,10 @@ reads: a Gaussian surface saved as a NetCDF height map (SurfaceTopography), a WV
 file computed with :mod:`labbrdf.optics` for a known index, and a ``.bsdf`` written from a
 trace (:func:`labbrdf.bsdf_export.binned_to_bsdf`) of a substrate with that index and the
 height map's GGX alpha.
+
+The validation report's bundled set (``labbrdf/data/fixtures/predict_measure/``) is made the
+same way by ``make_fixtures.py``, on a finer map and with a reflectance spectrum; these
+writers stay for the tests that vary the files (a coating, another seed, a wrong index).
 """
 
 from __future__ import annotations

@@ -42,7 +42,7 @@ def _fixture_files() -> set[str]:
     return {
         p.relative_to(ROOT).as_posix()
         for p in folder.rglob("*")
-        if p.is_file() and p.suffix in (".csv", ".dat", ".asc", ".md")
+        if p.is_file() and p.suffix in (".csv", ".dat", ".asc", ".sdf", ".bsdf", ".md")
     }
 
 

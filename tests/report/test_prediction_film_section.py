@@ -12,9 +12,8 @@ import pytest
 from labbrdf.films import Layer, Stack
 from labbrdf.report.builder import Builder
 from labbrdf.report.context import Context
-from labbrdf.report.sections.ingest import ingest_files, sample_groups
+from labbrdf.report.sections.ingest import ingest_inputs, sample_groups
 from labbrdf.report.sections.prediction import prediction_section, sample_inputs
-from labbrdf.report.sections.surface import ingest_height_maps
 from labbrdf.tracer import Coating
 
 pytest.importorskip("SurfaceTopography")
@@ -24,7 +23,7 @@ def _ctx(paths: list[Path], film: object | None) -> Context:
     b = Builder("t", progress=False)
     ctx = Context(b)
     with b.section("ingest", "Ingested files"):
-        ingest_files(ctx, ingest_height_maps(ctx, paths))
+        ingest_inputs(ctx, paths)
         sample_groups(ctx, paths, [paths])
     if film is not None:
         ctx.film_fits[paths[1].name] = film  # what section film leaves for this one

@@ -106,6 +106,7 @@ def test_quick_report_has_every_section_of_the_issue(quick_report):
         "physics",
         "compare",
         "colour",
+        "model_measurement",
         "errata",
     ):
         assert status[sid] == "ok", (sid, results["sections"][ids.index(sid)]["reason"])

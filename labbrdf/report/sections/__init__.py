@@ -7,26 +7,27 @@ A section whose inputs or modules are missing raises
 skipped). The workflows :mod:`labbrdf.report.validate` and :mod:`labbrdf.report.user` list
 the sections they run as ``(id, title, function)``; :func:`run` runs such a list.
 
-========================  ==============================================================
-module                    section id(s)
-========================  ==============================================================
-:mod:`.ingest`            ``ingest``
-:mod:`.measured`          ``measured``
-:mod:`.nk`                ``nk``
-:mod:`.film`              ``film`` (user: a stack fitted to angle-dependent psi/Delta)
-:mod:`.fits`              ``fits``
-:mod:`.scans`             ``scans``
-:mod:`.spectra`           ``spectra``
-:mod:`.hemispherical`     ``hemispherical``
-:mod:`.physics`           ``physics``
-:mod:`.compare`           ``compare``
-:mod:`.colour`            ``colour``
-:mod:`.tracer`            ``tracer_maps``, ``tracer_validation``
-:mod:`.errata`            ``errata``
-:mod:`.surface`           ``surface`` (user: height maps; validation: Gaussian ACF)
-:mod:`.smoothness`        ``smoothness`` (user: a height map against one sample's reflectance)
-:mod:`.prediction`        ``prediction`` (user: tracer prediction beside a measured BRDF)
-========================  ==============================================================
+=========================  ====================================================================
+module                     section id(s)
+=========================  ====================================================================
+:mod:`.ingest`             ``ingest``
+:mod:`.measured`           ``measured``
+:mod:`.nk`                 ``nk``
+:mod:`.film`               ``film`` (user: a stack fitted to angle-dependent psi/Delta)
+:mod:`.fits`               ``fits``
+:mod:`.scans`              ``scans``
+:mod:`.spectra`            ``spectra``
+:mod:`.hemispherical`      ``hemispherical``
+:mod:`.physics`            ``physics``
+:mod:`.compare`            ``compare``
+:mod:`.colour`             ``colour``
+:mod:`.tracer`             ``tracer_maps``, ``tracer_validation``
+:mod:`.errata`             ``errata``
+:mod:`.surface`            ``surface`` (user: height maps; validation: Gaussian ACF)
+:mod:`.smoothness`         ``smoothness`` (user: a height map against one sample's reflectance)
+:mod:`.prediction`         ``prediction`` (user: tracer prediction beside a measured BRDF)
+:mod:`.model_measurement`  ``model_measurement`` (validation: the two above on a bundled set)
+=========================  ====================================================================
 """
 
 from __future__ import annotations

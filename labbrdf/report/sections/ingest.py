@@ -24,8 +24,12 @@ __all__ = [
 
 
 def fixture_files(folder: Path) -> list[Path]:
-    """Every data file under ``folder`` except ``published/``, docs and the generator."""
-    skip_dirs = {"published", "__pycache__"}
+    """Every data file under ``folder`` except ``published/``, docs and the generator.
+
+    ``predict_measure/`` is left out too: that set is one sample for the section
+    ``model_measurement``, which reads it itself (its .bsdf is not a specular scan to fit).
+    """
+    skip_dirs = {"published", "predict_measure", "__pycache__"}
     out = []
     for p in sorted(folder.rglob("*")):
         rel = p.relative_to(folder)
@@ -85,11 +89,13 @@ def ingest_files(
     root: Path | None = None,
     *,
     check_id: str = "ingest.read",
+    table_id: str = "ingested_files",
 ) -> None:
     """Read every file as an optical export (``read_inputs``) and :func:`ingest_read` them."""
     if not paths:
         raise Unavailable("no input files")
-    ingest_read(ctx, adapters.read_inputs(paths, kind="optical").files, root, check_id=check_id)
+    files = adapters.read_inputs(paths, kind="optical").files
+    ingest_read(ctx, files, root, check_id=check_id, table_id=table_id)
 
 
 def ingest_inputs(ctx: Context, paths: Sequence[str | os.PathLike[str]]) -> None:
@@ -121,6 +127,7 @@ def ingest_read(
     root: Path | None = None,
     *,
     check_id: str = "ingest.read",
+    table_id: str = "ingested_files",
 ) -> None:
     """Files already read: a table of what each holds; a check that all were read.
 
@@ -131,8 +138,9 @@ def ingest_read(
         Optical inputs as :func:`labbrdf.adapters.read_inputs` read them (read or failed).
     root : Path, optional
         Files under it are named relative to it.
-    check_id : str
-        Id of the check that every file was read.
+    check_id, table_id : str
+        Ids of the check that every file was read and of the table (a second ingest on one
+        page, e.g. the validation report's model-against-measurement set, needs its own).
     """
     b = ctx.b
     if not files:
@@ -174,7 +182,7 @@ def ingest_read(
         ctx.files.append({**rec, "path": str(p), "meta": m.meta, "samples": s["sample"]})
         rows.append(rec)
     b.table(
-        "ingested_files",
+        table_id,
         "Ingested files",
         [
             ("file", "file", ""),

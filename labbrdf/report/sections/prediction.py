@@ -53,12 +53,17 @@ from ..builder import Unavailable, slug
 from ..context import Context
 from .tracer import _map
 
-__all__ = ["SLOPES", "prediction_section", "sample_inputs"]
+__all__ = ["SLOPES", "prediction_section", "rays_of", "sample_inputs"]
 
 #: |z| above which a tracer DOP is called inconsistent with the ellipsometer's
 DOP_Z_MAX = 3.0
 #: the roughness models the section offers (module docstring)
 SLOPES = ("ggx", "measured")
+
+
+def rays_of(ctx: Context) -> int:
+    """Tracer rays per run: the report's ``scale["prediction"]`` (validation), else the default."""
+    return int(ctx.scale.get("prediction", DEFAULT_RAYS))
 
 
 def _frame_of(ctx: Context, path: Path) -> pd.DataFrame | None:
@@ -174,7 +179,7 @@ def prediction_section(ctx: Context, *, slopes: str = "ggx") -> None:
         "coating's top, the substrate below as equally rough). A disagreement is therefore "
         "a finding about the model (single scattering, the slope distribution, the stack) "
         "or the samples, not a fit residual. Monte Carlo errors are the spread of the "
-        f"tracer's 8 independent batches ({DEFAULT_RAYS} rays per run; a bare substrate's "
+        f"tracer's 8 independent batches ({rays_of(ctx)} rays per run; a bare substrate's "
         "single scattering is closed form and has none)."
     )
     if lacking:
@@ -225,14 +230,25 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
         )
     else:
         try:
-            dop = specular_dop_comparison(frame, fit.alpha, seed=ctx.seed, map=_map(ctx))
+            dop = specular_dop_comparison(
+                frame, fit.alpha, rays=rays_of(ctx), seed=ctx.seed, map=_map(ctx)
+            )
         except PredictionError as exc:
             b.note("specular DOP not predicted", str(exc))
         else:
             _dop_part(ctx, sid, dop)
     for path in s["bsdf"]:
         try:
-            pred = predict_brdf(path, frame, fit, film=film, ndf=ndf, seed=ctx.seed, map=_map(ctx))
+            pred = predict_brdf(
+                path,
+                frame,
+                fit,
+                film=film,
+                ndf=ndf,
+                rays=rays_of(ctx),
+                seed=ctx.seed,
+                map=_map(ctx),
+            )
         except (PredictionError, ValueError) as exc:
             b.note(f"{path.name} not predicted", str(exc))
             continue
@@ -275,10 +291,10 @@ def _dop_part(ctx: Context, sid: str, c: DopComparison) -> None:
         f"prediction_dop_{sid}",
         "Specular DOP: ellipsometer against the tracer's prediction",
         "Degree of polarization of the specular reflection for unpolarized light (Dong et "
-        "al. 2022, Fig. 6). Line: from the ellipsometer's psi, DOP = |cos 2psi| (times "
+        "al. 2022, Fig. 6). Line (measured): from the ellipsometer's psi, DOP = |cos 2psi| (times "
         "1 - depolarization where the file has a depolarization channel at that angle: a "
         "partial depolarizer mixed in; a negative depolarization, noise about 0, counts as "
-        "0), band +-1 sigma from sigma(psi). Points: the tracer's "
+        "0), band +-1 sigma from sigma(psi). Points (modelled): the tracer's "
         "DOP in the bin holding the specular direction, with the batch standard error. For "
         "a bare substrate in single scattering the specular facets are the mean plane, so the "
         "tracer gives |cos 2psi| of the same n, k: a difference is the ellipsometer's "
