@@ -65,7 +65,7 @@ class Layered(Model):
     base : {"conductor", "diffuse"}, default "conductor"
         What lies under the coating: the rough conductor ``n + ik`` (parameter
         ``alpha_sub``) or a flat Lambertian, depolarizing base (parameter ``albedo``;
-        paints, plastics, vinyls; :meth:`labbrdf.tracer.Substrate.lambertian`).
+        paints, plastics, vinyls; :meth:`labbrdf.Substrate.lambertian`).
     coherent : bool, default False
         The tracer's coherent mode (:mod:`labbrdf.tracer`): coating and substrate as one
         rough interface whose facets carry a conformal film, reflecting with the Airy
