@@ -994,7 +994,8 @@ def coating_of_stack(
     Parameters
     ----------
     stack : labbrdf.films.Stack
-        The fitted stack (the ``stack`` of a :class:`labbrdf.FilmFit`), one layer over the substrate.
+        The fitted stack (the ``stack`` of a :class:`labbrdf.FilmFit`), one layer over the
+        substrate.
     wavelength_nm : float
         Vacuum wavelength [nm], inside ``fitted_range_nm``.
     fitted_range_nm : (float, float)
