@@ -785,6 +785,44 @@ def _checked_table(
     return t, path, float(wl)
 
 
+def _alpha_of(roughness: SlopeFit | float) -> tuple[float, float]:
+    """The GGX alpha and its uncertainty (NaN for a bare number) [1]."""
+    if isinstance(roughness, SlopeFit):
+        return float(roughness.alpha), float(roughness.alpha_u)
+    return float(roughness), math.nan
+
+
+def _substrate_and_coating(
+    path: str,
+    data: pd.DataFrame | None,
+    wl: float,
+    roughness: SlopeFit | float,
+    coating: Coating | None,
+    substrate_index: complex | None,
+    film: Any,
+    ndf: TabulatedNDF | None,
+) -> tuple[dict[str, Any], Coating | None, str]:
+    """The substrate's n, k (with sigmas), the coating and where the index came from."""
+    index_from = "psi/Delta"
+    if film is not None:
+        if coating is not None or substrate_index is not None:
+            raise PredictionError(
+                f"{path}: give the coating once: a film fit, or a coating and substrate index"
+            )
+        coating, substrate_index = film_coating(film, wl, roughness, ndf=ndf)
+        index_from = "film fit"
+    elif substrate_index is not None:
+        index_from = "given"
+    if substrate_index is not None:
+        nk: dict[str, Any] = {"n": [substrate_index.real], "k": [substrate_index.imag]}
+        nk.update(n_sigma=[math.nan], k_sigma=[math.nan])
+    elif data is None:
+        raise PredictionError(f"{path}: give the psi/Delta rows or the substrate index")
+    else:
+        nk = substrate_nk(data, [wl])
+    return nk, coating, index_from
+
+
 def predict_brdf(
     bsdf: str | os.PathLike[str] | zemax_bsdf.BsdfTable,
     data: pd.DataFrame | None,
@@ -840,35 +878,17 @@ def predict_brdf(
     Raises
     ------
     PredictionError
-        A file with several rotations, tristimulus channels or BTDF data; no stated
-        wavelength and none given; n, k not available at the wavelength; ``film`` with
-        ``coating`` or ``substrate_index``, or a film fit that gives no coating there
-        (:func:`film_coating`).
+        A file with several rotations, tristimulus channels or BTDF data; no wavelength;
+        no n, k at the wavelength; ``film`` with ``coating`` or ``substrate_index``, or a
+        film fit that gives no coating there (:func:`film_coating`).
     labbrdf.adapters.AdapterError
         A file that is not a readable ``.bsdf``.
     """
     t, path, wl = _checked_table(bsdf, wavelength_nm)
-    index_from = "psi/Delta"
-    if film is not None:
-        if coating is not None or substrate_index is not None:
-            raise PredictionError(
-                f"{path}: give the coating once: a film fit, or a coating and substrate index"
-            )
-        coating, substrate_index = film_coating(film, float(wl), roughness, ndf=ndf)
-        index_from = "film fit"
-    elif substrate_index is not None:
-        index_from = "given"
-    if substrate_index is not None:
-        nk = {"n": [substrate_index.real], "k": [substrate_index.imag]}
-        nk.update(n_sigma=[math.nan], k_sigma=[math.nan])
-    elif data is None:
-        raise PredictionError(f"{path}: give the psi/Delta rows or the substrate index")
-    else:
-        nk = substrate_nk(data, [float(wl)])
-    if isinstance(roughness, SlopeFit):
-        alpha, alpha_u = float(roughness.alpha), float(roughness.alpha_u)
-    else:
-        alpha, alpha_u = float(roughness), math.nan
+    nk, coating, index_from = _substrate_and_coating(
+        path, data, float(wl), roughness, coating, substrate_index, film, ndf
+    )
+    alpha, alpha_u = _alpha_of(roughness)
     ti = np.asarray(t.theta_i_deg, float)
     az, rad = np.asarray(t.azimuth_deg, float), np.asarray(t.radial_deg, float)
     tr, pr, above, off = _geometry(ti, az, rad)
@@ -879,25 +899,13 @@ def predict_brdf(
         for th in ti
     ]
     pred, se = _sampled(runs, tr, pr, above)
-    albedo = np.array([r.albedo() for r in runs])
-    albedo_se = np.array([r.albedo_stderr() for r in runs])
-    seconds = float(sum(r.seconds for r in runs))
-    results = runs
-    geo: dict[str, Any] = {
-        "theta_i_deg": ti,
-        "azimuth_deg": az,
-        "radial_deg": rad,
-        "symmetry": t.symmetry,
-    }
+    geo: dict[str, Any] = {"theta_i_deg": ti, "azimuth_deg": az, "radial_deg": rad}
+    geo["symmetry"] = t.symmetry
     gm = grid_integral(meas[None, None], **geo)
     gp = grid_integral(pred[None, None], **geo)
     lobe = max(MIN_LOBE_DEG, 2.0 * math.degrees(math.atan(alpha)))
-    region_table, tis_se = _regions(
-        runs,
-        {"tr": tr, "pr": pr, "above": above, "meas": meas, "pred": pred, "off": off},
-        geo,
-        lobe,
-    )
+    pts = {"tr": tr, "pr": pr, "above": above, "meas": meas, "pred": pred, "off": off}
+    region_table, tis_se = _regions(runs, pts, geo, lobe)
     return BrdfPrediction(
         path=path,
         wavelength_nm=float(wl),
@@ -922,15 +930,15 @@ def predict_brdf(
         tis_predicted=gp["integral"][0, 0],
         tis_predicted_stderr=tis_se,
         tis_file=np.asarray(t.tis, float)[0, 0],
-        albedo=albedo,
-        albedo_stderr=albedo_se,
+        albedo=np.array([r.albedo() for r in runs]),
+        albedo_stderr=np.array([r.albedo_stderr() for r in runs]),
         uncovered_fraction=gm["uncovered_fraction"],
         lobe_deg=lobe,
         rays=int(rays),
-        seconds=seconds,
+        seconds=float(sum(r.seconds for r in runs)),
         coating=None if coating is None else coating.to_dict(),
         slopes="ggx" if ndf is None else "measured",
         index_from=index_from,
         region_table=region_table,
-        results=results,
+        results=runs,
     )

@@ -161,22 +161,10 @@ def user_report(
         )
     paths, model_file, opts = _refused_early(paths, model, options, out, film_model, same_sample)
     film, film_how = film_model_of(film_model)
-    b = Builder(
-        title or f"labbrdf report: {model} fits",
-        progress=progress,
-        meta={
-            "labbrdf_version": __version__,
-            "mode": "user",
-            "model": model,
-            "options": opts,
-            "method": method,
-            "seed": seed,
-            "files": [str(p) for p in paths],
-            "film_model": film_how or None,
-            "prediction_slopes": prediction_slopes,
-            "environment": versions(),
-        },
-    )
+    meta = {"model": model, "options": opts, "method": method, "seed": seed}
+    meta.update(files=[str(p) for p in paths], film_model=film_how or None)
+    meta.update(prediction_slopes=prediction_slopes)
+    b = Builder(title or f"labbrdf report: {model} fits", progress=progress, meta=_meta(meta))
     ctx = Context(
         b,
         executor=as_executor(executor, scheduler=scheduler, workers=workers, progress=progress),
@@ -196,6 +184,11 @@ def user_report(
     write_report(out, b.results, page, inputs=paths + model_file)
     b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
     return code
+
+
+def _meta(run: dict[str, Any]) -> dict[str, Any]:
+    """The page's meta: the version, the mode, what was run, the environment."""
+    return {"labbrdf_version": __version__, "mode": "user", **run, "environment": versions()}
 
 
 def _refused_early(

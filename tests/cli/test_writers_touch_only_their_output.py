@@ -280,6 +280,7 @@ NOT_PATHS = {
     ("surface", "unit"),
     ("trace", "pixel_size"),
     ("trace", "unit"),
+    ("report", "prediction_slopes"),
 }
 
 
