@@ -424,6 +424,7 @@ def fit(
     weighting: str | None = None,
     relative_floor: float = RELATIVE_FLOOR,
     mask_zeros: bool = False,
+    replicates: int = 1,
 ) -> FitResult:
     """Fit a reflectance/BRDF model: an nlopt global stage inside the bounds, then a local one.
 
@@ -477,6 +478,8 @@ def fit(
     mask_zeros : bool
         Exclude points whose value is exactly 0 (instrument-masked directions), counted in
         ``FitResult.nmasked`` and named in ``warnings``.
+    replicates : int
+        R > 1: a stochastic model fitted with R seeds, combined (:func:`fit_replicates`).
 
     Returns
     -------
@@ -485,36 +488,23 @@ def fit(
     Raises
     ------
     FitError
-        Unknown method or parameter name, too few points, all points on the specular line
-        for smooth3's shape parameters, NaN/inf data, mixed quantities, bad sigma.
+        Unknown method or parameter name, too few points, only specular points for smooth3's
+        shape parameters, NaN/inf data, mixed quantities, bad sigma, bad ``replicates``.
     labbrdf.models.ModelError
         Unknown model name.
 
     Notes
     -----
-    Stages and budgets, the polish ending a converged local stage, uncertainties, weights,
-    the energy constraint and the refused specular-only design: docs/models.md 5 (Fitting).
+    Stages, budgets, polish, uncertainties, weights, energy constraint: docs/models.md 5.
     """
+    # every argument but the model, the data and the count: the same for each replicate
+    kw = {k: v for k, v in locals().items() if k not in ("model", "data", "replicates")}
+    if replicates != 1:
+        from .replicates import fit_replicates
+
+        return fit_replicates(model, data, replicates, **kw)
     t0 = time.perf_counter()
-    pb = _problem(
-        model,
-        data,
-        method=method,
-        params=params,
-        fix=fix,
-        profile=profile,
-        energy_constraint=energy_constraint,
-        maxeval=maxeval,
-        quantity=quantity,
-        unit=unit,
-        use_sigma=use_sigma,
-        nan_policy=nan_policy,
-        guess=guess,
-        ci=ci,
-        weighting=weighting,
-        relative_floor=relative_floor,
-        mask_zeros=mask_zeros,
-    )
+    pb = _problem(model, data, **{k: v for k, v in kw.items() if k != "seed"})
     x, stage_info, last_code, message = _search(
         pb.obj, pb.x0, pb.stages, pb.budgets, int(seed), pb.cons, pb.nfree, pb.use_sigma
     )
