@@ -20,6 +20,7 @@ from ..models import Model
 from ..models import get as get_model
 from .core import METHOD, fit, parse_method, setup_params
 from .data import FitData, FitError, select_rows, several_groups_message
+from .replicates import check_replicates
 from .result import FitResult
 
 __all__ = ["auto_weighting", "fit_many", "fit_many_nk", "fit_records"]
@@ -88,6 +89,12 @@ def _row(row: dict[str, Any], s: dict[str, Any], param_names: list[str]) -> dict
         row[f"{name}_stderr"] = ps.get("stderr")
         row[f"{name}_ci95_lo"], row[f"{name}_ci95_hi"] = ci
         row[f"{name}_flags"] = ";".join(ps.get("flags", []))
+        if s.get("replicates"):
+            row[f"{name}_seed_spread"] = (s.get("seed_spread") or {}).get(name)
+            vals = [r.get(name) for r in s["replicates"]]
+            row[f"{name}_replicates"] = ";".join(f"{v:.10g}" for v in vals if v is not None)
+    if s.get("replicates"):
+        row["replicates"] = len(s["replicates"])
     for col in ("rmse", "rmse_pct", "chisqr", "redchi", "aic", "bic", "ndata", "nfev"):
         row[col] = s.get(col)
     row["success"] = bool(s.get("success", False))
@@ -121,6 +128,7 @@ def fit_many(
     progress: bool | None = None,
     chunks: int | None = None,
     return_results: bool = False,
+    replicates: int = 1,
     **fit_kw: Any,
 ) -> pd.DataFrame | tuple[pd.DataFrame, list[tuple[dict[str, Any], FitResult]]]:
     """Fit one model to every group of a dataset; a parameter table like Tables 1-2 of 2013.
@@ -159,6 +167,11 @@ def fit_many(
         Also return the :class:`FitResult` of every fitted group, as a list of
         ``(group key dict, FitResult)`` in table order (groups that could not be fitted are
         left out).
+    replicates : int
+        Seed replicates of a stochastic model per group (:func:`fit`); each task carries its
+        seeds, so the table does not depend on the executor. R > 1 adds the columns
+        ``<name>_seed_spread`` (s_between), ``<name>_replicates`` (the R estimates,
+        ``;``-joined) and ``replicates``.
     **fit_kw :
         Any other :func:`fit` keyword (``fix``, ``energy_constraint``, ``quantity`` ...).
 
@@ -192,7 +205,9 @@ def fit_many(
         setup_params(model, fit_kw.get("params"), fit_kw.get("fix"))  # fail early on names
     d, qty, unt = select_rows(data, fit_kw.pop("quantity", None), fit_kw.pop("unit", None))
     keys, groups = _groups(d, by, qty, unt)
-    kw = dict(fit_kw, method=method, seed=seed)
+    if replicates != 1:
+        check_replicates(replicates, model if isinstance(model, Model) else None)
+    kw = dict(fit_kw, method=method, seed=seed, replicates=replicates)
     todo: list[tuple[int, Model, FitData]] = []
     for i, g in enumerate(groups):
         if isinstance(g, FitData):

@@ -22,7 +22,7 @@ from ..models import get as get_model
 from .data import FitError
 from .result import FitResult
 
-__all__ = ["combine_replicates", "fit_replicates"]
+__all__ = ["check_replicates", "combine_replicates", "fit_replicates"]
 
 
 def _fit_one(task: tuple[Model, Any, dict[str, Any]]) -> FitResult:
@@ -30,6 +30,25 @@ def _fit_one(task: tuple[Model, Any, dict[str, Any]]) -> FitResult:
 
     model, data, kw = task
     return fit(model, data, replicates=1, **kw)
+
+
+def check_replicates(replicates: Any, model: Model | None) -> None:
+    """Refuse a replicate count that is not an integer >= 2, or a deterministic model.
+
+    Raises
+    ------
+    FitError
+        With the count and, for a deterministic ``model``, its name.
+    """
+    if isinstance(replicates, bool) or not isinstance(replicates, (int, np.integer)):
+        raise FitError(f"replicates must be an integer >= 1; got {replicates!r}")
+    if replicates < 2:
+        raise FitError(f"replicates must be >= 2 for seed replicates; got {replicates}")
+    if model is not None and not getattr(model, "stochastic", False):
+        raise FitError(
+            f"model {model.name!r} is deterministic (no Monte Carlo seed): "
+            f"replicates={replicates} would repeat the same fit; use replicates=1"
+        )
 
 
 def fit_replicates(
@@ -70,16 +89,8 @@ def fit_replicates(
     FitError
         ``replicates`` not an integer >= 2, a deterministic model, or ``ci="profile"``.
     """
-    if isinstance(replicates, bool) or not isinstance(replicates, (int, np.integer)):
-        raise FitError(f"replicates must be an integer >= 1; got {replicates!r}")
-    if replicates < 2:
-        raise FitError(f"replicates must be >= 2 for seed replicates; got {replicates}")
     m = get_model(model) if isinstance(model, str) else model
-    if not getattr(m, "stochastic", False):
-        raise FitError(
-            f"model {m.name!r} is deterministic (no Monte Carlo seed): replicates={replicates} "
-            "would repeat the same fit; use replicates=1"
-        )
+    check_replicates(replicates, m)
     if fit_kw.get("ci", "wald") != "wald":
         raise FitError("seed replicates combine Wald errors: use ci='wald' with replicates > 1")
     t0 = time.perf_counter()

@@ -184,3 +184,60 @@ def test_coherent_layered_is_deterministic():
     assert not m.stochastic
     with pytest.raises(ModelError, match="deterministic"):
         m.reseeded(1)
+
+
+def _table_data():
+    import pandas as pd
+
+    d = _data()
+    rows = []
+    for sample, shift in (("A", 0.0), ("B", 0.1)):
+        rows.append(
+            pd.DataFrame(
+                {
+                    "sample": sample,
+                    "wavelength_nm": 550.0,
+                    "quantity": "brdf",
+                    "unit": "sr-1",
+                    "theta_i_deg": d.theta_i_deg,
+                    "phi_i_deg": 0.0,
+                    "theta_r_deg": d.theta_r_deg,
+                    "phi_r_deg": 180.0,
+                    "value": np.asarray(d.value) * (1 + shift),
+                    "sigma": SIGMA,
+                }
+            )
+        )
+    return pd.concat(rows, ignore_index=True)
+
+
+def test_fit_many_with_replicates_matches_fit_and_has_the_spread_columns():
+    from labbrdf.fitting import fit_many
+
+    df = _table_data()
+    table = fit_many(df, _SeededLine(0), method="LN_BOBYQA", replicates=3, executor="serial")
+    one = fit(_SeededLine(0), df[df["sample"] == "A"], method="LN_BOBYQA", replicates=3)
+    row = table.iloc[0]
+    assert row["a"] == one.params["a"].value
+    assert row["a_stderr"] == one.params["a"].stderr
+    assert row["a_seed_spread"] == one.seed_spread["a"]
+    assert row["a_replicates"].split(";") == [f"{r['a']:.10g}" for r in one.replicates]
+    assert list(table["replicates"]) == [3, 3]
+    pool = fit_many(
+        df,
+        _SeededLine(0),
+        method="LN_BOBYQA",
+        replicates=3,
+        executor=parallel.Executor("processes", workers=2),
+    )
+    cols = ["a", "a_stderr", "a_seed_spread", "a_replicates"]
+    assert pool[cols].equals(table[cols])
+
+
+def test_fit_many_refuses_replicates_of_a_deterministic_model():
+    from labbrdf.fitting import fit_many
+
+    with pytest.raises(FitError, match="deterministic"):
+        fit_many(_table_data(), _Line(0), replicates=2, executor="serial")
+    with pytest.raises(FitError, match="replicates must be >= 2"):
+        fit_many(_table_data(), _SeededLine(0), replicates=0, executor="serial")
