@@ -103,6 +103,26 @@ def _row(row: dict[str, Any], s: dict[str, Any], param_names: list[str]) -> dict
     return row
 
 
+def _todo(
+    groups: list[FitData | str],
+    keys: list[tuple[Any, ...]],
+    by: list[str],
+    model: Model | Callable[[dict[str, Any]], Model],
+    fit_kw: dict[str, Any],
+) -> list[tuple[int, Model, FitData]]:
+    """(group index, model, points) of every fittable group; a callable gives each model."""
+    todo: list[tuple[int, Model, FitData]] = []
+    for i, g in enumerate(groups):
+        if isinstance(g, FitData):
+            if isinstance(model, Model):
+                m = model
+            else:
+                m = model(dict(zip(by, map(_plain, keys[i]), strict=True)))
+                setup_params(m, fit_kw.get("params"), fit_kw.get("fix"))
+            todo.append((i, m, g))
+    return todo
+
+
 def _param_names(todo: list[tuple[int, Model, FitData]]) -> list[str]:
     """The parameter names of the groups' models, in first-seen order."""
     names: dict[str, None] = {}
@@ -128,7 +148,7 @@ def fit_many(
     progress: bool | None = None,
     chunks: int | None = None,
     return_results: bool = False,
-    replicates: int = 1,
+    replicates: int | None = None,
     **fit_kw: Any,
 ) -> pd.DataFrame | tuple[pd.DataFrame, list[tuple[dict[str, Any], FitResult]]]:
     """Fit one model to every group of a dataset; a parameter table like Tables 1-2 of 2013.
@@ -167,8 +187,9 @@ def fit_many(
         Also return the :class:`FitResult` of every fitted group, as a list of
         ``(group key dict, FitResult)`` in table order (groups that could not be fitted are
         left out).
-    replicates : int
-        Seed replicates of a stochastic model per group (:func:`fit`); each task carries its
+    replicates : int, optional
+        Seed replicates of a stochastic model per group, as for :func:`fit` (None: the
+        model's ``default_replicates``); each task carries its
         seeds, so the table does not depend on the executor. R > 1 adds the columns
         ``<name>_seed_spread`` (s_between), ``<name>_replicates`` (the R estimates,
         ``;``-joined) and ``replicates``.
@@ -205,19 +226,10 @@ def fit_many(
         setup_params(model, fit_kw.get("params"), fit_kw.get("fix"))  # fail early on names
     d, qty, unt = select_rows(data, fit_kw.pop("quantity", None), fit_kw.pop("unit", None))
     keys, groups = _groups(d, by, qty, unt)
-    if replicates != 1:
+    if replicates is not None and replicates != 1:
         check_replicates(replicates, model if isinstance(model, Model) else None)
     kw = dict(fit_kw, method=method, seed=seed, replicates=replicates)
-    todo: list[tuple[int, Model, FitData]] = []
-    for i, g in enumerate(groups):
-        if isinstance(g, FitData):
-            if model_of is None:
-                assert isinstance(model, Model)
-                m = model
-            else:
-                m = model_of(dict(zip(by, map(_plain, keys[i]), strict=True)))
-                setup_params(m, fit_kw.get("params"), fit_kw.get("fix"))
-            todo.append((i, m, g))
+    todo = _todo(groups, keys, by, model if model_of is None else model_of, fit_kw)
     if chunks is None:
         chunks = 4 * ex.nworkers
     nchunks = max(1, min(int(chunks), len(todo)))

@@ -20,6 +20,7 @@ from ..models import Model, Parameters
 from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
 from .objective import Objective
+from .replicates import ONE_SEED_WARNING
 from .result import FitResult
 from .uncertainty import AT_BOUND_FRAC, jacobian, noise_meat, uncertainties
 
@@ -424,7 +425,7 @@ def fit(
     weighting: str | None = None,
     relative_floor: float = RELATIVE_FLOOR,
     mask_zeros: bool = False,
-    replicates: int = 1,
+    replicates: int | None = None,
 ) -> FitResult:
     """Fit a reflectance/BRDF model: an nlopt global stage inside the bounds, then a local one.
 
@@ -478,8 +479,9 @@ def fit(
     mask_zeros : bool
         Exclude points whose value is exactly 0 (instrument-masked directions), counted in
         ``FitResult.nmasked`` and named in ``warnings``.
-    replicates : int
-        R > 1: a stochastic model fitted with R seeds, combined (:func:`fit_replicates`).
+    replicates : int, optional
+        R > 1: a stochastic model fitted with R seeds, combined (:func:`fit_replicates`);
+        None: the model's ``default_replicates`` (1 for a deterministic model).
 
     Returns
     -------
@@ -499,10 +501,12 @@ def fit(
     """
     # every argument but the model, the data and the count: the same for each replicate
     kw = {k: v for k, v in locals().items() if k not in ("model", "data", "replicates")}
-    if replicates != 1:
+    model = get_model(model) if isinstance(model, str) else model
+    if (model.default_replicates if replicates is None else replicates) != 1:
         from .replicates import fit_replicates
 
-        return fit_replicates(model, data, replicates, **kw)
+        R = model.default_replicates if replicates is None else replicates
+        return fit_replicates(model, data, R, **kw)
     t0 = time.perf_counter()
     pb = _problem(model, data, **{k: v for k, v in kw.items() if k != "seed"})
     x, stage_info, last_code, message = _search(
@@ -642,6 +646,7 @@ def _finish(
     ) + [f"{pb.nmasked} point(s) with value 0 excluded as instrument-masked (mask_zeros)"] * (
         pb.nmasked > 0
     )
+    warn += [ONE_SEED_WARNING] * bool(model.stochastic)
     if ci == "profile" and finite:
         delta = float(special.stdtrit(nfree, 0.975)) ** 2 * (1.0 if use_sigma else redchi)
         warn += _profile_intervals(model, fd, out, pb.weights, prof, varying, chisqr, delta, seed)

@@ -25,6 +25,12 @@ from .result import FitResult
 __all__ = ["check_replicates", "combine_replicates", "fit_replicates"]
 
 
+ONE_SEED_WARNING = (
+    "one Monte Carlo seed: the standard errors leave out the estimate's spread over seeds "
+    "(common random numbers make the map rough in the parameters); fit with replicates >= 2"
+)
+
+
 def _fit_one(task: tuple[Model, Any, dict[str, Any]]) -> FitResult:
     from .core import fit
 
@@ -190,4 +196,5 @@ def combine_replicates(results: list[FitResult], seeds: list[int]) -> FitResult:
             f"seed {s}: {r.message}" for s, r in zip(seeds, results, strict=True) if not r.success
         )
     base.weighting += note
+    base.warnings = [w for w in base.warnings if w != ONE_SEED_WARNING]
     return base

@@ -172,6 +172,8 @@ class Model(ABC):
     #: numbers): its fits are repeated over independent seeds (:meth:`reseeded`,
     #: :func:`labbrdf.fitting.fit` ``replicates``) to measure the estimate's seed spread
     stochastic: bool = False
+    #: seed replicates of a fit when none are asked for (``fit(replicates=None)``)
+    default_replicates: int = 1
 
     def __init__(self, **options: Any) -> None:
         self.options: dict[str, Any] = dict(options)

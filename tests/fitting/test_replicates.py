@@ -53,6 +53,7 @@ class _Line(_SeededLine):
 
 
 SIGMA = 0.01
+AL = {"n": 1.55, "k": 7.71}
 
 
 def _data() -> FitData:
@@ -168,9 +169,6 @@ def test_deterministic_model_has_no_reseeded():
         models.get("smooth3").reseeded(1)
 
 
-AL = {"n": 1.55, "k": 7.71}
-
-
 def test_layered_is_stochastic_and_reseeded_keeps_its_options():
     m = models.get("layered", rays=4000, grid="3x6", floor=True, **AL)
     assert m.stochastic
@@ -241,3 +239,28 @@ def test_fit_many_refuses_replicates_of_a_deterministic_model():
         fit_many(_table_data(), _Line(0), replicates=2, executor="serial")
     with pytest.raises(FitError, match="replicates must be >= 2"):
         fit_many(_table_data(), _SeededLine(0), replicates=0, executor="serial")
+
+
+def test_default_replicates_come_from_the_model():
+    class _Three(_SeededLine):
+        default_replicates = 3
+
+        def reseeded(self, seed: int) -> _Three:
+            m = _Three.__new__(_Three)
+            _SeededLine.__init__(m, seed)
+            return m
+
+    res = fit(_Three(0), _data(), method="LN_BOBYQA")
+    assert [r["seed"] for r in res.replicates] == [0, 1, 2]
+    assert not any("one Monte Carlo seed" in w for w in res.warnings)
+
+
+def test_one_seed_of_a_stochastic_model_warns_that_the_spread_is_missing():
+    res = fit(_SeededLine(0), _data(), method="LN_BOBYQA", replicates=1)
+    assert any("one Monte Carlo seed" in w for w in res.warnings)
+    assert not any("one Monte Carlo seed" in w for w in fit(_Line(0), _data()).warnings)
+
+
+def test_layered_defaults_to_three_replicates():
+    assert models.get("layered", **AL).default_replicates == 3
+    assert models.get("layered", coherent=True, **AL).default_replicates == 1
