@@ -226,10 +226,10 @@ def fit_many(
         setup_params(model, fit_kw.get("params"), fit_kw.get("fix"))  # fail early on names
     d, qty, unt = select_rows(data, fit_kw.pop("quantity", None), fit_kw.pop("unit", None))
     keys, groups = _groups(d, by, qty, unt)
-    if replicates is not None and replicates != 1:
-        check_replicates(replicates, model if isinstance(model, Model) else None)
     kw = dict(fit_kw, method=method, seed=seed, replicates=replicates)
     todo = _todo(groups, keys, by, model if model_of is None else model_of, fit_kw)
+    for _, m, _ in todo if replicates is not None and replicates != 1 else ():
+        check_replicates(replicates, m)  # before any fit runs
     if chunks is None:
         chunks = 4 * ex.nworkers
     nchunks = max(1, min(int(chunks), len(todo)))
@@ -405,7 +405,8 @@ def fit_records(
         Per row: ``group`` (``{column: value}`` of ``by``), ``params`` (per parameter
         ``value``, ``stderr``, ``ci95``, ``at_bound``), ``rmse``, ``redchi``,
         ``weighting``, ``nmasked``, ``flags`` (per flagged parameter), ``nfev``,
-        ``success``, ``message``. A group that could not be fitted has ``success`` false,
+        ``replicates`` and ``seed_spread`` (seed replicates, else None), ``success``,
+        ``message``. A group that could not be fitted has ``success`` false,
         empty ``params``, ``rmse`` and ``nfev`` None and the reason in ``message``.
         Values are plain Python (NaN stays NaN: :func:`labbrdf.jsonsafe.jsonable` makes
         it JSON's null).
@@ -439,6 +440,8 @@ def fit_records(
                     "nmasked": s["nmasked"],
                     "flags": {k: v["flags"] for k, v in s["params"].items() if v["flags"]},
                     "nfev": s["nfev"],
+                    "replicates": s["replicates"],
+                    "seed_spread": s["seed_spread"],
                     "success": s["success"],
                     "message": row.get("message", ""),
                 }
