@@ -122,12 +122,13 @@ def combine_replicates(results: list[FitResult], seeds: list[int]) -> FitResult:
     Returns
     -------
     FitResult
-        ``results[0]`` with every varying parameter's value the mean of the R estimates,
-        the covariance ``mean_r C_r + S / R`` (``C_r`` the fits' covariances, ``S`` the
-        sample covariance of the R estimate vectors, ddof 1), hence the standard error
-        ``sqrt(mean_r stderr_r^2 + s_between^2 / R)``; Wald intervals on that error;
-        ``replicates`` (seed and values per fit), ``seed_spread`` (s_between per
-        parameter), the summed ``nfev`` and ``elapsed_s``, and a note in ``weighting``.
+        ``results[0]`` (modified in place) with every varying parameter's value the mean
+        of the R estimates, the covariance ``mean_r C_r + S / R`` (``C_r`` the fits'
+        covariances, ``S`` the sample covariance of the R estimate vectors, ddof 1),
+        hence the standard error ``sqrt(mean_r stderr_r^2 + s_between^2 / R)``; Wald
+        intervals on that error; ``replicates`` (seed and values per fit),
+        ``seed_spread`` (s_between per parameter), the summed ``nfev`` and
+        ``elapsed_s``, and a note in ``weighting``.
 
     Notes
     -----
@@ -138,9 +139,9 @@ def combine_replicates(results: list[FitResult], seeds: list[int]) -> FitResult:
     ``s_between^2`` estimates ``v_MC`` without bias. Each fit's reported ``stderr_r^2``
     estimates ``v_D`` plus the per-bin Monte Carlo noise propagated through the sandwich
     covariance, which is a part of ``v_MC``: the combination therefore counts that part
-    once more and is conservative by at most the propagated term (at most a factor
-    ``1 + 1/R`` on it), while the part the per-bin noise misses, the roughness of the
-    common-random-number map in the parameters, enters through ``s_between``.
+    once more and is conservative by that term, while the part the per-bin noise misses,
+    the roughness of the common-random-number map in the parameters, enters through
+    ``s_between`` (docs/models.md 7, seed replicates).
     ``chisqr``, residuals and best fit are those of the first replicate at its own
     optimum, not at the mean.
     """
