@@ -502,10 +502,10 @@ def fit(
     # every argument but the model, the data and the count: the same for each replicate
     kw = {k: v for k, v in locals().items() if k not in ("model", "data", "replicates")}
     model = get_model(model) if isinstance(model, str) else model
-    if (model.default_replicates if replicates is None else replicates) != 1:
+    R = getattr(model, "default_replicates", 1) if replicates is None else replicates
+    if R != 1:  # a non-Model is refused by _problem
         from .replicates import fit_replicates
 
-        R = model.default_replicates if replicates is None else replicates
         return fit_replicates(model, data, R, **kw)
     t0 = time.perf_counter()
     pb = _problem(model, data, **{k: v for k, v in kw.items() if k != "seed"})

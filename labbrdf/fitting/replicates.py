@@ -96,6 +96,8 @@ def fit_replicates(
         ``replicates`` not an integer >= 2, a deterministic model, or ``ci="profile"``.
     """
     m = get_model(model) if isinstance(model, str) else model
+    if not isinstance(m, Model):
+        raise FitError(f"model: expected a Model or a model name, got {type(m).__name__}")
     check_replicates(replicates, m)
     if fit_kw.get("ci", "wald") != "wald":
         raise FitError("seed replicates combine Wald errors: use ci='wald' with replicates > 1")

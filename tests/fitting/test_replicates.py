@@ -149,6 +149,11 @@ def test_deterministic_model_with_replicates_is_refused():
         fit("smooth3", _data(), replicates=2)
 
 
+def test_replicates_of_a_non_model_are_refused():
+    with pytest.raises(FitError, match="expected a Model or a model name"):
+        fit(3, _data(), replicates=2)  # type: ignore[arg-type]
+
+
 def test_replicates_with_profile_intervals_are_refused():
     with pytest.raises(FitError, match="ci='wald'"):
         fit(_SeededLine(0), _data(), replicates=2, ci="profile")
