@@ -627,6 +627,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
     from . import adapters, models
     from .fitting import auto_weighting, fit_many, fit_many_nk, fit_records
 
+    if args.replicates is not None and args.replicates < 1:
+        raise UsageError(f"--replicates must be an integer >= 1; got {args.replicates}")
     executor = _executor(args, progress=not args.json)
     data = _selected(args, adapters.read_many(args.files))
     fix = _parse_assignments(args.fix, "--fix")
@@ -646,6 +648,8 @@ def cmd_fit(args: argparse.Namespace) -> int:
         "mask_zeros": not args.keep_zeros,
         "relative_floor": args.relative_floor,
     }
+    if args.replicates is not None:
+        kw["replicates"] = args.replicates
     weighting = args.weighting if args.weighting != "auto" else auto_weighting(data)
     if weighting is not None:
         kw["weighting"] = weighting
@@ -669,6 +673,11 @@ def cmd_fit(args: argparse.Namespace) -> int:
             model = models.get(args.model, **options)
         except models.ModelError as exc:
             raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
+        if (args.replicates or 1) > 1 and not model.stochastic:
+            raise UsageError(
+                f"--replicates {args.replicates}: model {args.model!r} is deterministic (no "
+                "Monte Carlo seed), every replicate would be the same fit; leave --replicates out"
+            )
         table, results = fit_many(data, model, **kw)
     if args.output:
         from .outputs import atomic_output, csv_safe_frame
@@ -1345,6 +1354,14 @@ def _fit_parser(sub: Any) -> None:
     s.add_argument("--by", default="sample,wavelength_nm", help="comma-separated group columns")
     s.add_argument("--method", default=METHOD, help="nlopt GLOBAL[+LOCAL]")
     s.add_argument("--seed", type=int, default=0)
+    s.add_argument(
+        "--replicates",
+        type=int,
+        default=None,
+        metavar="R",
+        help="fit a Monte Carlo model (layered) with R model seeds and report their mean, "
+        "with the seed spread in the standard error (default: the model's, 3 for layered)",
+    )
     s.add_argument("--fix", action="append", metavar="NAME=VALUE", help="fix a parameter")
     s.add_argument(
         "--param",

@@ -37,6 +37,7 @@ from .batch import auto_weighting, fit_many, fit_many_nk, fit_records
 from .core import ALGORITHMS, CONSTRAINED, METHOD, fit, parse_method
 from .data import FITTABLE_QUANTITIES, FitData, FitError
 from .objective import Objective
+from .replicates import combine_replicates, fit_replicates
 from .result import FitResult
 from .uncertainty import AT_BOUND_FRAC, COND_MAX, CORREL_MAX, REL_STDERR_MAX, REL_STDERR_POOR
 
@@ -55,9 +56,11 @@ __all__ = [
     "FitResult",
     "Objective",
     "auto_weighting",
+    "combine_replicates",
     "fit",
     "fit_many",
     "fit_many_nk",
+    "fit_replicates",
     "fit_records",
     "parse_method",
 ]

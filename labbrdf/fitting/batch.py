@@ -20,6 +20,7 @@ from ..models import Model
 from ..models import get as get_model
 from .core import METHOD, fit, parse_method, setup_params
 from .data import FitData, FitError, select_rows, several_groups_message
+from .replicates import check_replicates
 from .result import FitResult
 
 __all__ = ["auto_weighting", "fit_many", "fit_many_nk", "fit_records"]
@@ -88,12 +89,38 @@ def _row(row: dict[str, Any], s: dict[str, Any], param_names: list[str]) -> dict
         row[f"{name}_stderr"] = ps.get("stderr")
         row[f"{name}_ci95_lo"], row[f"{name}_ci95_hi"] = ci
         row[f"{name}_flags"] = ";".join(ps.get("flags", []))
+        if s.get("replicates"):
+            row[f"{name}_seed_spread"] = (s.get("seed_spread") or {}).get(name)
+            vals = [r.get(name) for r in s["replicates"]]
+            row[f"{name}_replicates"] = ";".join(f"{v:.10g}" for v in vals if v is not None)
+    if s.get("replicates"):
+        row["replicates"] = len(s["replicates"])
     for col in ("rmse", "rmse_pct", "chisqr", "redchi", "aic", "bic", "ndata", "nfev"):
         row[col] = s.get(col)
     row["success"] = bool(s.get("success", False))
     row["message"] = s.get("message", "")
     row["elapsed_s"] = s.get("elapsed_s")
     return row
+
+
+def _todo(
+    groups: list[FitData | str],
+    keys: list[tuple[Any, ...]],
+    by: list[str],
+    model: Model | Callable[[dict[str, Any]], Model],
+    fit_kw: dict[str, Any],
+) -> list[tuple[int, Model, FitData]]:
+    """(group index, model, points) of every fittable group; a callable gives each model."""
+    todo: list[tuple[int, Model, FitData]] = []
+    for i, g in enumerate(groups):
+        if isinstance(g, FitData):
+            if isinstance(model, Model):
+                m = model
+            else:
+                m = model(dict(zip(by, map(_plain, keys[i]), strict=True)))
+                setup_params(m, fit_kw.get("params"), fit_kw.get("fix"))
+            todo.append((i, m, g))
+    return todo
 
 
 def _param_names(todo: list[tuple[int, Model, FitData]]) -> list[str]:
@@ -121,6 +148,7 @@ def fit_many(
     progress: bool | None = None,
     chunks: int | None = None,
     return_results: bool = False,
+    replicates: int | None = None,
     **fit_kw: Any,
 ) -> pd.DataFrame | tuple[pd.DataFrame, list[tuple[dict[str, Any], FitResult]]]:
     """Fit one model to every group of a dataset; a parameter table like Tables 1-2 of 2013.
@@ -159,6 +187,12 @@ def fit_many(
         Also return the :class:`FitResult` of every fitted group, as a list of
         ``(group key dict, FitResult)`` in table order (groups that could not be fitted are
         left out).
+    replicates : int, optional
+        Seed replicates of a stochastic model per group, as for :func:`fit` (None: the
+        model's ``default_replicates``); each task carries its
+        seeds, so the table does not depend on the executor. R > 1 adds the columns
+        ``<name>_seed_spread`` (s_between), ``<name>_replicates`` (the R estimates,
+        ``;``-joined) and ``replicates``.
     **fit_kw :
         Any other :func:`fit` keyword (``fix``, ``energy_constraint``, ``quantity`` ...).
 
@@ -192,17 +226,10 @@ def fit_many(
         setup_params(model, fit_kw.get("params"), fit_kw.get("fix"))  # fail early on names
     d, qty, unt = select_rows(data, fit_kw.pop("quantity", None), fit_kw.pop("unit", None))
     keys, groups = _groups(d, by, qty, unt)
-    kw = dict(fit_kw, method=method, seed=seed)
-    todo: list[tuple[int, Model, FitData]] = []
-    for i, g in enumerate(groups):
-        if isinstance(g, FitData):
-            if model_of is None:
-                assert isinstance(model, Model)
-                m = model
-            else:
-                m = model_of(dict(zip(by, map(_plain, keys[i]), strict=True)))
-                setup_params(m, fit_kw.get("params"), fit_kw.get("fix"))
-            todo.append((i, m, g))
+    kw = dict(fit_kw, method=method, seed=seed, replicates=replicates)
+    todo = _todo(groups, keys, by, model if model_of is None else model_of, fit_kw)
+    for _, m, _ in todo if replicates is not None and replicates != 1 else ():
+        check_replicates(replicates, m)  # before any fit runs
     if chunks is None:
         chunks = 4 * ex.nworkers
     nchunks = max(1, min(int(chunks), len(todo)))
@@ -378,7 +405,8 @@ def fit_records(
         Per row: ``group`` (``{column: value}`` of ``by``), ``params`` (per parameter
         ``value``, ``stderr``, ``ci95``, ``at_bound``), ``rmse``, ``redchi``,
         ``weighting``, ``nmasked``, ``flags`` (per flagged parameter), ``nfev``,
-        ``success``, ``message``. A group that could not be fitted has ``success`` false,
+        ``replicates`` and ``seed_spread`` (seed replicates, else None), ``success``,
+        ``message``. A group that could not be fitted has ``success`` false,
         empty ``params``, ``rmse`` and ``nfev`` None and the reason in ``message``.
         Values are plain Python (NaN stays NaN: :func:`labbrdf.jsonsafe.jsonable` makes
         it JSON's null).
@@ -412,6 +440,8 @@ def fit_records(
                     "nmasked": s["nmasked"],
                     "flags": {k: v["flags"] for k, v in s["params"].items() if v["flags"]},
                     "nfev": s["nfev"],
+                    "replicates": s["replicates"],
+                    "seed_spread": s["seed_spread"],
                     "success": s["success"],
                     "message": row.get("message", ""),
                 }

@@ -20,6 +20,7 @@ from ..models import Model, Parameters
 from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
 from .objective import Objective
+from .replicates import ONE_SEED_WARNING
 from .result import FitResult
 from .uncertainty import AT_BOUND_FRAC, jacobian, noise_meat, uncertainties
 
@@ -424,6 +425,7 @@ def fit(
     weighting: str | None = None,
     relative_floor: float = RELATIVE_FLOOR,
     mask_zeros: bool = False,
+    replicates: int | None = None,
 ) -> FitResult:
     """Fit a reflectance/BRDF model: an nlopt global stage inside the bounds, then a local one.
 
@@ -477,6 +479,9 @@ def fit(
     mask_zeros : bool
         Exclude points whose value is exactly 0 (instrument-masked directions), counted in
         ``FitResult.nmasked`` and named in ``warnings``.
+    replicates : int, optional
+        R > 1: a stochastic model fitted with R seeds, combined (:func:`fit_replicates`);
+        None: the model's ``default_replicates`` (1 for a deterministic model).
 
     Returns
     -------
@@ -485,36 +490,25 @@ def fit(
     Raises
     ------
     FitError
-        Unknown method or parameter name, too few points, all points on the specular line
-        for smooth3's shape parameters, NaN/inf data, mixed quantities, bad sigma.
+        Unknown method or parameter name, too few points, only specular points for smooth3's
+        shape parameters, NaN/inf data, mixed quantities, bad sigma, bad ``replicates``.
     labbrdf.models.ModelError
         Unknown model name.
 
     Notes
     -----
-    Stages and budgets, the polish ending a converged local stage, uncertainties, weights,
-    the energy constraint and the refused specular-only design: docs/models.md 5 (Fitting).
+    Stages, budgets, polish, uncertainties, weights, energy constraint: docs/models.md 5.
     """
+    # every argument but the model, the data and the count: the same for each replicate
+    kw = {k: v for k, v in locals().items() if k not in ("model", "data", "replicates")}
+    model = get_model(model) if isinstance(model, str) else model
+    R = getattr(model, "default_replicates", 1) if replicates is None else replicates
+    if R != 1:  # a non-Model is refused by _problem
+        from .replicates import fit_replicates
+
+        return fit_replicates(model, data, R, **kw)
     t0 = time.perf_counter()
-    pb = _problem(
-        model,
-        data,
-        method=method,
-        params=params,
-        fix=fix,
-        profile=profile,
-        energy_constraint=energy_constraint,
-        maxeval=maxeval,
-        quantity=quantity,
-        unit=unit,
-        use_sigma=use_sigma,
-        nan_policy=nan_policy,
-        guess=guess,
-        ci=ci,
-        weighting=weighting,
-        relative_floor=relative_floor,
-        mask_zeros=mask_zeros,
-    )
+    pb = _problem(model, data, **{k: v for k, v in kw.items() if k != "seed"})
     x, stage_info, last_code, message = _search(
         pb.obj, pb.x0, pb.stages, pb.budgets, int(seed), pb.cons, pb.nfree, pb.use_sigma
     )
@@ -652,6 +646,7 @@ def _finish(
     ) + [f"{pb.nmasked} point(s) with value 0 excluded as instrument-masked (mask_zeros)"] * (
         pb.nmasked > 0
     )
+    warn += [ONE_SEED_WARNING] * bool(model.stochastic)
     if ci == "profile" and finite:
         delta = float(special.stdtrit(nfree, 0.975)) ** 2 * (1.0 if use_sigma else redchi)
         warn += _profile_intervals(model, fd, out, pb.weights, prof, varying, chisqr, delta, seed)

@@ -120,6 +120,11 @@ class FitResult:
         The model at the data points [data units].
     data : FitData or None
         The points fitted (after dropping and masking), for :meth:`plot`.
+    replicates : list of dict or None
+        Seed replicates of a stochastic model (:func:`labbrdf.fitting.fit_replicates`):
+        per fit its model ``seed`` and the varying parameters' values; None otherwise.
+    seed_spread : dict or None
+        name -> standard deviation (ddof 1) of the replicate estimates, s_between.
 
     Notes
     -----
@@ -168,6 +173,8 @@ class FitResult:
     residual: NDArray | None = field(default=None, repr=False)
     best_fit: NDArray | None = field(default=None, repr=False)
     data: FitData | None = field(default=None, repr=False)
+    replicates: list[dict[str, float]] | None = None
+    seed_spread: dict[str, float] | None = None
 
     @property
     def G(self) -> Any:
@@ -346,6 +353,8 @@ class FitResult:
             "cond": self.cond,
             "ci_method": self.ci_method,
             "nlopt_version": self.nlopt_version,
+            "replicates": self.replicates,
+            "seed_spread": self.seed_spread,
         }
         return jsonable(out)
 
@@ -403,6 +412,11 @@ class FitResult:
             lines += [s for _, s in sorted(pairs, reverse=True)]
         notes = [f"{k}: {r}" for k, rs in self.flag_reasons.items() for r in rs]
         notes += self.warnings
+        if self.replicates:
+            notes.append(f"weighting: {self.weighting}")
+            for k, sb in (self.seed_spread or {}).items():
+                vals = ", ".join(f"{r[k]:.6g}" for r in self.replicates)
+                notes.append(f"{k}: seed replicates {vals} (s_between {sb:.3g})")
         if self.energy:
             notes.append(
                 f"energy constraint: max rho = {self.energy['max_rho']:.6g} over "

@@ -168,10 +168,29 @@ class Model(ABC):
     #: that changes bin makes a small jump), so the fitter's difference steps and local
     #: tolerances are kept at or above it
     fd_rel_step: float | None = None
+    #: the model's value carries a Monte Carlo error fixed by a seed (common random
+    #: numbers): its fits are repeated over independent seeds (:meth:`reseeded`,
+    #: :func:`labbrdf.fitting.fit` ``replicates``) to measure the estimate's seed spread
+    stochastic: bool = False
+    #: seed replicates of a fit when none are asked for (``fit(replicates=None)``)
+    default_replicates: int = 1
 
     def __init__(self, **options: Any) -> None:
         self.options: dict[str, Any] = dict(options)
         self.params: Parameters = self.default_params()
+
+    def reseeded(self, seed: int) -> Model:
+        """The same model with the Monte Carlo seed ``seed`` (stochastic models only).
+
+        Raises
+        ------
+        ModelError
+            The model is deterministic: it has no seed to change.
+        """
+        raise ModelError(
+            f"model {self.name!r} is deterministic (no Monte Carlo seed): it has no seed "
+            "replicates"
+        )
 
     # ---------------------------------------------------------------- to implement
     @abstractmethod

@@ -132,6 +132,11 @@ class Layered(Model):
     #: parameter's range (below it, single rays changing bins show as small jumps); None
     #: in the coherent mode, whose map is evaluated in closed form
     fd_rel_step: float | None = 3e-3
+    #: traced (not in the coherent mode): the value depends on the seed
+    stochastic: bool = True
+    #: three seeds: the seed spread is estimated with 2 degrees of freedom at 3x the cost
+    #: of one fit (docs/models.md 7)
+    default_replicates: int = 3
 
     def __init__(
         self,
@@ -160,6 +165,8 @@ class Layered(Model):
         self._coherent = _flag(coherent, "coherent")
         if self._coherent:
             self.fd_rel_step = None
+            self.stochastic = False
+            self.default_replicates = 1
         self._floor = _flag(floor, "floor")
         self._nk = (1.0, 0.0)
         if base == "diffuse":
@@ -240,6 +247,14 @@ class Layered(Model):
             self.linear = ("scale", "kd")
         opts["grid"] = "auto" if self._grid is None else f"{self._grid[0]:g}x{self._grid[1]:g}"
         super().__init__(**opts)
+
+    def reseeded(self, seed: int) -> Layered:
+        """The same model (options, grid) with the tracer seed ``seed`` and a fresh cache."""
+        if not self.stochastic:
+            return super().reseeded(seed)  # type: ignore[return-value]
+        new = Layered(**{**self.options, "seed": seed})
+        new._grid = self._grid
+        return new
 
     def default_params(self) -> Parameters:
         """Defaults: n_coat 1.5 (fixed), alpha_top and alpha_sub 0.2, scale 1 (fixed), kd 0.
