@@ -105,6 +105,28 @@ class PredictionError(ValueError):
 # --------------------------------------------------------------------------- inputs
 
 
+def _areal(
+    heights: Any, pixel_size: float | Sequence[float] | None, what: str
+) -> tuple[NDArray, tuple[float, float], str]:
+    """Heights [m], pitch per axis [m] and a ``"file: "`` prefix of a map or an array.
+
+    Raises PredictionError for a profile (``what`` needs an areal map) or an array without
+    a pixel size.
+    """
+    where = ""
+    if hasattr(heights, "heights") and hasattr(heights, "pixel_size"):
+        where = f"{heights.path}: "
+        pixel_size = heights.pixel_size
+        heights = heights.heights
+    z = np.asarray(heights, dtype=float)
+    if z.ndim != 2:
+        raise PredictionError(f"{where}a line profile; {what} needs an areal height map (2-D)")
+    if pixel_size is None:
+        raise PredictionError("pixel_size is needed for a plain height array")
+    px = np.broadcast_to(np.asarray(pixel_size, float), (2,))
+    return z, (float(px[0]), float(px[1])), where
+
+
 def roughness_alpha(
     heights: Any, pixel_size: float | Sequence[float] | None = None, *, degree: int = 1
 ) -> SlopeFit:
@@ -132,19 +154,7 @@ def roughness_alpha(
         A profile (a slope distribution of an isotropic surface needs both axes) or a map
         without a pixel size.
     """
-    where = ""
-    if hasattr(heights, "heights") and hasattr(heights, "pixel_size"):
-        where = f"{heights.path}: "
-        pixel_size = heights.pixel_size
-        heights = heights.heights
-    z = np.asarray(heights, dtype=float)
-    if z.ndim != 2:
-        raise PredictionError(
-            f"{where}a line profile; the tracer's roughness needs an areal height map (2-D)"
-        )
-    if pixel_size is None:
-        raise PredictionError("pixel_size is needed for a plain height array")
-    px = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (2,)))
+    z, px, _ = _areal(heights, pixel_size, "the tracer's roughness")
     sx, sy = slopes(level(z, degree), px)
     return fit_slope_distribution(sx, sy).ggx
 
@@ -263,21 +273,9 @@ def slope_table(heights: Any, pixel_size: float | Sequence[float] | None = None)
     PredictionError
         A profile, or a map without a pixel size (as :func:`roughness_alpha`).
     """
-    where = ""
-    if hasattr(heights, "heights") and hasattr(heights, "pixel_size"):
-        where = f"{heights.path}: "
-        pixel_size = heights.pixel_size
-        heights = heights.heights
-    z = np.asarray(heights, dtype=float)
-    if z.ndim != 2:
-        raise PredictionError(
-            f"{where}a line profile; a slope table needs an areal height map (2-D)"
-        )
-    if pixel_size is None:
-        raise PredictionError("pixel_size is needed for a plain height array")
-    px = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (2,)))
+    z, px, where = _areal(heights, pixel_size, "a slope table")
     try:
-        ndf = Substrate.from_surface(z, (px[0], px[1])).ndf
+        ndf = Substrate.from_surface(z, px).ndf
     except ValueError as exc:
         raise PredictionError(f"{where}{exc}") from None
     assert ndf is not None

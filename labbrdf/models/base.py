@@ -17,7 +17,16 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import LabbrdfError
 
-__all__ = ["Model", "ModelError", "Parameter", "Parameters"]
+__all__ = ["Model", "ModelError", "Parameter", "Parameters", "lambert"]
+
+
+def lambert(theta_i: NDArray, theta_r: NDArray) -> NDArray:
+    """Lambertian BRDF of unit albedo [sr^-1]: ``1 / pi`` above the surface, else 0.
+
+    Both directions must be above the surface; the ``kd`` term of the models that have one.
+    """
+    up = (np.cos(theta_i) > 0) & (np.cos(theta_r) > 0)
+    return np.where(up, 1.0 / np.pi, 0.0)
 
 
 class ModelError(LabbrdfError, ValueError):

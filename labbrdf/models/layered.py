@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .base import Model, ModelError, Parameters
+from .base import Model, ModelError, Parameters, lambert
 
 __all__ = ["Layered"]
 
@@ -497,7 +497,7 @@ class Layered(Model):
         val, _ = self._maps_at(p, theta_i, theta_r, phi_r, wavelength)
         val = p["scale"] * val
         if self._floor:
-            val = val + p["kd"] * _lambert(theta_i, theta_r)
+            val = val + p["kd"] * lambert(theta_i, theta_r)
         return val
 
     def linear_components(
@@ -512,7 +512,7 @@ class Layered(Model):
         val, _ = self._maps_at(p, theta_i, theta_r, phi_r, wavelength)
         out = {"scale": np.broadcast_to(val, np.shape(theta_r)).copy()}
         if self._floor:
-            out["kd"] = np.broadcast_to(_lambert(theta_i, theta_r), np.shape(theta_r)).copy()
+            out["kd"] = np.broadcast_to(lambert(theta_i, theta_r), np.shape(theta_r)).copy()
         return out
 
     def point_noise(
@@ -582,12 +582,6 @@ def _flag(v: Any, name: str) -> bool:
 
 def _real(v: Any) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-
-
-def _lambert(theta_i: NDArray, theta_r: NDArray) -> NDArray:
-    """``1 / pi`` [sr^-1] where both directions are above the surface, else 0."""
-    up = (np.cos(theta_i) > 0) & (np.cos(theta_r) > 0)
-    return np.where(up, 1.0 / np.pi, 0.0)
 
 
 def _bilinear(m: NDArray, u: NDArray, v: NDArray) -> NDArray[np.float64]:

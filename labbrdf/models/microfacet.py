@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..ellipsometry import nk_from_psi_delta
 from ..optics import fresnel_cos
-from .base import Model, ModelError, Parameters
+from .base import Model, ModelError, Parameters, lambert
 
 __all__ = ["Microfacet", "ggx_distribution", "smith_g1_ggx", "stokes_from_jones"]
 
@@ -298,14 +298,8 @@ class Microfacet(Model):
         fres = 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
         out = self._scalar_factor(p, theta_i, theta_r, cos_h) * fres
         if self._diffuse:
-            out = out + p["kd"] * self._lambert(theta_i, theta_r)
+            out = out + p["kd"] * lambert(theta_i, theta_r)
         return out
-
-    @staticmethod
-    def _lambert(theta_i: NDArray, theta_r: NDArray) -> NDArray:
-        """``1 / pi`` [sr^-1] where both directions are above the surface, else 0."""
-        up = (np.cos(theta_i) > 0) & (np.cos(theta_r) > 0)
-        return np.where(up, 1.0 / np.pi, 0.0)
 
     def linear_components(
         self,
@@ -322,7 +316,7 @@ class Microfacet(Model):
         q["kd"] = 0.0
         return {
             "scale": self._evaluate(q, theta_i, theta_r, phi_r, wavelength),
-            "kd": np.broadcast_to(self._lambert(theta_i, theta_r), np.shape(theta_r)).copy(),
+            "kd": np.broadcast_to(lambert(theta_i, theta_r), np.shape(theta_r)).copy(),
         }
 
     # ------------------------------------------------------------------ polarization
@@ -393,5 +387,5 @@ class Microfacet(Model):
         m = stokes_from_jones(b_out @ jf @ b_in)
         out = self._scalar_factor(p, ti, tr, cos_h)[..., None, None] * m
         if self._diffuse:
-            out[..., 0, 0] += p["kd"] * self._lambert(ti, tr)
+            out[..., 0, 0] += p["kd"] * lambert(ti, tr)
         return out
