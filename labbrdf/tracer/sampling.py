@@ -237,6 +237,17 @@ class TabulatedNDF:
         Sub-cell midpoints per axis in the Lambda precomputation.
     name : str
         Label (e.g. ``"ggx(0.2)"``).
+    normalise : bool
+        Divide ``mass`` by its sum (the default). ``False`` keeps the masses exactly as
+        given; they must then already sum to 1 within rounding (``size * eps``).
+
+    Notes
+    -----
+    :meth:`from_dict` keeps the stored masses as they are (``normalise=False``), so a
+    table survives :meth:`to_dict` / :meth:`from_dict` bit for bit on any machine.
+    Dividing the stored masses by their sum again would not: their sum is 1 only to
+    rounding, and which rounding depends on the vector width numpy's pairwise summation
+    uses on the CPU at hand, so a renormalised copy differs in the last bits.
     """
 
     def __init__(
@@ -249,6 +260,7 @@ class TabulatedNDF:
         n_mu: int = 1024,
         sub: int = 2,
         name: str = "table",
+        normalise: bool = True,
     ) -> None:
         xe = np.asarray(x_edges, dtype=float)
         ye = np.asarray(y_edges, dtype=float)
@@ -266,7 +278,12 @@ class TabulatedNDF:
         if not np.all(np.isfinite(w)) or np.any(w < 0) or w.sum() <= 0:
             raise ValueError("mass must be finite, >= 0 and not all zero")
         self.x_edges, self.y_edges = xe, ye
-        self.mass = w / w.sum()
+        if normalise:
+            self.mass = w / w.sum()
+        elif abs(w.sum() - 1.0) <= w.size * np.finfo(float).eps:
+            self.mass = w
+        else:
+            raise ValueError(f"mass must sum to 1 when normalise=False, got {w.sum()!r}")
         self.name = str(name)
         self.n_phi, self.n_mu, self.sub = int(n_phi), int(n_mu), int(sub)
         area = np.diff(xe)[:, None] * np.diff(ye)[None, :]
@@ -433,10 +450,16 @@ class TabulatedNDF:
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> TabulatedNDF:
-        """The table written by :meth:`to_dict`."""
+        """The table written by :meth:`to_dict`, its masses kept bit for bit.
+
+        Masses that do not sum to 1 within rounding (a table written by hand) are
+        normalised as by the constructor.
+        """
         d = dict(data)
         d.pop("kind", None)
-        return cls(d.pop("x_edges"), d.pop("y_edges"), d.pop("mass"), **d)
+        mass = np.asarray(d.pop("mass"), dtype=float)
+        exact = mass.size > 0 and abs(mass.sum() - 1.0) <= mass.size * np.finfo(float).eps
+        return cls(d.pop("x_edges"), d.pop("y_edges"), mass, normalise=not exact, **d)
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, TabulatedNDF):
