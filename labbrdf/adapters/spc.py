@@ -14,6 +14,10 @@ exponent is -128, else int32 (int16 with flag TSPREC 0x01) scaled by 2**(exp - 3
 (2**(exp - 16)). X is evenly spaced from ``ffirst`` to ``flast`` unless TXVALS; it must be strictly
 monotonic (ascending or descending) and within 1 nm to 1 mm, else the header is corrupt.
 
+Old-format (version byte 0x4D) and big-endian (0x4C) files are recognised, whether the
+format is detected or forced, and refused by name with the advice to re-save them in the new
+LSB format.
+
 Supported: one or several subfiles sharing one X axis (TMULTI without TXYXYS), X in nm
 (``fxtype`` 3) or micrometres (2), Y absorbance (``fytype`` 2), transmission (128) or
 reflectance (129), the codes of Galactic's ``spc.h``. The format does not say whether a
@@ -56,6 +60,8 @@ __all__ = ["FORMATS", "read_spc"]
 INSTRUMENT = "galactic-spc"
 
 _HEADER = 512
+#: header size of the old format (version byte 0x4D) [bytes]
+_OLD_HEADER = 256
 _SUBHEADER = 32
 _TSPREC, _TMULTI, _TXYXYS, _TXVALS = 0x01, 0x04, 0x40, 0x80
 _XUNITS = {3: ("nm", 1.0), 2: ("micrometers", 1000.0)}
@@ -100,11 +106,22 @@ _WAVELENGTH_RANGE_NM = (1.0, 1.0e6)
 
 
 def _sniff(head: bytes) -> bool:
+    """True for a Galactic SPC of the new LSB format, or of a kind read_spc refuses by name.
+
+    Old-format and big-endian files are claimed so that detection gives the same precise
+    message as a forced format.
+    """
+    if len(head) < _OLD_HEADER:
+        return False
+    if head[1] == 0x4D:  # old format: float32 point count at 4, X unit code at 16
+        (npts,) = struct.unpack_from("<f", head, 4)
+        return 1 <= npts < 10_000_000 and npts == int(npts) and head[16] < 32
+    order = {0x4B: "little", 0x4C: "big"}.get(head[1])
     return (
-        len(head) >= _HEADER
-        and head[1] == 0x4B
+        order is not None
+        and len(head) >= _HEADER
         and head[28] in _XUNITS
-        and 0 < int.from_bytes(head[4:8], "little", signed=True) < 10_000_000
+        and 0 < int.from_bytes(head[4:8], order, signed=True) < 10_000_000  # type: ignore[arg-type]
     )
 
 
@@ -257,10 +274,6 @@ class _Header:
 
 def _header(path: str | os.PathLike[str], raw: bytes) -> _Header:
     """Check the version, flags, counts, units and size the header states."""
-    if len(raw) < _HEADER:
-        raise _fail(
-            path, f"file is {len(raw)} bytes, shorter than the 512-byte SPC header", len(raw)
-        )
     if is_ole2(raw):
         raise _fail(
             path,
@@ -270,12 +283,16 @@ def _header(path: str | os.PathLike[str], raw: bytes) -> _Header:
             "Python",
             0,
         )
-    flags, version = raw[0], raw[1]
-    if version in (0x4D, 0x4C):
-        kind = "old-format (0x4D)" if version == 0x4D else "big-endian (0x4C)"
+    if len(raw) >= 2 and raw[1] in (0x4D, 0x4C):  # before the size: old headers are shorter
+        kind = "old-format (0x4D)" if raw[1] == 0x4D else "big-endian (0x4C)"
         raise _fail(
             path, f"{kind} SPC files are not supported; re-save as new LSB format (0x4B)", 1
         )
+    if len(raw) < _HEADER:
+        raise _fail(
+            path, f"file is {len(raw)} bytes, shorter than the 512-byte SPC header", len(raw)
+        )
+    flags, version = raw[0], raw[1]
     if version != 0x4B:
         raise _fail(path, f"version byte 0x{version:02X}: expected 0x4B (new LSB SPC)", 1)
     fexp = struct.unpack_from("<b", raw, 3)[0]

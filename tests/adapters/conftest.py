@@ -7,7 +7,8 @@ plain functions, so that each vendor's file uses the same ones.
 
 Shimadzu UVProbe ``.spc`` and legacy JASCO ``.jws`` files are OLE2 compound documents. The
 tests build their own from named streams (``olefile`` reads but does not create them), so
-they run without ../shared. The writer follows [MS-CFB] version 3: 512-byte sectors, a FAT,
+they run without ../shared. The writer follows [MS-CFB] version 3: 512-byte sectors, a FAT
+(its sectors past the 109 the header lists in DIFAT sectors),
 streams under 4096 bytes in the mini stream (64-byte mini sectors, a mini FAT), directory
 entries of 128 bytes whose siblings are chained through the right-sibling pointer (a valid
 if unbalanced tree: readers do not check the red-black colours).
@@ -30,7 +31,8 @@ from labbrdf.adapters import AdapterError
 REL = 1e-12
 
 MAGIC = b"\xd0\xcf\x11\xe0\xa1\xb1\x1a\xe1"
-_FREE, _END, _FATSECT, _NOSTREAM = 0xFFFFFFFF, 0xFFFFFFFE, 0xFFFFFFFD, 0xFFFFFFFF
+_FREE, _END, _FATSECT, _DIFSECT = 0xFFFFFFFF, 0xFFFFFFFE, 0xFFFFFFFD, 0xFFFFFFFC
+_NOSTREAM = 0xFFFFFFFF
 _SECTOR, _MINI, _CUTOFF = 512, 64, 4096
 
 
@@ -73,11 +75,12 @@ def write_ole2(streams: dict[str, bytes]) -> bytes:
     nministream = -(-len(mini) // _SECTOR)
     big = [e for e in entries if e["type"] == 2 and len(e["data"]) >= _CUTOFF]
     nbig = sum(-(-len(e["data"]) // _SECTOR) for e in big)
-    nfat = 1
-    while nfat * 128 < nfat + ndir + nminifat + nministream + nbig:
+    nfat, ndifat = 1, 0  # past 109 FAT sectors (a file over 7 MB) DIFAT sectors list the rest
+    while nfat * 128 < nfat + ndifat + ndir + nminifat + nministream + nbig:
         nfat += 1
-    fat: list[int] = [_FATSECT] * nfat
-    nxt = nfat
+        ndifat = max(0, -(-(nfat - 109) // 127))
+    fat: list[int] = [_FATSECT] * nfat + [_DIFSECT] * ndifat
+    nxt = nfat + ndifat
 
     def chain(n: int) -> int:
         nonlocal nxt
@@ -133,13 +136,18 @@ def write_ole2(streams: dict[str, bytes]) -> bytes:
             _CUTOFF,
             minifat_start if minifat else _END,
             nminifat,
-            _END,
-            0,
+            nfat if ndifat else _END,
+            ndifat,
         )
-        + struct.pack("<109I", *(list(range(nfat)) + [_FREE] * (109 - nfat)))
+        + struct.pack("<109I", *(list(range(min(nfat, 109))) + [_FREE] * (109 - nfat)))
     )
     assert len(header) == _SECTOR
-    body = struct.pack(f"<{len(fat)}I", *fat) + raw_dir
+    body = struct.pack(f"<{len(fat)}I", *fat)
+    for k in range(ndifat):
+        listed = list(range(109 + 127 * k, min(nfat, 109 + 127 * (k + 1))))
+        after = nfat + k + 1 if k + 1 < ndifat else _END
+        body += struct.pack("<128I", *(listed + [_FREE] * (127 - len(listed)) + [after]))
+    body += raw_dir
     body += _pad(struct.pack(f"<{len(minifat)}I", *minifat), _SECTOR) if minifat else b""
     body += _pad(mini, _SECTOR)
     for e in big:

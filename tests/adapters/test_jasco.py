@@ -344,3 +344,65 @@ def test_jws_string_fields_fall_back_to_latin1(tmp_path: Path, write) -> None:
     data[0x180:0x187] = b"\x81\x20abcd\x00"  # neither UTF-8 nor cp932
     m = read_jasco_jws(write(tmp_path, "a.jws", bytes(data)))
     assert m.meta["title"] == "\x81 abcd"
+
+
+# ------------------------------------------------------- damaged OLE2 sector chains (legacy)
+
+
+def _ole_set(raw: bytes, at: int, value: int) -> bytes:
+    return raw[:at] + struct.pack("<I", value) + raw[at + 4 :]
+
+
+def _fat_entry(raw: bytes, sector: int) -> int:
+    """Byte offset of FAT entry ``sector`` (the FAT sectors are listed from byte 76)."""
+    fat_sector = struct.unpack_from("<I", raw, 76 + 4 * (sector // 128))[0]
+    return 512 * (fat_sector + 1) + 4 * (sector % 128)
+
+
+def test_real_legacy_jws_with_a_looped_chain_is_refused(
+    real_exports: Path, tmp_path: Path
+) -> None:
+    """Y-Data holds sectors 6-65; sector 30 pointing back to 6 read 6,399 of 7,113 rows."""
+    raw = (real_exports / LEGACY).read_bytes()
+    p = tmp_path / "legacy_trans_512.jws"
+    p.write_bytes(_ole_set(raw, _fat_entry(raw, 30), 6))
+    with pytest.raises(AdapterError, match=r"stream 'Y-Data' visits sector 6 twice \(a loop\)"):
+        labbrdf.read(p)
+
+
+def _legacy_big(make_ole2) -> tuple[bytes, list[int]]:
+    """1200 points: Y-Data (4800 bytes) in the FAT; its chain, from olefile."""
+    import olefile
+
+    raw = make_ole2(legacy_streams(np.linspace(10.0, 60.0, 1200)))
+    ole = olefile.OleFileIO(raw)
+    chain = [ole.direntries[ole._find("Y-Data")].isectStart]
+    while ole.fat[chain[-1]] != 0xFFFFFFFE:
+        chain.append(ole.fat[chain[-1]])
+    return raw, chain
+
+
+def test_synthetic_legacy_jws_with_a_looped_chain_is_refused(tmp_path: Path, make_ole2) -> None:
+    raw, y = _legacy_big(make_ole2)
+    p = tmp_path / "loop.jws"
+    p.write_bytes(_ole_set(raw, _fat_entry(raw, y[5]), y[2]))
+    with pytest.raises(AdapterError, match=rf"loop.jws: .*'Y-Data' visits sector {y[2]} twice"):
+        read_jasco_jws(p)
+
+
+def test_synthetic_legacy_jws_with_a_short_chain_is_refused(tmp_path: Path, make_ole2) -> None:
+    raw, y = _legacy_big(make_ole2)
+    p = tmp_path / "short.jws"
+    p.write_bytes(_ole_set(raw, _fat_entry(raw, y[4]), 0xFFFFFFFE))
+    with pytest.raises(AdapterError, match=r"'Y-Data' ends after 5 sector\(s\), .* needs 10"):
+        read_jasco_jws(p)
+
+
+def test_legacy_jws_whose_mini_stream_is_cut_short_is_refused(tmp_path: Path, make_ole2) -> None:
+    """The root entry's size bounds the mini sectors: DataInfo's must lie inside it."""
+    raw = make_ole2(legacy_streams())
+    at = raw.index("Root Entry".encode("utf-16-le")) + 120  # the root entry's size
+    p = tmp_path / "mini.jws"
+    p.write_bytes(_ole_set(raw, at, 64))  # one mini sector left of three streams' worth
+    with pytest.raises(AdapterError, match=r"mini.jws: .*corrupt.*mini"):
+        read_jasco_jws(p)

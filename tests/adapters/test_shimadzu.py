@@ -287,3 +287,92 @@ def test_cli_ingest_of_a_broken_spc_exits_2_naming_the_file(tmp_path: Path, make
     assert main(["ingest", str(p)]) == 2
     err = capsys.readouterr().err
     assert str(p) in err and "measuring mode 'Energy'" in err and "Traceback" not in err
+
+
+# ---------------------------------------------------------------- damaged OLE2 sector chains
+
+_END = 0xFFFFFFFE
+
+
+def _fat_entry(raw: bytes, sector: int) -> int:
+    """Byte offset of FAT entry ``sector`` (the FAT sectors are listed from byte 76)."""
+    fat_sector = struct.unpack_from("<I", raw, 76 + 4 * (sector // 128))[0]
+    return 512 * (fat_sector + 1) + 4 * (sector % 128)
+
+
+def _chain(raw: bytes, stream: str) -> list[int]:
+    import olefile
+
+    ole = olefile.OleFileIO(raw)
+    sect = ole.direntries[ole._find(stream)].isectStart
+    out = []
+    while sect != _END:
+        out.append(sect)
+        sect = ole.fat[sect]
+    return out
+
+
+def _set(raw: bytes, at: int, value: int) -> bytes:
+    return raw[:at] + struct.pack("<I", value) + raw[at + 4 :]
+
+
+_Y = f"{BASE}/DataSpectrumStorage/Data/Y Data.1"
+_X = f"{BASE}/DataSpectrumStorage/Data/X Data.1"
+
+
+@pytest.mark.parametrize(
+    ("sector", "value", "match"),
+    [  # Y Data.1 holds sectors 20-29, X Data.1 sectors 30-39
+        (22, 30, r"chain of stream '.*/Y Data.1' goes on past the 10 sector"),
+        (25, 20, r"chain of stream '.*/Y Data.1' visits sector 20 twice \(a loop\)"),
+        (39, 30, r"chain of stream '.*/X Data.1' visits sector 30 twice"),
+    ],
+)
+def test_real_spc_with_a_4_byte_fat_edit_is_refused_not_read_as_other_numbers(
+    real_exports: Path, tmp_path: Path, sector: int, value: int, match: str
+) -> None:
+    raw = (real_exports / FOLDER / f"{STEM}.spc").read_bytes()
+    assert _chain(raw, _Y) == list(range(20, 30)) and _chain(raw, _X) == list(range(30, 40))
+    p = write(tmp_path, f"{STEM}.spc", _set(raw, _fat_entry(raw, sector), value))
+    with pytest.raises(AdapterError, match=match) as exc:
+        labbrdf.read(p)
+    assert str(p) in str(exc.value)
+
+
+def _big_spc(make_ole2) -> bytes:
+    """600 points: X and Y (4800 bytes each) lie in the FAT, not the mini stream."""
+    x = np.linspace(900.0, 301.0, 600)
+    return make_ole2(spc_streams(x=x, y=np.linspace(0.1, 1.0, 600)))
+
+
+def test_synthetic_spc_with_a_looped_chain_is_refused(tmp_path: Path, make_ole2) -> None:
+    raw = _big_spc(make_ole2)
+    y = _chain(raw, _Y)
+    p = write(tmp_path, "loop.spc", _set(raw, _fat_entry(raw, y[-1]), y[3]))
+    with pytest.raises(AdapterError, match=rf"'.*/Y Data.1' visits sector {y[3]} twice"):
+        read_uvprobe_spc(p)
+
+
+def test_synthetic_spc_whose_chain_runs_into_another_stream_is_refused(
+    tmp_path: Path, make_ole2
+) -> None:
+    """Y's second sector replaced by X's: the right length, but a sector of two streams."""
+    raw = _big_spc(make_ole2)
+    x, y = _chain(raw, _X), _chain(raw, _Y)
+    raw = _set(raw, _fat_entry(raw, y[0]), x[1])
+    raw = _set(raw, _fat_entry(raw, x[1]), _END)  # X now ends at its second sector too
+    raw = _set(raw, _fat_entry(raw, x[0]), y[1])
+    p = write(tmp_path, "cross.spc", raw)
+    with pytest.raises(AdapterError, match=r"corrupt: .*(belongs to both|ends after|goes on)"):
+        read_uvprobe_spc(p)
+
+
+def test_spc_whose_tree_holds_an_unused_entry_names_the_file(tmp_path: Path, make_ole2) -> None:
+    """olefile lists such a tree with its own OleFileError, which named no file."""
+    raw = make_ole2(spc_streams())
+    at = raw.index("PageTexts0".encode("utf-16-le")) + 66  # the entry's type byte
+    p = write(tmp_path, "unused.spc", raw[:at] + b"\x00" + raw[at + 1 :])
+    with pytest.raises(AdapterError, match=r"unused.spc: .*corrupt") as exc:
+        labbrdf.read(p)
+    assert "OleFileError" not in str(exc.value)
+    assert main(["ingest", str(p)]) == 2

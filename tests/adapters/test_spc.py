@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import labbrdf
 from labbrdf.adapters import AdapterError
 from labbrdf.adapters.spc import read_spc
 
@@ -240,3 +241,34 @@ def test_spc_without_a_valid_date_and_with_non_finite_x_range(tmp_path: Path, wr
     struct.pack_into("<d", data, 16, float("inf"))
     with pytest.raises(AdapterError, match=r"byte 8: first/last X 400.0, inf: expected finite"):
         read_spc(write(tmp_path, "b.spc", bytes(data)))
+
+
+def _old_format_spc(npts: int = 3) -> bytes:
+    """An old-format SPC (version 0x4D): float32 point count and X range, 256-byte header."""
+    head = struct.pack("<BBhfff", 0, 0x4D, 0, float(npts), 400.0, 402.0) + bytes([3, 2])
+    head = head.ljust(256, b"\x00")
+    return head + struct.pack(f"<{npts}i", *range(npts))
+
+
+def _big_endian_spc() -> bytes:
+    raw = bytearray(spc(version=0x4C))
+    raw[4:8] = struct.pack(">i", 3)
+    return bytes(raw)
+
+
+@pytest.mark.parametrize(
+    ("make", "match"),
+    [
+        (_old_format_spc, r"byte 1: old-format \(0x4D\) SPC files are not supported; re-save"),
+        (_big_endian_spc, r"byte 1: big-endian \(0x4C\) SPC files are not supported"),
+    ],
+)
+def test_old_and_big_endian_spc_get_the_precise_message_when_detected(
+    tmp_path: Path, write, make, match: str
+) -> None:
+    """Auto-detection says what --format galactic-spc says, not 'no adapter recognises'."""
+    p = write(tmp_path, "old.spc", make())
+    for fmt in (None, "galactic-spc"):
+        with pytest.raises(AdapterError, match=match) as exc:
+            labbrdf.read(p, format=fmt)
+        assert str(p) in str(exc.value)
