@@ -33,6 +33,7 @@ from typing import Any
 from ..dataset import Measurement, concat
 from . import (
     accurion,
+    avantes,
     cary,
     columns,
     filmsense,
@@ -83,6 +84,7 @@ _VENDOR_MODULES = (
     spc,
     shimadzu,
     oceanoptics,
+    avantes,
     labbrdf_csv,
     native,
     zemax_bsdf,
