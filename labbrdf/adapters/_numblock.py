@@ -189,7 +189,7 @@ def check_last_field(
     Warned (the column's own writing varies, so a shorter value may be a real one, e.g.
     ``0.13`` beside ``0.1308`` from a writer that drops trailing zeros): the field has fewer
     decimals than some other row, fewer significant digits than every other row, or no
-    exponent where other rows have one.
+    exponent where other rows have one; or no other row has the column to compare with.
 
     Parameters
     ----------
@@ -233,8 +233,13 @@ def check_last_field(
         )
     ref = [s for p in previous[-TAIL_ROWS:] if len(fs := _fields(p, sep, tagged)) > j
            for s in [_shape(fs[j])] if s is not None]  # fmt: skip
-    if not ref:
-        return None
+    if not ref:  # nothing to compare with: say so rather than vouch for the value
+        return warn(
+            path,
+            f"{cut} has no other row of its column to compare with: the file may be "
+            f"truncated ({fix})",
+            line,
+        )
     decimals = [r.decimals for r in ref]
     exps = [r.exponent for r in ref if r.exponent is not None]
     fixed = len(ref) >= FIXED_ROWS and min(decimals) == max(decimals)

@@ -248,6 +248,10 @@ def _rows(
         fields = _split(s, sep)
         if not rows and not re.match(r"[+\-.0-9]", fields[0]):
             raise _header_error(path, s, n)
+        if cut and n == len(lines):  # the last line has no line end: cut mid-number?
+            previous = [lines[i - 1] for i in lines_of[-TAIL_ROWS:]]
+            note = check_last_field(path, line, previous, n, sep)
+            notes.extend([note] if note else [])
         if len(fields) != ncols:
             shown = "TAB" if sep == "\t" else repr(sep) if sep else "blanks"
             raise AdapterError(
@@ -256,10 +260,6 @@ def _rows(
                 f"{len(fields)} in {s[:40]!r}",
                 n,
             )
-        if cut and n == len(lines):  # the last line has no line end: cut mid-number?
-            previous = [lines[i - 1] for i in lines_of[-TAIL_ROWS:]]
-            note = check_last_field(path, line, previous, n, sep)
-            notes.extend([note] if note else [])
         rows.append(
             [
                 number(f, path, n, name) if name != _SKIP else 0.0
