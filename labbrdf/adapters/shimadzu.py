@@ -110,7 +110,8 @@ def read_uvprobe_text(path: str | os.PathLike[str]) -> Measurement:
     text, encoding = decode(raw, path, ("utf-8", "cp1252"))
     lines = split_lines(text)
     cut_at_end = unterminated(text)
-    frames, blocks, dropped = [], [], 0
+    frames, dropped = [], 0
+    blocks: list[dict[str, Any]] = []
     notes: list[str] = []
     n = 0
     while n < len(lines):
