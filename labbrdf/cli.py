@@ -31,6 +31,7 @@ import math
 import os
 import sys
 import time
+import warnings
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any, Literal
@@ -438,7 +439,7 @@ def cmd_ingest(args: argparse.Namespace) -> int:
         inputs = adapters.read_inputs(
             args.files,
             args.format,
-            columns=args.columns,
+            columns=_columns_spec(args),
             on_error="collect" if args.keep_going else "raise",
         )
     except (ValueError, NotImplementedError, OSError, ImportError) as exc:
@@ -458,6 +459,9 @@ def cmd_ingest(args: argparse.Namespace) -> int:
             unselected.append(f"{path}: {exc}")
             continue
         s = m.summary()
+        if m.meta.get("format") == "columns":  # e.g. the preamble lines it skipped
+            for note in m.meta.get("notes") or ():
+                print(f"labbrdf ingest: note: {path}: {note}", file=sys.stderr)
         measurements.append(m)
         rows.append(
             {
@@ -496,6 +500,15 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     for u in unselected:
         print(f"labbrdf ingest: nothing selected in {u}", file=sys.stderr)
     return 2 if failures else 0
+
+
+def _columns_spec(args: argparse.Namespace) -> str | None:
+    """``--columns`` with ``--skip-lines`` joined as its ``skip_lines=`` setting."""
+    if args.skip_lines is None:
+        return args.columns
+    if args.columns is None:
+        raise UsageError("--skip-lines skips the leading lines of a file read with --columns")
+    return f"{args.columns},skip_lines={args.skip_lines}"
 
 
 def _channels(d: Any) -> dict[str, list[str]]:
@@ -1323,6 +1336,13 @@ def _ingest_parser(sub: Any) -> None:
         "e.g. wavelength_nm,absorbance; see docs/formats.md",
     )
     s.add_argument(
+        "--skip-lines",
+        default=None,
+        metavar="N|auto",
+        help="with --columns: skip the first N lines (a title or header), or with 'auto' "
+        "every line before the first row of numbers; the skipped lines go in the metadata",
+    )
+    s.add_argument(
         "-o",
         "--output",
         action=OutputPath,
@@ -1797,12 +1817,31 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+@contextlib.contextmanager
+def _adapter_warnings(command: str) -> Iterator[None]:
+    """Print a reader's doubts (:class:`~labbrdf.adapters.AdapterWarning`) as one line each."""
+    from .adapters import AdapterWarning
+
+    with warnings.catch_warnings():
+        original = warnings.showwarning
+
+        def show(message: Any, category: Any, *rest: Any, **kw: Any) -> None:
+            if issubclass(category, AdapterWarning):
+                print(f"labbrdf {command}: warning: {message}", file=sys.stderr)
+            else:
+                original(message, category, *rest, **kw)
+
+        warnings.simplefilter("always", AdapterWarning)
+        warnings.showwarning = show
+        yield
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        with _checked_outputs(args):
+        with _checked_outputs(args), _adapter_warnings(args.command):
             return int(args.func(args))
     except UsageError as exc:
         print(f"labbrdf {args.command}: {exc}", file=sys.stderr)

@@ -51,12 +51,14 @@ from . import (
     zemax_bsdf,
 )
 from ._base import AdapterError, Example, Format, check_regular_file
+from ._numblock import AdapterWarning
 from ._ole2 import is_ole2
 from .columns import read_columns as _read_columns
 from .topography import height_map_format
 
 __all__ = [
     "AdapterError",
+    "AdapterWarning",
     "Example",
     "Format",
     "InputFile",
@@ -112,8 +114,13 @@ _OLE2_FORMATS = ("shimadzu-uvprobe-spc", "jasco-jws")
 _SNIFF_BYTES = 8192
 #: how to force a format, in the words of both interfaces
 _FORCE = "pass --format NAME on the command line or format=NAME in Python"
-#: a head of only numbers, separators and line breaks (a headerless column file)
-_NUMBERS_ONLY = re.compile(rb"\A(?:[ \t]*[-+0-9.,;eE \t]+[ \t]*\r?\n){2,}")
+#: a line of only numbers and separators
+_NUMBER_LINE = rb"[ \t]*[-+0-9.,;eE \t]+[ \t]*\r?\n"
+#: a head of only numbers, separators and line breaks (a headerless column file), after
+#: any ``#`` comment and blank lines (the columns reader skips those)
+_NUMBERS_ONLY = re.compile(rb"\A(?:[ \t]*(?:#[^\r\n]*)?\r?\n)*(?:" + _NUMBER_LINE + rb"){2,}")
+#: the same after a few lines of text (a title, a header): ``--skip-lines`` reads it
+_NUMBERS_AFTER_TEXT = re.compile(rb"\A((?:[^\r\n]*\r?\n){1,60}?)(?:" + _NUMBER_LINE + rb"){3,}")
 
 
 def formats() -> list[dict[str, Any]]:
@@ -219,6 +226,14 @@ def _no_match_message(path: Path, by_ext: list[str], head: bytes) -> str:
             "; its first lines are bare numbers: declare the columns with --columns on the "
             "command line or columns= in Python (format 'columns'), e.g. "
             "--columns wavelength_nm,absorbance"
+        )
+    elif m := _NUMBERS_AFTER_TEXT.match(head):
+        k = len(re.findall(rb"\n", m.group(1)))
+        hint = (
+            f"; after {k} line(s) of text it holds bare numbers: declare the columns and skip "
+            "the text with --columns and --skip-lines on the command line (columns= with a "
+            "skip_lines= entry in Python, format 'columns'), e.g. --columns "
+            f"wavelength_nm,absorbance --skip-lines {k}"
         )
     if not parts:
         return (

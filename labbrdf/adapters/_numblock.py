@@ -1,12 +1,17 @@
 """Numeric blocks of text exports: a vectorised parser with line-numbered errors.
 
-Private helpers shared by the ellipsometer adapters (Woollam, Accurion, Film Sense,
-SENTECH). The block parser reads a block of delimited numbers with
+Private helpers shared by the text adapters (Woollam, Accurion, Film Sense, SENTECH,
+Shimadzu UVProbe text, declared columns). The block parser reads a block of delimited numbers with
 :func:`pandas.read_csv` (C engine) and falls back to a strict line-by-line parser only when
 the fast path meets something it cannot read; the slow parser is the authority: it either
 returns the same table or raises :class:`AdapterError` naming the file, the line and what
 was expected. A reader therefore never returns a half-read file, and a good file is parsed
 at pandas speed.
+
+A file cut short in the middle of its last number (a copy or download that stopped) still
+parses: ``0,289`` cut to ``0,`` reads as 0. :func:`check_last_field` compares the last
+field of an unterminated last line with the same column in the rows before it and refuses
+or warns (see its docstring); :func:`parse_block` applies it to every block it reads.
 """
 
 from __future__ import annotations
@@ -16,7 +21,7 @@ import io
 import os
 import re
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -26,9 +31,12 @@ from ..dataset import DatasetError, Measurement
 from ._base import DECIMAL, NONFINITE, AdapterError
 
 __all__ = [
+    "AdapterWarning",
     "Block",
     "NUMBER",
     "build_frame",
+    "check_last_field",
+    "unterminated",
     "labels",
     "body_bytes",
     "group_angles",
@@ -66,6 +74,9 @@ class Block:
     tag_codes : tuple or None
         ``(codes, names)`` with ``tags == names[codes]`` when the parser knows them without
         hashing every tag (an untagged block: all codes 0, names ``[""]``); else None.
+    warnings : tuple of str
+        Doubts about the block (a last number that may be cut short), also issued as
+        :class:`AdapterWarning`.
     """
 
     values: np.ndarray
@@ -74,9 +85,208 @@ class Block:
     blank_lines: int
     nfields: np.ndarray | None = None
     tag_codes: tuple[np.ndarray, list[str]] | None = None
+    warnings: tuple[str, ...] = ()
 
 
 _EOL = re.compile(r"\r\n|\n|\r")
+
+
+class AdapterWarning(UserWarning):
+    """A file was read, but something in it may be wrong (the message names file and line).
+
+    Readers issue it with :func:`warnings.warn` and keep the text in ``meta["warnings"]``
+    where they can; the command line prints it as ``labbrdf <command>: warning: ...``.
+    """
+
+
+def warn(path: str | os.PathLike[str], message: str, line: int | None = None) -> str:
+    """Issue an :class:`AdapterWarning` naming the file and line; return its text."""
+    where = f"{os.fspath(path)}" + (f", line {line}" if line is not None else "")
+    text = f"{where}: {message}"
+    warnings.warn(AdapterWarning(text), stacklevel=3)
+    return text
+
+
+#: Rows before the last one that give a column its precision (the most recent ones).
+TAIL_ROWS = 200
+#: Rows that must agree on a column's decimals (or exponent digits) for a shorter last
+#: value to be refused rather than warned about: fewer could agree by chance.
+FIXED_ROWS = 5
+
+_SHAPE = re.compile(
+    r"[+-]?(?P<int>[0-9]*)(?P<mark>[.,]?)(?P<frac>[0-9]*)(?:(?P<e>[eE])[+-]?(?P<exp>[0-9]*))?"
+)
+
+
+@dataclass(frozen=True)
+class _Shape:
+    """How a number is written: decimals, exponent digits, significant digits."""
+
+    decimals: int
+    exponent: int | None
+    digits: int
+    dangling: bool
+
+
+def _shape(field: str) -> _Shape | None:
+    """The shape of a numeric field (None for text, ``nan``, ``inf`` or an empty field)."""
+    m = _SHAPE.fullmatch(field)
+    if m is None or not (m["int"] or m["frac"] or m["mark"]):
+        return None
+    digits = len((m["int"] + m["frac"]).lstrip("0"))
+    dangling = (
+        (m["mark"] != "" and m["frac"] == "" and m["e"] is None)  # "0," or "300."
+        or (m["e"] is not None and m["exp"] == "")  # "4.5E-" or "4.5e"
+        or not (m["int"] or m["frac"])  # "," alone
+    )
+    exp = len(m["exp"]) if m["e"] is not None else None
+    return _Shape(len(m["frac"]), exp, digits, dangling)
+
+
+def _fields(line: str, sep: str | None, tagged: bool) -> list[str]:
+    fields = [f.strip() for f in (line.split(sep) if sep is not None else line.split())]
+    while fields and not fields[-1]:
+        fields.pop()
+    if tagged and fields and fields[0][:1].isalpha():
+        fields = fields[1:]
+    return fields
+
+
+def _decimals(n: int) -> str:
+    return f"{n} decimal" + ("" if n == 1 else "s")
+
+
+def unterminated(text: str | bytes) -> bool:
+    """Whether the last line of ``text`` holds something and has no line end."""
+    if not text:
+        return False
+    tail = text[-1:]
+    if tail in ("\n", "\r", b"\n", b"\r"):
+        return False
+    return not text[-1:].isspace()
+
+
+def check_last_field(
+    path: str | os.PathLike[str],
+    last: str,
+    previous: list[str],
+    line: int,
+    sep: str | None,
+    *,
+    tagged: bool = False,
+) -> str | None:
+    """Refuse or warn when the unterminated last line of a file looks cut mid-number.
+
+    Only the last field of such a line can be cut (every other field is followed by a
+    separator); it is compared with the same column in ``previous``, the rows before it
+    (the most recent :data:`TAIL_ROWS` are enough).
+
+    Refused (the file looks truncated): the field ends in a decimal separator or in an
+    exponent without digits (``0,``, ``300.``, ``4.5E-``); or the column has a precision of
+    its own, every one of at least :data:`FIXED_ROWS` rows written with the same number of
+    decimals (or of exponent digits), and the field has fewer (``0,4`` where the column is
+    written ``0,322``; ``4.522`` or ``4.522E-0`` where it is written ``4.522E-02``).
+    Warned (the column's own writing varies, so a shorter value may be a real one, e.g.
+    ``0.13`` beside ``0.1308`` from a writer that drops trailing zeros): the field has fewer
+    decimals than some other row, fewer significant digits than every other row, or no
+    exponent where other rows have one; or no other row has the column to compare with.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (for the message).
+    last : str
+        The last line, without line end (the caller checked it has none: :func:`unterminated`).
+    previous : list of str
+        The data rows before it, oldest first.
+    line : int
+        1-based number of the last line.
+    sep : str or None
+        Field separator; None for runs of blanks.
+    tagged : bool
+        Whether a row may start with an alphabetic tag (not a column).
+
+    Returns
+    -------
+    str or None
+        The warning issued (an :class:`AdapterWarning`), or None when the field is complete.
+
+    Raises
+    ------
+    AdapterError
+        The field is certainly cut short; the message names the line.
+    """
+    if last[-1:].isspace() or (sep is not None and last.endswith(sep)):
+        return None  # the last field is followed by a separator: complete
+    fields = _fields(last, sep, tagged)
+    if not fields:
+        return None
+    j, text = len(fields) - 1, fields[-1]
+    f = _shape(text)
+    if f is None:
+        return None  # not a number: the reader's own parser refuses or keeps it
+    cut = f"field {j + 1} {text!r} on the last line, which has no line end,"
+    fix = "if the value is complete, end the line with a line break"
+    if f.dangling:
+        raise AdapterError(
+            path, f"{cut} ends without its digits: the file looks truncated ({fix})", line
+        )
+    ref = [s for p in previous[-TAIL_ROWS:] if len(fs := _fields(p, sep, tagged)) > j
+           for s in [_shape(fs[j])] if s is not None]  # fmt: skip
+    if not ref:  # nothing to compare with: say so rather than vouch for the value
+        return warn(
+            path,
+            f"{cut} has no other row of its column to compare with: the file may be "
+            f"truncated ({fix})",
+            line,
+        )
+    decimals = [r.decimals for r in ref]
+    exps = [r.exponent for r in ref if r.exponent is not None]
+    fixed = len(ref) >= FIXED_ROWS and min(decimals) == max(decimals)
+    if fixed and f.decimals < min(decimals):
+        raise AdapterError(
+            path,
+            f"{cut} has {_decimals(f.decimals)} where every other row of the column has "
+            f"at least {_decimals(min(decimals))}: the file looks truncated ({fix})",
+            line,
+        )
+    fixed_exp = len(ref) >= FIXED_ROWS and len(exps) == len(ref) and min(exps) == max(exps)
+    if fixed_exp and (f.exponent is None or f.exponent < min(exps)):
+        raise AdapterError(
+            path,
+            f"{cut} lacks the {min(exps)}-digit exponent every other row of the column has: "
+            f"the file looks truncated ({fix})",
+            line,
+        )
+    short = (
+        f.decimals < max(decimals)
+        or (f.exponent is None and exps)
+        or (f.exponent is not None and exps and f.exponent < min(exps))
+        or f.digits < min(r.digits for r in ref)
+    )
+    if not short:
+        return None
+    return warn(
+        path,
+        f"{cut} is written shorter than other values of its column (up to "
+        f"{_decimals(max(decimals))}): the file may be truncated ({fix})",
+        line,
+    )
+
+
+def tail_lines(data: bytes, start: int, n: int) -> list[str]:
+    """The last ``n`` lines of ``data[start:]`` (any line end), decoded as Latin-1."""
+    pos, count = len(data), 0
+    while count < n:
+        k = max(data.rfind(b"\n", start, pos), data.rfind(b"\r", start, pos))
+        if k < start:
+            pos = start
+            break
+        pos, count = k, count + 1
+        if k > start and data[k - 1 : k + 1] == b"\r\n":
+            pos = k - 1
+    chunk = data[pos:].decode("latin-1")
+    return [ln for ln in _EOL.split(chunk) if ln.strip()][-n:]
 
 
 def head_lines(text: str, n: int) -> tuple[list[str], int]:
@@ -426,7 +636,8 @@ def parse_block(
     Raises
     ------
     AdapterError
-        A row with too many fields or a field that is not a number, naming its line.
+        A row with too many fields or a field that is not a number, naming its line; a
+        last line without line end whose last number is cut short (:func:`check_last_field`).
     """
     if data is None:
         if body is None:
@@ -436,7 +647,7 @@ def parse_block(
     block = _fast(body, data, first_line, ncols, sep, tagged, count_fields, data_start)
     if block is None:
         block = _slow(path, _body(body, data, data_start), first_line, ncols, sep, tagged)
-    elif tagged and block.tags is None:
+    if tagged and block.tags is None:
         n = len(block.lines)
         tags = np.broadcast_to(np.array([""], dtype=object), (n,))  # read-only, no memory
         block = Block(
@@ -447,6 +658,13 @@ def parse_block(
             block.nfields,
             (np.zeros(n, dtype=np.intp), [""]),
         )
+    if len(block.lines) and len(data) > data_start and unterminated(data):
+        tail = tail_lines(data, data_start, TAIL_ROWS + 1)
+        note = check_last_field(
+            path, tail[-1], tail[:-1], int(block.lines[-1]), sep, tagged=tagged
+        )
+        if note is not None:
+            block = replace(block, warnings=(note,))
     return block
 
 

@@ -50,6 +50,7 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import AdapterError, Format, check_count, decode, read_bytes, split_lines
+from ._numblock import check_last_field, unterminated
 from ._ole2 import ole_names, open_ole2, read_stream
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
@@ -108,7 +109,10 @@ def read_uvprobe_text(path: str | os.PathLike[str]) -> Measurement:
     raw = read_bytes(path)
     text, encoding = decode(raw, path, ("utf-8", "cp1252"))
     lines = split_lines(text)
-    frames, blocks, dropped = [], [], 0
+    cut_at_end = unterminated(text)
+    frames, dropped = [], 0
+    blocks: list[dict[str, Any]] = []
+    notes: list[str] = []
     n = 0
     while n < len(lines):
         if not lines[n].strip():
@@ -151,6 +155,9 @@ def read_uvprobe_text(path: str | os.PathLike[str]) -> Measurement:
         ys: list[float] = []
         first_row = n + 1
         while n < len(lines) and lines[n].strip() and not lines[n].lstrip().startswith('"'):
+            if n == len(lines) - 1 and cut_at_end:
+                note = check_last_field(path, lines[n], lines[first_row - 1 : n], n + 1, sep)
+                notes.extend([note] if note else [])
             fields = lines[n].strip().split(sep)
             if len(fields) != 2:
                 raise AdapterError(
@@ -169,6 +176,7 @@ def read_uvprobe_text(path: str | os.PathLike[str]) -> Measurement:
             raise AdapterError(path, f"data set {title!r} has no data rows", first_row)
         x = np.asarray(xs)
         _check_axis(path, x, first_row)
+        _check_repeat(path, blocks, title, label, x, title_line)
         frame, d = spectrum_frame(
             path=path,
             sample=title or Path(path).stem,
@@ -180,16 +188,45 @@ def read_uvprobe_text(path: str | os.PathLike[str]) -> Measurement:
         )
         frames.append(frame)
         dropped += d
-        blocks.append({"title": title, "line": title_line, "ordinate": label, "points": len(xs)})
+        blocks.append(
+            {"title": title, "line": title_line, "ordinate": label, "points": len(xs), "x": x}
+        )
     if not frames:
         raise AdapterError(path, "no data set in the file")
     meta: dict[str, Any] = {
         "format": "shimadzu-uvprobe-text",
         "encoding": encoding,
-        "blocks": blocks,
+        "blocks": [{k: v for k, v in b.items() if k != "x"} for b in blocks],
         "dropped_points": dropped,
     }
+    if notes:
+        meta["warnings"] = notes
     return finish(path, frames, meta)
+
+
+def _check_repeat(
+    path: str | os.PathLike[str],
+    blocks: list[dict[str, Any]],
+    title: str,
+    label: str,
+    x: np.ndarray,
+    line: int,
+) -> None:
+    """Refuse a data set that repeats an earlier one's title, ordinate and wavelengths.
+
+    Two such blocks would merge into one spectrum with every wavelength twice: the file is
+    two exports of the same data set joined (``cat a.txt a.txt``), not two data sets.
+    """
+    for b in blocks:
+        if b["title"] == title and b["ordinate"].upper() == label.upper():
+            if np.intersect1d(b["x"], x).size:
+                raise AdapterError(
+                    path,
+                    f"data set {title!r} ({label}) starting here repeats the data set of line "
+                    f"{b['line']} (same title, ordinate and wavelengths): two exports joined "
+                    "into one file? Keep one copy, or give each data set its own title",
+                    line,
+                )
 
 
 def _check_axis(path: str | os.PathLike[str], x: np.ndarray, line: int) -> None:

@@ -7,11 +7,13 @@ AdapterError naming the line, never read a number.
 
 from __future__ import annotations
 
+import re
+import warnings
 from pathlib import Path
 
 import pytest
 
-from labbrdf.adapters import READERS, AdapterError
+from labbrdf.adapters import READERS, AdapterError, AdapterWarning
 from labbrdf.adapters._base import parse_number
 
 FULL = str.maketrans("0123456789", "０１２３４５６７８９")
@@ -71,3 +73,63 @@ def test_parse_number_refuses_what_float_would_take(text: str) -> None:
 def test_parse_number_takes_nonfinite_only_when_asked() -> None:
     assert parse_number(" -1.5e-3 ", "f", 1, "X") == -1.5e-3
     assert parse_number("inf", "f", 1, "X", nonfinite=True) == float("inf")
+
+
+#: the text formats read with the shared block parser (labbrdf.adapters._numblock.parse_block)
+#: and those that call its last-line check themselves
+CUT_CHECKED = [
+    "woollam-wvase",
+    "woollam-completeease",
+    "accurion-ep4",
+    "sentech-spectraray",
+    "shimadzu-uvprobe-text",
+]
+_CUT_FILES = {"shimadzu-uvprobe-text": "shimadzu-uvprobe/sa281-02-280K.txt"}
+
+
+def _last_number_cut(raw: bytes, keep: int) -> bytes:
+    """``raw`` without its trailing line ends, its last number cut after ``keep`` of its
+    characters past the decimal separator (0: right after the separator)."""
+    body = raw.rstrip(b"\r\n \t")
+    mark = max(body.rfind(b"."), body.rfind(b","))
+    return body[: mark + 1 + keep]
+
+
+@pytest.mark.parametrize("fmt", CUT_CHECKED)
+def test_every_block_reader_refuses_a_last_number_cut_at_its_separator(
+    real_exports: Path, tmp_path: Path, fmt: str
+) -> None:
+    """``0,`` or ``12.`` at the very end of a file is a number cut short, never 0 or 12."""
+    rel = _CUT_FILES.get(fmt) or CASES[fmt][0]
+    raw = (real_exports / rel).read_bytes()
+    cut = _last_number_cut(raw, 0)
+    line = len(cut.decode("latin-1").splitlines())
+    bad = tmp_path / Path(rel).name
+    bad.write_bytes(cut)
+    with pytest.raises(AdapterError, match=rf"line {line}: .*ends without its digits") as exc:
+        READERS[fmt].read(bad)
+    assert str(bad) in str(exc.value)
+
+
+@pytest.mark.parametrize("fmt", CUT_CHECKED)
+def test_every_block_reader_refuses_or_warns_on_a_last_number_missing_a_digit(
+    real_exports: Path, tmp_path: Path, fmt: str
+) -> None:
+    rel = _CUT_FILES.get(fmt) or CASES[fmt][0]
+    raw = (real_exports / rel).read_bytes()
+    body = raw.rstrip(b"\r\n \t")
+    cut = body[:-1]
+    line = len(cut.decode("latin-1").splitlines())
+    bad = tmp_path / Path(rel).name
+    bad.write_bytes(cut)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            READERS[fmt].read(bad)
+        except AdapterError as exc:
+            assert re.search(rf"line {line}: .*looks truncated", str(exc)), str(exc)
+            return
+    texts = [str(w.message) for w in caught if issubclass(w.category, AdapterWarning)]
+    assert texts and re.search(rf"line {line}: .*may be truncated", texts[0]), texts
+    body_line = body.decode("latin-1").splitlines()[-1]
+    assert body_line[-1].isdigit(), body_line

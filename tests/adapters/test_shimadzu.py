@@ -154,6 +154,67 @@ def test_real_text_cut_in_a_row_is_refused_at_that_line(
         read_uvprobe_text(write(tmp_path, "cut.txt", cut))
 
 
+@pytest.mark.parametrize(
+    ("nbytes", "line", "shown"),
+    [
+        (173, 11, "'0,'"),
+        (174, 11, "'0,2'"),
+        (172, 11, "'0'"),
+        (169, 11, "'308,0'"),
+        (168, 11, "'308,'"),
+    ],
+)
+def test_real_text_cut_mid_number_is_refused_as_truncated(
+    real_exports: Path, tmp_path: Path, nbytes: int, line: int, shown: str
+) -> None:
+    """``head -c 173`` ends in ``308,00<TAB>0,``: read as 0.0 for 0.289 before."""
+    raw = (real_exports / FOLDER / f"{STEM}.txt").read_bytes()
+    p = write(tmp_path, "cut.txt", raw[:nbytes])
+    with pytest.raises(
+        AdapterError, match=rf"line {line}: field \d {shown} .*looks truncated"
+    ) as exc:
+        read_uvprobe_text(p)
+    assert str(p) in str(exc.value)
+
+
+def test_real_text_cut_after_a_whole_number_reads_the_rows_before(
+    real_exports: Path, tmp_path: Path
+) -> None:
+    raw = (real_exports / FOLDER / f"{STEM}.txt").read_bytes()
+    m = read_uvprobe_text(write(tmp_path, "cut.txt", raw[:176]))  # "308,00\t0,289"
+    assert m.data["value"].iloc[-1] == 0.289 and len(m) == 9
+    assert "warnings" not in m.meta
+
+
+def test_text_whose_last_value_is_shorter_than_a_varying_column_is_warned_about(
+    tmp_path: Path,
+) -> None:
+    rows = "500\t0,25\r\n501\t0,5\r\n502\t0,125\r\n503\t0,7"  # no line end
+    p = write(tmp_path, "v.txt", text(rows=rows))
+    with pytest.warns(labbrdf.adapters.AdapterWarning, match=r"line 6: .*may be truncated"):
+        m = read_uvprobe_text(p)
+    assert m.meta["warnings"] and str(p) in m.meta["warnings"][0]
+
+
+def test_real_text_joined_with_itself_is_refused_at_the_second_copy(
+    real_exports: Path, tmp_path: Path
+) -> None:
+    raw = (real_exports / FOLDER / f"{STEM}.txt").read_bytes()
+    line = raw.count(b"\n") + 1 + (not raw.endswith(b"\n"))
+    for joined in (raw + raw, raw + b"\r\n" + raw):
+        p = write(tmp_path, "twice.txt", joined)
+        second = joined.index(b'"', len(raw) - 1)
+        line = joined[:second].count(b"\n") + 1
+        with pytest.raises(AdapterError, match=rf"line {line}: data set .* repeats the data set "
+                           r"of line 1"):  # fmt: skip
+            read_uvprobe_text(p)
+
+
+def test_two_data_sets_of_one_title_on_other_wavelengths_are_kept(tmp_path: Path) -> None:
+    raw = text(rows="500\t1\r\n501\t2\r\n") + text(rows="600\t1\r\n601\t2\r\n")
+    assert len(read_uvprobe_text(write(tmp_path, "two.txt", raw))) == 4
+
+
 # ----------------------------------------------------------------------------- binary
 
 BASE = "DataStorage1/DataSetGroup/DataSet1"
