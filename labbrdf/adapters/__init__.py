@@ -40,6 +40,7 @@ from . import (
     jcamp,
     labbrdf_csv,
     native,
+    nexus,
     oceanoptics,
     perkinelmer,
     refused,
@@ -86,6 +87,7 @@ _VENDOR_MODULES = (
     labbrdf_csv,
     native,
     zemax_bsdf,
+    nexus,
     refused,
     columns,
 )
