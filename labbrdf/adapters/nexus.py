@@ -35,12 +35,18 @@ shapes disagree. Every array's shape and type are checked before it is read, so 
 that declares a huge dataset is refused before anything is allocated.
 
 Reading needs :mod:`h5py` (the ``nexus`` extra: ``pip install labbrdf[nexus]``); the file is
-opened read-only and without HDF5 file locking, so nothing is ever written to it.
+opened read-only and without HDF5 file locking, so nothing is ever written to it. The HDF5
+library follows the file's internal addresses without checking them, and a few damaged
+bytes can make it loop forever: the file is read in a child process, which is stopped
+after :data:`READ_TIMEOUT_S` seconds, and the file is refused (inside a daemonic process,
+such as a dask worker, which may not start one, it is read in place).
 """
 
 from __future__ import annotations
 
+import multiprocessing as mp
 import os
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -75,6 +81,8 @@ _RADIANS = {"rad", "radian", "radians"}
 _NO_UNIT = {"", "not_provided", "none", "nx_any", "nx_angle"}
 #: most values one numeric array may hold (the data array: N_spectrum x observables x ...)
 MAX_VALUES = 4 * MAX_POINTS
+#: most seconds the HDF5 library may take to read one file (a damaged file can make it loop)
+READ_TIMEOUT_S = 60.0
 #: most characters of a text field that is read (names, data type)
 _MAX_TEXT = 1000
 
@@ -122,6 +130,13 @@ def read_nexus(path: str | os.PathLike[str]) -> Measurement:
     check_regular_file(path)
     if os.path.getsize(path) == 0:
         raise AdapterError(path, "the file is empty")
+    _import_h5py(path)
+    if mp.current_process().daemon:  # a daemonic process may not start one (dask workers)
+        return _read_here(os.fspath(path))
+    return _read_in_child(path)
+
+
+def _read_here(path: str) -> Measurement:
     h5py = _import_h5py(path)
     try:
         with h5py.File(path, "r", locking=False) as f:
@@ -133,6 +148,60 @@ def read_nexus(path: str | os.PathLike[str]) -> Measurement:
         raise AdapterError(
             path, f"not a readable HDF5 file ({type(exc).__name__}: {str(exc)[:200]})"
         ) from None
+
+
+def _child(path: str, conn: Any) -> None:
+    """Read in a child process and send back (True, Measurement) or (False, error)."""
+    result: tuple[bool, Any]
+    try:
+        result = (True, _read_here(path))
+    except AdapterError as exc:
+        result = (False, exc)
+    except MemoryError:
+        result = (False, AdapterError(path, "ran out of memory reading it (corrupt sizes?)"))
+    conn.send(result)
+    conn.close()
+
+
+def _read_in_child(path: str | os.PathLike[str]) -> Measurement:
+    """Read the file in a child process that is stopped after :data:`READ_TIMEOUT_S`.
+
+    The HDF5 library trusts the file's internal addresses: a few damaged bytes (a heap
+    reference of a text field) can make it loop forever or crash, which must not take the
+    caller with it.
+    """
+    method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
+    if threading.active_count() > 1:  # forking a threaded process is unsafe
+        method = "spawn"
+    ctx = mp.get_context(method)
+    receiver, sender = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_child, args=(os.fspath(path), sender), daemon=True)
+    proc.start()
+    sender.close()
+    try:
+        if not receiver.poll(READ_TIMEOUT_S):
+            raise AdapterError(
+                path,
+                f"the HDF5 library did not finish reading the file in {READ_TIMEOUT_S:g} s "
+                "(damaged internal structure?)",
+            )
+        try:
+            ok, payload = receiver.recv()
+        except EOFError:
+            proc.join(5)
+            raise AdapterError(
+                path,
+                f"the HDF5 library stopped while reading the file (exit code {proc.exitcode}; "
+                "damaged internal structure?)",
+            ) from None
+    finally:
+        if proc.is_alive():
+            proc.kill()
+        proc.join()
+        receiver.close()
+    if ok:
+        return payload  # type: ignore[no-any-return]
+    raise payload
 
 
 def _read_file(path: str | os.PathLike[str], f: Any) -> Measurement:

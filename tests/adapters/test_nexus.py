@@ -231,3 +231,19 @@ def test_sniffer_claims_hdf5_signature_only() -> None:
     assert f.sniff(HDF5_MAGIC + b"\0" * 100)
     assert f.sniff(b"\0" * 512 + HDF5_MAGIC)  # after a user block
     assert not f.sniff(b"VASEmethod[" + HDF5_MAGIC)
+
+
+def test_a_file_that_makes_hdf5_loop_is_refused_after_the_timeout(
+    real_exports: Path, tmp_path: Path, monkeypatch
+) -> None:
+    """Three bytes of the real file changed (found by mutation): the HDF5 library then loops
+    forever reading the 'definition' text; the read is stopped and the file refused."""
+    raw = bytearray((real_exports / REAL).read_bytes())
+    for offset, byte in ((101422, 0o2), (107705, 0o12), (107768, 0o234)):  # cmp -l, 1-based
+        raw[offset] = byte
+    p = tmp_path / "loops.nxs"
+    p.write_bytes(bytes(raw))
+    monkeypatch.setattr("labbrdf.adapters.nexus.READ_TIMEOUT_S", 3.0)
+    with pytest.raises(AdapterError, match=r"did not finish reading the file in 3 s") as info:
+        read_nexus(p)
+    assert str(p) in str(info.value)
