@@ -34,6 +34,7 @@ from ..dataset import Measurement, concat
 from . import (
     accurion,
     cary,
+    cid,
     columns,
     filmsense,
     jasco,
@@ -47,6 +48,7 @@ from . import (
     sentech,
     shimadzu,
     spc,
+    wasatch,
     woollam,
     zemax_bsdf,
 )
@@ -84,6 +86,8 @@ _VENDOR_MODULES = (
     spc,
     shimadzu,
     oceanoptics,
+    wasatch,
+    cid,
     labbrdf_csv,
     native,
     zemax_bsdf,
