@@ -177,7 +177,9 @@ def _row(path: str | os.PathLike[str], line: str, n: int, count: int) -> dict[st
             f"Mode {mode!r}: {why}; labbrdf reads the Reflectance and Transmittance modes",
             n,
         )
-    row = {k: v.strip()[:200] for k, v in zip(_FIELDS[:-1], meta[:-1], strict=True)}
+    row: dict[str, Any] = {
+        k: v.strip()[:200] for k, v in zip(_FIELDS[:-1], meta[:-1], strict=True)
+    }
     row["quantity"] = quantity
     row["values"] = np.array([number(v, path, n, "value") for v in values])
     return row

@@ -173,7 +173,7 @@ def _read_in_child(path: str | os.PathLike[str]) -> Measurement:
     method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
     if threading.active_count() > 1:  # forking a threaded process is unsafe
         method = "spawn"
-    ctx = mp.get_context(method)
+    ctx: Any = mp.get_context(method)
     receiver, sender = ctx.Pipe(duplex=False)
     proc = ctx.Process(target=_child, args=(os.fspath(path), sender), daemon=True)
     proc.start()
@@ -200,7 +200,7 @@ def _read_in_child(path: str | os.PathLike[str]) -> Measurement:
         proc.join()
         receiver.close()
     if ok:
-        return payload  # type: ignore[no-any-return]
+        return payload
     raise payload
 
 
