@@ -1,4 +1,4 @@
-"""Binary formats that are recognised but not read, with what to do instead.
+"""Formats that are recognised but not read, with what to do instead.
 
 Woollam CompleteEASE ``.SE`` (``woollam-completeease-se``)
     CompleteEASE saves its measurements in a proprietary binary ``.SE`` file whose layout is
@@ -11,11 +11,12 @@ Woollam CompleteEASE ``.SE`` (``woollam-completeease-se``)
 from __future__ import annotations
 
 import os
+import re
 
 from ..dataset import Measurement
 from ._base import AdapterError, Format, check_regular_file
 
-__all__ = ["FORMATS", "refuse_completeease_se"]
+__all__ = ["FORMATS", "refuse_completeease_se", "refuse_completeease_sesnap", "refuse_spectrapen"]
 
 _SE_HINT = (
     "a Woollam CompleteEASE binary .SE file, whose layout is not published; export it as "
@@ -60,6 +61,94 @@ def refuse_completeease_se(path: str | os.PathLike[str]) -> Measurement:
     )
 
 
+_ZIP = b"PK\x03\x04"
+
+
+def _head(path: str | os.PathLike[str], n: int = 4096) -> bytes:
+    check_regular_file(path)
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(n)
+    except OSError as exc:
+        raise AdapterError(path, f"cannot be read ({exc.strerror or exc})") from None
+    if not head or head.isspace():
+        raise AdapterError(path, "the file is empty")
+    return head
+
+
+def refuse_completeease_sesnap(path: str | os.PathLike[str]) -> Measurement:
+    """Refuse a CompleteEASE ``.SEsnap`` snapshot with what to do instead.
+
+    Raises
+    ------
+    AdapterError
+        Always: a ZIP archive gets the CompleteEASE text-export advice; anything else is
+        told that it is not a snapshot.
+    """
+    head = _head(path)
+    if head.startswith(_ZIP):
+        raise AdapterError(
+            path,
+            "a Woollam CompleteEASE snapshot (.SEsnap: a ZIP archive around a binary .SE file, "
+            "whose layout is not published); export the data as text from CompleteEASE (the "
+            "ASCII .dat export, read by format 'woollam-completeease')",
+        )
+    raise AdapterError(
+        path,
+        "this .sesnap file is not a ZIP archive, so not a CompleteEASE snapshot; read it with "
+        "the format of its content (--format on the command line, format= in Python)",
+    )
+
+
+#: the SpectraPen title line: a quantity, blanks or a TAB, a unit in brackets, a comma
+_PSI_TITLE = re.compile(r"^\s*([A-Za-z][A-Za-z ]{0,40}?)\s*\[([^\]\r\n]{1,40})\]\s*,?\s*$")
+
+
+def _psi_lines(head: bytes) -> list[str]:
+    text = head.decode("utf-8", "replace")
+    return [ln.strip() for ln in text.splitlines()[:12] if ln.strip()]
+
+
+def _sniff_spectrapen(head: bytes) -> bool:
+    lines = _psi_lines(head)
+    return (
+        len(lines) >= 3
+        and _PSI_TITLE.match(lines[0]) is not None
+        and lines[1].startswith("Time,")
+        and lines[2].startswith("Index,")
+    )
+
+
+def refuse_spectrapen(path: str | os.PathLike[str]) -> Measurement:
+    """Refuse a PSI SpectraPen CSV export, naming the quantity its title states.
+
+    Raises
+    ------
+    AdapterError
+        Always: spectral irradiance (or another quantity of the light) has no dataset
+        quantity; a file that does not have the SpectraPen layout is told so.
+    """
+    head = _head(path)
+    lines = _psi_lines(head)
+    if not _sniff_spectrapen(head):
+        raise AdapterError(
+            path,
+            "expected a PSI SpectraPen export: a title '<Quantity> [<unit>],' then the rows "
+            "'Time,...' and 'Index,...'",
+            1,
+        )
+    m = _PSI_TITLE.match(lines[0])
+    assert m is not None  # checked by the sniffer
+    quantity, unit = m.group(1).strip(), m.group(2).strip()
+    raise AdapterError(
+        path,
+        f"a PSI SpectraPen export of {quantity} [{unit}]: a measurement of the light reaching "
+        "the instrument, not an optical property of a sample (reflectance, transmittance, "
+        "absorbance), so labbrdf has no quantity for it and does not read it",
+        1,
+    )
+
+
 FORMATS = (
     Format(
         "woollam-completeease-se",
@@ -68,5 +157,24 @@ FORMATS = (
         _sniff_se,
         refuse_completeease_se,
         (),
+    ),
+    Format(
+        "woollam-completeease-sesnap",
+        "Woollam CompleteEASE snapshot .SEsnap (ZIP around a .SE): recognised and refused "
+        "(export it as text)",
+        (".sesnap",),
+        _sniff_se,
+        refuse_completeease_sesnap,
+        (),
+    ),
+    Format(
+        "psi-spectrapen",
+        "PSI SpectraPen CSV (spectral irradiance): recognised and refused (not a property "
+        "of a sample)",
+        (".csv",),
+        _sniff_spectrapen,
+        refuse_spectrapen,
+        (),
+        keywords=(b"Irradiance",),
     ),
 )

@@ -153,11 +153,16 @@ def test_mutated_real_files_raise_adaptererror_or_keep_their_count(
         pytest.skip(f"no real export of {fmt}")
     with tempfile.TemporaryDirectory() as tmp:
         for path in files:
-            try:
-                n0: int | None = _points(READERS[fmt].read(path))
-            except AdapterError:  # refused by name (raw counts, irradiance): stays refused
-                n0 = None
+            n0 = _points_or_refused(fmt, path)  # None: refused by name, stays refused
             _fuzz_file(fmt, path.read_bytes(), n0, Path(tmp) / path.name)
+
+
+def _points_or_refused(fmt: str, path: Path) -> int | None:
+    """Points of a real file, None for a file its format recognises only to refuse it."""
+    try:
+        return _points(READERS[fmt].read(path))
+    except AdapterError:
+        return None
 
 
 #: synthetic files of labbrdf's own CSV layouts (no real export exists), one row per line

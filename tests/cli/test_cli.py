@@ -153,13 +153,18 @@ def test_every_real_export_reads_through_one_entry_point(real_exports):
     )
     # 29 of the first collection + 6 of the second (its 9 less 3 height maps, the .bsdf in)
     # + 8 of the third round (Ta2O5 wafer three ways, UVProbe .txt/.spc, Ocean Optics,
-    # headerless columns, legacy .jws) + 8 of the fourth round
+    # headerless columns, legacy .jws) + 8 of the fourth (Avantes, Wasatch, CID, PSI, Jaz,
+    # Ocean Optics .pi, Speos BSDF, NeXus)
     assert len(files) == 51
-    # raw counts and irradiance have no labbrdf quantity: refused by name
-    refused = {"oceanoptics-pi": "raw detector", "avantes-avasoft": "radiometric"}
+    # recognised and refused by name: raw counts and irradiance are no property of a sample
+    refused = {
+        "oceanoptics-pi": "raw detector",
+        "avantes-avasoft": "radiometric",
+        "psi-spectrapen": "not an optical property",
+    }
     for p in files:
         if p.parent.name in refused:
-            with pytest.raises(AdapterError, match=refused[p.parent.name]):
+            with pytest.raises(labbrdf.AdapterError, match=refused[p.parent.name]):
                 labbrdf.read(p)
             continue
         # a headerless column file says nothing of itself: its columns are declared
