@@ -230,3 +230,26 @@ def test_a_bad_cap_setting_names_the_variable(monkeypatch, text):
 def test_the_default_cap_suits_a_laptop(monkeypatch):
     monkeypatch.delenv(cache.ENV_MAX_BYTES, raising=False)
     assert cache.max_bytes() == cache.DEFAULT_MAX_BYTES == 2**30
+
+
+def test_a_planted_operator_never_changes_a_trace(tmp_path, monkeypatch):
+    from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    cfg = TraceConfig(
+        rays=2000,
+        theta_i_deg=45.0,
+        substrate=Substrate(n=1.55, k=7.71, alpha=0.2),
+        coating=Coating(n=1.5, thickness_nm=100.0, alpha=0.2),
+        scattering="single",
+        theta_step_deg=10.0,
+        phi_step_deg=20.0,
+    )
+    ref = trace(cfg)
+    (path,) = cache_dir().glob("exit-*.op")
+    for plant in (_zeros, _nans):
+        plant(path)
+        with pytest.warns(CacheWarning, match=path.name):
+            got = trace(cfg)
+        assert got.albedo() == ref.albedo()
+        assert np.array_equal(got.sums, ref.sums)
