@@ -395,8 +395,9 @@ def _executor(args: argparse.Namespace, progress: bool = True) -> Any:
 def _executor_errors(cmd: Any) -> Any:
     """Make a run abandoned by the executor exit with code 2 and the reason.
 
-    Dead workers or an unreachable scheduler give the reason on stderr, not a traceback;
-    nothing partial has been written.
+    Dead workers, an unreachable scheduler or a local cluster that did not start give the
+    reason on stderr, not a traceback; nothing partial has been written. Ctrl-C says that
+    the run was interrupted (exit 130, from :func:`main`).
     """
 
     @functools.wraps(cmd)
@@ -407,6 +408,9 @@ def _executor_errors(cmd: Any) -> Any:
             return cmd(args)
         except ParallelError as exc:
             raise UsageError(str(exc)) from None
+        except KeyboardInterrupt:
+            print(f"labbrdf {args.command}: interrupted; the run is abandoned", file=sys.stderr)
+            raise
 
     return wrapper
 

@@ -149,7 +149,7 @@ def _header(key: str, array: NDArray) -> bytes:
         "key": key,
         "dtype": array.dtype.str,
         "shape": list(array.shape),
-        "blake2b": hashlib.blake2b(memoryview(array).cast("B")).hexdigest(),
+        "blake2b": hashlib.blake2b(array.data.cast("B")).hexdigest(),
     }
     return _MAGIC + json.dumps(head, sort_keys=True).encode() + b"\n"
 
@@ -179,7 +179,7 @@ def _read_verified(fh, key: str, shape: tuple[int, ...], dtype: np.dtype) -> NDA
     if st.st_size != fh.tell() + nbytes:
         raise ValueError(f"{st.st_size} bytes, expected {fh.tell() + nbytes}")
     out = np.empty(shape, dtype=dtype)
-    buf = memoryview(out).cast("B")
+    buf = out.data.cast("B")
     if fh.readinto(buf) != nbytes:
         raise ValueError("truncated while reading")
     if hashlib.blake2b(buf).hexdigest() != head.get("blake2b"):
@@ -255,7 +255,7 @@ def store(key: str, array: NDArray) -> Path | None:
         try:
             with os.fdopen(fd, "wb") as fh:
                 fh.write(head)
-                fh.write(memoryview(array).cast("B"))
+                fh.write(array.data.cast("B"))
                 fh.flush()
                 os.fsync(fh.fileno())
             os.replace(tmp, path)
@@ -301,7 +301,7 @@ class CacheInfo:
 
 def _ours(folder: Path) -> list[tuple[Path, os.stat_result]]:
     """Regular files of our naming in ``folder`` that the user owns (not followed)."""
-    out = []
+    out: list[tuple[Path, os.stat_result]] = []
     try:
         names = os.listdir(folder)
     except OSError:
