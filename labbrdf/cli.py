@@ -396,8 +396,9 @@ def _executor(args: argparse.Namespace, progress: bool = True) -> Any:
 def _executor_errors(cmd: Any) -> Any:
     """Make a run abandoned by the executor exit with code 2 and the reason.
 
-    Dead workers or an unreachable scheduler give the reason on stderr, not a traceback;
-    nothing partial has been written.
+    Dead workers, an unreachable scheduler or a local cluster that did not start give the
+    reason on stderr, not a traceback; nothing partial has been written. Ctrl-C says that
+    the run was interrupted (exit 130, from :func:`main`).
     """
 
     @functools.wraps(cmd)
@@ -408,6 +409,9 @@ def _executor_errors(cmd: Any) -> Any:
             return cmd(args)
         except ParallelError as exc:
             raise UsageError(str(exc)) from None
+        except KeyboardInterrupt:
+            print(f"labbrdf {args.command}: interrupted; the run is abandoned", file=sys.stderr)
+            raise
 
     return wrapper
 
@@ -598,6 +602,36 @@ def cmd_formats(args: argparse.Namespace) -> int:
     else:
         for f in fmts:
             print(f"{f['name']:<28} {' '.join(f['extensions']):<18} {f['description']}")
+    return 0
+
+
+# ------------------------------------------------------------------------------- cache
+
+
+def cmd_cache(args: argparse.Namespace) -> int:
+    """Show (``info``) or empty (``clear``) the tracer's operator cache."""
+    from .tracer import cache
+
+    if args.action == "clear":
+        n, size = cache.clear()
+        print(f"removed {n} file(s), {size / 1e6:.1f} MB, from {cache.cache_dir()}")
+        return 0
+    info = cache.info()
+    if args.json:
+        _emit_json(
+            {
+                "folder": str(info.folder),
+                "entries": [vars(e) for e in info.entries],
+                "total_bytes": info.total_bytes,
+                "max_bytes": info.max_bytes,
+                "problem": info.problem,
+            }
+        )
+        return 0
+    print(f"folder   {info.folder}" + (f" (not used: {info.problem})" if info.problem else ""))
+    print(f"entries  {len(info.entries)}")
+    print(f"total    {info.total_bytes / 1e6:.1f} MB")
+    print(f"cap      {info.max_bytes / 1e6:.1f} MB (set with {cache.ENV_MAX_BYTES})")
     return 0
 
 
@@ -1364,6 +1398,21 @@ def _formats_parser(sub: Any) -> None:
     s.set_defaults(func=cmd_formats)
 
 
+def _cache_parser(sub: Any) -> None:
+    """The ``cache`` subcommand's options."""
+    s = sub.add_parser("cache", help="show or clear the tracer's operator cache")
+    s.add_argument(
+        "action",
+        nargs="?",
+        choices=("info", "clear"),
+        default="info",
+        help="info: where the cache is, its entries, their total size and the cap (default); "
+        "clear: remove labbrdf's entries",
+    )
+    s.add_argument("--json", action="store_true", help="info as JSON")
+    s.set_defaults(func=cmd_cache)
+
+
 def _fit_parser(sub: Any) -> None:
     """The ``fit`` subcommand's options."""
     from .fitting.core import METHOD
@@ -1812,6 +1861,7 @@ def build_parser() -> argparse.ArgumentParser:
     _trace_parser(sub)
     _validate_parser(sub)
     _report_parser(sub)
+    _cache_parser(sub)
     for sp in sub.choices.values():  # what _checked_outputs checks, per command
         sp.set_defaults(path_actions=tuple(path_actions(sp)))
     return p

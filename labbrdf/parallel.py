@@ -31,9 +31,14 @@ Schedulers
 Security
 --------
 Whoever can connect to a dask scheduler can run any code on every worker. ``local`` binds
-the scheduler, the workers, their nannies and every HTTP service to ``127.0.0.1`` and starts
-no dashboard unless asked (:func:`configure` ``dashboard=True``, ``labbrdf --dashboard`` or
-``LABBRDF_DASK_DASHBOARD=1``; it then listens on ``127.0.0.1:8787`` or a free port).
+the scheduler, the workers and their nannies to ``127.0.0.1``, and leaves no port that
+answers HTTP: dask's HTTP servers on the scheduler and on every worker (``/health``,
+``/metrics``, ``/info``, unauthenticated) are started without routes and closed once the
+cluster is up, unless the dashboard is asked for (:func:`configure` ``dashboard=True``,
+``labbrdf --dashboard`` or ``LABBRDF_DASK_DASHBOARD=1``; the scheduler's then listens on
+``127.0.0.1:8787`` or a free port). A cluster that does not start raises
+:class:`ParallelError`; its worker processes ignore the terminal's Ctrl-C, which interrupts
+this process, and it closes them.
 Loopback alone does not keep out the other users of a shared machine, so ``local`` always
 runs on mutual TLS: with the certificates configured below, or else with temporary
 credentials that dask makes in memory for this cluster
@@ -431,30 +436,7 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
     trim = env.pop("MALLOC_TRIM_THRESHOLD_", None)
     if trim is not None and os.environ.get("MALLOC_TRIM_THRESHOLD_") == str(trim):
         del os.environ["MALLOC_TRIM_THRESHOLD_"]
-    # everything on the loopback interface: the scheduler's HTTP server (which dask binds
-    # to all interfaces when given ":0"), the workers and their nannies; no dashboard
-    # unless asked; always TLS (configured certificates or temporary ones)
-    extra: dict[str, Any] = {"security": sec, "protocol": "tls://"}
-    with dask.config.set({"distributed.nanny.pre-spawn-environ": env}):
-        cluster = LocalCluster(
-            n_workers=key[0],
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            dashboard_address="127.0.0.1:8787" if dash else None,
-            # each worker's own HTTP server (metrics): older distributed releases (2024.8)
-            # bind it to 0.0.0.0 unless told
-            worker_dashboard_address="127.0.0.1:0",
-            scheduler_kwargs={
-                "allowed_failures": key[1],
-                "dashboard": dash,
-                "dashboard_address": "127.0.0.1:8787" if dash else "127.0.0.1:0",
-            },
-            **extra,
-        )
-    client = Client(cluster, set_as_default=False, security=sec)
-    if dash:
-        _warn(f"dask dashboard (no authentication, this machine only): {client.dashboard_link}")
+    client, cluster = _start_local(Client, LocalCluster, key, sec, env, dash)
     with _LOCAL_LOCK:
         _LOCAL.update(key=key, client=client, cluster=cluster)
         if not _ATEXIT:
@@ -462,6 +444,146 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
             atexit.register(shutdown)
             _ATEXIT.append(True)
     return client, False
+
+
+def _start_local(
+    Client: Any, LocalCluster: Any, key: tuple, sec: Any, env: dict, dash: bool
+) -> tuple[Any, Any]:
+    """Start the ``local`` LocalCluster and its Client; ParallelError if it cannot start.
+
+    Everything listens on the loopback interface, on TLS. dask always starts an HTTP
+    server on the scheduler and on each worker (``/health``, ``/metrics``, ``/info``,
+    without authentication): the workers' are started with no route
+    (``distributed.worker.http.routes``) and then closed (:func:`_close_http`), and so is
+    the scheduler's unless its dashboard is asked for.
+
+    Raises
+    ------
+    ParallelError
+        The cluster did not start (a worker that died at start-up, a port that could not
+        be bound, a timeout): the message says why; anything started is closed.
+    KeyboardInterrupt
+        Ctrl-C during start-up, after closing whatever had started.
+    """
+    import dask
+
+    # workers never serve HTTP; the scheduler only when its dashboard is asked for
+    config: dict[str, Any] = {
+        "distributed.nanny.pre-spawn-environ": env,
+        "distributed.nanny.preload": [
+            *dask.config.get("distributed.nanny.preload", []),
+            __name__,  # dask_setup below: workers start deaf to Ctrl-C
+        ],
+        "distributed.worker.http.routes": [],
+    }
+    if not dash:
+        config["distributed.scheduler.http.routes"] = []
+    cluster = client = None
+    before = _spec_clusters()
+    try:
+        with dask.config.set(config):
+            cluster = LocalCluster(
+                n_workers=key[0],
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address="127.0.0.1:8787" if dash else None,
+                # each worker's own HTTP server: older distributed releases (2024.8) bind it
+                # to 0.0.0.0 unless told
+                worker_dashboard_address="127.0.0.1:0",
+                scheduler_kwargs={
+                    "allowed_failures": key[1],
+                    "dashboard": dash,
+                    "dashboard_address": "127.0.0.1:8787" if dash else "127.0.0.1:0",
+                },
+                security=sec,
+                protocol="tls://",
+            )
+            client = Client(cluster, set_as_default=False, security=sec)
+            _close_http(client, scheduler=not dash)
+    except BaseException as exc:
+        # the cluster, or (interrupted inside its constructor) the half-started one
+        started = [client, cluster, *(_spec_clusters() - before)]
+        _close_quietly([obj for obj in started if obj is not None])
+        if isinstance(exc, (KeyboardInterrupt, SystemExit, GeneratorExit)):
+            raise
+        raise ParallelError(
+            f"the local dask cluster did not start ({type(exc).__name__}: {exc}); "
+            "nothing was run. Check free memory and that labbrdf imports in a fresh "
+            "Python, or use --scheduler processes"
+        ) from exc
+    if dash:
+        _warn(f"dask dashboard (no authentication, this machine only): {client.dashboard_link}")
+    return client, cluster
+
+
+def dask_setup(nanny: Any) -> None:
+    """Nanny preload of the ``local`` cluster: its worker processes ignore Ctrl-C.
+
+    Called by dask on the event-loop thread before the nanny starts its worker process. It
+    blocks SIGINT in that thread (Python handles signals in the main thread only, so this
+    changes nothing here); the threads that start worker processes and the processes
+    themselves inherit the blocked signal. A Ctrl-C in the terminal, which reaches every
+    process of the group, then interrupts this process alone, which closes the cluster,
+    instead of printing a traceback from each worker that was still starting.
+    """
+    import signal
+    from multiprocessing import resource_tracker
+
+    # started first: starting it later would unblock SIGINT in the starting thread
+    resource_tracker.ensure_running()
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+
+
+def _spec_clusters() -> set[Any]:
+    """The dask clusters of this process (a constructor that fails leaves one behind)."""
+    from distributed.deploy.spec import SpecCluster
+
+    return set(SpecCluster._instances)
+
+
+def _close_quietly(objs: list[Any]) -> None:
+    """Close clients and clusters of a failed or interrupted start-up, saying nothing.
+
+    A cluster interrupted while its workers start cannot close cleanly (dask asserts on
+    the workers' state); it is not closed again at exit, where dask would print that.
+    """
+    for obj in objs:
+        try:
+            obj.close(timeout=10)
+        except BaseException:  # noqa: BLE001, S110 - already failing; the cause is reported
+            pass
+        if hasattr(obj, "shutdown_on_close"):
+            obj.shutdown_on_close = False
+
+
+def _stop_scheduler_http(dask_scheduler: Any) -> None:
+    """Stop the scheduler's HTTP server from listening (run on the scheduler)."""
+    dask_scheduler.http_server.stop()
+
+
+def _no_http_plugin() -> Any:
+    """A worker plugin that stops each worker's HTTP server (restarted workers too)."""
+    from distributed.diagnostics.plugin import WorkerPlugin
+
+    class NoHTTP(WorkerPlugin):  # defined here: dask sends it to the workers by value
+        name = "labbrdf-no-http"
+
+        def setup(self, worker: Any) -> None:
+            worker.http_server.stop()
+
+    return NoHTTP()
+
+
+def _close_http(client: Any, scheduler: bool) -> None:
+    """Close the HTTP servers of the ``local`` cluster's workers, and of its scheduler.
+
+    The workers' through a plugin, so that a worker restarted later is closed too; the
+    scheduler's only when ``scheduler`` (not when its dashboard was asked for).
+    """
+    if scheduler:
+        client.run_on_scheduler(_stop_scheduler_http)
+    client.register_plugin(_no_http_plugin())
 
 
 def _wait_for_a_worker(client: Any, scheduler: str) -> None:

@@ -537,6 +537,41 @@ def test_cli_trace_without_dask_exits_2_with_the_install_hint(monkeypatch, capsy
     assert "pip install labbrdf[dask]" in capsys.readouterr().err
 
 
+class _ClusterThatFails:
+    """A LocalCluster stand-in whose start-up fails as ``error`` says (no process started)."""
+
+    error: BaseException = RuntimeError("Cluster failed to start: Nanny failed to start.")
+
+    def __init__(self, *args: Any, **kw: Any) -> None:
+        raise self.error
+
+
+@pytest.mark.parametrize(
+    ("error", "code", "message"),
+    [
+        (RuntimeError("Cluster failed to start: Nanny failed to start."), 2, "did not start"),
+        (TimeoutError("no worker within 60 s"), 2, "did not start"),
+        (KeyboardInterrupt(), 130, "interrupted"),
+    ],
+    ids=["nanny", "timeout", "ctrl-c"],
+)
+@pytest.mark.usefixtures("dask_ok")
+def test_cli_local_cluster_that_does_not_start_is_one_message(
+    monkeypatch, capsys, trace_sample, error, code, message
+):
+    from dask.distributed import Client
+
+    parallel.shutdown()
+    monkeypatch.setattr(_ClusterThatFails, "error", error)
+    monkeypatch.setattr(parallel, "_import_dask", lambda: (Client, _ClusterThatFails))
+    assert main([*trace_sample, "--rays", "1000", "--scheduler", "local"]) == code
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1, err
+    if code == 2:
+        assert str(error) in err  # the cause, in dask's words
+
+
 def test_validate_checks_the_scheduler_before_running_any_section(monkeypatch, tmp_path):
     from labbrdf.report import validate
 
@@ -780,24 +815,44 @@ def reset_parallel_options() -> Any:
 
 LISTEN = textwrap.dedent(
     """
-    import json, sys
+    import json, os, socket, sys
     import psutil
     from labbrdf import parallel
+
+    def http(port):
+        # what a plain HTTP request to 127.0.0.1:port gets back (bounded waits)
+        try:
+            with socket.create_connection(("127.0.0.1", port), timeout=3) as s:
+                s.settimeout(3)
+                s.sendall(b"GET /health HTTP/1.0\\r\\nHost: 127.0.0.1\\r\\n\\r\\n")
+                return s.recv(64).decode("latin-1")
+        except OSError:
+            return ""
+
+    def blocked(_):
+        import signal
+        return signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, [])
 
     def main():
         assert parallel.run(abs, [-1, 2], scheduler="local", workers=2) == [1, 2]
         client = parallel._LOCAL["client"]
+        deaf = parallel.run(blocked, [0, 1], scheduler="local", workers=2)
+        if os.environ.get("RESTART_A_WORKER"):  # a worker restarted by its nanny
+            client.restart_workers([sorted(client.scheduler_info()["workers"])[0]])
+            client.wait_for_workers(2, timeout=60)
+            assert parallel.run(abs, [-3], scheduler="local", workers=2) == [3]
         me = psutil.Process()
         listen = []
         for p in [me, *me.children(recursive=True)]:
             for c in p.net_connections(kind="inet"):
                 if c.status == psutil.CONN_LISTEN:
-                    listen.append([p.pid, c.laddr.ip, c.laddr.port])
+                    port = c.laddr.port
+                    listen.append([p.pid, c.laddr.ip, port, http(port)])
         info = client.scheduler_info()
         addresses = [info["address"]]
         for w, v in info["workers"].items():
             addresses += [w, v.get("nanny")]
-        print(json.dumps({"listen": listen, "addresses": addresses,
+        print(json.dumps({"listen": listen, "addresses": addresses, "deaf": deaf,
                           "services": info.get("services", {}),
                           "pids": len(me.children(recursive=True))}))
         parallel.shutdown()
@@ -819,16 +874,21 @@ def _run_listen(env_extra: dict[str, str]) -> dict[str, Any]:
 
 
 @pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
-def test_local_cluster_listens_on_loopback_only_and_has_no_dashboard():
-    info = _run_listen({"LABBRDF_DASK_DASHBOARD": ""})
+def test_local_cluster_listens_on_loopback_only_and_no_port_answers_http():
+    # one worker is restarted by its nanny first: a new worker must be as closed
+    info = _run_listen({"LABBRDF_DASK_DASHBOARD": "", "RESTART_A_WORKER": "1"})
     assert info["pids"] >= 2  # the worker processes were inspected too
-    assert info["listen"], info
-    for pid, ip, port in info["listen"]:
+    assert len(info["listen"]) >= 5, info  # scheduler, 2 nannies, 2 workers: all probed
+    for pid, ip, port, _ in info["listen"]:
         assert ip == "127.0.0.1", f"pid {pid} listens on {ip}:{port}"
     for a in info["addresses"]:
         assert a.startswith("tls://127.0.0.1:"), a  # TLS even without certificates
-    # dask always runs the scheduler's HTTP server (/health, /metrics; listed as
-    # "dashboard"): checked above to be on 127.0.0.1 like every other socket
+    # dask starts an HTTP server (/health, /metrics, /info, no authentication) on the
+    # scheduler and on every worker, dashboard or not: none may be left answering
+    answered = [(pid, port, got) for pid, _, port, got in info["listen"] if "HTTP" in got]
+    assert answered == []
+    # workers ignore the terminal's Ctrl-C (this process closes them): no traceback each
+    assert info["deaf"] == [True, True]
 
 
 @pytest.mark.usefixtures("dask_ok", "reset_parallel_options")
@@ -836,9 +896,11 @@ def test_dashboard_only_when_asked_and_on_loopback():
     pytest.importorskip("bokeh")
     info = _run_listen({"LABBRDF_DASK_DASHBOARD": "1"})
     port = info["services"]["dashboard"]
-    assert any(ip == "127.0.0.1" and p == port for _, ip, p in info["listen"])
-    for _, ip, _ in info["listen"]:
+    assert any(ip == "127.0.0.1" and p == port for _, ip, p, _ in info["listen"])
+    for _, ip, _, _ in info["listen"]:
         assert ip == "127.0.0.1"
+    # the dashboard, asked for, is the one port that answers HTTP
+    assert [p for _, _, p, got in info["listen"] if "HTTP" in got] == [port]
 
 
 # --------------------------------------------------------------------------- TLS

@@ -25,28 +25,27 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 import time
 from collections import OrderedDict
 from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
+from . import cache as _cache
 from .binning import Grid
+from .cache import cache_dir
 from .evaluate import bin_nodes, cell_centroids, transmission_mueller
 from .interfaces import fresnel_abcs
 from .sampling import ggx_d, smith_g1
 
 __all__ = ["ExitOperator", "build_exit_operator", "cache_dir", "exit_operator", "memory_cache"]
 
-# part of the cache key: bump when the operator's definition changes
-VERSION = 1
+# part of the cache key: bump when the operator's definition or its file format changes
+VERSION = 2
 
 #: operators kept in memory inside :func:`memory_cache` (None outside: the disk cache)
 _MEMORY: ContextVar[OrderedDict[str, ExitOperator] | None] = ContextVar(
@@ -190,15 +189,6 @@ def build_exit_operator(
     return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
 
 
-def cache_dir() -> Path:
-    """The user's cache folder for operators: ``$XDG_CACHE_HOME/labbrdf/tracer``.
-
-    ``~/.cache`` when ``XDG_CACHE_HOME`` is unset; never the working folder.
-    """
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "labbrdf" / "tracer"
-
-
 @contextmanager
 def memory_cache(store: OrderedDict[str, ExitOperator] | None = None) -> Iterator[None]:
     """Within this block :func:`exit_operator` keeps operators in memory, not on disk.
@@ -242,12 +232,13 @@ def exit_operator(
 ) -> ExitOperator:
     """:func:`build_exit_operator`, cached under :func:`cache_dir`.
 
-    The file name is a hash of everything the operator depends on (grid, indices, alpha,
-    quadrature, format version). A file is written to a temporary name in the cache folder
-    and renamed into place (atomic on POSIX), so concurrent runs and interrupted writes
-    never leave a half-written operator under the final name; an unreadable or
-    mismatched file is rebuilt. A cache folder that cannot be written only costs the
-    rebuild next time. Inside :func:`memory_cache` the operator is kept in memory instead.
+    The cache key is a hash of everything the operator depends on (grid, indices, alpha,
+    quadrature, format version); :mod:`labbrdf.tracer.cache` keeps the file: verified on
+    load (key, shape, dtype and a digest of the contents), private to the user, written
+    atomically and bounded by a size cap with least-recently-used eviction. A file that
+    fails a check is rebuilt with a :class:`~labbrdf.tracer.cache.CacheWarning` naming
+    it; a cache folder that cannot be written only costs the rebuild next time. Inside
+    :func:`memory_cache` the operator is kept in memory instead.
     """
     if not cache:
         return build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes)
@@ -262,32 +253,12 @@ def exit_operator(
                 memory.popitem(last=False)
         memory.move_to_end(key)
         return op
-    path = cache_dir() / f"exit-{_key(grid, n_below, alpha, n_above, nodes)}.npy"
+    key = _key(grid, n_below, alpha, n_above, nodes)
     nt, npf = grid.n_theta, grid.n_phi
-    shape = (npf // 2 + 1, 4 * nt, 4 * nt)
     t0 = time.perf_counter()
-    try:
-        # memory-mapped first: the header's shape is checked before anything is read
-        mm = np.load(path, allow_pickle=False, mmap_mode="r")
-        if mm.shape == shape and mm.dtype == np.complex64:
-            spec = np.array(mm)
-            del mm
-            return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
-    except (OSError, ValueError, EOFError):
-        pass
+    spec = _cache.load(key, (npf // 2 + 1, 4 * nt, 4 * nt), np.complex64)
+    if spec is not None:
+        return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
     op = build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".exit-", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                np.save(fh, op.spectrum, allow_pickle=False)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-    except OSError:
-        pass
+    _cache.store(key, op.spectrum)
     return op

@@ -16,6 +16,7 @@ import pytest
 
 from labbrdf import optics
 from labbrdf.tracer import Coating, Grid, Substrate, TraceConfig, trace
+from labbrdf.tracer.cache import CacheWarning
 from labbrdf.tracer.operator import PARITY, build_exit_operator, cache_dir, exit_operator
 
 AL = Substrate(n=1.55, k=7.71, alpha=0.2)
@@ -368,21 +369,24 @@ def test_operator_cache_is_written_atomically_and_reread(tmp_path, monkeypatch):
     grid = Grid(10.0, 20.0)
     a = exit_operator(grid, 1.5, 0.3)
     files = list(cache_dir().iterdir())
-    assert [f.suffix for f in files] == [".npy"]  # no temporary file left behind
+    assert [f.suffix for f in files] == [".op"]  # no temporary file left behind
     assert str(cache_dir()).startswith(str(tmp_path))
     b = exit_operator(grid, 1.5, 0.3)
     assert np.array_equal(a.spectrum, b.spectrum)
     # a half-written file under the final name is rebuilt, not trusted
     files[0].write_bytes(files[0].read_bytes()[:100])
-    c = exit_operator(grid, 1.5, 0.3)
+    with pytest.warns(CacheWarning, match=files[0].name):
+        c = exit_operator(grid, 1.5, 0.3)
     assert np.array_equal(a.spectrum, c.spectrum)
-    # a valid file of another shape (say, another grid's) is rebuilt too
-    np.save(files[0], np.zeros((2, 2), dtype=np.complex64))
-    d = exit_operator(grid, 1.5, 0.3)
+    # a valid .npy file under the final name is not a cache file: rebuilt too
+    with open(files[0], "wb") as fh:
+        np.save(fh, np.zeros((2, 2), dtype=np.complex64))
+    with pytest.warns(CacheWarning, match="magic"):
+        d = exit_operator(grid, 1.5, 0.3)
     assert np.array_equal(a.spectrum, d.spectrum)
     # another index is another file
     exit_operator(grid, 1.4, 0.3)
-    assert len(list(cache_dir().glob("*.npy"))) == 2
+    assert len(list(cache_dir().glob("*.op"))) == 2
 
 
 def test_operator_cache_dir_that_cannot_be_written_costs_only_the_rebuild(tmp_path, monkeypatch):

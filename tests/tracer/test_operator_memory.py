@@ -28,7 +28,7 @@ def test_memory_cache_writes_nothing_and_reuses_the_operator(tmp_path, monkeypat
     assert np.array_equal(a.spectrum, ref.spectrum)
     # outside the block the disk cache is back
     exit_operator(grid, 1.5, 0.3)
-    assert [f.suffix for f in cache_dir().iterdir()] == [".npy"]
+    assert [f.suffix for f in cache_dir().iterdir()] == [".op"]
 
 
 def test_a_store_carries_operators_between_blocks_and_keeps_the_latest(tmp_path, monkeypatch):
