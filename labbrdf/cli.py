@@ -51,8 +51,21 @@ class InputPath(argparse.Action):
     """An option or positional argument that names files the command reads.
 
     Every output of the command refuses all of them (see :func:`_checked_outputs`), so
-    an option declared with ``action=InputPath`` cannot be forgotten by a writer.
+    an option declared with ``action=InputPath`` cannot be forgotten by a writer. A file
+    that names other files (``inside="model"``: a film model file, ``inside="fit"``: a film
+    fit JSON) brings those in as inputs too (:func:`labbrdf.films.named_inputs`).
     """
+
+    def __init__(
+        self,
+        option_strings: Sequence[str],
+        dest: str,
+        *,
+        inside: Literal["model", "fit"] | None = None,
+        **kw: Any,
+    ) -> None:
+        super().__init__(option_strings, dest, **kw)
+        self.inside = inside
 
     def __call__(
         self,
@@ -112,9 +125,24 @@ def _named_paths(args: argparse.Namespace, kind: type) -> list[tuple[argparse.Ac
     return out
 
 
-def _inputs(args: argparse.Namespace) -> list[str]:
-    """Every file the command reads, whichever option names it."""
-    return [p for _, p in _named_paths(args, InputPath)]
+def _inputs(args: argparse.Namespace) -> tuple[list[str], list[str]]:
+    """Every file the command reads: those its options name, and those named inside them.
+
+    Returns (named by options, named inside those files: a model's or a fit's tables, the
+    files of ``--layer``). Both are refused as outputs before anything is written.
+    """
+    direct = [p for _, p in _named_paths(args, InputPath)]
+    inner = [f for spec in getattr(args, "layer", None) or () for f in _layer_files(spec)]
+    for a, p in _named_paths(args, InputPath):
+        kind = getattr(a, "inside", None)
+        if kind is not None:
+            from .films import named_inputs
+
+            try:
+                inner += [str(f) for f in named_inputs(p, kind)]
+            except ValueError as exc:  # the loader's message, naming the file
+                raise UsageError(f"{_option_name(a)} {exc}") from None
+    return direct, inner
 
 
 @contextlib.contextmanager
@@ -127,9 +155,9 @@ def _checked_outputs(args: argparse.Namespace) -> Iterator[None]:
     """
     from .outputs import check_file_output, check_input_files, check_report_dir, write_policy
 
-    inputs = _inputs(args)
-    with write_policy(overwrite=bool(getattr(args, "overwrite", False)), inputs=inputs):
-        check_input_files(inputs)
+    direct, inner = _inputs(args)  # inner ones are checked by their readers, naming the file
+    with write_policy(overwrite=bool(getattr(args, "overwrite", False)), inputs=direct + inner):
+        check_input_files(direct)
         seen: dict[Path, str] = {}
         for a, path in _named_paths(args, OutputPath):
             if not isinstance(a, OutputPath):  # pragma: no cover - _named_paths filtered
@@ -796,6 +824,12 @@ def _film_value(text: str, what: str) -> tuple[float, tuple[float, float] | None
     return (lo + hi) / 2, (lo, hi)
 
 
+def _layer_files(spec: str) -> list[str]:
+    """The file a ``--layer NAME:MATERIAL:...`` names as its material, if any."""
+    fields = spec.split(":")
+    return [fields[1]] if len(fields) >= 2 and os.path.exists(fields[1]) else []
+
+
 def _film_model(args: argparse.Namespace) -> Any:
     """The FilmModel of --model FILE, or of --substrate and --layer, or the default."""
     from . import films
@@ -829,7 +863,7 @@ def _film_model(args: argparse.Namespace) -> Any:
         name, mat, thick = fields[0] or f"layer{j}", fields[1], fields[2]
         d, dbox = _film_value(thick, f"--layer {name}: thickness")
         try:
-            m = films.as_material(mat) if not os.path.exists(mat) else tabulated_from_file(mat)
+            m = tabulated_from_file(mat) if _layer_files(spec) else films.as_material(mat)
         except ValueError as exc:
             raise UsageError(f"--layer {name}: {exc}") from None
         values = {}
@@ -1466,7 +1500,12 @@ def _film_parser(sub: Any) -> None:
         help="files of one sample (joint fit)",
     )
     s.add_argument(
-        "--model", action=InputPath, default=None, metavar="MODEL.toml", help="a film model file"
+        "--model",
+        action=InputPath,
+        inside="model",
+        default=None,
+        metavar="MODEL.toml",
+        help="a film model file",
     )
     s.add_argument(
         "--substrate",
@@ -1633,6 +1672,7 @@ def _trace_parser(sub: Any) -> None:
         "--coating-from",
         default=None,
         action=InputPath,
+        inside="fit",
         metavar="FIT.json",
         help="coating index at --wavelength and thickness from a one-layer film fit",
     )
@@ -1730,6 +1770,7 @@ def _report_parser(sub: Any) -> None:
         "--film-model",
         default=None,
         action=InputPath,
+        inside="model",
         metavar="FILE.toml",
         help="fit this film stack to psi/Delta files whose angles disagree",
     )
