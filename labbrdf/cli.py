@@ -125,13 +125,13 @@ def _named_paths(args: argparse.Namespace, kind: type) -> list[tuple[argparse.Ac
     return out
 
 
-def _inputs(args: argparse.Namespace) -> tuple[list[str], list[str]]:
-    """Every file the command reads: those its options name, and those named inside them.
+def _inputs(args: argparse.Namespace) -> list[str]:
+    """Every file the command's options name as an input."""
+    return [p for _, p in _named_paths(args, InputPath)]
 
-    Returns (named by options, named inside those files: a model's or a fit's tables, the
-    files of ``--layer``). Both are refused as outputs before anything is written.
-    """
-    direct = [p for _, p in _named_paths(args, InputPath)]
+
+def _named_inside(args: argparse.Namespace) -> list[str]:
+    """The files named inside the inputs: a model's or a fit's tables, ``--layer`` files."""
     inner = [f for spec in getattr(args, "layer", None) or () for f in _layer_files(spec)]
     for a, p in _named_paths(args, InputPath):
         kind = getattr(a, "inside", None)
@@ -142,7 +142,26 @@ def _inputs(args: argparse.Namespace) -> tuple[list[str], list[str]]:
                 inner += [str(f) for f in named_inputs(p, kind)]
             except ValueError as exc:  # the loader's message, naming the file
                 raise UsageError(f"{_option_name(a)} {exc}") from None
-    return direct, inner
+    return inner
+
+
+def _check_outputs(args: argparse.Namespace) -> None:
+    """Check every output option against the :func:`labbrdf.outputs.write_policy` in force."""
+    from .outputs import check_file_output, check_report_dir
+
+    seen: dict[Path, str] = {}
+    for a, path in _named_paths(args, OutputPath):
+        if not isinstance(a, OutputPath):  # pragma: no cover - _named_paths filtered
+            continue
+        name = _option_name(a)
+        if a.kind == "dir":
+            out = check_report_dir(path, option=name)
+        else:
+            out = check_file_output(path, suffixes=a.suffixes, option=name)
+        key = Path(os.path.abspath(out))
+        if key in seen:
+            raise UsageError(f"{name} {path}: also given to {seen[key]}; expected two names")
+        seen[key] = name
 
 
 @contextlib.contextmanager
@@ -151,26 +170,20 @@ def _checked_outputs(args: argparse.Namespace) -> Iterator[None]:
 
     The rule (:func:`labbrdf.outputs.write_policy`): an existing output is replaced only
     with ``--overwrite``, an input never; every file written inside, sidecars included,
-    follows it.
+    follows it. The files named inside the inputs (:func:`_named_inside`) are inputs too,
+    checked against every output before the command runs; their readers check that they
+    are regular files, naming the file that names them.
     """
-    from .outputs import check_file_output, check_input_files, check_report_dir, write_policy
+    from .outputs import check_input_files, refuse_input_as_output, write_policy
 
-    direct, inner = _inputs(args)  # inner ones are checked by their readers, naming the file
-    with write_policy(overwrite=bool(getattr(args, "overwrite", False)), inputs=direct + inner):
-        check_input_files(direct)
-        seen: dict[Path, str] = {}
-        for a, path in _named_paths(args, OutputPath):
-            if not isinstance(a, OutputPath):  # pragma: no cover - _named_paths filtered
-                continue
-            name = _option_name(a)
-            if a.kind == "dir":
-                out = check_report_dir(path, option=name)
-            else:
-                out = check_file_output(path, suffixes=a.suffixes, option=name)
-            key = Path(os.path.abspath(out))
-            if key in seen:
-                raise UsageError(f"{name} {path}: also given to {seen[key]}; expected two names")
-            seen[key] = name
+    inputs = _inputs(args)
+    check_input_files(inputs)
+    for a, path in _named_paths(args, OutputPath):  # an input given as an output: said first
+        kind = a.kind if isinstance(a, OutputPath) else "file"
+        refuse_input_as_output(path, inputs=inputs, kind=kind, option=_option_name(a))
+    inputs += _named_inside(args)
+    with write_policy(overwrite=bool(getattr(args, "overwrite", False)), inputs=inputs):
+        _check_outputs(args)
         yield
 
 

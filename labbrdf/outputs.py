@@ -74,6 +74,7 @@ __all__ = [
     "csv_safe_frame",
     "note_inputs",
     "read_input_file",
+    "refuse_input_as_output",
     "replace_dir",
     "write_policy",
 ]
@@ -451,6 +452,52 @@ def _refuse_inputs(p: Path, inputs: Iterable[Path], option: str) -> None:
             )
 
 
+def refuse_input_as_output(
+    path: str | os.PathLike[str],
+    *,
+    inputs: Iterable[str | os.PathLike[str]] = (),
+    kind: str = "file",
+    option: str = "-o",
+) -> None:
+    """Refuse an output that is one of the inputs (a file) or holds or lies in one (a folder).
+
+    Only this check of :func:`check_file_output` and :func:`check_report_dir`, which both
+    make it first: the CLI makes it alone before reading the inputs that name other files,
+    so that an input given as an output is refused as such.
+
+    Parameters
+    ----------
+    path : path-like
+        The output.
+    inputs : iterable of path-like
+        The inputs (with those of the :func:`write_policy` in force).
+    kind : {"file", "dir"}
+        A file output or a report folder.
+    option : str
+        The option name, for the messages.
+
+    Raises
+    ------
+    OutputError
+        Naming the output and the input.
+    """
+    if kind != "dir":
+        _refuse_inputs(Path(path), _policy_inputs(inputs), option)
+        return
+    if os.path.lexists(path) and not os.path.isdir(path):
+        return  # an existing file where a folder should go: check_report_dir says so
+    out, shown = _resolved(path), os.fspath(path)
+    for f in _policy_inputs(inputs):
+        fp = _resolved(f)
+        if _is_within(fp, out):
+            raise OutputError(
+                f"{option} {shown}: contains the input {f}; expected a folder that holds "
+                "none of the input files"
+            )
+        if _is_within(out, fp):
+            raise OutputError(f"{option} {shown}: lies inside the input {f}")
+
+
 def _put_in_place(tmp: str, target: Path, overwrite: bool) -> None:
     """Rename ``tmp`` onto ``target``; without ``overwrite``, never replace a file.
 
@@ -687,15 +734,7 @@ def check_report_dir(
             "(a new name, an empty folder or an earlier report)"
         )
     out = _resolved(path)
-    for f in _policy_inputs(inputs):
-        fp = _resolved(f)
-        if _is_within(fp, out):
-            raise OutputError(
-                f"{option} {shown}: contains the input {f}; expected a folder that holds "
-                "none of the input files"
-            )
-        if _is_within(out, fp):
-            raise OutputError(f"{option} {shown}: lies inside the input {f}")
+    refuse_input_as_output(path, inputs=inputs, kind="dir", option=option)
     try:
         cwd = Path.cwd().resolve()
     except OSError:
