@@ -44,6 +44,7 @@ if TYPE_CHECKING:  # at run time through __getattr__ below (the fit imports this
 __all__ = [
     "FILM_QUANTITIES",
     "MAX_FIT_JSON_BYTES",
+    "MAX_INDEX",
     "MAX_LAYERS",
     "MAX_MODEL_BYTES",
     "MAX_TABLE_POINTS",
@@ -81,6 +82,10 @@ MAX_THICKNESS_NM = 1.0e7
 
 #: the wavelengths a model or fit may state [nm]: 1 nm (soft X-rays) to 1 mm (far IR)
 WAVELENGTH_LIMITS_NM = (1.0, 1.0e6)
+
+#: the largest index modulus |n + ik| a fit JSON's stack may have over its fitted range [1]
+#: (metals in the far infrared reach a few hundred)
+MAX_INDEX = 1.0e4
 
 #: largest film model file (TOML) read [bytes]: a model of MAX_LAYERS layers is ~50 kB
 MAX_MODEL_BYTES = 1 << 20
@@ -898,6 +903,33 @@ def _tabulated(stack: Stack) -> list[tuple[str, disp.Tabulated]]:
     return [(name, m) for name, m in mats if isinstance(m, disp.Tabulated)]
 
 
+def _check_indices(stack: Stack, rng: tuple[float, float], where: str) -> None:
+    """Every medium's index is physical over the fitted range: finite, n > 0, k >= 0.
+
+    Checked on 65 wavelengths spanning the range, with ``|N| <=`` :data:`MAX_INDEX`.
+    """
+    names = ["ambient", *(lay.name for lay in stack.layers), "substrate"]
+    grid = np.linspace(rng[0], rng[1], 65)
+    cover = [m.covers(grid) for _, m in _tabulated(stack)]
+    if not all(cover):
+        return  # the range check that follows names the table
+    try:
+        with np.errstate(all="ignore"):
+            indices = stack.indices(grid)
+    except (FilmError, disp.DispersionError, ValueError) as exc:
+        raise FilmError(f"{where}: stack: {exc}") from None
+    for name, n in zip(names, indices, strict=True):
+        n = np.asarray(n, complex)
+        ok = np.isfinite(n) & (n.real > 0) & (n.imag >= 0) & (np.abs(n) <= MAX_INDEX)
+        if not np.all(ok):
+            bad = float(grid[np.argmin(ok)])
+            raise FilmError(
+                f"{where}: stack: the {name} index at {bad:g} nm is {complex(n[np.argmin(ok)])}; "
+                f"expected finite n > 0, k >= 0 and |n + ik| <= {MAX_INDEX:g} over the fitted "
+                "range (labbrdf.films.MAX_INDEX)"
+            )
+
+
 def _fit_doc(path: str | os.PathLike[str]) -> tuple[Path, dict[str, Any]]:
     """(path, document) of a film fit JSON: a regular file within the caps, schema-checked."""
     p = Path(path)
@@ -936,8 +968,9 @@ def read_fit_json(path: str | os.PathLike[str]) -> tuple[Stack, tuple[float, flo
     :data:`MAX_THICKNESS_NM`] nm, finite numbers, tables of at most
     :data:`MAX_TABLE_POINTS` rows) and ``wavelength_range_nm`` (finite, ordered, within
     :data:`WAVELENGTH_LIMITS_NM` and inside every table of the stack: a fit never used
-    wavelengths its tables do not cover). A ``file`` table is an input of the command
-    (:func:`named_inputs`). The file is a regular file of at most
+    wavelengths its tables do not cover), and every medium's index over that range
+    (finite, ``n > 0``, ``k >= 0``, ``|N| <=`` :data:`MAX_INDEX`). A ``file`` table is
+    an input of the command (:func:`named_inputs`). The file is a regular file of at most
     :data:`MAX_FIT_JSON_BYTES`.
 
     Parameters
@@ -965,6 +998,7 @@ def read_fit_json(path: str | os.PathLike[str]) -> tuple[Stack, tuple[float, flo
         rng = check_wavelength_range(doc["wavelength_range_nm"], "wavelength_range_nm")
     except FilmError as exc:
         raise FilmError(f"{p}: {exc}") from None
+    _check_indices(stack, rng, str(p))
     for name, table in _tabulated(stack):
         if not table.covers(np.asarray(rng)):
             lo, hi = table.range_nm

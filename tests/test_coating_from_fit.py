@@ -151,6 +151,14 @@ WRONG = {
         "finite number, got nan",
     ),
     "unknown-key": (lambda d: _layer(d).__setitem__("thick", 1), "unknown key 'thick'"),
+    "negative-index": (
+        lambda d: _layer(d)["material"].__setitem__("A", -1.0),
+        r"stack: the coat index at 450 nm is \(-",
+    ),
+    "huge-absorption": (
+        lambda d: _layer(d)["material"].__setitem__("k_amp", 1e308),
+        r"the coat index .*\|n \+ ik\| <= 10000",
+    ),
     "huge-int": (lambda d: _layer(d).__setitem__("thickness_nm", 10**400), "finite number"),
 }
 
