@@ -52,8 +52,21 @@ class InputPath(argparse.Action):
     """An option or positional argument that names files the command reads.
 
     Every output of the command refuses all of them (see :func:`_checked_outputs`), so
-    an option declared with ``action=InputPath`` cannot be forgotten by a writer.
+    an option declared with ``action=InputPath`` cannot be forgotten by a writer. A file
+    that names other files (``inside="model"``: a film model file, ``inside="fit"``: a film
+    fit JSON) brings those in as inputs too (:func:`labbrdf.films.named_inputs`).
     """
+
+    def __init__(
+        self,
+        option_strings: Sequence[str],
+        dest: str,
+        *,
+        inside: Literal["model", "fit"] | None = None,
+        **kw: Any,
+    ) -> None:
+        super().__init__(option_strings, dest, **kw)
+        self.inside = inside
 
     def __call__(
         self,
@@ -114,8 +127,42 @@ def _named_paths(args: argparse.Namespace, kind: type) -> list[tuple[argparse.Ac
 
 
 def _inputs(args: argparse.Namespace) -> list[str]:
-    """Every file the command reads, whichever option names it."""
+    """Every file the command's options name as an input."""
     return [p for _, p in _named_paths(args, InputPath)]
+
+
+def _named_inside(args: argparse.Namespace) -> list[str]:
+    """The files named inside the inputs: a model's or a fit's tables, ``--layer`` files."""
+    inner = [f for spec in getattr(args, "layer", None) or () for f in _layer_files(spec)]
+    for a, p in _named_paths(args, InputPath):
+        kind = getattr(a, "inside", None)
+        if kind is not None:
+            from .films import named_inputs
+
+            try:
+                inner += [str(f) for f in named_inputs(p, kind)]
+            except ValueError as exc:  # the loader's message, naming the file
+                raise UsageError(f"{_option_name(a)} {exc}") from None
+    return inner
+
+
+def _check_outputs(args: argparse.Namespace) -> None:
+    """Check every output option against the :func:`labbrdf.outputs.write_policy` in force."""
+    from .outputs import check_file_output, check_report_dir
+
+    seen: dict[Path, str] = {}
+    for a, path in _named_paths(args, OutputPath):
+        if not isinstance(a, OutputPath):  # pragma: no cover - _named_paths filtered
+            continue
+        name = _option_name(a)
+        if a.kind == "dir":
+            out = check_report_dir(path, option=name)
+        else:
+            out = check_file_output(path, suffixes=a.suffixes, option=name)
+        key = Path(os.path.abspath(out))
+        if key in seen:
+            raise UsageError(f"{name} {path}: also given to {seen[key]}; expected two names")
+        seen[key] = name
 
 
 @contextlib.contextmanager
@@ -124,26 +171,20 @@ def _checked_outputs(args: argparse.Namespace) -> Iterator[None]:
 
     The rule (:func:`labbrdf.outputs.write_policy`): an existing output is replaced only
     with ``--overwrite``, an input never; every file written inside, sidecars included,
-    follows it.
+    follows it. The files named inside the inputs (:func:`_named_inside`) are inputs too,
+    checked against every output before the command runs; their readers check that they
+    are regular files, naming the file that names them.
     """
-    from .outputs import check_file_output, check_input_files, check_report_dir, write_policy
+    from .outputs import check_input_files, refuse_input_as_output, write_policy
 
     inputs = _inputs(args)
+    check_input_files(inputs)
+    for a, path in _named_paths(args, OutputPath):  # an input given as an output: said first
+        kind = a.kind if isinstance(a, OutputPath) else "file"
+        refuse_input_as_output(path, inputs=inputs, kind=kind, option=_option_name(a))
+    inputs += _named_inside(args)
     with write_policy(overwrite=bool(getattr(args, "overwrite", False)), inputs=inputs):
-        check_input_files(inputs)
-        seen: dict[Path, str] = {}
-        for a, path in _named_paths(args, OutputPath):
-            if not isinstance(a, OutputPath):  # pragma: no cover - _named_paths filtered
-                continue
-            name = _option_name(a)
-            if a.kind == "dir":
-                out = check_report_dir(path, option=name)
-            else:
-                out = check_file_output(path, suffixes=a.suffixes, option=name)
-            key = Path(os.path.abspath(out))
-            if key in seen:
-                raise UsageError(f"{name} {path}: also given to {seen[key]}; expected two names")
-            seen[key] = name
+        _check_outputs(args)
         yield
 
 
@@ -843,6 +884,12 @@ def _film_value(text: str, what: str) -> tuple[float, tuple[float, float] | None
     return (lo + hi) / 2, (lo, hi)
 
 
+def _layer_files(spec: str) -> list[str]:
+    """The file a ``--layer NAME:MATERIAL:...`` names as its material, if any."""
+    fields = spec.split(":")
+    return [fields[1]] if len(fields) >= 2 and os.path.exists(fields[1]) else []
+
+
 def _film_model(args: argparse.Namespace) -> Any:
     """The FilmModel of --model FILE, or of --substrate and --layer, or the default."""
     from . import films
@@ -876,7 +923,7 @@ def _film_model(args: argparse.Namespace) -> Any:
         name, mat, thick = fields[0] or f"layer{j}", fields[1], fields[2]
         d, dbox = _film_value(thick, f"--layer {name}: thickness")
         try:
-            m = films.as_material(mat) if not os.path.exists(mat) else tabulated_from_file(mat)
+            m = tabulated_from_file(mat) if _layer_files(spec) else films.as_material(mat)
         except ValueError as exc:
             raise UsageError(f"--layer {name}: {exc}") from None
         values = {}
@@ -1535,7 +1582,12 @@ def _film_parser(sub: Any) -> None:
         help="files of one sample (joint fit)",
     )
     s.add_argument(
-        "--model", action=InputPath, default=None, metavar="MODEL.toml", help="a film model file"
+        "--model",
+        action=InputPath,
+        inside="model",
+        default=None,
+        metavar="MODEL.toml",
+        help="a film model file",
     )
     s.add_argument(
         "--substrate",
@@ -1702,6 +1754,7 @@ def _trace_parser(sub: Any) -> None:
         "--coating-from",
         default=None,
         action=InputPath,
+        inside="fit",
         metavar="FIT.json",
         help="coating index at --wavelength and thickness from a one-layer film fit",
     )
@@ -1799,6 +1852,7 @@ def _report_parser(sub: Any) -> None:
         "--film-model",
         default=None,
         action=InputPath,
+        inside="model",
         metavar="FILE.toml",
         help="fit this film stack to psi/Delta files whose angles disagree",
     )

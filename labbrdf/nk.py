@@ -71,6 +71,10 @@ __all__ = [
     "read_nk",
 ]
 
+#: largest n,k table (or ellipsometer file) that :func:`tabulated_from_file` reads [bytes]:
+#: a table of a million rows is ~40 MB
+MAX_TABLE_BYTES = 64 << 20
+
 #: Stage positions closer than this (chained, per coordinate) are the same spot [mm].
 POSITION_TOL_MM = 0.5
 
@@ -961,21 +965,14 @@ def coating_from_fit(path: str | os.PathLike[str], wavelength_nm: float) -> tupl
         wavelength lies outside the fitted range (a dispersion model is not extrapolated
         beyond the data that fixed it).
     """
-    import json
+    from .films import read_fit_json  # the film objects, imported where needed
 
-    from .films import Stack  # the film objects, imported where needed
-
-    p = Path(path)
-    stack = Stack.from_fit_json(p)
-    doc = json.loads(p.read_text("utf-8"))
-    rng = doc.get("wavelength_range_nm")
-    if not (isinstance(rng, list) and len(rng) == 2):
-        raise ValueError(f"{p}: no 'wavelength_range_nm' (not a film fit of labbrdf)")
+    stack, fitted = read_fit_json(path)
     layer_n, thickness, _ = coating_of_stack(
         stack,
         wavelength_nm,
-        (float(rng[0]), float(rng[1])),
-        where=str(p),
+        fitted,
+        where=str(path),
         hint="fit one layer, or give --coating and --thickness",
     )
     return layer_n, thickness
@@ -1193,13 +1190,18 @@ def tabulated_from_file(
     Raises
     ------
     labbrdf.dispersion.DispersionError
-        The file cannot be read as either; names the file (and the line of a table).
+        The file cannot be read as either, is not a regular file (a device, a FIFO: refused
+        before it is opened) or is larger than :data:`MAX_TABLE_BYTES`; names the file (and
+        the line of a table).
     """
+    from .outputs import InputFileError, read_input_file
+
     p = Path(path)
     try:
-        text = p.read_text("utf-8", errors="replace")
-    except OSError as exc:
-        raise disp.DispersionError(f"{p}: cannot read ({exc.strerror})") from None
+        raw = read_input_file(p, max_bytes=MAX_TABLE_BYTES, what="n,k table or ellipsometer file")
+    except InputFileError as exc:
+        raise disp.DispersionError(str(exc)) from None
+    text = raw.decode("utf-8", errors="replace")
     try:
         w, n, k = disp.parse_nk_table(text, str(p))
     except disp.DispersionError as table_error:

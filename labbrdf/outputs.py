@@ -62,6 +62,7 @@ from typing import Any
 __all__ = [
     "CSV_FORMULA_PREFIXES",
     "REPORT_MARKER",
+    "InputFileError",
     "OutputError",
     "WritePolicy",
     "atomic_output",
@@ -71,6 +72,9 @@ __all__ = [
     "clean_leftovers",
     "csv_safe_cell",
     "csv_safe_frame",
+    "note_inputs",
+    "read_input_file",
+    "refuse_input_as_output",
     "replace_dir",
     "write_policy",
 ]
@@ -83,6 +87,13 @@ REPORT_MARKER = ".labbrdf-report"
 CSV_FORMULA_PREFIXES = ("=", "+", "-", "@", "\t", "\r")
 
 _LEGACY_REPORT_KEYS = {"title", "meta", "sections", "tables", "checks", "summary"}
+
+
+class InputFileError(ValueError):
+    """An input that labbrdf refuses to open: not a regular file, or larger than its cap.
+
+    The message names the path and what was expected (CLI exit code 2).
+    """
 
 
 class OutputError(ValueError, OSError):
@@ -248,6 +259,23 @@ def _ends_with_sep(p: str | os.PathLike[str]) -> bool:
 # --------------------------------------------------------------------------- inputs
 
 
+def _not_regular(mode: int) -> str | None:
+    """What a non-regular file is (``"a folder"``, ``"a FIFO (named pipe)"``, ...), or None."""
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    if stat.S_ISCHR(mode):
+        return "a character device"
+    if stat.S_ISFIFO(mode):
+        return "a FIFO (named pipe)"
+    if stat.S_ISBLK(mode):
+        return "a block device"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    return "not a regular file"
+
+
 def check_input_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
     """Refuse inputs that are not regular files.
 
@@ -262,14 +290,91 @@ def check_input_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
         except OSError:
             out.append(path)
             continue
-        if stat.S_ISDIR(st.st_mode):
+        kind = _not_regular(st.st_mode)
+        if kind == "a folder":
             raise OutputError(f"{path}: is a folder; expected a data file")
-        if not stat.S_ISREG(st.st_mode):
-            raise OutputError(
-                f"{path}: not a regular file (a device or pipe); expected a data file"
-            )
+        if kind is not None:
+            raise OutputError(f"{path}: is {kind}, not a regular file; expected a data file")
         out.append(path)
     return out
+
+
+def note_inputs(paths: Iterable[str | os.PathLike[str]]) -> None:
+    """Add files the running command reads to the inputs of the :func:`write_policy` in force.
+
+    A file named inside another input (a table named by a model file, ...) is an input too:
+    from here on no output of the command may replace it, even with ``--overwrite``.
+    Outside a :func:`write_policy` block this does nothing.
+    """
+    policy = _POLICY.get()
+    if policy is None:
+        return
+    known = set(policy.inputs)
+    new = tuple(p for p in (Path(x) for x in paths) if p not in known)
+    if new:
+        _POLICY.set(WritePolicy(policy.overwrite, policy.inputs + new))
+
+
+def read_input_file(path: str | os.PathLike[str], *, max_bytes: int, what: str = "file") -> bytes:
+    """Read a whole user-named input file: a regular file of at most ``max_bytes``.
+
+    The one way labbrdf opens a file that a user or another input names outside the
+    instrument readers (model files, fit JSON, n,k tables). The file is checked from its
+    ``stat`` before it is opened, so ``/dev/zero`` is never read and a folder never
+    opened; it is opened with ``O_NONBLOCK``, so a FIFO put in its place meanwhile cannot
+    block the open, and checked again on the open descriptor. Its size is checked before
+    reading and while reading (a file that grows). Under a :func:`write_policy` the file
+    joins the command's inputs (:func:`note_inputs`).
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    max_bytes : int
+        Largest size accepted [bytes].
+    what : str
+        What the file is, for the messages (``"model file"``, ...).
+
+    Returns
+    -------
+    bytes
+        The file's contents.
+
+    Raises
+    ------
+    InputFileError
+        Missing or unreadable (with the OS's reason), not a regular file (a folder, a
+        device, a FIFO, a socket), or larger than ``max_bytes``; the message names the path.
+    """
+    p = Path(path)
+    note_inputs([p])
+    try:
+        kind = _not_regular(os.stat(p).st_mode)
+        if kind is not None:
+            raise InputFileError(f"{p}: is {kind}; expected a regular {what}")
+        fd = os.open(p, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except OSError as exc:
+        raise InputFileError(f"{p}: cannot read the {what} ({exc.strerror or exc})") from None
+    try:
+        st = os.fstat(fd)
+        kind = _not_regular(st.st_mode)
+        if kind is not None:
+            raise InputFileError(f"{p}: is {kind}; expected a regular {what}")
+        too_big = InputFileError(
+            f"{p}: larger than {max_bytes:,} bytes, the most a {what} may have; expected a "
+            f"{what} written by hand or by labbrdf"
+        )
+        if st.st_size > max_bytes:
+            raise too_big
+        with os.fdopen(fd, "rb", closefd=False) as fh:
+            data = fh.read(max_bytes + 1)
+        if len(data) > max_bytes:
+            raise too_big
+        return data
+    except OSError as exc:
+        raise InputFileError(f"{p}: cannot read the {what} ({exc.strerror or exc})") from None
+    finally:
+        os.close(fd)
 
 
 # --------------------------------------------------------------------------- files
@@ -345,6 +450,52 @@ def _refuse_inputs(p: Path, inputs: Iterable[Path], option: str) -> None:
                 f"{option} {p} is one of the input files ({fp}); refusing to overwrite it, "
                 "even with --overwrite"
             )
+
+
+def refuse_input_as_output(
+    path: str | os.PathLike[str],
+    *,
+    inputs: Iterable[str | os.PathLike[str]] = (),
+    kind: str = "file",
+    option: str = "-o",
+) -> None:
+    """Refuse an output that is one of the inputs (a file) or holds or lies in one (a folder).
+
+    Only this check of :func:`check_file_output` and :func:`check_report_dir`, which both
+    make it first: the CLI makes it alone before reading the inputs that name other files,
+    so that an input given as an output is refused as such.
+
+    Parameters
+    ----------
+    path : path-like
+        The output.
+    inputs : iterable of path-like
+        The inputs (with those of the :func:`write_policy` in force).
+    kind : {"file", "dir"}
+        A file output or a report folder.
+    option : str
+        The option name, for the messages.
+
+    Raises
+    ------
+    OutputError
+        Naming the output and the input.
+    """
+    if kind != "dir":
+        _refuse_inputs(Path(path), _policy_inputs(inputs), option)
+        return
+    if os.path.lexists(path) and not os.path.isdir(path):
+        return  # an existing file where a folder should go: check_report_dir says so
+    out, shown = _resolved(path), os.fspath(path)
+    for f in _policy_inputs(inputs):
+        fp = _resolved(f)
+        if _is_within(fp, out):
+            raise OutputError(
+                f"{option} {shown}: contains the input {f}; expected a folder that holds "
+                "none of the input files"
+            )
+        if _is_within(out, fp):
+            raise OutputError(f"{option} {shown}: lies inside the input {f}")
 
 
 def _put_in_place(tmp: str, target: Path, overwrite: bool) -> None:
@@ -583,15 +734,7 @@ def check_report_dir(
             "(a new name, an empty folder or an earlier report)"
         )
     out = _resolved(path)
-    for f in _policy_inputs(inputs):
-        fp = _resolved(f)
-        if _is_within(fp, out):
-            raise OutputError(
-                f"{option} {shown}: contains the input {f}; expected a folder that holds "
-                "none of the input files"
-            )
-        if _is_within(out, fp):
-            raise OutputError(f"{option} {shown}: lies inside the input {f}")
+    refuse_input_as_output(path, inputs=inputs, kind="dir", option=option)
     try:
         cwd = Path.cwd().resolve()
     except OSError:

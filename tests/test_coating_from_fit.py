@@ -102,3 +102,121 @@ def test_trace_coating_from_errors_are_exit_2(fit_json: Path, capsys, extra, mes
 def test_trace_coating_from_a_missing_file_is_exit_2(tmp_path: Path, capsys) -> None:
     assert main([*BASE, "--coating-from", str(tmp_path / "none.json")]) == 2
     assert "none.json" in capsys.readouterr().err
+
+
+# ---------------------------------------------------- a hand-edited fit JSON: its schema
+
+
+def _layer(d: dict) -> dict:
+    return d["stack"]["layers"][0]
+
+
+#: (edit of the fit JSON, the key the message names): the wrong types met as TypeError or
+#: AttributeError inside the film objects before the fit JSON had a schema, and others
+WRONG = {
+    "stack-array": (lambda d: d.__setitem__("stack", []), "stack: expected an object"),
+    "layers-number": (
+        lambda d: d["stack"].__setitem__("layers", 5),
+        "stack.layers: expected an array",
+    ),
+    "layer-string": (
+        lambda d: d["stack"].__setitem__("layers", ["x"]),
+        r"stack.layers\[0\]: expected an object",
+    ),
+    "thickness-array": (
+        lambda d: _layer(d).__setitem__("thickness_nm", [1]),
+        r"thickness_nm: expected a number",
+    ),
+    "thickness-null": (
+        lambda d: _layer(d).__setitem__("thickness_nm", None),
+        r"thickness_nm: expected a number, got null",
+    ),
+    "parameter-null": (
+        lambda d: _layer(d)["material"].__setitem__("A", None),
+        r"material.A: expected a number",
+    ),
+    "name-object": (lambda d: _layer(d).__setitem__("name", {}), r"name: expected a string"),
+    "range-null": (
+        lambda d: d.__setitem__("wavelength_range_nm", [None, 700]),
+        r"wavelength_range_nm\[0\]",
+    ),
+    "table-without-n": (
+        lambda d: _layer(d).__setitem__(
+            "material", {"model": "tabulated", "wavelength_nm": [1, 2]}
+        ),
+        "a tabulated material gives one of",
+    ),
+    "nan-thickness": (
+        lambda d: _layer(d).__setitem__("thickness_nm", float("nan")),
+        "finite number, got nan",
+    ),
+    "unknown-key": (lambda d: _layer(d).__setitem__("thick", 1), "unknown key 'thick'"),
+    "negative-index": (
+        lambda d: _layer(d)["material"].__setitem__("A", -1.0),
+        r"stack: the coat index at 450 nm is \(-",
+    ),
+    "huge-absorption": (
+        lambda d: _layer(d)["material"].__setitem__("k_amp", 1e308),
+        r"the coat index .*\|n \+ ik\| <= 10000",
+    ),
+    "huge-int": (lambda d: _layer(d).__setitem__("thickness_nm", 10**400), "finite number"),
+}
+
+
+def _edited(fit_json: Path, tmp_path: Path, edit) -> Path:
+    doc = json.loads(fit_json.read_text())
+    edit(doc)
+    p = tmp_path / "edited.json"
+    p.write_text(json.dumps(doc))
+    return p
+
+
+@pytest.mark.parametrize("case", sorted(WRONG))
+def test_a_wrong_type_in_a_fit_json_names_the_file_and_the_key(fit_json, tmp_path, case):
+    edit, key = WRONG[case]
+    p = _edited(fit_json, tmp_path, edit)
+    with pytest.raises(films.FilmError, match=key) as exc:
+        coating_from_fit(p, 633.0)
+    assert str(exc.value).startswith(str(p))
+
+
+@pytest.mark.parametrize("case", ["layer-string", "parameter-null", "thickness-array"])
+def test_trace_coating_from_a_wrong_type_is_exit_2(fit_json, tmp_path, capsys, case):
+    p = _edited(fit_json, tmp_path, WRONG[case][0])
+    assert main([*BASE, "--coating-from", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and f"--coating-from {p}:" in err, err
+
+
+@pytest.mark.parametrize(
+    ("rng", "match"),
+    [
+        ([0, 1e308], r"wavelength_range_nm\[0\]: expected a number in \[1, 1e\+06\]"),
+        ([450, 1e308], r"wavelength_range_nm\[1\]: expected a number in"),
+        ([750, 450], r"not a range \[min, max\] with min < max"),
+        ([450, 450], r"not a range"),
+    ],
+)
+def test_an_implausible_fitted_range_is_refused(fit_json, tmp_path, rng, match):
+    p = _edited(fit_json, tmp_path, lambda d: d.__setitem__("wavelength_range_nm", rng))
+    with pytest.raises(films.FilmError, match=match):
+        coating_from_fit(p, 633.0)
+
+
+def test_a_fitted_range_beyond_the_stack_s_table_is_refused(tmp_path):
+    st = films.Stack([films.Layer(Cauchy(**CAUCHY), D_NM, "coat")], "si")  # Si: 250-1450 nm
+    doc = {"stack": st.to_dict(), "wavelength_range_nm": [300.0, 5000.0]}
+    p = tmp_path / "wide.json"
+    p.write_text(json.dumps(doc))
+    with pytest.raises(films.FilmError, match=r"reaches beyond the substrate table \(250-1450"):
+        coating_from_fit(p, 633.0)
+
+
+def test_a_deeply_nested_fit_json_is_a_clear_error(tmp_path, capsys):
+    p = tmp_path / "deep.json"
+    p.write_text('{"stack": ' + "[" * 100_000 + "]" * 100_000 + "}")
+    with pytest.raises(films.FilmError, match="deep.json: .*nested too deeply"):
+        coating_from_fit(p, 633.0)
+    assert main([*BASE, "--coating-from", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert "nested too deeply" in err and "Traceback" not in err

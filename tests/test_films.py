@@ -3,13 +3,23 @@
 from __future__ import annotations
 
 import json
+import os
 
 import numpy as np
 import pytest
 
 from labbrdf import stack as stk
 from labbrdf.dispersion import Cauchy, Sellmeier, Tabulated
-from labbrdf.films import FilmError, Layer, Roughness, Stack, load_model
+from labbrdf.films import (
+    MAX_LAYERS,
+    FilmError,
+    Layer,
+    Roughness,
+    Stack,
+    load_model,
+    named_inputs,
+    read_fit_json,
+)
 
 
 def _oxide_on_si(d=100.0):
@@ -165,3 +175,93 @@ def test_the_fit_module_and_the_objects_module_import_in_either_order():
         code = f"import {first}\nfrom labbrdf.films import FilmFit, fit_film\nprint('ok')"
         done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
         assert done.stdout.strip() == "ok", done.stderr
+
+
+# ------------------------------------------------------- model files: numbers, caps, files
+
+
+@pytest.mark.parametrize(
+    ("edit", "match"),
+    [
+        (lambda t: t.replace("thickness_nm = [0, 10]", "thickness_nm = nan"), r"line 10: thick"),
+        (lambda t: t.replace("thickness_nm = [0, 10]", "thickness_nm = [0, inf]"), r"line 10: "),
+        (lambda t: t.replace("thickness_nm = [0, 10]", 'thickness_nm = {value = "x"}'), "line 10"),
+        (lambda t: t.replace("B = 0.0036", "B = nan"), r"line 12: B: expected a finite"),
+        (lambda t: t.replace("B = 0.0036", "B = {value = 1, vary = 2}"), r"line 12: .*vary"),
+        (lambda t: "ambient = inf\n" + t, r"line 1: ambient must be a real index"),
+        (lambda t: t.replace("[300, 1000]", "[300, inf]"), r"line 2: wavelength_nm"),
+        (lambda t: t.replace("[300, 1000]", "[0.001, 1000]"), r"line 2: .*outside the wave"),
+        (lambda t: t.replace("[300, 1000]", "[300, 1e308]"), r"line 2: .*outside the wave"),
+        (lambda t: t.replace('name = "oxide"', "name = 5"), r"line 8: name must be a string"),
+        (lambda t: "layer = [1, 2]\n" + t[: t.index("[[layer]]")], r"line 1: 'layer' must"),
+        (
+            lambda t: t + '\n[[layer]]\nname = "oxide"\nmaterial = "si"\nthickness_nm = 1\n',
+            "line 16",
+        ),
+        (lambda t: t.replace("thickness_nm = [0, 10]", "thickness_nm = 1e9"), r"line 10: .*<= 1e"),
+    ],
+)
+def test_every_bad_number_of_a_model_names_the_file_and_the_line(tmp_path, edit, match):
+    p = tmp_path / "bad.toml"
+    p.write_text(edit(GOOD))
+    with pytest.raises(FilmError, match=match) as exc:
+        load_model(p)
+    assert str(exc.value).startswith(str(p))
+
+
+def test_a_model_of_more_layers_than_the_cap_is_refused_naming_the_file(tmp_path):
+    p = tmp_path / "many.toml"
+    layer = '[[layer]]\nmaterial = "sio2"\nthickness_nm = 1\n'
+    p.write_text('[substrate]\nmaterial = "si"\n' + layer * 2000)
+    with pytest.raises(FilmError, match=r"many.toml, line 1503: 2,000 layers; .* at most 500"):
+        load_model(p)
+    with pytest.raises(FilmError, match="at most 500"):
+        Stack([Layer("sio2", 1.0)] * (MAX_LAYERS + 1), "si")
+
+
+@pytest.mark.parametrize(
+    ("body", "match"),
+    [
+        ("x = [" + "0," * 2_000_000 + "]\n", "larger than 1,048,576 bytes"),  # 2 M elements
+        ("x = " + "[" * 100_000 + "]" * 100_000 + "\n", "nested too deeply"),
+        ("x = " + "[" * 1000 + "]" * 1000 + "\n", "nested too deeply"),
+        ("x = 1" + "0" * 5000 + "\n", "not a film model"),  # more digits than Python converts
+    ],
+    ids=["huge-array", "deep", "deep-1000", "long-int"],
+)
+def test_a_huge_or_deep_model_file_is_refused_at_once(tmp_path, body, match):
+    p = tmp_path / "big.toml"
+    p.write_text('[substrate]\nmaterial = "si"\n' + body)
+    with pytest.raises(FilmError, match=match) as exc:
+        load_model(p)
+    assert str(exc.value).startswith(str(p))
+    assert len(str(exc.value)) < 500
+
+
+def test_a_device_or_a_fifo_named_in_a_model_is_refused_at_once(tmp_path):
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    for name, kind in (("/dev/zero", "character device"), ("pipe.csv", "FIFO")):
+        p = tmp_path / "m.toml"
+        p.write_text(f'[substrate]\nfile = "{name}"\n')
+        with pytest.raises(FilmError, match=rf"m.toml, line 2: .*{kind}"):
+            load_model(p)
+    with pytest.raises(FilmError, match="FIFO"):
+        load_model(fifo)  # the model file itself
+
+
+def test_named_inputs_are_the_files_the_loaders_open(tmp_path):
+    (tmp_path / "metal.csv").write_text("300,1.5,3.0\n1200,2.0,4.0\n")
+    (tmp_path / "film.csv").write_text("300,1.4,0.0\n1200,1.5,0.0\n")
+    p = tmp_path / "m.toml"
+    p.write_text(
+        '[substrate]\nfile = "metal.csv"\n\n[[layer]]\nfile = "film.csv"\nthickness_nm = 10\n'
+        '[[layer]]\nmaterial = "sio2"\nthickness_nm = 10\n'
+    )
+    assert named_inputs(p, "model") == [tmp_path / "metal.csv", tmp_path / "film.csv"]
+    st = load_model(p).stack
+    doc = {"stack": st.to_dict(), "wavelength_range_nm": [400.0, 800.0]}
+    fit = tmp_path / "fit.json"
+    fit.write_text(json.dumps(doc))
+    assert named_inputs(fit, "fit") == [tmp_path / "metal.csv", tmp_path / "film.csv"]
+    assert read_fit_json(fit)[0].to_dict() == st.to_dict()

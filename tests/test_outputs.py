@@ -494,3 +494,40 @@ def test_library_reports_refuse_a_foreign_folder_before_any_work(tmp_path, capsy
         report.validate(out=out, progress=True, quick=True)
     assert "section" not in capsys.readouterr().err  # nothing ran
     assert [p.name for p in out.iterdir()] == ["thesis.tex"]
+
+
+# --------------------------------------------------------------------------- inputs
+
+
+def test_read_input_file_refuses_devices_fifos_folders_and_oversized_files(tmp_path):
+    from labbrdf.outputs import InputFileError, read_input_file
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)  # opening it for reading would block until a writer came
+    for path, kind in (("/dev/zero", "character device"), (fifo, "FIFO"), (tmp_path, "folder")):
+        with pytest.raises(InputFileError, match=rf"{path}: is a {kind}"):
+            read_input_file(path, max_bytes=100, what="table")
+    big = tmp_path / "big.txt"
+    big.write_bytes(b"x" * 101)
+    with pytest.raises(InputFileError, match=r"big.txt: larger than 100 bytes"):
+        read_input_file(big, max_bytes=100, what="table")
+    assert read_input_file(big, max_bytes=101) == b"x" * 101
+    with pytest.raises(InputFileError, match="absent.txt: cannot read the table"):
+        read_input_file(tmp_path / "absent.txt", max_bytes=100, what="table")
+
+
+def test_a_file_read_under_a_write_policy_becomes_an_input(tmp_path):
+    from labbrdf.outputs import read_input_file
+
+    table = tmp_path / "table.csv"
+    table.write_text("300,1.5\n")
+    with write_policy(overwrite=True, inputs=[]):
+        read_input_file(table, max_bytes=100)
+        with pytest.raises(OutputError, match="one of the input files"):
+            check_file_output(table)
+        with pytest.raises(OutputError, match="one of the input files"):
+            with atomic_output(table) as tmp:
+                Path(tmp).write_text("replaced\n")
+    assert table.read_text() == "300,1.5\n"
+    with atomic_output(table) as tmp:  # outside the policy: the library replaces it
+        Path(tmp).write_text("replaced\n")

@@ -172,3 +172,66 @@ def test_substrate_from_an_nk_file_and_a_bad_one(film_file, tmp_path, capsys):
     assert main([*argv, "--substrate", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "bad.csv, line 2: expected numbers" in err and "Traceback" not in err
+
+
+# ------------------------------------------------- files named inside the model are inputs
+
+
+def _si_table(path):
+    lam = np.arange(250.0, 1451.0, 10.0)
+    n_si = Stack([], "si").nk(lam)["substrate"]
+    path.write_text("".join(f"{w},{n.real},{n.imag}\n" for w, n in zip(lam, n_si, strict=True)))
+    return path
+
+
+def test_the_table_a_model_names_is_never_replaced_even_with_overwrite(
+    film_file, tmp_path, capsys
+):
+    table = _si_table(tmp_path / "sub.csv")
+    model = tmp_path / "m.toml"
+    model.write_text(
+        '[substrate]\nfile = "sub.csv"\n\n[[layer]]\nname = "film"\nmaterial = "cauchy"\n'
+        "thickness_nm = [50, 200]\nA = [1.3, 1.8]\nB = 0.004\n"
+    )
+    before = (table.read_bytes(), table.stat().st_mtime_ns)
+    for out in (["-o", str(table)], ["--fit-json", str(tmp_path / "sub.json")]):
+        if out[0] == "--fit-json":  # the fit JSON named by the model file? a table of it
+            (tmp_path / "sub.json").write_bytes(table.read_bytes())
+            model.write_text(model.read_text().replace("sub.csv", "sub.json"))
+        assert main(["film", str(film_file), "--model", str(model), *out, "--overwrite"]) == 2
+        err = capsys.readouterr().err
+        assert "is one of the input files" in err and "Traceback" not in err, err
+    assert (table.read_bytes(), table.stat().st_mtime_ns) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.toml", "sub.csv", "sub.json"]
+
+
+def test_the_table_a_layer_names_is_never_replaced(film_file, tmp_path, capsys):
+    table = _si_table(tmp_path / "nk.csv")
+    before = table.read_bytes()
+    argv = ["film", str(film_file), "--layer", f"f:{table}:50..200", "-o", str(table)]
+    assert main([*argv, "--overwrite"]) == 2
+    assert "is one of the input files" in capsys.readouterr().err
+    assert table.read_bytes() == before
+
+
+def test_a_device_or_fifo_named_in_a_model_exits_2_at_once(film_file, tmp_path, capsys):
+    import os
+
+    os.mkfifo(tmp_path / "pipe.csv")
+    for name, kind in (("/dev/zero", "character device"), ("pipe.csv", "FIFO")):
+        model = tmp_path / "m.toml"
+        model.write_text(f'[substrate]\nfile = "{name}"\n')
+        assert main(["film", str(film_file), "--model", str(model)]) == 2
+        err = capsys.readouterr().err
+        assert f"m.toml, line 2: {name if name.startswith('/') else tmp_path / name}" in err, err
+        assert kind in err and "Traceback" not in err
+
+
+def test_a_nan_thickness_names_the_model_file_and_line(film_file, tmp_path, capsys):
+    model = tmp_path / "nan.toml"
+    model.write_text(
+        '[substrate]\nmaterial = "si"\n\n[[layer]]\nmaterial = "sio2"\nthickness_nm = nan\n'
+    )
+    assert main(["film", str(film_file), "--model", str(model)]) == 2
+    err = capsys.readouterr().err
+    assert f"{model}, line 6: thickness_nm: expected a finite number" in err, err

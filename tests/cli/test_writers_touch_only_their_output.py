@@ -15,7 +15,8 @@ Then, enumerated from the parser itself (so that an option added later is covere
 editing this file): for every command, every argument that names an input and every
 output option, the output naming that input (or a link to it, or for a report folder the
 folder holding it) is refused with exit 2, with and without --overwrite, and the input
-keeps its bytes.
+keeps its bytes. The same for every file named inside an input (the table a film model
+file or a fit JSON names): an output naming it is refused before any work.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import json
 import os
 import re
 import tempfile
@@ -360,3 +362,90 @@ def test_no_output_may_name_an_input_whichever_option_names_it(
     assert "input" in err and str(out) in err, err
     assert (src.read_bytes(), src.stat().st_mtime_ns) == before
     assert sorted(p.name for p in src.parent.iterdir() if p.name.startswith(".")) == []
+
+
+# ------------------------------------------------------------ files named inside an input
+
+TABLE = "300,1.5,3.0\n1200,2.0,4.0\n"
+
+
+def _naming_file(kind: str, folder: Path, table: Path) -> Path:
+    """A film model file (``kind="model"``) or fit JSON (``"fit"``) naming ``table``."""
+    if kind == "model":
+        p = folder / "model.toml"
+        p.write_text(
+            f'[substrate]\nfile = "{table}"\n\n[[layer]]\nmaterial = "sio2"\nthickness_nm = 10\n'
+        )
+        return p
+    p = folder / "fit.json"
+    coat = {"model": "cauchy", "A": 1.5, "B": 0.004, "C": 0.0}
+    stack = {
+        "ambient": {"model": "constant", "n": 1.0, "k": 0.0},
+        "layers": [{"name": "coat", "thickness_nm": 100.0, "material": coat}],
+        "substrate": {"model": "tabulated", "file": str(table)},
+    }
+    p.write_text(json.dumps({"stack": stack, "wavelength_range_nm": [400.0, 800.0]}))
+    return p
+
+
+def _inside_pairs() -> list[tuple[str, str, str]]:
+    pairs = []
+    for name, sp in _subparsers().items():
+        acts = path_actions(sp)
+        for i in (a for a in acts if isinstance(a, InputPath) and a.inside):
+            for o in (a for a in acts if isinstance(a, OutputPath)):
+                pairs.append((name, i.dest, o.dest))
+    return pairs
+
+
+INSIDE_PAIRS = _inside_pairs()
+
+
+def test_the_options_whose_files_name_files_are_declared():
+    for pair in [
+        ("film", "model", "output"),
+        ("film", "model", "fit_json"),
+        ("trace", "coating_from", "output"),
+        ("trace", "coating_from", "png"),
+        ("report", "film_model", "output"),
+    ]:
+        assert pair in INSIDE_PAIRS
+
+
+@pytest.mark.parametrize("overwrite", [False, True], ids=["plain", "overwrite"])
+@pytest.mark.parametrize("link", [False, True], ids=["same", "link"])
+@pytest.mark.parametrize(("command", "input_dest", "output_dest"), INSIDE_PAIRS, ids=str)
+def test_no_output_may_name_a_file_that_an_input_names(
+    tmp_path, capsys, command, input_dest, output_dest, link, overwrite
+):
+    """A table named inside a model file or fit JSON is an input: never an output."""
+    sp = _subparsers()[command]
+    in_action = next(a for a in path_actions(sp) if a.dest == input_dest)
+    out_action = next(a for a in path_actions(sp) if a.dest == output_dest)
+    filler = tmp_path / "other.dat"
+    filler.write_bytes(b"another input")
+    if out_action.kind == "dir":
+        folder = tmp_path / "rep"
+        folder.mkdir()
+        table = folder / "table.csv"
+        out = tmp_path / "link" if link else folder
+        if link:
+            out.symlink_to(folder, target_is_directory=True)
+    else:
+        suffix = out_action.suffixes[0] if out_action.suffixes else ".dat"
+        table = tmp_path / f"table{suffix}"
+        out = tmp_path / f"link{suffix}" if link else table
+        if link:
+            out.symlink_to(table)
+    table.write_text(TABLE)
+    before = (table.read_bytes(), table.stat().st_mtime_ns)
+    naming = _naming_file(in_action.inside, tmp_path, table)
+    argv = _argv_naming(command, input_dest, str(naming), output_dest, str(out), str(filler))
+    if overwrite:
+        argv.append("--overwrite")
+    assert main(argv) == 2, argv
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert "input" in err and str(out) in err, err
+    assert (table.read_bytes(), table.stat().st_mtime_ns) == before
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
