@@ -36,7 +36,8 @@ linearly onto a uniform grid at their median spacing by SurfaceTopography's
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -395,16 +396,15 @@ def check_geometry(
 
 #: Extensions SurfaceTopography's readers do not list although the instrument writes them.
 _EXT_FORMAT = {"di": "di"}
+#: SurfaceTopography's plain-text formats: a file with their extensions (.txt, .csv, .asc)
+#: may be any of them, so detection decides, not the extension.
+_TEXT_FORMATS = frozenset({"asc", "xyz"})
 
 
-def _open(st: Any, p: str) -> Any:
-    """The reader of ``p``; on failure, the error of the reader its extension names."""
-    try:
-        return st.open_topography(p)
-    except Exception as exc:  # noqa: BLE001 - the reader's errors vary by format
-        detect = exc
+def _extension_readers(st: Any, p: str) -> list[Any]:
+    """SurfaceTopography's readers whose file extensions include that of ``p``."""
     ext = os.path.splitext(p)[1].lstrip(".").lower()
-    causes = []
+    out = []
     for r in getattr(st.IO, "readers", ()):
         try:
             exts = [e.lower() for e in (r.file_extensions() or ())]
@@ -412,22 +412,85 @@ def _open(st: Any, p: str) -> Any:
         except Exception:  # noqa: BLE001 - a reader without extensions
             continue
         if ext and (ext in exts or _EXT_FORMAT.get(ext) == fmt):
-            try:
-                r(p)
-            except Exception as err:  # noqa: BLE001
-                causes.append(f"as {fmt}: {_one_line(err)}")
-    cause = "; ".join(causes) if causes else None
-    if cause is None:
-        tried = [ln for ln in str(detect).splitlines() if ln.strip()]
-        causes = [
-            f"{a.strip().removeprefix('tried ').rstrip(': ')}: {b.strip()}"
-            for a, b in zip(tried[::2], tried[1::2], strict=False)
-            if a.strip().startswith("tried")
-        ]
-        cause = "; ".join(causes[:4]) or _one_line(detect)
+            out.append(r)
+    return out
+
+
+def _try_open(open_reader: Callable[[], Any]) -> tuple[Any, str, BaseException | None]:
+    """Open a reader and list its channels, whatever it raises (but MemoryError).
+
+    ``(reader, "", None)`` for a reader that opens and lists a channel, else
+    ``(None, why, error)``.
+    """
+    try:
+        reader = open_reader()
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - the readers' errors vary by format
+        return None, _one_line(exc), exc
+    name = type(reader).__name__
+    try:
+        chans = list(reader.channels)
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001
+        return None, f"{name} cannot list the channels: {_one_line(exc)}", exc
+    if not chans:
+        return None, f"{name} found no data channel in the file", None
+    return reader, "", None
+
+
+def _open(st: Any, p: str) -> Any:
+    """The reader of ``p``, with at least one channel.
+
+    A file whose extension only one reader lists (``.nms``, ``.opdx``, ``.di``) is opened
+    with that reader first: formats without magic bytes (Nanofocus ``.nms``) are otherwise
+    claimed by whichever reader detection tries first (a MATLAB v4 reader that finds no
+    matrix in a confocal map's header); when it refuses the file, its error is the answer,
+    except for plain text (:data:`_TEXT_FORMATS`, which several readers take), where
+    SurfaceTopography's detection follows. On failure, the error of the reader the
+    extension names, else what detection tried.
+    """
+    named = _extension_readers(st, p)
+    if len(named) == 1:
+        fmt = named[0].format()
+        reader, why, err = _try_open(lambda: st.open_topography(p, format=fmt))
+        if reader is not None:
+            return reader
+        if fmt not in _TEXT_FORMATS:
+            raise AdapterError(
+                p, f"not a {fmt} file SurfaceTopography can read (as {fmt}: {why})"
+            ) from err
+    reader, why, err = _try_open(lambda: st.open_topography(p))
+    if reader is not None:
+        return reader
     raise AdapterError(
-        p, f"not a topography file SurfaceTopography can read ({cause})"
-    ) from detect
+        p,
+        "not a topography file SurfaceTopography can read"
+        f" ({_cause(p, named, str(err) if err is not None and str(err).strip() else why)})",
+    ) from err
+
+
+def _cause(p: str, named: list[Any], detect: str) -> str:
+    """Why no reader could read ``p``.
+
+    The errors of the readers its extension names, or what detection tried (``detect``,
+    SurfaceTopography's list of tries).
+    """
+    causes = []
+    for r in named:
+        reader, why, _ = _try_open(lambda r=r: r(p))
+        if reader is None:
+            causes.append(f"as {r.format()}: {why}")
+    if causes:
+        return "; ".join(causes)
+    tried = [ln for ln in detect.splitlines() if ln.strip()]
+    causes = [
+        f"{a.strip().removeprefix('tried ').rstrip(': ')}: {b.strip()}"
+        for a, b in zip(tried[::2], tried[1::2], strict=False)
+        if a.strip().startswith("tried")
+    ]
+    return "; ".join(causes[:4]) or " ".join(detect.split())
 
 
 def _one_line(exc: BaseException) -> str:
@@ -480,24 +543,44 @@ def read_height_map(
     if unit is not None and unit not in _UNITS_M:
         raise AdapterError(p, f"unit {unit!r} unknown; use one of {list(_UNITS_M)}")
     reader = _open(st, p)
-    chans = list(reader.channels)
-    names = tuple(str(c.name) for c in chans)
-    index = _channel_index(p, reader, names, channel)
-    ch = chans[index]
-    kw = _topography_kwargs(p, ch, names[index], index, physical_sizes, unit, pixel_size)
-    z, pixel, topo, warnings = _heights_m(p, reader, kw, unit)
+    with _reader_errors(p, reader):
+        chans = list(reader.channels)
+        names = tuple(str(c.name) for c in chans)
+        index = _channel_index(p, reader, names, channel)
+        ch = chans[index]
+        kw = _topography_kwargs(p, ch, names[index], index, physical_sizes, unit, pixel_size)
+        z, pixel, topo, warnings = _heights_m(p, reader, kw, unit)
+        unit_in_file = str(ch.unit)
+        info = dict(getattr(topo, "info", {}) or {})
     if pixel_size is not None:
         pixel = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (z.ndim,)))
     if not np.isfinite(z).any():
         raise AdapterError(p, "no defined height in the file")
     warnings[:0] = check_geometry(p, z, pixel)
-    meta: dict[str, Any] = {"unit_in_file": str(ch.unit), "reader": type(reader).__name__}
+    meta: dict[str, Any] = {"unit_in_file": unit_in_file, "reader": type(reader).__name__}
     if unit is not None:
         meta["unit_stated"] = unit
     if pixel_size is not None:
         meta["pixel_size_stated_m"] = list(pixel)
-    meta.update(_json_meta(dict(getattr(topo, "info", {}) or {})))
+    meta.update(_json_meta(info))
     return HeightMap(z, pixel, p, names[index], names, meta, tuple(warnings))
+
+
+@contextmanager
+def _reader_errors(p: str, reader: Any) -> Iterator[None]:
+    """Any error of SurfaceTopography's reader as an :class:`AdapterError`.
+
+    The message names the file and the reader (the errors vary by format: IndexError,
+    KeyError, struct.error, ...).
+    """
+    try:
+        yield
+    except (AdapterError, MemoryError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - whatever the reader raises
+        raise AdapterError(
+            p, f"SurfaceTopography's {type(reader).__name__} cannot read it ({_one_line(exc)})"
+        ) from exc
 
 
 def _channel_index(p: str, reader: Any, names: tuple[str, ...], channel: int | str | None) -> int:
@@ -594,7 +677,9 @@ def _heights_m(
     except AdapterError:
         raise
     except Exception as exc:  # noqa: BLE001
-        raise AdapterError(p, f"cannot read the heights ({_one_line(exc)})") from exc
+        raise AdapterError(
+            p, f"{type(reader).__name__} cannot read the heights ({_one_line(exc)})"
+        ) from exc
     z = np.array(np.ma.getdata(h), dtype=float)
     if scale != 1.0:
         z *= scale

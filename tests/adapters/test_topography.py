@@ -290,3 +290,90 @@ def test_out_of_memory_names_the_file_and_exits_2(big_map):
     assert r.returncode == 2, r.stderr
     assert "big.bcrf" in r.stderr and "memory" in r.stderr.lower()
     assert "Traceback" not in r.stderr
+
+
+# ---------------------------------------------------------------- Nanofocus .nms
+def write_nms(path, z_u16, pitch_mm=312.5e-6, zmin_um=-2.3, zmax_um=4.1, cut=0):
+    """A Nanofocus .nms confocal map as SurfaceTopography's NMSReader reads it.
+
+    A 3468-byte header (z range as two little-endian doubles at byte 16 [um]; points
+    nx, ny as uint32 and pitch dx, dy as doubles [mm] at byte 1368), then ny x nx uint16
+    heights scaled between zmin and zmax. The format has no magic bytes.
+    """
+    ny, nx = z_u16.shape
+    hdr = bytearray(3468)
+    hdr[16:32] = np.array([zmin_um, zmax_um], "<f8").tobytes()
+    hdr[1368:1376] = np.array([nx, ny], "<u4").tobytes()
+    hdr[1376:1392] = np.array([pitch_mm, pitch_mm], "<f8").tobytes()
+    data = bytes(hdr) + np.asarray(z_u16, "<u2").tobytes()
+    path.write_bytes(data[: len(data) - cut])
+    return path
+
+
+def test_nms_map_is_read_by_the_nanofocus_reader_not_a_detected_one(tmp_path, capsys):
+    """A real confocal map's z range (here -2.3..4.1 um) makes the header look like a MATLAB
+    v4 file to detection, whose reader lists no channel: a bare IndexError before."""
+    u = np.random.default_rng(2).integers(0, 2**16 - 2, size=(512, 512)).astype("<u2")
+    p = write_nms(tmp_path / "conf.nms", u)
+    hm = read_height_map(p)
+    assert hm.meta["reader"] == "NMSReader" and hm.heights.shape == (512, 512)
+    assert hm.pixel_size == pytest.approx((312.5e-9, 312.5e-9), rel=1e-12)
+    expect_um = u.T / (2**16 - 2) * (4.1 - -2.3) + -2.3  # the reader's own scaling
+    np.testing.assert_allclose(hm.heights, expect_um * 1e-6, rtol=1e-12, atol=1e-21)
+    rc, out, err = run(["ingest", str(p)], capsys)
+    assert rc == 0 and "512 x 512 points" in out and "NMSReader" in out, err
+
+
+def test_truncated_nms_is_refused_with_the_nanofocus_reason(tmp_path, capsys):
+    u = np.zeros((64, 64), "<u2")
+    p = write_nms(tmp_path / "cut.nms", u, cut=1000)
+    with pytest.raises(AdapterError, match=r"cut\.nms: .*as nms: .*too small"):
+        read_height_map(p)
+    for cmd in ("ingest", "surface"):
+        rc, _, err = run([cmd, str(p)], capsys)
+        assert rc == 2 and "cut.nms" in err and "as nms" in err and "Traceback" not in err
+
+
+class _Failing:
+    """A SurfaceTopography reader whose ``where`` raises ``exc`` (channels or topography)."""
+
+    def __init__(self, exc, where):
+        self.exc, self.where = exc, where
+
+    @property
+    def channels(self):
+        if self.where == "channels":
+            raise self.exc
+        return [_Channel()]
+
+    @property
+    def default_channel(self):
+        if self.where == "default_channel":
+            raise self.exc
+        return self.channels[0]
+
+    def topography(self, **kw):
+        raise self.exc
+
+
+class _Channel:
+    name, index, unit, physical_sizes, nb_grid_pts = "Height", 0, "um", (1.0, 1.0), (4, 4)
+
+
+@pytest.mark.parametrize(
+    "exc",
+    [IndexError("list index out of range"), KeyError("xres"), TypeError("x"), ZeroDivisionError()],
+)
+@pytest.mark.parametrize("where", ["channels", "default_channel", "topography"])
+def test_any_reader_error_names_the_file_and_the_reader(tmp_path, monkeypatch, capsys, exc, where):
+    import SurfaceTopography
+
+    p = write_bcrf(tmp_path / "any.bcrf", rough(16), 16.0)
+    monkeypatch.setattr(SurfaceTopography, "open_topography", lambda *a, **k: _Failing(exc, where))
+    with pytest.raises(AdapterError) as e:
+        read_height_map(p)
+    msg = str(e.value)
+    assert msg.startswith(str(p)) and "_Failing" in msg and type(exc).__name__ in msg
+    for cmd in ("ingest", "surface"):
+        rc, _, err = run([cmd, str(p)], capsys)
+        assert rc == 2 and "any.bcrf" in err and "Traceback" not in err
