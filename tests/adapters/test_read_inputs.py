@@ -331,3 +331,25 @@ def test_ingest_of_height_maps_only_writes_nothing_and_says_so(
     assert not out.exists()
     assert f"no optical data, {out} not written" in text.err
     assert text.out.startswith(f"{hm}: height map")  # no empty optical table
+
+
+@pytest.mark.parametrize("exc", [IndexError("list index out of range"), KeyError("xres")])
+def test_any_error_of_one_file_is_its_failure_and_the_others_are_read(
+    tmp_path: Path, fixtures_dir: Path, monkeypatch: pytest.MonkeyPatch, exc: Exception
+) -> None:
+    """A reader's unexpected error fails that file, named; before, it ended the whole list."""
+    wvase = fixtures_dir / "ellipsometry" / "al_bare_wvase.dat"
+    hm = tmp_path / "map.bcrf"
+    hm.write_bytes(b"fileformat = bcrf\n")
+
+    def broken(path, *a, **kw):
+        raise exc
+
+    monkeypatch.setattr(inputs_mod, "read_height_map", broken)
+    got = labbrdf.read_inputs([hm, wvase])
+    (fail,) = got.failures
+    assert fail.path == str(hm) and fail.kind == "height_map"
+    assert fail.error.startswith(f"{hm}: unexpected {type(exc).__name__}")
+    assert len(got.measurements) == 1 and got.measurement is not None
+    with pytest.raises(type(exc)):
+        labbrdf.read_inputs([hm, wvase], on_error="raise")
