@@ -36,6 +36,7 @@ linearly onto a uniform grid at their median spacing by SurfaceTopography's
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -58,6 +59,7 @@ __all__ = [
     "check_geometry",
     "height_map_format",
     "length_m",
+    "nanoscope_scale_warnings",
     "read_height_map",
     "topography_statistics",
 ]
@@ -146,7 +148,7 @@ class HeightMap:
         return tuple(n * p for n, p in zip(self.heights.shape, self.pixel_size, strict=True))
 
     def summary(self) -> dict[str, Any]:
-        """What the map holds, JSON-safe: kind, reader, channel, points, size, pitch."""
+        """What the map holds, JSON-safe: kind, reader, channel, points, size, pitch, warnings."""
         return {
             "kind": "profile" if self.is_profile else "areal map",
             "reader": self.meta.get("reader", ""),
@@ -155,17 +157,21 @@ class HeightMap:
             "size_um": [s * 1e6 for s in self.physical_sizes],
             "pixel_nm": [s * 1e9 for s in self.pixel_size],
             "missing": int(self.mask.sum()),
+            "warnings": list(self.warnings),
         }
 
     def summary_line(self) -> str:
-        """One line: ``areal map, 512 x 512 points, 10 x 10 um, pixel 19.53 nm, ...``."""
+        """One line: ``areal map, 512 x 512 points, 10 x 10 um, pixel 19.53 nm, ...``.
+
+        The reading's warnings (:attr:`warnings`) follow, each as ``; warning: ...``.
+        """
         s = self.summary()
         size = " x ".join(f"{v:.4g}" for v in s["size_um"])
         pixel = " x ".join(f"{v:.4g}" for v in s["pixel_nm"])
         return (
             f"{s['kind']}, {' x '.join(map(str, s['points']))} points, {size} um, pixel "
             f"{pixel} nm, channel {s['channel']}, {s['missing']} missing points"
-            f" ({s['reader']})"
+            f" ({s['reader']})" + "".join(f"; warning: {w}" for w in self.warnings)
         )
 
 
@@ -556,6 +562,8 @@ def read_height_map(
         pixel = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (z.ndim,)))
     if not np.isfinite(z).any():
         raise AdapterError(p, "no defined height in the file")
+    if type(reader).__name__ == "DIReader":
+        warnings.extend(nanoscope_scale_warnings(p, index))
     warnings[:0] = check_geometry(p, z, pixel)
     meta: dict[str, Any] = {"unit_in_file": unit_in_file, "reader": type(reader).__name__}
     if unit is not None:
@@ -581,6 +589,55 @@ def _reader_errors(p: str, reader: Any) -> Iterator[None]:
         raise AdapterError(
             p, f"SurfaceTopography's {type(reader).__name__} cannot read it ({_one_line(exc)})"
         ) from exc
+
+
+#: Most header bytes read for :func:`nanoscope_scale_warnings` (headers are 8-80 KiB).
+_DI_HEADER_MAX = 1 << 20
+_DI_Z_SCALE = re.compile(r"^\\@([24]):Z scale:.*?(-?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*$")
+
+
+def nanoscope_scale_warnings(path: str, index: int) -> tuple[str, ...]:
+    """Doubts about the Z scale of image ``index`` of a Nanoscope file.
+
+    A Nanoscope header states the Z scale of an image as ``@2:Z scale`` and, from
+    version 9 on, also as ``@4:Z scale``; SurfaceTopography uses the ``@4`` one when both
+    are there. When the two disagree, the file contradicts itself about the heights: the
+    warning names both values, their ratio, and the one used.
+
+    Parameters
+    ----------
+    path : str
+        The file.
+    index : int
+        The image (channel) index, in the order of the header's image lists.
+
+    Returns
+    -------
+    tuple of str
+        One warning, or none.
+    """
+    with open(path, "rb") as f:
+        head = f.read(_DI_HEADER_MAX).decode("latin-1")
+    head = head.split("\\*File list end", 1)[0]
+    images = head.split("\\*Ciao image list")[1:]
+    if not 0 <= index < len(images):
+        return ()
+    found: dict[str, tuple[float, str, str]] = {}
+    for line in images[index].splitlines():
+        m = _DI_Z_SCALE.match(line.strip())
+        if m and m.group(1) not in found:
+            found[m.group(1)] = (float(m.group(2)), m.group(3), line.strip())
+    if "2" not in found or "4" not in found:
+        return ()
+    (v4, u4, l4), (v2, u2, l2) = found["4"], found["2"]
+    if v4 == v2 and u4 == u2:
+        return ()
+    ratio = f" ({v4 / v2:.4g} times)" if v2 and u4 == u2 else ""
+    return (
+        f"the file states two Z scales for image {index}: '{l4}' and '{l2}'{ratio}; the"
+        " heights use the @4:Z scale (SurfaceTopography's choice): the file disagrees with"
+        " itself, check the heights against a known step",
+    )
 
 
 def _channel_index(p: str, reader: Any, names: tuple[str, ...], channel: int | str | None) -> int:

@@ -377,3 +377,37 @@ def test_any_reader_error_names_the_file_and_the_reader(tmp_path, monkeypatch, c
     for cmd in ("ingest", "surface"):
         rc, _, err = run([cmd, str(p)], capsys)
         assert rc == 2 and "any.bcrf" in err and "Traceback" not in err
+
+
+# ------------------------------------------------------------- Nanoscope Z scale
+@pytest.mark.shared
+def test_nanoscope_with_two_disagreeing_z_scales_says_which_is_used(
+    real_exports, tmp_path, capsys
+):
+    """A mutant of the real di-1.di whose first image states an @4:Z scale 16 times its
+    @2:Z scale (the header keeps its length, so every offset stays): the heights follow
+    one of them, and the warning says which and that the file disagrees with itself."""
+    src = real_exports / "topography" / "di-1.di"
+    raw = src.read_bytes()
+    old = (
+        b"\\Tip x width correction factor sigma: 1\r\n\\Tip y width correction factor sigma: 1\r\n"
+    )
+    new = b"\\@4:Z scale: V [Sens. Zsens] (0.005035400 V/LSB) 46.56738 V\r\n"
+    new += b"\\Note:" + b" " * (len(old) - len(new) - 8) + b"\r\n"
+    assert len(new) == len(old) and raw.count(old) >= 1
+    i = raw.index(old)
+    mut = tmp_path / "mutant.di"
+    mut.write_bytes(raw[:i] + new + raw[i + len(old) :])
+    ref, hm = read_height_map(src), read_height_map(mut)
+    assert not any("Z scale" in w for w in ref.warnings)
+    (w,) = [w for w in hm.warnings if "Z scale" in w]
+    assert "46.56738 V" in w and "2.910461 V" in w and "(16 times)" in w
+    assert "heights use the @4:Z scale" in w and "disagrees with itself" in w
+    ratio = np.nanstd(hm.heights) / np.nanstd(ref.heights)
+    assert ratio == pytest.approx(46.56738 / 2.910461, rel=1e-6)
+    rc, out, _ = run(["ingest", str(mut)], capsys)
+    assert rc == 0 and "warning: the file states two Z scales" in out
+    rc, out, _ = run(["ingest", "--json", str(mut)], capsys)
+    assert any("Z scale" in x for x in json.loads(out)[0]["height_map"]["warnings"])
+    rc, _, err = run(["surface", str(mut), "--blocks", "0"], capsys)
+    assert rc == 0 and "two Z scales" in err
