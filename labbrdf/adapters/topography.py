@@ -207,6 +207,9 @@ class HeightMapFormat:
         to no format is a height map when a sniffer here claims it.
     sniff : callable
         ``sniff(head: bytes) -> bool`` on the first bytes: cheap, never raises.
+    shared_only : bool
+        The sniffer claims only files with one of :attr:`shared_extensions` (plain numbers
+        are a height profile in a ``.asc`` but may be anything in a file of another name).
     """
 
     name: str
@@ -214,6 +217,34 @@ class HeightMapFormat:
     extensions: tuple[str, ...]
     shared_extensions: tuple[str, ...] = ()
     sniff: Callable[[bytes], bool] = _never
+    shared_only: bool = False
+
+
+#: Header keys of ASCII topography exports SurfaceTopography's text reader knows (Gwyddion,
+#: Wyko, SPIP, ...), at the start of a line after an optional ``#``.
+_ASCII_TOPO_KEYS = re.compile(
+    rb"^\s*#?\s*(Width|Height|Value units|Wyko ASCII Data File Format|File Format\s*=\s*ASCII"
+    rb"|x-pixels|y-pixels|X Size|Y Size)\b",
+    re.IGNORECASE | re.MULTILINE,
+)
+_NUMBER_ROW = re.compile(rb"^\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?([\s,;]+\S+)*\s*$")
+
+
+def _ascii_topography(head: bytes) -> bool:
+    """An ASCII height profile or matrix: known header keys, or rows of plain numbers.
+
+    A two-column ``x z`` profile (the shape of SurfaceTopography's ``nonuniform.asc``) or a
+    matrix of heights; never a file that starts with another format's magic (PerkinElmer's
+    ``PE UV``), nor one with a NUL byte.
+    """
+    if b"\0" in head or head.lstrip().startswith(b"PE UV"):
+        return False
+    if _ASCII_TOPO_KEYS.search(head[:4096]):
+        return True
+    rows = [r for r in head.splitlines()[:40] if r.strip() and not r.lstrip().startswith(b"#")]
+    if head and not head.endswith((b"\n", b"\r")):
+        rows = rows[:-1]  # the last row may be cut mid-number
+    return len(rows) >= 2 and all(_NUMBER_ROW.match(r) for r in rows)
 
 
 #: The height-map formats. SurfaceTopography chooses its own reader from the content; the
@@ -243,6 +274,15 @@ HEIGHT_MAP_FORMATS: tuple[HeightMapFormat, ...] = (
         "BCR-STM / BCRF scanning-probe file",
         (".bcr", ".bcrf"),
         sniff=lambda head: head.startswith((b"fileformat = bcr", b"fileformat = bcrf")),
+    ),
+    HeightMapFormat(
+        "ascii-topography",
+        "plain ASCII height profile (x z columns) or height matrix, with or without a"
+        " Gwyddion / Wyko / SPIP header (SurfaceTopography's text readers)",
+        (),
+        (".asc",),
+        _ascii_topography,
+        shared_only=True,
     ),
     HeightMapFormat(
         "surfacetopography",
@@ -283,6 +323,8 @@ def height_map_format(
         if name.endswith(f.extensions):
             return f, True
     for f in HEIGHT_MAP_FORMATS:
+        if f.shared_only and not name.endswith(f.shared_extensions):
+            continue
         if f.sniff(head):
             return f, False
     return None
