@@ -29,8 +29,9 @@ states the true geometry with ``pixel_size`` and ``unit`` (CLI ``--pixel-size``,
 ``--unit``).
 
 Non-uniform line scans (stylus profilometer exports with irregular x) are interpolated
-linearly onto a uniform grid at their median spacing by SurfaceTopography's
-``to_uniform`` (every statistic here needs a uniform grid); the metadata says so.
+linearly onto a uniform grid at their finest spacing by SurfaceTopography's ``to_uniform``
+(every statistic here needs a uniform grid; a coarser step would lose slope); the
+warnings say so.
 """
 
 from __future__ import annotations
@@ -122,6 +123,11 @@ class HeightMap:
     warnings : tuple of str
         Doubts about the geometry (:func:`check_geometry`) or the reading (interpolation
         of a non-uniform line scan).
+    points : (ndarray, ndarray) or None
+        A non-uniform line scan's measured positions and heights [m], as in the file
+        (``heights`` is then their interpolation onto a uniform grid); None otherwise.
+        :func:`labbrdf.topography.on_measured_points` computes sigma and the RMS slope
+        on them.
     """
 
     heights: NDArray[np.float64]
@@ -131,6 +137,7 @@ class HeightMap:
     channels: tuple[str, ...] = ()
     meta: dict[str, Any] = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+    points: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
 
     @property
     def mask(self) -> NDArray[np.bool_]:
@@ -597,7 +604,7 @@ def read_height_map(
         index = _channel_index(p, reader, names, channel)
         ch = chans[index]
         kw = _topography_kwargs(p, ch, names[index], index, physical_sizes, unit, pixel_size)
-        z, pixel, topo, warnings = _heights_m(p, reader, kw, unit)
+        z, pixel, topo, warnings, points = _heights_m(p, reader, kw, unit)
         unit_in_file = str(ch.unit)
         info = dict(getattr(topo, "info", {}) or {})
     if pixel_size is not None:
@@ -613,7 +620,9 @@ def read_height_map(
     if pixel_size is not None:
         meta["pixel_size_stated_m"] = list(pixel)
     meta.update(_json_meta(info))
-    return HeightMap(z, pixel, p, names[index], names, meta, tuple(warnings))
+    if pixel_size is not None:
+        points = None  # the stated pitch replaces the file's positions
+    return HeightMap(z, pixel, p, names[index], names, meta, tuple(warnings), points)
 
 
 @contextmanager
@@ -738,36 +747,63 @@ def _topography_kwargs(
     return kw
 
 
+#: Most points of a non-uniform line scan put on a uniform grid (32 MiB of float64
+#: heights): the grid's step is the scan's finest spacing unless that needs more.
+MAX_PROFILE_POINTS = 2**22
+
+
 def _uniform(p: str, topo: Any, warnings: list[str]) -> Any:
-    """A non-uniform line scan interpolated onto its median spacing (said in ``warnings``)."""
+    """A non-uniform line scan interpolated onto its finest spacing (said in ``warnings``).
+
+    Linear interpolation at a step no coarser than any measured spacing keeps every
+    segment between measured points: the RMS height and slope of the grid are those of
+    the measured points (SurfaceTopography's piecewise-linear ``rms_height_from_profile``,
+    ``rms_slope_from_profile``) up to the grid steps that straddle a measured point. A
+    coarser step (the median) would smooth the short segments and lose slope.
+    """
     if getattr(topo, "is_uniform", True):
         return topo
     x = np.asarray(topo.positions(), dtype=float)
-    step = float(np.median(np.diff(x)))
-    if not step > 0:
+    dx = np.diff(x)
+    if not (dx.size and np.all(dx > 0)):
         raise AdapterError(p, "the line scan's x positions do not increase")
+    length = float(x[-1] - x[0])
+    step = float(np.min(dx))
+    how = "its finest spacing"
+    if length / step + 1 > MAX_PROFILE_POINTS:
+        step = length / (MAX_PROFILE_POINTS - 1)
+        how = f"a step coarser than its finest spacing (at most {MAX_PROFILE_POINTS} points)"
     n_in = x.size
     topo = topo.to_uniform(pixel_size=step)
     warnings.append(
-        f"non-uniform line scan ({n_in} points, spacing {np.min(np.diff(x)):.4g}"
-        f"..{np.max(np.diff(x)):.4g} {topo.unit}) interpolated linearly onto"
-        f" {topo.nb_grid_pts[0]} points at its median spacing {step:.4g} {topo.unit}"
+        f"non-uniform line scan ({n_in} points, spacing {np.min(dx):.4g}"
+        f"..{np.max(dx):.4g} {topo.unit}) interpolated linearly onto"
+        f" {topo.nb_grid_pts[0]} points at {how}, {step:.4g} {topo.unit}"
     )
     return topo
 
 
 def _heights_m(
     p: str, reader: Any, kw: dict[str, Any], unit: str | None
-) -> tuple[NDArray[np.float64], tuple[float, ...], Any, list[str]]:
-    """(heights [m] with NaN where undefined, pitch [m], the topography, warnings)."""
+) -> tuple[NDArray[np.float64], tuple[float, ...], Any, list[str], Any]:
+    """Heights [m] and pitch [m] of the channel the keywords ``kw`` select.
+
+    Returns (heights with NaN where undefined, pitch, the topography, warnings, the
+    measured (x, heights) [m] of a non-uniform line scan or None).
+    """
     warnings: list[str] = []
+    points = None
     try:
-        topo = _uniform(p, reader.topography(**kw), warnings)
+        raw = reader.topography(**kw)
+        topo = _uniform(p, raw, warnings)
         tunit = unit if unit is not None else topo.unit
         if tunit in _UNITS_M:
             scale = _UNITS_M[tunit]
             h = topo.heights()
             pixel = tuple(float(v) * scale for v in np.atleast_1d(topo.pixel_size))
+            if topo is not raw:
+                x, hx = raw.positions_and_heights()
+                points = (np.asarray(x, float) * scale, np.asarray(hx, float) * scale)
         else:
             topo_m = topo.to_unit("m")
             scale = 1.0
@@ -784,7 +820,7 @@ def _heights_m(
         z *= scale
     if np.ma.isMaskedArray(h):
         z[np.ma.getmaskarray(h)] = np.nan
-    return z, pixel, topo, warnings
+    return z, pixel, topo, warnings, points
 
 
 def topography_statistics(
@@ -811,12 +847,13 @@ def topography_statistics(
     -------
     RoughnessStats
     """
-    from labbrdf.topography import roughness_statistics
+    from labbrdf.topography import on_measured_points, roughness_statistics
 
     hm = read_height_map(path, channel, **read_kw)
     if require_areal and hm.is_profile:
         raise AdapterError(hm.path, "is a line profile; an areal height map is needed")
     try:
-        return roughness_statistics(hm.heights, hm.pixel_size, degree=degree, blocks=blocks)
+        st = roughness_statistics(hm.heights, hm.pixel_size, degree=degree, blocks=blocks)
+        return on_measured_points(st, hm.points, degree)
     except ValueError as exc:
         raise AdapterError(hm.path, str(exc)) from exc

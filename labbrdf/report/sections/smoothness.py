@@ -31,7 +31,13 @@ from ... import nk as nkmod
 from ... import smoothness as sm
 from ...adapters.topography import HeightMap
 from ...samples import SampleGroup
-from ...topography import RoughnessStats, level, roughness_statistics, s_filter
+from ...topography import (
+    RoughnessStats,
+    level,
+    on_measured_points,
+    roughness_statistics,
+    s_filter,
+)
 from .. import figures
 from ..builder import Unavailable, slug
 from ..context import Context
@@ -99,7 +105,7 @@ def _roughness(ctx: Context) -> dict[str, MapRoughness]:
         if hm.path in store:
             continue
         try:
-            st = roughness_statistics(hm.heights, hm.pixel_size)
+            st = on_measured_points(roughness_statistics(hm.heights, hm.pixel_size), hm.points)
         except ValueError:
             continue  # the surface section reports it
         size = max(hm.physical_sizes) * 1e9
