@@ -36,6 +36,7 @@ warnings say so.
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 from collections.abc import Callable, Iterator
@@ -534,7 +535,7 @@ def _cause(p: str, named: list[Any], detect: str) -> str:
     """
     causes = []
     for r in named:
-        reader, why, _ = _try_open(lambda r=r: r(p))
+        reader, why, _ = _try_open(functools.partial(r, p))
         if reader is None:
             causes.append(f"as {r.format()}: {why}")
     if causes:
