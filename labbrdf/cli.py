@@ -1180,7 +1180,7 @@ def _progress_printer(label: str, after_s: float = 2.0) -> Any:
 def cmd_surface(args: argparse.Namespace) -> int:
     from .adapters.topography import length_m
     from .outputs import check_file_output, check_input_files
-    from .topography import level, roughness_statistics
+    from .topography import level, on_measured_points, roughness_statistics
 
     check_input_files([args.file])
     if args.png:
@@ -1204,6 +1204,7 @@ def cmd_surface(args: argparse.Namespace) -> int:
             erode=args.erode_mask,
             progress=_progress_printer(f"labbrdf surface: {args.file}"),
         )
+        st = on_measured_points(st, hm.points, args.degree)
         if args.png:
             from .report.figures import save_png, surface_figure
 

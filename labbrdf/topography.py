@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -67,6 +67,7 @@ __all__ = [
     "autocorrelation",
     "fit_slope_distribution",
     "level",
+    "on_measured_points",
     "roughness_statistics",
     "slopes",
 ]
@@ -1158,4 +1159,70 @@ def roughness_statistics(
         bandwidth=band,
         n_eroded=n_eroded,
         **kw,
+    )
+
+
+#: SurfaceTopography's detrend mode for each levelling degree of a line scan
+_DETREND_MODES = {0: "center", 1: "height", 2: "curvature"}
+
+
+def on_measured_points(
+    stats: RoughnessStats,
+    points: tuple[ArrayLike, ArrayLike] | None,
+    degree: int = 1,
+) -> RoughnessStats:
+    """sigma and RMS slope of a non-uniform line scan computed on its measured points.
+
+    A stylus export with irregular x is interpolated onto a uniform grid for the
+    statistics (:func:`roughness_statistics`); the grid's forward differences mix the
+    slopes of neighbouring segments and lose slope (10 % on a real Dektak scan spaced
+    0.1-0.2 um). Here the RMS height and RMS slope are those of the measured points
+    joined by straight segments, as SurfaceTopography's ``NonuniformLineScan`` computes
+    them (``rms_height_from_profile``, ``rms_slope_from_profile``) after its detrend of the
+    same degree (0 ``center``, 1 ``height``, 2 ``curvature``); ``alpha_gaussian_acf``
+    follows the new sigma. Correlation lengths, slope distributions and their alphas stay
+    those of the grid; a note says so.
+
+    Parameters
+    ----------
+    stats : RoughnessStats
+        The statistics of the interpolated profile.
+    points : (array_like, array_like) or None
+        Measured positions and heights [m] (:attr:`labbrdf.adapters.topography.HeightMap.points`).
+    degree : int
+        The levelling degree ``stats`` used.
+
+    Returns
+    -------
+    RoughnessStats
+        ``stats`` itself when there are no points, for an areal map, a levelling degree
+        above 2, or statistics of S-filtered or eroded heights (which the measured points
+        are not).
+    """
+    if points is None or stats.kind != "profile" or stats.n_eroded:
+        return stats
+    if math.isfinite(stats.short_cutoff) or degree not in _DETREND_MODES:
+        return stats
+    from SurfaceTopography import NonuniformLineScan
+
+    x, z = (np.asarray(a, dtype=float) for a in points)
+    ok = np.isfinite(z)
+    line = NonuniformLineScan(x[ok], z[ok]).detrend(detrend_mode=_DETREND_MODES[degree])
+    sigma = float(line.rms_height_from_profile())
+    slope = float(line.rms_slope_from_profile())
+    s2 = math.sqrt(2.0) * sigma
+    note = (
+        f"sigma and RMS slope from the {int(ok.sum())} measured points of the non-uniform "
+        f"line scan (piecewise linear; the uniform grid gave {stats.sigma:.4g} m and "
+        f"{stats.slope_rms_x:.4g}); correlation length, slope distributions and their alphas "
+        "from the grid"
+    )
+    return replace(
+        stats,
+        sigma=sigma,
+        slope_rms_x=slope,
+        slope_rms=slope,
+        alpha_gaussian_acf=s2 / stats.c,
+        alpha_gaussian_acf_x=s2 / stats.c_x,
+        notes=(*stats.notes, note),
     )

@@ -455,3 +455,34 @@ def test_pair_counts_of_a_grid_minus_a_tile_equal_the_fft_counts(shape, hole):
     np.testing.assert_allclose(
         autocorrelation(z, v, hole=hole), autocorrelation(z, v), rtol=1e-10, atol=1e-12
     )
+
+
+# ------------------------------------------------------- non-uniform line scans
+def test_non_uniform_profile_statistics_are_those_of_the_measured_points(tmp_path, capsys):
+    """A stylus-like scan spaced 0.1-0.2 um: sigma and RMS slope equal SurfaceTopography's
+    piecewise-linear values on the measured points after the same detrend. Both sides do
+    the same sums on the same parsed numbers (in um there, in m here): 1e-12 relative.
+    Before: the grid at the median spacing lost about 13 % of the slope."""
+    SurfaceTopography = pytest.importorskip("SurfaceTopography")
+    from labbrdf.adapters.topography import read_height_map, topography_statistics
+    from labbrdf.cli import main
+
+    rng = np.random.default_rng(7)
+    x = np.cumsum(rng.uniform(0.1, 0.2, 3000))  # um
+    z = np.cumsum(rng.normal(0.0, 0.004, 3000))  # um, a rough random walk
+    p = tmp_path / "dektak.csv"
+    p.write_text("\n".join(f"{a:.6f},{b:.6f}" for a, b in zip(x, z, strict=True)) + "\n")
+    xs, zs = np.loadtxt(p, delimiter=",", unpack=True)  # the numbers as the file has them
+    for degree, mode in ((0, "center"), (1, "height")):
+        ref = SurfaceTopography.NonuniformLineScan(xs, zs, unit="um").detrend(detrend_mode=mode)
+        st = topography_statistics(p, unit="um", degree=degree, blocks=0)
+        assert st.slope_rms_x == pytest.approx(ref.rms_slope_from_profile(), rel=1e-12)
+        assert st.slope_rms == st.slope_rms_x
+        assert st.sigma == pytest.approx(ref.rms_height_from_profile() * 1e-6, rel=1e-12)
+        assert any("measured points" in n for n in st.notes)
+    hm = read_height_map(p, unit="um")
+    assert hm.pixel_size[0] == pytest.approx(np.min(np.diff(xs)) * 1e-6, rel=1e-9)
+    assert main(["surface", str(p), "--unit", "um", "--json", "--blocks", "0"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    ref = SurfaceTopography.NonuniformLineScan(xs, zs, unit="um").detrend(detrend_mode="height")
+    assert d["slope_rms_x"] == pytest.approx(ref.rms_slope_from_profile(), rel=1e-12)

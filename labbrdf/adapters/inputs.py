@@ -134,10 +134,18 @@ def _guessed_kind(path: str | os.PathLike[str]) -> str:
     return "height_map" if claim is not None and claim[1] else "optical"
 
 
+#: the errors of a file that cannot be read; any other is unexpected and named as such
+_READ_ERRORS = (ValueError, NotImplementedError, OSError, ImportError, MemoryError)
+
+
 def _message(path: str | os.PathLike[str], exc: BaseException) -> str:
     """The error as a line that starts with the file (an AdapterError already does)."""
-    text = str(exc) or type(exc).__name__
-    return text if isinstance(exc, AdapterError) else f"{path}: {text}"
+    text = " ".join(str(exc).split())
+    if isinstance(exc, AdapterError):
+        return text
+    if isinstance(exc, _READ_ERRORS):
+        return f"{path}: {text or type(exc).__name__}"
+    return f"{path}: unexpected {type(exc).__name__} while reading{': ' + text if text else ''}"
 
 
 def read_inputs(
@@ -190,11 +198,12 @@ def read_inputs(
 
     Notes
     -----
-    Errors caught per file (``"collect"``) are those of a file that cannot be read:
-    :class:`AdapterError` and the dataset's validation errors (both ``ValueError``),
-    ``NotImplementedError`` (a recognised but unsupported format), ``OSError`` and, for a
-    height map, the ``ImportError`` of a missing SurfaceTopography. Anything else is a bug
-    and propagates.
+    With ``"collect"``, whatever reading one file raises makes that file a failure and the
+    others are still read: the errors of a file that cannot be read (:class:`AdapterError`
+    and the dataset's validation errors, both ``ValueError``; ``NotImplementedError`` for a
+    recognised but unsupported format; ``OSError``; ``MemoryError``; for a height map the
+    ``ImportError`` of a missing SurfaceTopography) and any other, which the message names
+    as unexpected. One file never takes the others down.
     """
     if kind not in (None, *KINDS):
         raise ValueError(f"kind {kind!r}: expected one of {KINDS} or None")
@@ -209,7 +218,7 @@ def read_inputs(
         try:
             k = _kind_of(path, kind, format, columns)
             files.append(_read_as(path, k, format, columns, hm_kw))
-        except (ValueError, NotImplementedError, OSError, ImportError) as exc:
+        except Exception as exc:  # noqa: BLE001 - one file's failure, whatever it is
             if on_error == "raise":
                 raise
             files.append(InputFile(str(path), k or _guessed_kind(path), error=_message(path, exc)))

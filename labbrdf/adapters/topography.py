@@ -29,14 +29,18 @@ states the true geometry with ``pixel_size`` and ``unit`` (CLI ``--pixel-size``,
 ``--unit``).
 
 Non-uniform line scans (stylus profilometer exports with irregular x) are interpolated
-linearly onto a uniform grid at their median spacing by SurfaceTopography's
-``to_uniform`` (every statistic here needs a uniform grid); the metadata says so.
+linearly onto a uniform grid at their finest spacing by SurfaceTopography's ``to_uniform``
+(every statistic here needs a uniform grid; a coarser step would lose slope); the
+warnings say so.
 """
 
 from __future__ import annotations
 
+import functools
 import os
-from collections.abc import Callable
+import re
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -57,6 +61,7 @@ __all__ = [
     "check_geometry",
     "height_map_format",
     "length_m",
+    "nanoscope_scale_warnings",
     "read_height_map",
     "topography_statistics",
 ]
@@ -119,6 +124,11 @@ class HeightMap:
     warnings : tuple of str
         Doubts about the geometry (:func:`check_geometry`) or the reading (interpolation
         of a non-uniform line scan).
+    points : (ndarray, ndarray) or None
+        A non-uniform line scan's measured positions and heights [m], as in the file
+        (``heights`` is then their interpolation onto a uniform grid); None otherwise.
+        :func:`labbrdf.topography.on_measured_points` computes sigma and the RMS slope
+        on them.
     """
 
     heights: NDArray[np.float64]
@@ -128,6 +138,7 @@ class HeightMap:
     channels: tuple[str, ...] = ()
     meta: dict[str, Any] = field(default_factory=dict)
     warnings: tuple[str, ...] = ()
+    points: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
 
     @property
     def mask(self) -> NDArray[np.bool_]:
@@ -145,7 +156,7 @@ class HeightMap:
         return tuple(n * p for n, p in zip(self.heights.shape, self.pixel_size, strict=True))
 
     def summary(self) -> dict[str, Any]:
-        """What the map holds, JSON-safe: kind, reader, channel, points, size, pitch."""
+        """What the map holds, JSON-safe: kind, reader, channel, points, size, pitch, warnings."""
         return {
             "kind": "profile" if self.is_profile else "areal map",
             "reader": self.meta.get("reader", ""),
@@ -154,17 +165,21 @@ class HeightMap:
             "size_um": [s * 1e6 for s in self.physical_sizes],
             "pixel_nm": [s * 1e9 for s in self.pixel_size],
             "missing": int(self.mask.sum()),
+            "warnings": list(self.warnings),
         }
 
     def summary_line(self) -> str:
-        """One line: ``areal map, 512 x 512 points, 10 x 10 um, pixel 19.53 nm, ...``."""
+        """One line: ``areal map, 512 x 512 points, 10 x 10 um, pixel 19.53 nm, ...``.
+
+        The reading's warnings (:attr:`warnings`) follow, each as ``; warning: ...``.
+        """
         s = self.summary()
         size = " x ".join(f"{v:.4g}" for v in s["size_um"])
         pixel = " x ".join(f"{v:.4g}" for v in s["pixel_nm"])
         return (
             f"{s['kind']}, {' x '.join(map(str, s['points']))} points, {size} um, pixel "
             f"{pixel} nm, channel {s['channel']}, {s['missing']} missing points"
-            f" ({s['reader']})"
+            f" ({s['reader']})" + "".join(f"; warning: {w}" for w in self.warnings)
         )
 
 
@@ -200,6 +215,9 @@ class HeightMapFormat:
         to no format is a height map when a sniffer here claims it.
     sniff : callable
         ``sniff(head: bytes) -> bool`` on the first bytes: cheap, never raises.
+    shared_only : bool
+        The sniffer claims only files with one of :attr:`shared_extensions` (plain numbers
+        are a height profile in a ``.asc`` but may be anything in a file of another name).
     """
 
     name: str
@@ -207,6 +225,34 @@ class HeightMapFormat:
     extensions: tuple[str, ...]
     shared_extensions: tuple[str, ...] = ()
     sniff: Callable[[bytes], bool] = _never
+    shared_only: bool = False
+
+
+#: Header keys of ASCII topography exports SurfaceTopography's text reader knows (Gwyddion,
+#: Wyko, SPIP, ...), at the start of a line after an optional ``#``.
+_ASCII_TOPO_KEYS = re.compile(
+    rb"^\s*#?\s*(Width|Height|Value units|Wyko ASCII Data File Format|File Format\s*=\s*ASCII"
+    rb"|x-pixels|y-pixels|X Size|Y Size)\b",
+    re.IGNORECASE | re.MULTILINE,
+)
+_NUMBER_ROW = re.compile(rb"^\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?([\s,;]+\S+)*\s*$")
+
+
+def _ascii_topography(head: bytes) -> bool:
+    """An ASCII height profile or matrix: known header keys, or rows of plain numbers.
+
+    A two-column ``x z`` profile (the shape of SurfaceTopography's ``nonuniform.asc``) or a
+    matrix of heights; never a file that starts with another format's magic (PerkinElmer's
+    ``PE UV``), nor one with a NUL byte.
+    """
+    if b"\0" in head or head.lstrip().startswith(b"PE UV"):
+        return False
+    if _ASCII_TOPO_KEYS.search(head[:4096]):
+        return True
+    rows = [r for r in head.splitlines()[:40] if r.strip() and not r.lstrip().startswith(b"#")]
+    if head and not head.endswith((b"\n", b"\r")):
+        rows = rows[:-1]  # the last row may be cut mid-number
+    return len(rows) >= 2 and all(_NUMBER_ROW.match(r) for r in rows)
 
 
 #: The height-map formats. SurfaceTopography chooses its own reader from the content; the
@@ -236,6 +282,15 @@ HEIGHT_MAP_FORMATS: tuple[HeightMapFormat, ...] = (
         "BCR-STM / BCRF scanning-probe file",
         (".bcr", ".bcrf"),
         sniff=lambda head: head.startswith((b"fileformat = bcr", b"fileformat = bcrf")),
+    ),
+    HeightMapFormat(
+        "ascii-topography",
+        "plain ASCII height profile (x z columns) or height matrix, with or without a"
+        " Gwyddion / Wyko / SPIP header (SurfaceTopography's text readers)",
+        (),
+        (".asc",),
+        _ascii_topography,
+        shared_only=True,
     ),
     HeightMapFormat(
         "surfacetopography",
@@ -276,6 +331,8 @@ def height_map_format(
         if name.endswith(f.extensions):
             return f, True
     for f in HEIGHT_MAP_FORMATS:
+        if f.shared_only and not name.endswith(f.shared_extensions):
+            continue
         if f.sniff(head):
             return f, False
     return None
@@ -395,16 +452,15 @@ def check_geometry(
 
 #: Extensions SurfaceTopography's readers do not list although the instrument writes them.
 _EXT_FORMAT = {"di": "di"}
+#: SurfaceTopography's plain-text formats: a file with their extensions (.txt, .csv, .asc)
+#: may be any of them, so detection decides, not the extension.
+_TEXT_FORMATS = frozenset({"asc", "xyz"})
 
 
-def _open(st: Any, p: str) -> Any:
-    """The reader of ``p``; on failure, the error of the reader its extension names."""
-    try:
-        return st.open_topography(p)
-    except Exception as exc:  # noqa: BLE001 - the reader's errors vary by format
-        detect = exc
+def _extension_readers(st: Any, p: str) -> list[Any]:
+    """SurfaceTopography's readers whose file extensions include that of ``p``."""
     ext = os.path.splitext(p)[1].lstrip(".").lower()
-    causes = []
+    out = []
     for r in getattr(st.IO, "readers", ()):
         try:
             exts = [e.lower() for e in (r.file_extensions() or ())]
@@ -412,22 +468,85 @@ def _open(st: Any, p: str) -> Any:
         except Exception:  # noqa: BLE001 - a reader without extensions
             continue
         if ext and (ext in exts or _EXT_FORMAT.get(ext) == fmt):
-            try:
-                r(p)
-            except Exception as err:  # noqa: BLE001
-                causes.append(f"as {fmt}: {_one_line(err)}")
-    cause = "; ".join(causes) if causes else None
-    if cause is None:
-        tried = [ln for ln in str(detect).splitlines() if ln.strip()]
-        causes = [
-            f"{a.strip().removeprefix('tried ').rstrip(': ')}: {b.strip()}"
-            for a, b in zip(tried[::2], tried[1::2], strict=False)
-            if a.strip().startswith("tried")
-        ]
-        cause = "; ".join(causes[:4]) or _one_line(detect)
+            out.append(r)
+    return out
+
+
+def _try_open(open_reader: Callable[[], Any]) -> tuple[Any, str, BaseException | None]:
+    """Open a reader and list its channels, whatever it raises (but MemoryError).
+
+    ``(reader, "", None)`` for a reader that opens and lists a channel, else
+    ``(None, why, error)``.
+    """
+    try:
+        reader = open_reader()
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - the readers' errors vary by format
+        return None, _one_line(exc), exc
+    name = type(reader).__name__
+    try:
+        chans = list(reader.channels)
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001
+        return None, f"{name} cannot list the channels: {_one_line(exc)}", exc
+    if not chans:
+        return None, f"{name} found no data channel in the file", None
+    return reader, "", None
+
+
+def _open(st: Any, p: str) -> Any:
+    """The reader of ``p``, with at least one channel.
+
+    A file whose extension only one reader lists (``.nms``, ``.opdx``, ``.di``) is opened
+    with that reader first: formats without magic bytes (Nanofocus ``.nms``) are otherwise
+    claimed by whichever reader detection tries first (a MATLAB v4 reader that finds no
+    matrix in a confocal map's header); when it refuses the file, its error is the answer,
+    except for plain text (:data:`_TEXT_FORMATS`, which several readers take), where
+    SurfaceTopography's detection follows. On failure, the error of the reader the
+    extension names, else what detection tried.
+    """
+    named = _extension_readers(st, p)
+    if len(named) == 1:
+        fmt = named[0].format()
+        reader, why, err = _try_open(lambda: st.open_topography(p, format=fmt))
+        if reader is not None:
+            return reader
+        if fmt not in _TEXT_FORMATS:
+            raise AdapterError(
+                p, f"not a {fmt} file SurfaceTopography can read (as {fmt}: {why})"
+            ) from err
+    reader, why, err = _try_open(lambda: st.open_topography(p))
+    if reader is not None:
+        return reader
     raise AdapterError(
-        p, f"not a topography file SurfaceTopography can read ({cause})"
-    ) from detect
+        p,
+        "not a topography file SurfaceTopography can read"
+        f" ({_cause(p, named, str(err) if err is not None and str(err).strip() else why)})",
+    ) from err
+
+
+def _cause(p: str, named: list[Any], detect: str) -> str:
+    """Why no reader could read ``p``.
+
+    The errors of the readers its extension names, or what detection tried (``detect``,
+    SurfaceTopography's list of tries).
+    """
+    causes = []
+    for r in named:
+        reader, why, _ = _try_open(functools.partial(r, p))
+        if reader is None:
+            causes.append(f"as {r.format()}: {why}")
+    if causes:
+        return "; ".join(causes)
+    tried = [ln for ln in detect.splitlines() if ln.strip()]
+    causes = [
+        f"{a.strip().removeprefix('tried ').rstrip(': ')}: {b.strip()}"
+        for a, b in zip(tried[::2], tried[1::2], strict=False)
+        if a.strip().startswith("tried")
+    ]
+    return "; ".join(causes[:4]) or " ".join(detect.split())
 
 
 def _one_line(exc: BaseException) -> str:
@@ -480,24 +599,97 @@ def read_height_map(
     if unit is not None and unit not in _UNITS_M:
         raise AdapterError(p, f"unit {unit!r} unknown; use one of {list(_UNITS_M)}")
     reader = _open(st, p)
-    chans = list(reader.channels)
-    names = tuple(str(c.name) for c in chans)
-    index = _channel_index(p, reader, names, channel)
-    ch = chans[index]
-    kw = _topography_kwargs(p, ch, names[index], index, physical_sizes, unit, pixel_size)
-    z, pixel, topo, warnings = _heights_m(p, reader, kw, unit)
+    with _reader_errors(p, reader):
+        chans = list(reader.channels)
+        names = tuple(str(c.name) for c in chans)
+        index = _channel_index(p, reader, names, channel)
+        ch = chans[index]
+        kw = _topography_kwargs(p, ch, names[index], index, physical_sizes, unit, pixel_size)
+        z, pixel, topo, warnings, points = _heights_m(p, reader, kw, unit)
+        unit_in_file = str(ch.unit)
+        info = dict(getattr(topo, "info", {}) or {})
     if pixel_size is not None:
         pixel = tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size, float), (z.ndim,)))
     if not np.isfinite(z).any():
         raise AdapterError(p, "no defined height in the file")
+    if type(reader).__name__ == "DIReader":
+        warnings.extend(nanoscope_scale_warnings(p, index))
     warnings[:0] = check_geometry(p, z, pixel)
-    meta: dict[str, Any] = {"unit_in_file": str(ch.unit), "reader": type(reader).__name__}
+    meta: dict[str, Any] = {"unit_in_file": unit_in_file, "reader": type(reader).__name__}
     if unit is not None:
         meta["unit_stated"] = unit
     if pixel_size is not None:
         meta["pixel_size_stated_m"] = list(pixel)
-    meta.update(_json_meta(dict(getattr(topo, "info", {}) or {})))
-    return HeightMap(z, pixel, p, names[index], names, meta, tuple(warnings))
+    meta.update(_json_meta(info))
+    if pixel_size is not None:
+        points = None  # the stated pitch replaces the file's positions
+    return HeightMap(z, pixel, p, names[index], names, meta, tuple(warnings), points)
+
+
+@contextmanager
+def _reader_errors(p: str, reader: Any) -> Iterator[None]:
+    """Any error of SurfaceTopography's reader as an :class:`AdapterError`.
+
+    The message names the file and the reader (the errors vary by format: IndexError,
+    KeyError, struct.error, ...).
+    """
+    try:
+        yield
+    except (AdapterError, MemoryError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - whatever the reader raises
+        raise AdapterError(
+            p, f"SurfaceTopography's {type(reader).__name__} cannot read it ({_one_line(exc)})"
+        ) from exc
+
+
+#: Most header bytes read for :func:`nanoscope_scale_warnings` (headers are 8-80 KiB).
+_DI_HEADER_MAX = 1 << 20
+_DI_Z_SCALE = re.compile(r"^\\@([24]):Z scale:.*?(-?[0-9.]+(?:[eE][-+]?[0-9]+)?)\s*(\S*)\s*$")
+
+
+def nanoscope_scale_warnings(path: str, index: int) -> tuple[str, ...]:
+    """Doubts about the Z scale of image ``index`` of a Nanoscope file.
+
+    A Nanoscope header states the Z scale of an image as ``@2:Z scale`` and, from
+    version 9 on, also as ``@4:Z scale``; SurfaceTopography uses the ``@4`` one when both
+    are there. When the two disagree, the file contradicts itself about the heights: the
+    warning names both values, their ratio, and the one used.
+
+    Parameters
+    ----------
+    path : str
+        The file.
+    index : int
+        The image (channel) index, in the order of the header's image lists.
+
+    Returns
+    -------
+    tuple of str
+        One warning, or none.
+    """
+    with open(path, "rb") as f:
+        head = f.read(_DI_HEADER_MAX).decode("latin-1")
+    head = head.split("\\*File list end", 1)[0]
+    images = head.split("\\*Ciao image list")[1:]
+    if not 0 <= index < len(images):
+        return ()
+    found: dict[str, tuple[float, str, str]] = {}
+    for line in images[index].splitlines():
+        m = _DI_Z_SCALE.match(line.strip())
+        if m and m.group(1) not in found:
+            found[m.group(1)] = (float(m.group(2)), m.group(3), line.strip())
+    if "2" not in found or "4" not in found:
+        return ()
+    (v4, u4, l4), (v2, u2, l2) = found["4"], found["2"]
+    if v4 == v2 and u4 == u2:
+        return ()
+    ratio = f" ({v4 / v2:.4g} times)" if v2 and u4 == u2 else ""
+    return (
+        f"the file states two Z scales for image {index}: '{l4}' and '{l2}'{ratio}; the"
+        " heights use the @4:Z scale (SurfaceTopography's choice): the file disagrees with"
+        " itself, check the heights against a known step",
+    )
 
 
 def _channel_index(p: str, reader: Any, names: tuple[str, ...], channel: int | str | None) -> int:
@@ -556,36 +748,63 @@ def _topography_kwargs(
     return kw
 
 
+#: Most points of a non-uniform line scan put on a uniform grid (32 MiB of float64
+#: heights): the grid's step is the scan's finest spacing unless that needs more.
+MAX_PROFILE_POINTS = 2**22
+
+
 def _uniform(p: str, topo: Any, warnings: list[str]) -> Any:
-    """A non-uniform line scan interpolated onto its median spacing (said in ``warnings``)."""
+    """A non-uniform line scan interpolated onto its finest spacing (said in ``warnings``).
+
+    Linear interpolation at a step no coarser than any measured spacing keeps every
+    segment between measured points: the RMS height and slope of the grid are those of
+    the measured points (SurfaceTopography's piecewise-linear ``rms_height_from_profile``,
+    ``rms_slope_from_profile``) up to the grid steps that straddle a measured point. A
+    coarser step (the median) would smooth the short segments and lose slope.
+    """
     if getattr(topo, "is_uniform", True):
         return topo
     x = np.asarray(topo.positions(), dtype=float)
-    step = float(np.median(np.diff(x)))
-    if not step > 0:
+    dx = np.diff(x)
+    if not (dx.size and np.all(dx > 0)):
         raise AdapterError(p, "the line scan's x positions do not increase")
+    length = float(x[-1] - x[0])
+    step = float(np.min(dx))
+    how = "its finest spacing"
+    if length / step + 1 > MAX_PROFILE_POINTS:
+        step = length / (MAX_PROFILE_POINTS - 1)
+        how = f"a step coarser than its finest spacing (at most {MAX_PROFILE_POINTS} points)"
     n_in = x.size
     topo = topo.to_uniform(pixel_size=step)
     warnings.append(
-        f"non-uniform line scan ({n_in} points, spacing {np.min(np.diff(x)):.4g}"
-        f"..{np.max(np.diff(x)):.4g} {topo.unit}) interpolated linearly onto"
-        f" {topo.nb_grid_pts[0]} points at its median spacing {step:.4g} {topo.unit}"
+        f"non-uniform line scan ({n_in} points, spacing {np.min(dx):.4g}"
+        f"..{np.max(dx):.4g} {topo.unit}) interpolated linearly onto"
+        f" {topo.nb_grid_pts[0]} points at {how}, {step:.4g} {topo.unit}"
     )
     return topo
 
 
 def _heights_m(
     p: str, reader: Any, kw: dict[str, Any], unit: str | None
-) -> tuple[NDArray[np.float64], tuple[float, ...], Any, list[str]]:
-    """(heights [m] with NaN where undefined, pitch [m], the topography, warnings)."""
+) -> tuple[NDArray[np.float64], tuple[float, ...], Any, list[str], Any]:
+    """Heights [m] and pitch [m] of the channel the keywords ``kw`` select.
+
+    Returns (heights with NaN where undefined, pitch, the topography, warnings, the
+    measured (x, heights) [m] of a non-uniform line scan or None).
+    """
     warnings: list[str] = []
+    points = None
     try:
-        topo = _uniform(p, reader.topography(**kw), warnings)
+        raw = reader.topography(**kw)
+        topo = _uniform(p, raw, warnings)
         tunit = unit if unit is not None else topo.unit
         if tunit in _UNITS_M:
             scale = _UNITS_M[tunit]
             h = topo.heights()
             pixel = tuple(float(v) * scale for v in np.atleast_1d(topo.pixel_size))
+            if topo is not raw:
+                x, hx = raw.positions_and_heights()
+                points = (np.asarray(x, float) * scale, np.asarray(hx, float) * scale)
         else:
             topo_m = topo.to_unit("m")
             scale = 1.0
@@ -594,13 +813,15 @@ def _heights_m(
     except AdapterError:
         raise
     except Exception as exc:  # noqa: BLE001
-        raise AdapterError(p, f"cannot read the heights ({_one_line(exc)})") from exc
+        raise AdapterError(
+            p, f"{type(reader).__name__} cannot read the heights ({_one_line(exc)})"
+        ) from exc
     z = np.array(np.ma.getdata(h), dtype=float)
     if scale != 1.0:
         z *= scale
     if np.ma.isMaskedArray(h):
         z[np.ma.getmaskarray(h)] = np.nan
-    return z, pixel, topo, warnings
+    return z, pixel, topo, warnings, points
 
 
 def topography_statistics(
@@ -627,12 +848,13 @@ def topography_statistics(
     -------
     RoughnessStats
     """
-    from labbrdf.topography import roughness_statistics
+    from labbrdf.topography import on_measured_points, roughness_statistics
 
     hm = read_height_map(path, channel, **read_kw)
     if require_areal and hm.is_profile:
         raise AdapterError(hm.path, "is a line profile; an areal height map is needed")
     try:
-        return roughness_statistics(hm.heights, hm.pixel_size, degree=degree, blocks=blocks)
+        st = roughness_statistics(hm.heights, hm.pixel_size, degree=degree, blocks=blocks)
+        return on_measured_points(st, hm.points, degree)
     except ValueError as exc:
         raise AdapterError(hm.path, str(exc)) from exc

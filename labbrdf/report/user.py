@@ -229,14 +229,18 @@ def _ingest(
     selection: Mapping[str, Any] | None,
     same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
 ) -> None:
-    """Read every file (optical data or height maps), then apply the row selection."""
+    """Read every file (optical data or height maps), then apply the row selection.
+
+    A file that cannot be read is named with its reason and left out: the rest of the report
+    is what it would be without it (its sample groups too).
+    """
     ctx.b.text(
         f"{len(paths)} file(s) given; each was read once with labbrdf.read_inputs: an "
         "optical export into the common dataset, a topography file (height map or profile) "
         "with SurfaceTopography."
     )
-    ingest_inputs(ctx, paths)
-    sample_groups(ctx, paths, same_sample)
+    read = ingest_inputs(ctx, paths)
+    sample_groups(ctx, read, _among(same_sample, read))
     if selection:
         from ..selection import SelectionError, select
 
@@ -252,6 +256,22 @@ def _ingest(
             + f"; {sum(len(f) for f in kept)} of {sum(len(f) for f in ctx.frames)} rows kept."
         )
         ctx.frames[:] = [f for f in kept if len(f)]
+
+
+def _among(
+    groups: Sequence[Sequence[str | os.PathLike[str]]], paths: Sequence[str | os.PathLike[str]]
+) -> list[list[str | os.PathLike[str]]]:
+    """The given sample groups restricted to ``paths`` (the files read).
+
+    A group left with fewer than two files is no group.
+    """
+    keep = {os.path.normcase(os.path.realpath(os.fspath(p))) for p in paths}
+    out = []
+    for g in groups:
+        left = [p for p in g if os.path.normcase(os.path.realpath(os.fspath(p))) in keep]
+        if len(left) >= 2:
+            out.append(left)
+    return out
 
 
 def _sections(

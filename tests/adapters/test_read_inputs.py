@@ -331,3 +331,68 @@ def test_ingest_of_height_maps_only_writes_nothing_and_says_so(
     assert not out.exists()
     assert f"no optical data, {out} not written" in text.err
     assert text.out.startswith(f"{hm}: height map")  # no empty optical table
+
+
+@pytest.mark.parametrize("exc", [IndexError("list index out of range"), KeyError("xres")])
+def test_any_error_of_one_file_is_its_failure_and_the_others_are_read(
+    tmp_path: Path, fixtures_dir: Path, monkeypatch: pytest.MonkeyPatch, exc: Exception
+) -> None:
+    """A reader's unexpected error fails that file, named; before, it ended the whole list."""
+    wvase = fixtures_dir / "ellipsometry" / "al_bare_wvase.dat"
+    hm = tmp_path / "map.bcrf"
+    hm.write_bytes(b"fileformat = bcrf\n")
+
+    def broken(path, *a, **kw):
+        raise exc
+
+    monkeypatch.setattr(inputs_mod, "read_height_map", broken)
+    got = labbrdf.read_inputs([hm, wvase])
+    (fail,) = got.failures
+    assert fail.path == str(hm) and fail.kind == "height_map"
+    assert fail.error.startswith(f"{hm}: unexpected {type(exc).__name__}")
+    assert len(got.measurements) == 1 and got.measurement is not None
+    with pytest.raises(type(exc)):
+        labbrdf.read_inputs([hm, wvase], on_error="raise")
+
+
+# ------------------------------------------------------------- ASCII height profiles
+def _profile_asc(path: Path) -> Path:
+    """A two-column x z height profile as SurfaceTopography's ``nonuniform.asc`` is laid out:
+    no header, fixed-width scientific numbers, irregular x."""
+    rng = np.random.default_rng(0)
+    x = np.cumsum(rng.uniform(10.0, 18.0, 140))
+    z = 190.0 + np.cumsum(rng.normal(0.0, 3.0, 140))
+    path.write_text("".join(f"   {a:.7e}   {b:.7e}\n" for a, b in zip(x, z, strict=True)))
+    return path
+
+
+def _gwyddion_asc(path: Path) -> Path:
+    """A height matrix exported as text by Gwyddion: a '#' header with sizes and unit."""
+    z = np.random.default_rng(1).normal(0.0, 1e-8, (16, 16))
+    head = "# Channel: Height\n# Width: 10.000 µm\n# Height: 10.000 µm\n# Value units: m\n"
+    path.write_text(head + "\n".join("\t".join(f"{v:.4e}" for v in r) for r in z) + "\n")
+    return path
+
+
+def test_an_ascii_height_profile_asc_is_a_height_map_not_a_perkinelmer_spectrum(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Before: routed to the PerkinElmer reader ("expected the magic 'PE UV ...'")."""
+    pytest.importorskip("SurfaceTopography")
+    prof = _profile_asc(tmp_path / "profile.asc")
+    gwy = _gwyddion_asc(tmp_path / "matrix.asc")
+    pe = tmp_path / "spectrum.asc"
+    pe.write_text("PE UV       SUBTECH     SPECTRUM    ASCII       PEDS        4.00\n1\n")
+    assert adapters.input_kind(prof) == "height_map"
+    assert adapters.input_kind(gwy) == "height_map"
+    assert adapters.input_kind(pe) == "optical"
+    cut = tmp_path / "cut.bin"  # plain numbers under another name stay optical
+    cut.write_bytes(prof.read_bytes())
+    assert adapters.input_kind(cut) == "optical"
+    assert main(["ingest", str(prof)]) == 2  # a profile in unknown units: refused as one
+    err = capsys.readouterr().err
+    assert "profile.asc" in err and "--unit" in err and "PE UV" not in err
+    assert main(["ingest", str(gwy)]) == 0
+    assert "matrix.asc: height map" in capsys.readouterr().out
+    hm = topography.read_height_map(prof, unit="um")
+    assert hm.is_profile and "non-uniform line scan (140 points" in hm.warnings[0]

@@ -202,8 +202,9 @@ def test_non_uniform_line_scan_is_interpolated_and_says_so(tmp_path, capsys):
     assert any(
         "non-uniform line scan (400 points" in w and "interpolated" in w for w in hm.warnings
     )
-    step = float(np.median(np.diff(x))) * 1e-6
+    step = float(np.min(np.diff(x))) * 1e-6  # the finest spacing: no segment is skipped
     assert hm.pixel_size[0] == pytest.approx(step)
+    assert hm.points is not None and len(hm.points[0]) == 400
     # linear interpolation of the sine: RMS height 50/sqrt(2) nm within the interpolation
     # error of a 1-um step on a 40-um wavelength (< 0.5 %) and the partial last period
     sig = float(np.sqrt(np.nanmean((hm.heights - np.nanmean(hm.heights)) ** 2)))
@@ -290,3 +291,124 @@ def test_out_of_memory_names_the_file_and_exits_2(big_map):
     assert r.returncode == 2, r.stderr
     assert "big.bcrf" in r.stderr and "memory" in r.stderr.lower()
     assert "Traceback" not in r.stderr
+
+
+# ---------------------------------------------------------------- Nanofocus .nms
+def write_nms(path, z_u16, pitch_mm=312.5e-6, zmin_um=-2.3, zmax_um=4.1, cut=0):
+    """A Nanofocus .nms confocal map as SurfaceTopography's NMSReader reads it.
+
+    A 3468-byte header (z range as two little-endian doubles at byte 16 [um]; points
+    nx, ny as uint32 and pitch dx, dy as doubles [mm] at byte 1368), then ny x nx uint16
+    heights scaled between zmin and zmax. The format has no magic bytes.
+    """
+    ny, nx = z_u16.shape
+    hdr = bytearray(3468)
+    hdr[16:32] = np.array([zmin_um, zmax_um], "<f8").tobytes()
+    hdr[1368:1376] = np.array([nx, ny], "<u4").tobytes()
+    hdr[1376:1392] = np.array([pitch_mm, pitch_mm], "<f8").tobytes()
+    data = bytes(hdr) + np.asarray(z_u16, "<u2").tobytes()
+    path.write_bytes(data[: len(data) - cut])
+    return path
+
+
+def test_nms_map_is_read_by_the_nanofocus_reader_not_a_detected_one(tmp_path, capsys):
+    """A real confocal map's z range (here -2.3..4.1 um) makes the header look like a MATLAB
+    v4 file to detection, whose reader lists no channel: a bare IndexError before."""
+    u = np.random.default_rng(2).integers(0, 2**16 - 2, size=(512, 512)).astype("<u2")
+    p = write_nms(tmp_path / "conf.nms", u)
+    hm = read_height_map(p)
+    assert hm.meta["reader"] == "NMSReader" and hm.heights.shape == (512, 512)
+    assert hm.pixel_size == pytest.approx((312.5e-9, 312.5e-9), rel=1e-12)
+    expect_um = u.T / (2**16 - 2) * (4.1 - -2.3) + -2.3  # the reader's own scaling
+    np.testing.assert_allclose(hm.heights, expect_um * 1e-6, rtol=1e-12, atol=1e-21)
+    rc, out, err = run(["ingest", str(p)], capsys)
+    assert rc == 0 and "512 x 512 points" in out and "NMSReader" in out, err
+
+
+def test_truncated_nms_is_refused_with_the_nanofocus_reason(tmp_path, capsys):
+    u = np.zeros((64, 64), "<u2")
+    p = write_nms(tmp_path / "cut.nms", u, cut=1000)
+    with pytest.raises(AdapterError, match=r"cut\.nms: .*as nms: .*too small"):
+        read_height_map(p)
+    for cmd in ("ingest", "surface"):
+        rc, _, err = run([cmd, str(p)], capsys)
+        assert rc == 2 and "cut.nms" in err and "as nms" in err and "Traceback" not in err
+
+
+class _Failing:
+    """A SurfaceTopography reader whose ``where`` raises ``exc`` (channels or topography)."""
+
+    def __init__(self, exc, where):
+        self.exc, self.where = exc, where
+
+    @property
+    def channels(self):
+        if self.where == "channels":
+            raise self.exc
+        return [_Channel()]
+
+    @property
+    def default_channel(self):
+        if self.where == "default_channel":
+            raise self.exc
+        return self.channels[0]
+
+    def topography(self, **kw):
+        raise self.exc
+
+
+class _Channel:
+    name, index, unit, physical_sizes, nb_grid_pts = "Height", 0, "um", (1.0, 1.0), (4, 4)
+
+
+@pytest.mark.parametrize(
+    "exc",
+    [IndexError("list index out of range"), KeyError("xres"), TypeError("x"), ZeroDivisionError()],
+)
+@pytest.mark.parametrize("where", ["channels", "default_channel", "topography"])
+def test_any_reader_error_names_the_file_and_the_reader(tmp_path, monkeypatch, capsys, exc, where):
+    import SurfaceTopography
+
+    p = write_bcrf(tmp_path / "any.bcrf", rough(16), 16.0)
+    monkeypatch.setattr(SurfaceTopography, "open_topography", lambda *a, **k: _Failing(exc, where))
+    with pytest.raises(AdapterError) as e:
+        read_height_map(p)
+    msg = str(e.value)
+    assert msg.startswith(str(p)) and "_Failing" in msg and type(exc).__name__ in msg
+    for cmd in ("ingest", "surface"):
+        rc, _, err = run([cmd, str(p)], capsys)
+        assert rc == 2 and "any.bcrf" in err and "Traceback" not in err
+
+
+# ------------------------------------------------------------- Nanoscope Z scale
+@pytest.mark.shared
+def test_nanoscope_with_two_disagreeing_z_scales_says_which_is_used(
+    real_exports, tmp_path, capsys
+):
+    """A mutant of the real di-1.di whose first image states an @4:Z scale 16 times its
+    @2:Z scale (the header keeps its length, so every offset stays): the heights follow
+    one of them, and the warning says which and that the file disagrees with itself."""
+    src = real_exports / "topography" / "di-1.di"
+    raw = src.read_bytes()
+    old = (
+        b"\\Tip x width correction factor sigma: 1\r\n\\Tip y width correction factor sigma: 1\r\n"
+    )
+    new = b"\\@4:Z scale: V [Sens. Zsens] (0.005035400 V/LSB) 46.56738 V\r\n"
+    new += b"\\Note:" + b" " * (len(old) - len(new) - 8) + b"\r\n"
+    assert len(new) == len(old) and raw.count(old) >= 1
+    i = raw.index(old)
+    mut = tmp_path / "mutant.di"
+    mut.write_bytes(raw[:i] + new + raw[i + len(old) :])
+    ref, hm = read_height_map(src), read_height_map(mut)
+    assert not any("Z scale" in w for w in ref.warnings)
+    (w,) = [w for w in hm.warnings if "Z scale" in w]
+    assert "46.56738 V" in w and "2.910461 V" in w and "(16 times)" in w
+    assert "heights use the @4:Z scale" in w and "disagrees with itself" in w
+    ratio = np.nanstd(hm.heights) / np.nanstd(ref.heights)
+    assert ratio == pytest.approx(46.56738 / 2.910461, rel=1e-6)
+    rc, out, _ = run(["ingest", str(mut)], capsys)
+    assert rc == 0 and "warning: the file states two Z scales" in out
+    rc, out, _ = run(["ingest", "--json", str(mut)], capsys)
+    assert any("Z scale" in x for x in json.loads(out)[0]["height_map"]["warnings"])
+    rc, _, err = run(["surface", str(mut), "--blocks", "0"], capsys)
+    assert rc == 0 and "two Z scales" in err

@@ -55,3 +55,75 @@ def test_coated_wafer_without_a_film_model_says_how_to_fit_one(trio: dict) -> No
     assert film["status"] == "not available"
     assert "w1_12082006.dat: pseudo-constants of a stack" in film["reason"]
     assert "--film-model" in film["reason"]
+
+
+# ------------------------------------------------------------- rough samples' reflectance
+N, K = 1.5, 3.0  # bulk n, k of the sample, as an ellipsometer's combined table gives them
+
+
+def _rough_ctx(tmp_path: Path, *, paired: bool):
+    """A 20 nm Gaussian map (20 um, c 2 um) and the reflectance a rough sample of n, k
+    reflects: the smooth Fresnel R times Davies' exp(-g) from the map's sigma, 1 % sigma."""
+    import numpy as np
+    import pandas as pd
+
+    from labbrdf import smoothness as sm
+    from labbrdf.adapters.topography import HeightMap
+    from labbrdf.dataset import make_frame
+    from labbrdf.report.builder import Builder
+    from labbrdf.report.context import Context
+    from labbrdf.samples import pair_samples
+    from labbrdf.surface import gaussian_surface
+
+    s = gaussian_surface(128, 20e-6, 20e-9, 2e-6, rng=3)
+    hm_path, refl_path = tmp_path / "map.di", tmp_path / "refl.csv"
+    hm = HeightMap(s.z, tuple(s.spacing), str(hm_path), "height")
+    wl = np.linspace(400.0, 1000.0, 13)
+    r0 = abs((complex(N, K) - 1) / (complex(N, K) + 1)) ** 2
+    sigma = float(np.std(s.z - s.z.mean())) * 1e9
+    r = r0 * sm.specular_loss(sm.rayleigh_parameter(sigma, wl))
+    refl = make_frame(
+        sample="S", instrument="synthetic", source="refl.csv", quantity="reflectance",
+        value=r, sigma=0.01 * r, unit="1", wavelength_nm=wl,
+    )  # fmt: skip
+    ctx = Context(Builder("t", progress=False))
+    ctx.height_maps.append(hm)
+    ctx.frames.append(refl)
+    ctx.files.append({"path": str(refl_path), "samples": ["S"], "meta": {}})
+    same = [[hm_path, refl_path]] if paired else []
+    ctx.samples[:] = pair_samples([(hm_path, ()), (refl_path, "S")], same, given_as="given")
+    comb = pd.DataFrame(
+        {"sample": "S", "source": "ell.dat", "wavelength_nm": [300.0, 1100.0], "n": N, "k": K,
+         "n_sigma": 0.0, "k_sigma": 0.0, "nk_cov": 0.0}
+    )  # fmt: skip
+    return ctx, comb, refl
+
+
+def _compared(ctx, comb, refl) -> tuple[dict, dict, list[str]]:
+    from labbrdf.report.sections.nk import _compare
+
+    rows: list = []
+    with ctx.b.section("nk", "t"):
+        _compare(ctx, "t", "ell.dat", comb, refl, "refl.csv", rows)
+    res = ctx.b.results
+    (c,) = [c for c in res["checks"] if c["id"] == "nk.reflectance.t"]
+    notes = [i["text"] for s in res["sections"] for i in s["items"] if i["kind"] == "note"]
+    return c, rows[0], notes
+
+
+def test_rough_sample_paired_with_its_map_is_compared_with_fresnel_times_exp_minus_g(tmp_path):
+    """Before: chi2/dof in the thousands against the smooth Fresnel R, FAIL."""
+    c, row, notes = _compared(*_rough_ctx(tmp_path, paired=True))
+    assert c["status"] == "pass", c
+    assert "exp(-g) of map.di" in c["name"] and "exp(-g)" in c["justification"]
+    assert row["prediction"] == "Fresnel x exp(-g), map.di"
+    # the band-limited sigma (periods above lambda) differs from the full map's by < 1 %
+    assert row["chi2_dof"] < 1.0
+    assert not any("roughness is a possible" in n for n in notes)
+
+
+def test_rough_sample_without_a_map_fails_and_names_roughness_as_a_possible_cause(tmp_path):
+    c, row, notes = _compared(*_rough_ctx(tmp_path, paired=False))
+    assert c["status"] == "fail" and row["prediction"] == "Fresnel" and row["mean_diff"] < 0
+    assert "roughness is a possible cause" in c["justification"]
+    assert any("refl.csv" in n and "roughness is a possible cause" in n for n in notes)

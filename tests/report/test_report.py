@@ -441,8 +441,9 @@ def test_user_report_unreadable_file_fails_with_the_file_named(tmp_path):
     good = _scan_file(tmp_path / "scan.csv", "tile", "plain")
     assert report.user_report([good, bad], "smooth3", tmp_path / "r", progress=False) == 1
     res = json.loads((tmp_path / "r" / "results.json").read_text())
-    c = {x["id"]: x for x in res["checks"]}["ingest.read"]
+    c = {x["id"]: x for x in res["checks"]}["ingest.unreadable"]
     assert c["status"] == "fail" and "nothing.csv" in c["reason"]
+    assert [r["file"] for r in res["tables"]["ingested_files"]["rows"]] == ["scan.csv"]
 
 
 def test_user_report_refuses_unknown_model(tmp_path):

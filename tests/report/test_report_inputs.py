@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 from pathlib import Path
 
 import numpy as np
@@ -69,19 +70,19 @@ def test_the_report_reads_each_input_once_by_its_kind(
     assert row["file"] == hm.name and row["points"] == "32 x 32" and row["size_um"] == "32 x 32"
 
 
-def test_a_file_of_neither_kind_is_an_optical_failure_naming_it(
+def test_a_file_of_neither_kind_is_named_as_unreadable_and_left_out(
     tmp_path: Path, fixtures_dir: Path
 ) -> None:
     wvase = fixtures_dir / "ellipsometry" / "al_bare_wvase.dat"
     junk = tmp_path / "junk.dat"
     junk.write_text("nothing here\n")
     ctx, res = _ingested([wvase, junk])
-    rows = {r["file"]: r for r in res["tables"]["ingested_files"]["rows"]}
-    assert rows["junk.dat"]["status"] == "error"
-    assert rows["junk.dat"]["error"].startswith(str(junk))
+    assert [r["file"] for r in res["tables"]["ingested_files"]["rows"]] == [wvase.name]
     assert "ingested_height_maps" not in res["tables"]
-    (check,) = [c for c in res["checks"] if c["id"] == "ingest.read"]
-    assert check["status"] == "fail" and "junk.dat" in check["reason"]
+    (check,) = [c for c in res["checks"] if c["id"] == "ingest.unreadable"]
+    assert check["status"] == "fail" and str(junk) in check["reason"]
+    (note,) = [i for s in res["sections"] for i in s["items"] if i["kind"] == "note"]
+    assert str(junk) in note["text"]
 
 
 @pytest.mark.shared
@@ -94,3 +95,59 @@ def test_a_metropro_dat_is_parsed_once_as_a_height_map(
     assert counted == {mp.name: 1}  # no optical parser tried it first
     (hm,) = ctx.height_maps
     assert hm.heights.shape == (640, 480)
+
+
+def _nms(path: Path, cut: int = 0) -> Path:
+    """A Nanofocus .nms (3468-byte header, uint16 heights), ``cut`` bytes short."""
+    hdr = bytearray(3468)
+    hdr[16:32] = np.array([-2.3, 4.1], "<f8").tobytes()  # z range [um]
+    hdr[1368:1392] = np.array([64, 64], "<u4").tobytes() + np.full(2, 312.5e-6).tobytes()
+    data = bytes(hdr) + np.arange(64 * 64, dtype="<u2").tobytes()
+    path.write_bytes(data[: len(data) - cut])
+    return path
+
+
+def _report(tmp_path: Path, name: str, paths: list[Path], **kw) -> dict:
+    from labbrdf.report import user_report
+
+    code = user_report(paths, "smooth3", tmp_path / name, progress=False, **kw)
+    res = json.loads((tmp_path / name / "results.json").read_text())
+    res["code"] = code
+    return res
+
+
+def _notes(res: dict) -> list[str]:
+    items = [i for s in res["sections"] for i in s["items"]]
+    return [i["text"] for i in items if i["kind"] == "note" and i["label"] == "not read"]
+
+
+@pytest.mark.parametrize("how", ["refused", "reader bug"])
+def test_an_unreadable_file_leaves_the_rest_of_the_report_as_without_it(
+    tmp_path: Path, fixtures_dir: Path, monkeypatch: pytest.MonkeyPatch, how: str
+) -> None:
+    """The tables of [good + bad] are those of [good] alone; a note and a check name the bad
+    file and the reason (before: a failed row in the tables, or, for a reader's IndexError,
+    a report with no table at all)."""
+    pytest.importorskip("SurfaceTopography")
+    good = fixtures_dir / "ellipsometry" / "al_bare_wvase.dat"
+    alone = _report(tmp_path, "alone", [good])
+    bad = _nms(tmp_path / "conf.nms", cut=1000)
+    if how == "reader bug":
+        bad = _nms(tmp_path / "conf.nms")
+
+        def broken(path, *a, **kw):
+            raise IndexError("list index out of range")
+
+        monkeypatch.setattr(inputs_mod, "read_height_map", broken)
+    both = _report(tmp_path, "both", [good, bad], same_sample=[[good, bad]])
+    assert both["tables"] == alone["tables"] and alone["tables"]["ingested_files"]["rows"]
+    reason = "too small" if how == "refused" else "unexpected IndexError"
+    (note,) = _notes(both)
+    assert str(bad) in note and reason in note
+    c = {x["id"]: x for x in both["checks"]}
+    assert (
+        c["ingest.unreadable"]["status"] == "fail" and str(bad) in c["ingest.unreadable"]["reason"]
+    )
+    assert both["code"] == 1 and alone["code"] == 0
+    rest = {k: v["status"] for k, v in c.items() if k != "ingest.unreadable"}
+    assert rest == {x["id"]: x["status"] for x in alone["checks"]}

@@ -79,10 +79,10 @@ def test_corrupt_topography_file_is_a_failed_ingest(tmp_path: Path) -> None:
     code = user_report([bad], "smooth3", tmp_path / "rep", progress=False)
     res = json.loads((tmp_path / "rep" / "results.json").read_text())
     assert code == 1
-    c = _checks(res)["ingest.topography"]
+    c = _checks(res)["ingest.unreadable"]
     assert c["status"] == "fail" and "broken.di" in c["reason"]
-    (row,) = res["tables"]["ingested_height_maps"]["rows"]
-    assert row["status"] == "error" and "SurfaceTopography" in row["error"]
+    assert "SurfaceTopography" in c["reason"]
+    assert "ingested_height_maps" not in res["tables"]
     assert not any(ch["id"].endswith(".completed") for ch in res["checks"])
 
 

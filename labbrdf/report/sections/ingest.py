@@ -19,6 +19,7 @@ __all__ = [
     "ingest_files",
     "ingest_inputs",
     "ingest_read",
+    "list_unreadable",
     "sample_groups",
 ]
 
@@ -98,12 +99,19 @@ def ingest_files(
     ingest_read(ctx, files, root, check_id=check_id, table_id=table_id)
 
 
-def ingest_inputs(ctx: Context, paths: Sequence[str | os.PathLike[str]]) -> None:
+def ingest_inputs(ctx: Context, paths: Sequence[str | os.PathLike[str]]) -> list[str]:
     """Read a user's files once (:func:`labbrdf.adapters.read_inputs`) and list them.
 
     Height maps go to ``ctx.height_maps`` with their table and check
     (:func:`~labbrdf.report.sections.surface.ingest_height_maps`), optical exports to
-    ``ctx.frames`` with theirs (:func:`ingest_read`).
+    ``ctx.frames`` with theirs (:func:`ingest_read`). A file that cannot be read is left out
+    of both, as if it had not been given, and listed with its reason
+    (:func:`list_unreadable`).
+
+    Returns
+    -------
+    list of str
+        The paths that were read, in the given order.
 
     Raises
     ------
@@ -113,12 +121,42 @@ def ingest_inputs(ctx: Context, paths: Sequence[str | os.PathLike[str]]) -> None
     from .surface import ingest_height_maps  # the section that shows the height maps
 
     inputs = adapters.read_inputs(paths)
-    ingest_height_maps(ctx, inputs.files)
-    optical = [f for f in inputs.files if f.kind == "optical"]
+    list_unreadable(ctx, inputs.failures)
+    read = [f for f in inputs.files if f.ok]
+    ingest_height_maps(ctx, read)
+    optical = [f for f in read if f.kind == "optical"]
     if optical:
         ingest_read(ctx, optical)
     elif not ctx.height_maps:
         raise Unavailable("no file could be read")
+    return [f.path for f in read]
+
+
+def list_unreadable(ctx: Context, failures: Sequence[InputFile]) -> None:
+    """A note naming every file that cannot be read and why, and a failed check.
+
+    The report's tables are those of the other files alone: an unreadable file is named
+    here and nowhere else.
+    """
+    if not failures:
+        return
+    lines = [f.error if f.error.startswith(f.path) else f"{f.path}: {f.error}" for f in failures]
+    ctx.b.note(
+        "not read",
+        f"{len(failures)} file(s) could not be read and are left out; everything else is "
+        "reported as if they had not been given: " + "; ".join(lines),
+    )
+    ctx.b.check(
+        "ingest.unreadable",
+        "every input file can be read",
+        False,
+        against="the readers of labbrdf.read_inputs (optical exports and height maps)",
+        value=len(failures),
+        tolerance=0,
+        justification="value = files that could not be read; none may be",
+        reason="; ".join(lines)[:2000],
+        substantive=False,
+    )
 
 
 def ingest_read(

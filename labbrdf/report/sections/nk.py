@@ -24,6 +24,7 @@ from ..builder import Unavailable, slug
 from ..context import Context
 from ..pairing import how_to_pair, same_sample
 from .measured import file_frames
+from .smoothness import SpecularLoss, specular_loss_for
 
 __all__ = ["P_AGREE", "nk_section"]
 
@@ -86,6 +87,9 @@ def _compare(
             str(exc),
         )
         return
+    rough = _with_roughness(ctx, rsrc, cmp)
+    if rough is not None:
+        cmp = rough[0]
     z = cmp["z"].to_numpy(float)
     ok = np.isfinite(z)
     nz = int(ok.sum())
@@ -109,6 +113,7 @@ def _compare(
             "chi2_dof": chi2 / nz if nz else None,
             "p_value": p if nz else None,
             "outside": int(cmp.attrs.get("outside_range", 0)),
+            "prediction": "Fresnel" if rough is None else f"Fresnel x exp(-g), {rough[1].map}",
         }
     )
     x = cmp["wavelength_nm"].to_numpy(float)
@@ -127,7 +132,7 @@ def _compare(
         )
         series_m.append(
             {
-                "label": f"Fresnel from n, k {lab}",
+                "label": f"{'Fresnel' if rough is None else 'Fresnel x exp(-g)'} from n, k {lab}",
                 "x": g["wavelength_nm"],
                 "y": g["predicted"],
                 "band": g["predicted_sigma"].to_numpy(float),
@@ -146,23 +151,90 @@ def _compare(
         f"Reflectance of {rsrc} against the Fresnel prediction from n, k of {src}",
         f"Measured: {kind} [1] from {rsrc} ({len(x)} points, {x.min():.4g}-{x.max():.4g} nm). "
         f"Modelled: Fresnel reflectance of a bare half-space with the combined n, k of {src} "
-        "(two-phase model), band = propagated 1-sigma of n, k. Right: measured - predicted with "
+        "(two-phase model)"
+        + ("" if rough is None else f" times the specular loss exp(-g) of {rough[1].map}")
+        + ", band = propagated 1-sigma. Right: measured - predicted with "
         "the combined 1-sigma band"
         + ("" if has_sigma else " (the prediction's sigma alone: the file gives none)")
         + ".",
         figures.reflectance_comparison_figure(series_m, series_d, panel_size=(5.0, 3.2)),
     )
+    agree = nz > 0 and p >= P_AGREE
+    why = _roughness_words(rough, cmp, agree)
+    if why and rough is None:
+        b.note("roughness?", f"{rsrc}: {why}")
     b.check(
         f"nk.reflectance.{tag}",
-        f"{rsrc}: measured {kind} agrees with the Fresnel prediction from n, k of {src}",
-        nz > 0 and p >= P_AGREE,
-        against="Fresnel equations (two-phase) with the ellipsometric n, k",
+        f"{rsrc}: measured {kind} agrees with the Fresnel prediction from n, k of {src}"
+        + ("" if rough is None else f" times the specular loss exp(-g) of {rough[1].map}"),
+        agree,
+        against="Fresnel equations (two-phase) with the ellipsometric n, k"
+        + ("" if rough is None else ", times exp(-g) from the paired height map's sigma"),
         value=p if nz else None,
         tolerance=P_AGREE,
-        justification=f"chi-square test of z = difference / sigma over {nz} points "
-        f"(chi2/dof {chi2 / nz:.3g}); value = p-value, fails below the tolerance"
-        if nz
-        else "no point with a finite uncertainty",
+        justification=(
+            f"chi-square test of z = difference / sigma over {nz} points "
+            f"(chi2/dof {chi2 / nz:.3g}); value = p-value, fails below the tolerance"
+            if nz
+            else "no point with a finite uncertainty"
+        )
+        + (f"; {why}" if why else ""),
+    )
+
+
+def _with_roughness(
+    ctx: Context, rsrc: str, cmp: pd.DataFrame
+) -> tuple[pd.DataFrame, SpecularLoss] | None:
+    """The comparison against Fresnel times the specular loss of the paired height map.
+
+    None when no height map is of the same sample as ``rsrc``. The loss is the smoothness
+    section's (:func:`~labbrdf.report.sections.smoothness.specular_loss_for`); its 1-sigma
+    (from sigma's) joins the prediction's in quadrature. Rows outside the map's band are
+    dropped (no loss predicted there).
+    """
+    sl = specular_loss_for(ctx, rsrc, cmp["wavelength_nm"], cmp["theta_i_deg"])
+    if sl is None or not np.isfinite(sl.loss).any():
+        return None
+    pred0 = cmp["predicted"].to_numpy(float)
+    pred = pred0 * sl.loss
+    psig = np.hypot(cmp["predicted_sigma"].to_numpy(float) * sl.loss, pred0 * sl.u_loss)
+    msig = cmp["measured_sigma"].to_numpy(float)
+    diff = cmp["measured"].to_numpy(float) - pred
+    dsig = np.where(np.isnan(msig), psig, np.hypot(msig, psig))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = diff / dsig
+    out = cmp.assign(
+        predicted=pred,
+        predicted_sigma=psig,
+        difference=diff,
+        difference_sigma=dsig,
+        z=z,
+        specular_loss=sl.loss,
+        g=sl.g,
+    )
+    out.attrs.update(cmp.attrs)
+    return out[np.isfinite(sl.loss)].reset_index(drop=True), sl
+
+
+def _roughness_words(
+    rough: tuple[pd.DataFrame, SpecularLoss] | None, cmp: pd.DataFrame, agree: bool
+) -> str:
+    """What roughness has to do with the comparison, for the check's text ("" if nothing)."""
+    if rough is not None:
+        sl = rough[1]
+        return (
+            f"the prediction is the smooth Fresnel R times the specular loss exp(-g) of the "
+            f"paired height map {sl.map} (g = (4 pi sigma cos theta / lambda)^2, sigma "
+            f"{np.nanmin(sl.sigma_nm):.3g}-{np.nanmax(sl.sigma_nm):.3g} nm, exp(-g) "
+            f"{np.nanmin(sl.loss):.3g}-{np.nanmax(sl.loss):.3g})"
+        )
+    below = float(np.nanmean(cmp["difference"].to_numpy(float))) < 0
+    if agree or not below:
+        return ""
+    return (
+        "the measured R lies below the smooth Fresnel value: surface roughness is a possible "
+        "cause (a specular loss exp(-g)); give the sample's height map (paired by sample "
+        "name or --same-sample) to account for it"
     )
 
 
@@ -482,12 +554,15 @@ def _comparison_table(ctx: Context, cmp_rows: list[dict[str, Any]]) -> None:
             ("chi2_dof", "\u03c7\u00b2/dof", ".3g"),
             ("p_value", "p", ".2g"),
             ("outside", "rows outside n, k range", "d"),
+            ("prediction", "prediction", ""),
         ],
         cmp_rows,
         caption="diff = measured - predicted; sigma diff adds the measurement's and the "
         "prediction's 1-sigma in quadrature (the prediction's alone where the file has "
         "none: a lower bound). Spectrophotometer rows without an angle are taken at "
-        "normal incidence.",
+        "normal incidence. Where a height map of the sample is given, the prediction is "
+        "the smooth Fresnel R times the specular loss exp(-g) from the map's sigma (section "
+        "'Roughness against wavelength').",
     )
 
 

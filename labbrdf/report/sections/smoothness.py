@@ -31,12 +31,24 @@ from ... import nk as nkmod
 from ... import smoothness as sm
 from ...adapters.topography import HeightMap
 from ...samples import SampleGroup
-from ...topography import RoughnessStats, level, roughness_statistics, s_filter
+from ...topography import (
+    RoughnessStats,
+    level,
+    on_measured_points,
+    roughness_statistics,
+    s_filter,
+)
 from .. import figures
 from ..builder import Unavailable, slug
 from ..context import Context
 
-__all__ = ["MAX_WAVELENGTHS", "rayleigh_flags", "smoothness_section"]
+__all__ = [
+    "MAX_WAVELENGTHS",
+    "SpecularLoss",
+    "rayleigh_flags",
+    "smoothness_section",
+    "specular_loss_for",
+]
 
 #: most wavelengths per map in the table (evenly picked from the sample's)
 MAX_WAVELENGTHS = 8
@@ -93,7 +105,7 @@ def _roughness(ctx: Context) -> dict[str, MapRoughness]:
         if hm.path in store:
             continue
         try:
-            st = roughness_statistics(hm.heights, hm.pixel_size)
+            st = on_measured_points(roughness_statistics(hm.heights, hm.pixel_size), hm.points)
         except ValueError:
             continue  # the surface section reports it
         size = max(hm.physical_sizes) * 1e9
@@ -115,6 +127,70 @@ def _groups_with_maps(ctx: Context) -> list[tuple[SampleGroup, list[MapRoughness
         if mine and optical:
             out.append((g, mine, optical))
     return out
+
+
+@dataclass(frozen=True)
+class SpecularLoss:
+    """The Davies specular loss a paired height map predicts for rows of reflectance.
+
+    Attributes
+    ----------
+    map : str
+        The height map's file name.
+    sigma_nm, g, loss, u_loss : ndarray
+        Per row: sigma of the roughness that scatters [nm], the Rayleigh parameter g [1],
+        ``exp(-g)`` [1] and its 1-sigma from sigma's uncertainty [1]; NaN where the map's
+        band holds no period that scatters.
+    """
+
+    map: str
+    sigma_nm: np.ndarray
+    g: np.ndarray
+    loss: np.ndarray
+    u_loss: np.ndarray
+
+
+def specular_loss_for(
+    ctx: Context, source: str, wavelength_nm: Sequence[float], theta_deg: Sequence[float]
+) -> SpecularLoss | None:
+    """``exp(-g)`` per (wavelength, angle) from the height map paired with file ``source``.
+
+    The sigma is the same as in this section's table (:meth:`MapRoughness.sigma_for`: the
+    roughness that scatters at that wavelength and angle), g and exp(-g) those of
+    :mod:`labbrdf.smoothness`. None when no height map is of the same sample as ``source``
+    (a file name, as the rows' ``source`` gives it); the first map of the group otherwise.
+    """
+    maps = [m for _, ms, optical in _groups_with_maps(ctx) if source in optical for m in ms]
+    if not maps:
+        return None
+    m = maps[0]
+    wl = np.asarray(wavelength_nm, dtype=float)
+    th = np.radians(np.asarray(theta_deg, dtype=float))
+    d = np.asarray(sm.shortest_scattering_period(wl, th), dtype=float)
+    sigma = _sigmas(m, d)
+    g = np.asarray(sm.rayleigh_parameter(np.nan_to_num(sigma), wl, th), dtype=float)
+    g[~np.isfinite(sigma)] = np.nan
+    u = np.nan_to_num(sigma * m.u_rel)
+    u_g = np.asarray(sm.rayleigh_parameter_uncertainty(np.nan_to_num(sigma), u, wl, th))
+    loss = np.asarray(sm.specular_loss(np.nan_to_num(g)), dtype=float)
+    loss[~np.isfinite(g)] = np.nan
+    return SpecularLoss(m.name, sigma, g, loss, loss * u_g)
+
+
+#: most S-filtered sigmas computed per map for one comparison; between them, interpolated
+#: in the period (sigma varies smoothly with the band's short end)
+MAX_PERIODS = 64
+
+
+def _sigmas(m: MapRoughness, periods: np.ndarray) -> np.ndarray:
+    """sigma [nm] of the roughness that scatters, per shortest scattering period [nm]."""
+    u = np.unique(periods)
+    if u.size > MAX_PERIODS:
+        u = np.linspace(u[0], u[-1], MAX_PERIODS)
+    at = np.array([m.sigma_for(float(v))[0] for v in u])
+    if u.size == 1:
+        return np.full(periods.shape, at[0])
+    return np.asarray(np.interp(periods, u, at), dtype=float)
 
 
 def _judge(m: MapRoughness, wl_nm: float, theta_deg: float) -> dict[str, Any]:

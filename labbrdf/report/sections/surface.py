@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 from ...adapters.inputs import InputFile
 from ...adapters.topography import HeightMap
 from ...surface import gaussian_surface
-from ...topography import autocorrelation, level, roughness_statistics
+from ...topography import autocorrelation, level, on_measured_points, roughness_statistics
 from ...tracer import Substrate, TraceConfig, TraceResult
 from .. import figures
 from ..builder import Builder, Unavailable, slug
@@ -266,7 +266,7 @@ def _map_part(ctx: Context, hm: HeightMap, sid: str, albedo_rows: list[dict[str,
         f"{kind}, {' x '.join(str(v) for v in hm.heights.shape)} points, channel {hm.channel}",
     )
     try:
-        st = roughness_statistics(hm.heights, hm.pixel_size)
+        st = on_measured_points(roughness_statistics(hm.heights, hm.pixel_size), hm.points)
     except ValueError as exc:
         b.check(
             f"surface.{sid}.statistics",
