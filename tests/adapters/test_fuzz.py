@@ -334,20 +334,7 @@ def truncation_sweep(real_exports: Path, fmt: str, tmp: Path, cuts: int = CUTS) 
     return counts
 
 
-_CARY_FOOTER = pytest.mark.xfail(
-    strict=True,
-    reason="a Cary file cut inside its method footer loses the sphere accessory and reads as "
-    "specular reflectance instead of hemispherical (osr_sphere_cary.csv)",
-)
-
-
-@pytest.mark.parametrize(
-    "fmt",
-    [
-        pytest.param(f, marks=_CARY_FOOTER) if f == "agilent-cary-winuv-csv" else f
-        for f in TRUNCATION_FORMATS
-    ],
-)
+@pytest.mark.parametrize("fmt", TRUNCATION_FORMATS)
 def test_a_file_cut_anywhere_is_refused_warned_or_a_prefix_of_the_whole(
     real_exports: Path, tmp_path: Path, fmt: str
 ) -> None:
