@@ -166,6 +166,30 @@ def unterminated(text: str | bytes) -> bool:
     return not text[-1:].isspace()
 
 
+def _check_missing_cells(
+    path: str | os.PathLike[str],
+    last: str,
+    previous: list[str],
+    line: int,
+    sep: str | None,
+    tagged: bool,
+) -> str | None:
+    """Refuse (or warn about) a last line that ends in a separator before cells every
+    earlier row fills: ``550,30,31.8,180,0.0694797,`` where each row has its sigma."""
+    have = len(_fields(last, sep, tagged))
+    ref = [len(_fields(p, sep, tagged)) for p in previous[-TAIL_ROWS:] if p.strip()]
+    if not have or not ref or min(ref) <= have:
+        return None
+    what = (
+        f"the last line, which has no line end, stops after {have} field(s) where every "
+        f"other row has at least {min(ref)}"
+    )
+    fix = "if the row is complete, end the line with a line break"
+    if len(ref) >= FIXED_ROWS:
+        raise AdapterError(path, f"{what}: the file looks truncated ({fix})", line)
+    return warn(path, f"{what}: the file may be truncated ({fix})", line)
+
+
 def check_last_field(
     path: str | os.PathLike[str],
     last: str,
@@ -179,7 +203,10 @@ def check_last_field(
 
     Only the last field of such a line can be cut (every other field is followed by a
     separator); it is compared with the same column in ``previous``, the rows before it
-    (the most recent :data:`TAIL_ROWS` are enough).
+    (the most recent :data:`TAIL_ROWS` are enough). A line that ends in a separator may
+    have lost the fields after it: it is refused where at least :data:`FIXED_ROWS` earlier
+    rows all have more fields (``...,0.0694797,`` where every row has a sigma after the
+    value), warned about where fewer do.
 
     Refused (the file looks truncated): the field ends in a decimal separator or in an
     exponent without digits (``0,``, ``300.``, ``4.5E-``); or the column has a precision of
@@ -217,7 +244,9 @@ def check_last_field(
         The field is certainly cut short; the message names the line.
     """
     if last[-1:].isspace() or (sep is not None and last.endswith(sep)):
-        return None  # the last field is followed by a separator: complete
+        # the last field is followed by a separator: complete, but the cells after it may
+        # be missing
+        return _check_missing_cells(path, last, previous, line, sep, tagged)
     fields = _fields(last, sep, tagged)
     if not fields:
         return None

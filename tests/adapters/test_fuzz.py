@@ -175,22 +175,32 @@ _OWN = {
 def test_mutated_own_csv_files_raise_adaptererror_or_lose_only_the_touched_rows(
     tmp_path: Path, fmt: str
 ) -> None:
-    """One data row per line: a truncated file gives exactly its remaining data lines (the
-    last one possibly cut short but still numeric), a deleted line costs at most one row, a
-    duplicated line adds at most one; ``#`` inserted or flipped in at a line start comments
-    a row out, so a flip or an insertion may lose rows (one per changed byte) but never
-    add one."""
+    """One data row per line: a truncated file is refused, warned about (a last number
+    that may be cut short), or gives exactly its complete remaining data lines, each a row
+    of the whole file (never a cut value); a deleted line costs at most one row, a
+    duplicated line adds at most one; ``#`` inserted or flipped in at a line start
+    comments a row out, so a flip or an insertion may lose rows (one per changed byte) but
+    never add one."""
     raw = _OWN[fmt].encode()
     src = tmp_path / "orig.csv"
     src.write_bytes(raw)
     n0 = _points(READERS[fmt].read(src))
     assert n0 == 18 if fmt == "labbrdf-specular-scan" else n0 == 20
+    whole = _rows(READERS[fmt].read(src))
     target = tmp_path / "mutated.csv"
+    last = raw.rstrip().rfind(b"\n") + 1  # every cut inside the last row, as well
+    for cut in range(last + 1, len(raw)):
+        outcome = _truncation_outcome(READERS[fmt].read, raw, cut, target, whole)
+        assert outcome in ("refused", "warned", "prefix"), f"cut at {cut}: {raw[last:cut]!r}"
 
     @settings(max_examples=60, deadline=None, derandomize=True, database=None)
     @given(data=st.data())
     def run(data: st.DataObject) -> None:
         op, mutated, _ = _mutate(raw, data)
+        if op == "truncate":
+            outcome = _truncation_outcome(READERS[fmt].read, raw, len(mutated), target, whole)
+            assert outcome in ("refused", "warned", "prefix"), f"cut at {len(mutated)}"
+            return
         target.write_bytes(mutated)
         try:
             m = READERS[fmt].read(target)
@@ -198,12 +208,7 @@ def test_mutated_own_csv_files_raise_adaptererror_or_lose_only_the_touched_rows(
             assert str(target) in str(exc)
             return
         n = _points(m)
-        if op == "truncate":  # exactly the data lines kept, the last one maybe partial
-            lines = mutated.splitlines()
-            head = next(i for i, ln in enumerate(lines) if ln.startswith(b"wavelength_nm"))
-            low = high = sum(1 for ln in lines[head + 1 :] if ln.strip())
-        else:
-            low, high = {"delete": (n0 - 1, n0), "duplicate": (n0, n0 + 1)}.get(op, (n0 - 4, n0))
+        low, high = {"delete": (n0 - 1, n0), "duplicate": (n0, n0 + 1)}.get(op, (n0 - 4, n0))
         assert low <= n <= high, f"{op}: {n} points from a file of {n0}"
 
     run()
@@ -247,8 +252,8 @@ def test_reading_never_writes(real_exports: Path, tmp_path: Path, monkeypatch) -
 
 #: text formats cut at byte offsets: those whose readers check the last line of a file cut
 #: short (:func:`labbrdf.adapters._numblock.check_last_field`: UVProbe text, Woollam,
-#: Accurion, SENTECH, declared columns) and those whose files state their point count or
-#: end with a footer or end marker
+#: Accurion, SENTECH, declared columns, labbrdf's own CSV layouts...) and those whose files
+#: state their point count or end with a footer or end marker
 TRUNCATION_FORMATS = (
     "shimadzu-uvprobe-text",
     "woollam-wvase",
@@ -262,6 +267,8 @@ TRUNCATION_FORMATS = (
     "filmsense",
     "jcamp-dx",
     "zemax-bsdf",
+    "labbrdf-specular-scan",
+    "labbrdf-hemispherical-reflectance",
 )
 #: the declared columns of the real headerless file
 _COLUMNS_FILES = {"MoS2_fromCzech2015.txt": "wavelength_nm,absorbance"}
