@@ -21,6 +21,7 @@ import io
 import os
 import re
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -36,6 +37,7 @@ __all__ = [
     "NUMBER",
     "build_frame",
     "check_last_field",
+    "check_last_row",
     "unterminated",
     "labels",
     "body_bytes",
@@ -215,8 +217,10 @@ def check_last_field(
     written ``0,322``; ``4.522`` or ``4.522E-0`` where it is written ``4.522E-02``).
     Warned (the column's own writing varies, so a shorter value may be a real one, e.g.
     ``0.13`` beside ``0.1308`` from a writer that drops trailing zeros): the field has fewer
-    decimals than some other row, fewer significant digits than every other row, or no
-    exponent where other rows have one; or no other row has the column to compare with.
+    decimals than some other row, fewer significant digits than every other row or (where
+    the decimals vary, as a writer of significant digits writes ``0.00152198`` beside
+    ``2.78913``) than some other row, or no exponent where other rows have one; or no other
+    row has the column to compare with.
 
     Parameters
     ----------
@@ -292,15 +296,62 @@ def check_last_field(
         or (f.exponent is None and exps)
         or (f.exponent is not None and exps and f.exponent < min(exps))
         or f.digits < min(r.digits for r in ref)
+        # a writer of significant digits (%g: 0.00152198 beside 2.78913): fewer of them
+        or (not fixed and f.digits < max(r.digits for r in ref))
     )
     if not short:
         return None
     return warn(
         path,
         f"{cut} is written shorter than other values of its column (up to "
-        f"{_decimals(max(decimals))}): the file may be truncated ({fix})",
+        f"{_decimals(max(decimals))}, {max(r.digits for r in ref)} significant digits): "
+        f"the file may be truncated ({fix})",
         line,
     )
+
+
+def check_last_row(
+    path: str | os.PathLike[str],
+    text: str | bytes,
+    lines: list[str],
+    rows: Sequence[int],
+    sep: str | None,
+    *,
+    tagged: bool = False,
+) -> str | None:
+    """:func:`check_last_field` for a reader that parses its rows itself.
+
+    Does nothing unless the file's last line has no line end and is the last data row.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (for the message).
+    text : str or bytes
+        The whole file (only its last characters are looked at).
+    lines : list of str
+        Its lines, split at CR, LF or CRLF (:func:`labbrdf.adapters._base.split_lines`).
+    rows : sequence of int
+        1-based line numbers of the data rows, in file order.
+    sep : str or None
+        Field separator; None for runs of blanks.
+    tagged : bool
+        Whether a row may start with an alphabetic tag.
+
+    Returns
+    -------
+    str or None
+        The warning issued, if any.
+
+    Raises
+    ------
+    AdapterError
+        The last number (or the cells after the last separator) was certainly cut short.
+    """
+    if not rows or rows[-1] != len(lines) or not unterminated(text):
+        return None
+    previous = [lines[k - 1] for k in rows[-TAIL_ROWS - 1 : -1]]
+    return check_last_field(path, lines[-1].strip(), previous, rows[-1], sep, tagged=tagged)
 
 
 def tail_lines(data: bytes, start: int, n: int) -> list[str]:

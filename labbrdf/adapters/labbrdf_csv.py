@@ -90,7 +90,7 @@ from typing import Any
 
 from ..dataset import Measurement, make_frame
 from ._base import AdapterError, Format, decode, read_bytes, split_lines
-from ._numblock import TAIL_ROWS, check_last_field, unterminated
+from ._numblock import check_last_row
 from ._spectro import finish, number
 
 __all__ = ["FORMATS", "read_hemispherical", "read_specular_scan"]
@@ -191,11 +191,7 @@ def _check_cut(
     path: str | os.PathLike[str], text: str, lines: list[str], rows: list[tuple[int, list[str]]]
 ) -> str:
     """Refuse (or warn about, returned) a last data row without line end that looks cut."""
-    n = rows[-1][0]
-    if not unterminated(text) or n != len(lines):
-        return ""
-    previous = [lines[k - 1] for k, _ in rows[-TAIL_ROWS - 1 : -1]]
-    return check_last_field(path, lines[n - 1].strip(), previous, n, ",") or ""
+    return check_last_row(path, text, lines, [n for n, _ in rows], ",") or ""
 
 
 def _columns(

@@ -269,11 +269,16 @@ TRUNCATION_FORMATS = (
     "zemax-bsdf",
     "labbrdf-specular-scan",
     "labbrdf-hemispherical-reflectance",
+    "oceanoptics-text",
+    "oceanoptics-jaz",
+    "avantes-avasoft",
 )
 #: the declared columns of the real headerless file
 _COLUMNS_FILES = {"MoS2_fromCzech2015.txt": "wavelength_nm,absorbance"}
 #: cut offsets tried per file (seeded by the file name: the same offsets on every run)
 CUTS = 40
+#: and the cuts in the last bytes of the last line (the last number or two)
+LAST_LINE_CUTS = 24
 
 
 def _rows(m: labbrdf.Measurement) -> set[tuple]:
@@ -309,35 +314,70 @@ def _truncation_outcome(read, raw: bytes, cut: int, target: Path, whole: set[tup
     return "prefix" if _rows(m) <= whole else "changed"
 
 
-def _truncation_cases(real_exports: Path, fmt: str) -> list[tuple[Path, Any]]:
+def _avantes_rows(n: int) -> str:
+    """AvaSoft 8 ASCII rows whose processed column is 100 (S - D) / (R - D), 5 decimals."""
+    rows = []
+    for i in range(n):
+        d, r, s = 1000.0 + i, 31000.0 + 7 * i, 9000.0 + 13 * i
+        rows.append(
+            f"{400 + 0.6 * i:.2f};{s:9.3f};{d:9.3f};{r:9.3f};{100 * (s - d) / (r - d):.5f}\r\n"
+        )
+    return "".join(rows)
+
+
+#: synthetic files of the formats whose only real file is refused whole (irradiance)
+_SYNTHETIC = {
+    "avantes-avasoft": [
+        (
+            "feather_reflection.txt",
+            "\r\nIntegration time [ms]:  84.900\r\nAveraging Nr. [scans]: 10\r\n"
+            "Smoothing Nr. [pixels]: 1\r\nData measured with spectrometer [name]: 1501154U1\r\n"
+            "Wave   ;Sample   ;Dark     ;Reference;Reflectance\r\n"
+            "[nm]   ;[counts] ;[counts] ;[counts] ;[%]\r\n\r\n" + _avantes_rows(40),
+        )
+    ]
+}
+
+
+def _truncation_cases(real_exports: Path, fmt: str) -> list[tuple[str, bytes, Any]]:
+    """(file name, its bytes, the reader) of every real file, fixture or synthetic file."""
     if fmt == "columns":
         return [
-            (real_exports / "generic-columns" / name, lambda p, c=cols: labbrdf.read(p, columns=c))
+            (name, p.read_bytes(), lambda p, c=cols: labbrdf.read(p, columns=c))
             for name, cols in _COLUMNS_FILES.items()
-            if (real_exports / "generic-columns" / name).is_file()
+            if (p := real_exports / "generic-columns" / name).is_file()
         ]  # fmt: skip
     files = [p for p in _real_files(real_exports) if _format_of(p) == fmt]
     files += [p for p in sorted(FIXTURES.glob("*/*")) if p.is_file() and sniff(p) == [fmt]]
-    return [(p, READERS[fmt].read) for p in files]
+    read = READERS[fmt].read
+    cases = [(p.name, p.read_bytes(), read) for p in files]
+    return cases + [(name, text.encode("cp1252"), read) for name, text in _SYNTHETIC.get(fmt, [])]
 
 
 def truncation_sweep(real_exports: Path, fmt: str, tmp: Path, cuts: int = CUTS) -> Counter:
-    """Cut every real file of ``fmt`` at ``cuts`` seeded offsets; count the outcomes."""
+    """Cut every file of ``fmt`` at ``cuts`` seeded offsets and inside its last line; count
+    the outcomes (and the files read whole, ``files``)."""
     counts: Counter = Counter()
-    for path, read in _truncation_cases(real_exports, fmt):
-        raw = path.read_bytes()
+    for name, raw, read in _truncation_cases(real_exports, fmt):
+        src = tmp / "whole" / name
+        src.parent.mkdir(exist_ok=True)
+        src.write_bytes(raw)
         try:
-            whole = _rows(read(path))
+            whole = _rows(read(src))
         except AdapterError:  # refused whole (a layout the reader does not take yet)
             continue
-        rng = random.Random(path.name)
-        offsets = sorted(rng.sample(range(1, len(raw)), min(cuts, len(raw) - 1)))
-        target = tmp / path.name
-        for cut in offsets:
+        counts["files"] += 1
+        rng = random.Random(name)
+        offsets = set(rng.sample(range(1, len(raw)), min(cuts, len(raw) - 1)))
+        body = raw.rstrip()  # and every cut in the end of the last line, where a number ends
+        start = max(body.rfind(b"\n"), body.rfind(b"\r"), len(body) - LAST_LINE_CUTS - 1)
+        offsets |= set(range(start + 2, len(body)))
+        target = tmp / name
+        for cut in sorted(offsets):
             outcome = _truncation_outcome(read, raw, cut, target, whole)
             counts[outcome] += 1
             if outcome == "changed":
-                counts.setdefault("first_changed", f"{path.name} cut at byte {cut}")  # type: ignore[arg-type]
+                counts.setdefault("first_changed", f"{name} cut at byte {cut}")  # type: ignore[arg-type]
     return counts
 
 
@@ -350,4 +390,5 @@ def test_a_file_cut_anywhere_is_refused_warned_or_a_prefix_of_the_whole(
     if not _truncation_cases(real_exports, fmt):
         pytest.skip(f"no real export of {fmt}")
     counts = truncation_sweep(real_exports, fmt, tmp_path)
+    assert counts["files"] > 0, f"no file of {fmt} is read whole"
     assert counts["changed"] == 0, dict(counts)
