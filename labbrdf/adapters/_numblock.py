@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import os
 import re
 import warnings
@@ -38,6 +39,7 @@ __all__ = [
     "build_frame",
     "check_last_field",
     "check_last_row",
+    "check_joined",
     "unterminated",
     "labels",
     "body_bytes",
@@ -352,6 +354,55 @@ def check_last_row(
         return None
     previous = [lines[k - 1] for k in rows[-TAIL_ROWS - 1 : -1]]
     return check_last_field(path, lines[-1].strip(), previous, rows[-1], sep, tagged=tagged)
+
+
+def check_joined(path: str | os.PathLike[str], lines: list[str]) -> None:
+    """Refuse a single-export file whose first line comes again: two exports joined.
+
+    The first non-blank line of an export (its magic, title or column line) is written
+    once; ``cat a.txt a.txt > b.txt`` repeats it where the second export starts, and the
+    reader would otherwise read the second copy as more data, a footer or a confusing
+    error further on.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (for the message).
+    lines : list of str
+        Its lines (:func:`labbrdf.adapters._base.split_lines`).
+
+    Raises
+    ------
+    AdapterError
+        Naming the line where the second export starts.
+    """
+    heads = list(itertools.islice((i for i, ln in enumerate(lines) if ln.strip()), 2))
+    if not heads:
+        return
+    first = heads[0]
+    head = lines[first]
+    at = _index(lines, head, first + 1)
+    if at < 0 and len(heads) == 2:  # "a" without a final line end: its last line and the
+        # copy's first line are one line, found by the copy's second line after it
+        j = _index(lines, lines[heads[1]], heads[1] + 1)
+        if j > 0 and head.strip() and lines[j - 1].rstrip().endswith(head.strip()):
+            at = j - 1
+    if at >= 0:
+        raise AdapterError(
+            path,
+            f"the first line of the export ({head.strip()[:40]!r}, line {first + 1}) comes "
+            "again here: the file holds two exports joined (a copy starts at this line); "
+            "split it into one file per export",
+            at + 1,
+        )
+
+
+def _index(lines: list[str], line: str, start: int) -> int:
+    """``lines.index(line, start)`` (C speed), or -1."""
+    try:
+        return lines.index(line, start)
+    except ValueError:
+        return -1
 
 
 def tail_lines(data: bytes, start: int, n: int) -> list[str]:

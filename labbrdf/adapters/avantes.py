@@ -52,7 +52,7 @@ import numpy as np
 from ..dataset import Measurement
 from ._base import MAX_POINTS, AdapterError, Format, check_regular_file, decode, split_lines
 from ._base import read_bytes as _read_bytes
-from ._numblock import check_last_row
+from ._numblock import check_joined, check_last_row
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_avasoft"]
@@ -125,6 +125,7 @@ def read_avasoft(path: str | os.PathLike[str]) -> Measurement:
         raise AdapterError(path, f"{size} bytes: more than {MAX_POINTS} rows can take")
     text, encoding = decode(_read_bytes(path), path, ("utf-8", "cp1252"))
     lines = split_lines(text)
+    check_joined(path, lines)
     arrow = bool(lines) and lines[0].lstrip().startswith("Filename-->")
     lay = _arrow_layout(path, lines) if arrow else _ascii_layout(path, lines)
     quantity, scale = _quantity(path, lay)

@@ -40,7 +40,7 @@ import pandas as pd
 
 from ..dataset import Measurement
 from ._base import DECIMAL, AdapterError, Example, Format, decode, read_bytes, split_lines
-from ._numblock import warn
+from ._numblock import check_joined, warn
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_cary_csv"]
@@ -98,6 +98,7 @@ def read_cary_csv(path: str | os.PathLike[str]) -> Measurement:
     raw = read_bytes(path)
     text, encoding = decode(raw, path)
     lines = split_lines(text)
+    check_joined(path, lines)
     if len(lines) < 3:
         raise AdapterError(path, "expected sample names, column titles and data rows")
     modes = _y_modes(path, lines[1])

@@ -62,7 +62,7 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import AdapterError, Example, Format, check_count, decode, read_bytes, split_lines
-from ._numblock import check_last_row
+from ._numblock import check_joined, check_last_row
 from ._ole2 import ole_names, open_ole2, read_stream
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
@@ -178,6 +178,7 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
         # report where cp932 fails, not where UTF-8 did (a valid cp932 footer is not UTF-8)
         text, encoding = decode(raw, path, ("cp932",))
     lines = split_lines(text)
+    check_joined(path, lines)
     header, sep, xy_line = _text_header(path, lines)
     xunits = header.get("XUNITS", "")
     if xunits.upper() not in ("NANOMETERS", "NM"):

@@ -74,7 +74,7 @@ from ._base import (
     read_bytes,
     split_lines,
 )
-from ._numblock import check_last_row
+from ._numblock import check_joined, check_last_row
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_jaz", "read_oceanoptics", "refuse_raspberry_pi"]
@@ -224,6 +224,7 @@ def _load(path: str | os.PathLike[str]) -> _Text:
         )
     text, encoding = decode(read_bytes(path), path, ("utf-8", "cp1252"))
     lines = split_lines(text)
+    check_joined(path, lines)
     begin = next((i for i, s in enumerate(lines) if _BEGIN.fullmatch(s.strip())), None)
     return _Text(lines, encoding, begin, declared, at, key, text)
 

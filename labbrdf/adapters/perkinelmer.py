@@ -35,7 +35,7 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import AdapterError, Example, Format, check_count, decode, read_bytes, split_lines
-from ._numblock import check_last_row
+from ._numblock import check_joined, check_last_row
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_perkinelmer_asc"]
@@ -112,6 +112,7 @@ def read_perkinelmer_asc(path: str | os.PathLike[str]) -> Measurement:
     raw = read_bytes(path)
     text, encoding = decode(raw, path)
     lines = split_lines(text)
+    check_joined(path, lines)
     m = _MAGIC.fullmatch(lines[0]) if lines else None
     if m is None:
         raise AdapterError(
