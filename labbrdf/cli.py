@@ -504,9 +504,7 @@ def cmd_ingest(args: argparse.Namespace) -> int:
             unselected.append(f"{path}: {exc}")
             continue
         s = m.summary()
-        if m.meta.get("format") == "columns":  # e.g. the preamble lines it skipped
-            for note in m.meta.get("notes") or ():
-                print(f"labbrdf ingest: note: {path}: {note}", file=sys.stderr)
+        _print_notes("ingest", path, i.measurement.meta if i.measurement is not None else m.meta)
         measurements.append(m)
         rows.append(
             {
@@ -545,6 +543,18 @@ def cmd_ingest(args: argparse.Namespace) -> int:
     for u in unselected:
         print(f"labbrdf ingest: nothing selected in {u}", file=sys.stderr)
     return 2 if failures else 0
+
+
+def _print_notes(command: str, path: str, meta: dict[str, Any]) -> None:
+    """Print what a reader noted in ``meta["notes"]`` (rows dropped, lines skipped...).
+
+    One line per note on stderr, prefixed with the file.
+    """
+    notes = list(meta.get("notes") or ())
+    for part in meta.get("parts") or ():
+        notes += (part.get("meta") or {}).get("notes") or ()
+    for note in notes:
+        print(f"labbrdf {command}: note: {path}: {note}", file=sys.stderr)
 
 
 def _columns_spec(args: argparse.Namespace) -> str | None:

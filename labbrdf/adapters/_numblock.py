@@ -18,9 +18,11 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import os
 import re
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -36,6 +38,8 @@ __all__ = [
     "NUMBER",
     "build_frame",
     "check_last_field",
+    "check_last_row",
+    "check_joined",
     "unterminated",
     "labels",
     "body_bytes",
@@ -166,6 +170,30 @@ def unterminated(text: str | bytes) -> bool:
     return not text[-1:].isspace()
 
 
+def _check_missing_cells(
+    path: str | os.PathLike[str],
+    last: str,
+    previous: list[str],
+    line: int,
+    sep: str | None,
+    tagged: bool,
+) -> str | None:
+    """Refuse (or warn about) a last line that ends in a separator before cells every
+    earlier row fills: ``550,30,31.8,180,0.0694797,`` where each row has its sigma."""
+    have = len(_fields(last, sep, tagged))
+    ref = [len(_fields(p, sep, tagged)) for p in previous[-TAIL_ROWS:] if p.strip()]
+    if not have or not ref or min(ref) <= have:
+        return None
+    what = (
+        f"the last line, which has no line end, stops after {have} field(s) where every "
+        f"other row has at least {min(ref)}"
+    )
+    fix = "if the row is complete, end the line with a line break"
+    if len(ref) >= FIXED_ROWS:
+        raise AdapterError(path, f"{what}: the file looks truncated ({fix})", line)
+    return warn(path, f"{what}: the file may be truncated ({fix})", line)
+
+
 def check_last_field(
     path: str | os.PathLike[str],
     last: str,
@@ -179,7 +207,10 @@ def check_last_field(
 
     Only the last field of such a line can be cut (every other field is followed by a
     separator); it is compared with the same column in ``previous``, the rows before it
-    (the most recent :data:`TAIL_ROWS` are enough).
+    (the most recent :data:`TAIL_ROWS` are enough). A line that ends in a separator may
+    have lost the fields after it: it is refused where at least :data:`FIXED_ROWS` earlier
+    rows all have more fields (``...,0.0694797,`` where every row has a sigma after the
+    value), warned about where fewer do.
 
     Refused (the file looks truncated): the field ends in a decimal separator or in an
     exponent without digits (``0,``, ``300.``, ``4.5E-``); or the column has a precision of
@@ -188,8 +219,10 @@ def check_last_field(
     written ``0,322``; ``4.522`` or ``4.522E-0`` where it is written ``4.522E-02``).
     Warned (the column's own writing varies, so a shorter value may be a real one, e.g.
     ``0.13`` beside ``0.1308`` from a writer that drops trailing zeros): the field has fewer
-    decimals than some other row, fewer significant digits than every other row, or no
-    exponent where other rows have one; or no other row has the column to compare with.
+    decimals than some other row, fewer significant digits than every other row or (where
+    the decimals vary, as a writer of significant digits writes ``0.00152198`` beside
+    ``2.78913``) than some other row, or no exponent where other rows have one; or no other
+    row has the column to compare with.
 
     Parameters
     ----------
@@ -217,7 +250,9 @@ def check_last_field(
         The field is certainly cut short; the message names the line.
     """
     if last[-1:].isspace() or (sep is not None and last.endswith(sep)):
-        return None  # the last field is followed by a separator: complete
+        # the last field is followed by a separator: complete, but the cells after it may
+        # be missing
+        return _check_missing_cells(path, last, previous, line, sep, tagged)
     fields = _fields(last, sep, tagged)
     if not fields:
         return None
@@ -263,15 +298,111 @@ def check_last_field(
         or (f.exponent is None and exps)
         or (f.exponent is not None and exps and f.exponent < min(exps))
         or f.digits < min(r.digits for r in ref)
+        # a writer of significant digits (%g: 0.00152198 beside 2.78913): fewer of them
+        or (not fixed and f.digits < max(r.digits for r in ref))
     )
     if not short:
         return None
     return warn(
         path,
         f"{cut} is written shorter than other values of its column (up to "
-        f"{_decimals(max(decimals))}): the file may be truncated ({fix})",
+        f"{_decimals(max(decimals))}, {max(r.digits for r in ref)} significant digits): "
+        f"the file may be truncated ({fix})",
         line,
     )
+
+
+def check_last_row(
+    path: str | os.PathLike[str],
+    text: str | bytes,
+    lines: list[str],
+    rows: Sequence[int],
+    sep: str | None,
+    *,
+    tagged: bool = False,
+) -> str | None:
+    """:func:`check_last_field` for a reader that parses its rows itself.
+
+    Does nothing unless the file's last line has no line end and is the last data row.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (for the message).
+    text : str or bytes
+        The whole file (only its last characters are looked at).
+    lines : list of str
+        Its lines, split at CR, LF or CRLF (:func:`labbrdf.adapters._base.split_lines`).
+    rows : sequence of int
+        1-based line numbers of the data rows, in file order.
+    sep : str or None
+        Field separator; None for runs of blanks.
+    tagged : bool
+        Whether a row may start with an alphabetic tag.
+
+    Returns
+    -------
+    str or None
+        The warning issued, if any.
+
+    Raises
+    ------
+    AdapterError
+        The last number (or the cells after the last separator) was certainly cut short.
+    """
+    if not rows or rows[-1] != len(lines) or not unterminated(text):
+        return None
+    previous = [lines[k - 1] for k in rows[-TAIL_ROWS - 1 : -1]]
+    return check_last_field(path, lines[-1].strip(), previous, rows[-1], sep, tagged=tagged)
+
+
+def check_joined(path: str | os.PathLike[str], lines: list[str]) -> None:
+    """Refuse a single-export file whose first line comes again: two exports joined.
+
+    The first non-blank line of an export (its magic, title or column line) is written
+    once; ``cat a.txt a.txt > b.txt`` repeats it where the second export starts, and the
+    reader would otherwise read the second copy as more data, a footer or a confusing
+    error further on.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (for the message).
+    lines : list of str
+        Its lines (:func:`labbrdf.adapters._base.split_lines`).
+
+    Raises
+    ------
+    AdapterError
+        Naming the line where the second export starts.
+    """
+    heads = list(itertools.islice((i for i, ln in enumerate(lines) if ln.strip()), 2))
+    if not heads:
+        return
+    first = heads[0]
+    head = lines[first]
+    at = _index(lines, head, first + 1)
+    if at < 0 and len(heads) == 2:  # "a" without a final line end: its last line and the
+        # copy's first line are one line, found by the copy's second line after it
+        j = _index(lines, lines[heads[1]], heads[1] + 1)
+        if j > 0 and head.strip() and lines[j - 1].rstrip().endswith(head.strip()):
+            at = j - 1
+    if at >= 0:
+        raise AdapterError(
+            path,
+            f"the first line of the export ({head.strip()[:40]!r}, line {first + 1}) comes "
+            "again here: the file holds two exports joined (a copy starts at this line); "
+            "split it into one file per export",
+            at + 1,
+        )
+
+
+def _index(lines: list[str], line: str, start: int) -> int:
+    """``lines.index(line, start)`` (C speed), or -1."""
+    try:
+        return lines.index(line, start)
+    except ValueError:
+        return -1
 
 
 def tail_lines(data: bytes, start: int, n: int) -> list[str]:

@@ -52,6 +52,7 @@ import numpy as np
 from ..dataset import Measurement
 from ._base import MAX_POINTS, AdapterError, Format, check_regular_file, decode, split_lines
 from ._base import read_bytes as _read_bytes
+from ._numblock import check_joined, check_last_row
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_avasoft"]
@@ -124,17 +125,22 @@ def read_avasoft(path: str | os.PathLike[str]) -> Measurement:
         raise AdapterError(path, f"{size} bytes: more than {MAX_POINTS} rows can take")
     text, encoding = decode(_read_bytes(path), path, ("utf-8", "cp1252"))
     lines = split_lines(text)
+    check_joined(path, lines)
     arrow = bool(lines) and lines[0].lstrip().startswith("Filename-->")
     lay = _arrow_layout(path, lines) if arrow else _ascii_layout(path, lines)
     quantity, scale = _quantity(path, lay)
     a, at = _rows(path, lines, lay)
+    doubt = check_last_row(path, text, lines, at, lay.sep)
     x = a[:, 0]
     k = np.flatnonzero(np.diff(x) <= 0)
     if k.size:
         raise AdapterError(
             path, f"wavelength {x[k[0] + 1]:g} nm does not increase", at[int(k[0]) + 1]
         )
-    return _measurement(path, lay, quantity, scale, a, at, encoding)
+    m = _measurement(path, lay, quantity, scale, a, at, encoding)
+    if doubt:
+        m.meta["warnings"] = [doubt]
+    return m
 
 
 def _arrow_layout(path: str | os.PathLike[str], lines: list[str]) -> _Layout:

@@ -40,6 +40,7 @@ import pandas as pd
 
 from ..dataset import Measurement
 from ._base import DECIMAL, AdapterError, Example, Format, decode, read_bytes, split_lines
+from ._numblock import check_joined, warn
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_cary_csv"]
@@ -53,6 +54,8 @@ _YMODES: dict[str, tuple[str, float]] = {
 }
 _XHEADER = "Wavelength (nm)"
 _SPHERE = re.compile(r"sphere|\bDRA\b", re.IGNORECASE)
+#: the line that ends every metadata block
+_END_OF_BLOCK = "<Current Wavelength>"
 
 
 def _sniff(head: bytes) -> bool:
@@ -95,6 +98,7 @@ def read_cary_csv(path: str | os.PathLike[str]) -> Measurement:
     raw = read_bytes(path)
     text, encoding = decode(raw, path)
     lines = split_lines(text)
+    check_joined(path, lines)
     if len(lines) < 3:
         raise AdapterError(path, "expected sample names, column titles and data rows")
     modes = _y_modes(path, lines[1])
@@ -103,6 +107,7 @@ def read_cary_csv(path: str | os.PathLike[str]) -> Measurement:
     cols = _columns(path, lines, names, modes)
     end = cols.end
     blocks = _footer_blocks(lines, end)
+    _check_footer_complete(path, text, lines, blocks)
     paired = len(blocks) == nsample and all(
         b["name"] == n for b, n in zip(blocks, names, strict=True)
     )
@@ -120,6 +125,8 @@ def read_cary_csv(path: str | os.PathLike[str]) -> Measurement:
         "samples": samples_meta,
         "dropped_points": dropped_total,
     }
+    if not blocks and "%R" in modes:
+        meta["warnings"] = [_warn_no_footer(path, end, names, modes)]
     return finish(path, frames, meta)
 
 
@@ -310,6 +317,49 @@ def _check_steps(
             "(a data row lost or duplicated?)",
             int(rows[j + 1]) + 1,
         )
+
+
+def _check_footer_complete(
+    path: str | os.PathLike[str], text: str, lines: list[str], blocks: list[dict[str, Any]]
+) -> None:
+    """Refuse a file cut inside its last metadata block.
+
+    Cary ends every block with its ``<Current Wavelength>`` line. A last block without it,
+    or a file whose last line has no line end, was cut short: what is missing may be the
+    parameter that names the sphere, and with it the quantity of a %R sample.
+    """
+    if not blocks:
+        return
+    last = max(i for i, ln in enumerate(lines) if ln.strip())
+    if not lines[last].strip().startswith(_END_OF_BLOCK):
+        raise AdapterError(
+            path,
+            f"the metadata block of sample {blocks[-1]['name']!r} ends without its "
+            f"{_END_OF_BLOCK!r} line: the file looks truncated (its accessory, and so the "
+            "quantity of a %R sample, may be in the part that is missing)",
+            last + 1,
+        )
+    if not text.endswith(("\n", "\r")):
+        raise AdapterError(
+            path,
+            f"the last line ({lines[last].strip()[:40]!r}) has no line end: the file looks "
+            "truncated",
+            last + 1,
+        )
+
+
+def _warn_no_footer(
+    path: str | os.PathLike[str], end: int, names: list[str], modes: list[str]
+) -> str:
+    """The doubt about a %R sample of a file that ends after its data (no metadata blocks)."""
+    r = [n for n, m in zip(names, modes, strict=True) if m == "%R"]
+    return warn(
+        path,
+        f"the data end without the metadata blocks Cary writes after them (file truncated?): "
+        f"the accessory is unknown, so the %R sample(s) {r} are read as specular "
+        "'reflectance', not 'hemispherical_reflectance', and no wavelength step is checked",
+        end + 1,
+    )
 
 
 def _footer_blocks(lines: list[str], start: int) -> list[dict[str, Any]]:

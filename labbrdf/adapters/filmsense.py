@@ -32,7 +32,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..dataset import Measurement, wrap_delta
 from ._base import AdapterError, Example, Format, decode, read_bytes, split_lines
-from ._numblock import NUMBER, build_frame, group_angles, measurement
+from ._numblock import (
+    NUMBER,
+    build_frame,
+    check_joined,
+    check_last_row,
+    group_angles,
+    measurement,
+)
 
 __all__ = ["FORMATS", "filmsense_psi_delta", "read_filmsense", "sniff_filmsense"]
 
@@ -161,6 +168,7 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
     raw = read_bytes(path)
     text, encoding = decode(raw, path)
     lines = split_lines(text)
+    check_joined(path, lines)
     p = Path(path)
     f, head, aoi_file = _count_line(path, lines)
     aoi = abs(aoi_file)
@@ -182,6 +190,9 @@ def read_filmsense(path: str | os.PathLike[str]) -> Measurement:
         rows = _static_rows(f, k0, wl)
     else:
         rows = _dynamic_rows(f, k0, wl, meta)
+    doubt = check_last_row(path, text, lines, sorted(set(rows.lineno.tolist())), "\t")
+    if doubt:
+        meta["warnings"] = [doubt]
     bad = ~((rows.nn >= -1) & (rows.nn <= 1))
     if bad.any():
         raise AdapterError(

@@ -62,6 +62,7 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import AdapterError, Example, Format, check_count, decode, read_bytes, split_lines
+from ._numblock import check_joined, check_last_row
 from ._ole2 import ole_names, open_ole2, read_stream
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
@@ -177,6 +178,7 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
         # report where cp932 fails, not where UTF-8 did (a valid cp932 footer is not UTF-8)
         text, encoding = decode(raw, path, ("cp932",))
     lines = split_lines(text)
+    check_joined(path, lines)
     header, sep, xy_line = _text_header(path, lines)
     xunits = header.get("XUNITS", "")
     if xunits.upper() not in ("NANOMETERS", "NM"):
@@ -193,6 +195,7 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
         # a data row "x<TAB>y<LF>" takes at least 4 bytes
         check_count(path, "NPOINTS", int(npoints), file_size=len(raw), bytes_per_point=4)
     xs, ys, end_of_data = _text_xy(path, lines, xy_line, sep)
+    doubt = check_last_row(path, text, lines, range(xy_line + 1, end_of_data + 1), sep)
     footer, footer_en = _read_footer(path, lines, end_of_data, sep)
     if npoints is not None:
         if npoints != len(xs):
@@ -225,6 +228,8 @@ def read_jasco_text(path: str | os.PathLike[str]) -> Measurement:
         "npoints": len(xs),
         "dropped_points": dropped,
     }
+    if doubt:
+        meta["warnings"] = [doubt]
     return finish(path, [frame], meta)
 
 

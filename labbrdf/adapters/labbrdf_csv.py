@@ -24,6 +24,11 @@ Common rules
 5. ``sample`` defaults to the file stem, ``instrument`` to ``labbrdf-csv``.
 6. A bad row raises :class:`~labbrdf.AdapterError` with its line number: wrong
    cell count, a non-number, wavelength <= 0, an angle outside its range, sigma < 0.
+7. A last data row without line end whose last number is written shorter than its column
+   (a file cut mid-number: ``0.0`` where the column is written ``0.01``) is refused, or
+   warned about where the column's writing varies
+   (:func:`labbrdf.adapters._numblock.check_last_field`; the warning is kept in
+   ``meta["warnings"]``).
 
 (a) Specular scan: ``# labbrdf specular-scan v1``
 -------------------------------------------------
@@ -85,6 +90,7 @@ from typing import Any
 
 from ..dataset import Measurement, make_frame
 from ._base import AdapterError, Format, decode, read_bytes, split_lines
+from ._numblock import check_last_row
 from ._spectro import finish, number
 
 __all__ = ["FORMATS", "read_hemispherical", "read_specular_scan"]
@@ -177,7 +183,15 @@ def _parse(
     if not rows:
         raise AdapterError(path, "no data rows after the column header")
     keys["__comments__"] = "\n".join(comments)
+    keys["__warnings__"] = _check_cut(path, text, lines, rows)
     return keys, lines, columns, rows
+
+
+def _check_cut(
+    path: str | os.PathLike[str], text: str, lines: list[str], rows: list[tuple[int, list[str]]]
+) -> str:
+    """Refuse (or warn about, returned) a last data row without line end that looks cut."""
+    return check_last_row(path, text, lines, [n for n, _ in rows], ",") or ""
 
 
 def _columns(
@@ -217,12 +231,16 @@ def _cell(
 
 def _meta(keys: dict[str, str], layout: str, used: tuple[str, ...]) -> dict[str, Any]:
     comments = keys.pop("__comments__")
-    return {
+    doubt = keys.pop("__warnings__")
+    meta: dict[str, Any] = {
         "format": f"labbrdf-{layout}",
         "version": 1,
         "header": {k: v for k, v in keys.items() if k not in used},
         "comments": comments.split("\n") if comments else [],
     }
+    if doubt:
+        meta["warnings"] = [doubt]
+    return meta
 
 
 def _range(

@@ -74,6 +74,7 @@ from ._base import (
     read_bytes,
     split_lines,
 )
+from ._numblock import check_joined, check_last_row
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_jaz", "read_oceanoptics", "refuse_raspberry_pi"]
@@ -172,6 +173,7 @@ class _Text:
     declared: int | None  # declared pixel count
     declared_at: int | None  # its 1-based line
     declared_key: str = "Number of Pixels"  # the header key as written
+    text: str = ""  # the whole file (is its last line cut short?)
 
 
 _DECLARED = re.compile(r"(Number of Pixels in (?:Processed )?Spectrum)\s*:\s*(.*)", re.IGNORECASE)
@@ -222,8 +224,9 @@ def _load(path: str | os.PathLike[str]) -> _Text:
         )
     text, encoding = decode(read_bytes(path), path, ("utf-8", "cp1252"))
     lines = split_lines(text)
+    check_joined(path, lines)
     begin = next((i for i, s in enumerate(lines) if _BEGIN.fullmatch(s.strip())), None)
-    return _Text(lines, encoding, begin, declared, at, key)
+    return _Text(lines, encoding, begin, declared, at, key, text)
 
 
 def read_oceanoptics(path: str | os.PathLike[str]) -> Measurement:
@@ -252,7 +255,7 @@ def read_oceanoptics(path: str | os.PathLike[str]) -> Measurement:
         return _read_headerless(path, t)
     header, data_from = _header(path, t.lines, t.begin)
     quantity, scale, basis = _mode(path, data_from)
-    x, ys = _pairs(path, t)
+    x, ys, doubts = _pairs(path, t)
     frame, dropped = spectrum_frame(
         path=path,
         sample=Path(path).stem,
@@ -270,17 +273,20 @@ def read_oceanoptics(path: str | os.PathLike[str]) -> Measurement:
         "percent": scale == PERCENT,
         "dropped_points": dropped,
     }
+    if doubts:
+        meta["warnings"] = doubts
     return finish(path, [frame], meta)
 
 
-def _pairs(path: str | os.PathLike[str], t: _Text) -> tuple[np.ndarray, list[float]]:
-    """The checked wavelength and value rows of a marked export."""
+def _pairs(path: str | os.PathLike[str], t: _Text) -> tuple[np.ndarray, list[float], list[str]]:
+    """The checked wavelength and value rows of a marked export, and doubts about them."""
     assert t.begin is not None
     rows, first = _rows(path, t.lines, t.begin + 1, 2, t.declared)
+    doubt = check_last_row(path, t.text, t.lines, first, "\t")
     _check_declared(path, t, len(rows))
     x = np.asarray([r[0] for r in rows])
     _increasing(path, x, first)
-    return x, [r[1] for r in rows]
+    return x, [r[1] for r in rows], [doubt] if doubt else []
 
 
 def _check_declared(path: str | os.PathLike[str], t: _Text, n: int) -> None:
@@ -424,6 +430,7 @@ def _read_headerless(path: str | os.PathLike[str], t: _Text) -> Measurement:
         )
     quantity, scale, basis = found
     rows, at = _headerless_rows(path, lines, first)
+    doubt = check_last_row(path, t.text, lines, at, "\t" if "\t" in lines[-1] else None)
     x = np.asarray([r[0] for r in rows])
     _increasing(path, x, at)
     frame, dropped = spectrum_frame(
@@ -444,6 +451,8 @@ def _read_headerless(path: str | os.PathLike[str], t: _Text) -> Measurement:
         "dropped_points": dropped,
         "layout": "header-less (title line, then two columns)",
     }
+    if doubt:
+        meta["warnings"] = [doubt]
     return finish(path, [frame], meta)
 
 
@@ -516,10 +525,14 @@ def read_jaz(path: str | os.PathLike[str]) -> Measurement:
     header, _ = _header(path, t.lines, t.begin)
     names = _jaz_columns(path, t)
     rows, at = _rows(path, t.lines, t.begin + 2, len(names), t.declared, tuple(names))
+    doubt = check_last_row(path, t.text, t.lines, at, "\t")
     _check_declared(path, t, len(rows))
     a = np.asarray(rows, dtype=float)
     _increasing(path, a[:, 0], at)
-    return _jaz_measurement(path, t, header, a, at)
+    m = _jaz_measurement(path, t, header, a, at)
+    if doubt:
+        m.meta["warnings"] = [doubt]
+    return m
 
 
 def _jaz_columns(path: str | os.PathLike[str], t: _Text) -> list[str]:

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import AdapterError, Example, Format, check_count, decode, read_bytes, split_lines
+from ._numblock import check_joined, check_last_row
 from ._spectro import PERCENT, finish, number, spectrum_frame
 
 __all__ = ["FORMATS", "read_perkinelmer_asc"]
@@ -111,6 +112,7 @@ def read_perkinelmer_asc(path: str | os.PathLike[str]) -> Measurement:
     raw = read_bytes(path)
     text, encoding = decode(raw, path)
     lines = split_lines(text)
+    check_joined(path, lines)
     m = _MAGIC.fullmatch(lines[0]) if lines else None
     if m is None:
         raise AdapterError(
@@ -120,7 +122,8 @@ def read_perkinelmer_asc(path: str | os.PathLike[str]) -> Measurement:
     gr = _find(path, lines, "#GR", hdr + 1)
     data = _find(path, lines, "#DATA", gr + 1)
     grm = _gr_block(path, lines, gr, data, len(raw))
-    xs, ys = _data_rows(path, lines, data, grm)
+    xs, ys, at = _data_rows(path, lines, data, grm)
+    doubt = check_last_row(path, text, lines, at, "\t" if "\t" in lines[-1] else None)
     header = {key: lines[n - 1].strip() for n, key in _HEADER_LINES.items() if n <= hdr}
     accessory = header.get("accessory", "")
     sphere = bool(_SPHERE.search(accessory))
@@ -146,6 +149,8 @@ def read_perkinelmer_asc(path: str | os.PathLike[str]) -> Measurement:
         "gr": grm,
         "dropped_points": dropped,
     }
+    if doubt:
+        meta["warnings"] = [doubt]
     return finish(path, [frame], meta)
 
 
@@ -189,11 +194,15 @@ def _gr_block(
 
 def _data_rows(
     path: str | os.PathLike[str], lines: list[str], data: int, grm: dict[str, Any]
-) -> tuple[list[float], list[float]]:
-    """The ``x<TAB>y`` rows after #DATA, checked against NPOINTS and the FIRSTX/DELTAX grid."""
+) -> tuple[list[float], list[float], list[int]]:
+    """The ``x<TAB>y`` rows after #DATA and their 1-based lines.
+
+    Checked against NPOINTS and the FIRSTX/DELTAX grid.
+    """
     firstx, deltax, npoints = grm["firstx_nm"], grm["deltax_nm"], grm["npoints"]
     xs: list[float] = []
     ys: list[float] = []
+    at: list[int] = []
     last = data
     for i in range(data + 1, len(lines)):
         line = lines[i]
@@ -207,6 +216,7 @@ def _data_rows(
         xs.append(number(cells[0], path, i + 1, "X"))
         ys.append(number(cells[1], path, i + 1, "Y"))
         last = i + 1
+        at.append(last)
     if len(xs) != npoints:
         raise AdapterError(
             path,
@@ -223,7 +233,7 @@ def _data_rows(
             f"X {xs[k]} is not on the FIRSTX + i*DELTAX grid (expected {grid[k]:.6g})",
             data + 2 + k,
         )
-    return xs, ys
+    return xs, ys, at
 
 
 FORMATS = (

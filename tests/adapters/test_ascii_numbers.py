@@ -76,15 +76,26 @@ def test_parse_number_takes_nonfinite_only_when_asked() -> None:
 
 
 #: the text formats read with the shared block parser (labbrdf.adapters._numblock.parse_block)
-#: and those that call its last-line check themselves
+#: and those that call its last-line check themselves (check_last_row); JCAMP-DX, Cary and
+#: Zemax files end with a marker or footer, which a cut removes (refused as truncated)
 CUT_CHECKED = [
     "woollam-wvase",
     "woollam-completeease",
     "accurion-ep4",
     "sentech-spectraray",
     "shimadzu-uvprobe-text",
+    "jasco-spectramanager-text",
+    "perkinelmer-uvwinlab-asc",
+    "filmsense",
+    "oceanoptics-text",
 ]
-_CUT_FILES = {"shimadzu-uvprobe-text": "shimadzu-uvprobe/sa281-02-280K.txt"}
+#: files that end with a data row (where CASES names another)
+_CUT_FILES = {
+    "shimadzu-uvprobe-text": "shimadzu-uvprobe/sa281-02-280K.txt",
+    "jasco-spectramanager-text": "jasco-spectramanager-text/PbSe batch 1.txt",
+    "filmsense": "filmsense-txt/Filmsense_kineticTest.txt",
+    "oceanoptics-text": "oceanoptics-oceanview/ambient_0_40_Absorbance_10-54-38-373.txt",
+}
 
 
 def _last_number_cut(raw: bytes, keep: int) -> bytes:

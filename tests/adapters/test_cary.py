@@ -10,12 +10,16 @@ line (text) or byte offset (binary) and what was expected.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import pytest
 
-from labbrdf.adapters import AdapterError
+import labbrdf
+from labbrdf.adapters import AdapterError, AdapterWarning
 from labbrdf.adapters.cary import read_cary_csv
+
+FIXTURES = Path(labbrdf.__file__).parent / "data" / "fixtures"
 
 
 def test_cary_single_sample(real_exports: Path, value_at, check_spectrum) -> None:
@@ -132,8 +136,56 @@ def test_cary_errors(tmp_path: Path, data: bytes, match: str, write) -> None:
 
 
 def test_cary_without_metadata_blocks_skips_the_step_check(tmp_path: Path, write) -> None:
-    m = read_cary_csv(write(tmp_path, "a.csv", cary("500.1,50,500.0,1.5,\r\n", blocks="")))
+    p = write(tmp_path, "a.csv", cary("500.1,50,500.0,1.5,\r\n", blocks=""))
+    with pytest.warns(AdapterWarning, match=r"a.csv, line 4: the data end without the metadata"):
+        m = read_cary_csv(p)
     assert len(m.data) == 2 and "parameters" not in m.meta["samples"][0]
+    assert "'S1'" in m.meta["warnings"][0] and "specular 'reflectance'" in m.meta["warnings"][0]
+
+
+def test_cary_without_metadata_blocks_and_no_r_sample_reads_without_a_doubt(
+    tmp_path: Path, write
+) -> None:
+    p = write(
+        tmp_path,
+        "a.csv",
+        cary("500.1,50,500.0,1.5,\r\n", modes="%T,Wavelength (nm),Abs", blocks=""),
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = read_cary_csv(p)
+    assert "warnings" not in m.meta
+
+
+def test_cary_sphere_fixture_cut_inside_its_footer_is_refused(tmp_path: Path) -> None:
+    """Cut before the parameter that names the DRA sphere, the %R sample would read as
+    specular reflectance: every cut inside the footer is refused naming the last line."""
+    raw = (FIXTURES / "spectrophotometer" / "osr_sphere_cary.csv").read_bytes()
+    start = raw.index(b"\r\n\r\n") + 4  # the first metadata block
+    p = tmp_path / "cut.csv"
+    for cut in range(start + 1, len(raw) - 3):  # up to "360.0" before its CR LF
+        p.write_bytes(raw[:cut])
+        line = len(raw[:cut].decode("ascii").splitlines())
+        with pytest.raises(AdapterError, match=rf"cut.csv, line {line}: ") as exc:
+            read_cary_csv(p)
+        assert "truncated" in str(exc.value), cut
+    p.write_bytes(raw[: len(raw) - 2])  # only the trailing blank line missing: complete
+    m = read_cary_csv(p)
+    assert set(m.data["quantity"].astype(str)) == {"hemispherical_reflectance"}
+
+
+@pytest.mark.parametrize(
+    ("cut", "match"),
+    [
+        ("Accessory ", r"line 24: the metadata block of sample .S2. ends without its .<Cur"),
+        ("<Current Wavelength> , 45", r"line 27: the last line .* has no line end"),
+    ],
+)
+def test_cary_last_block_cut_short_is_refused(tmp_path: Path, write, cut: str, match: str) -> None:
+    raw = cary()
+    p = write(tmp_path, "a.csv", raw[: raw.rindex(cut.encode()) + len(cut)])
+    with pytest.raises(AdapterError, match=match):
+        read_cary_csv(p)
 
 
 def test_utf16_cary_text_is_refused_as_the_wrong_encoding(tmp_path: Path, write) -> None:

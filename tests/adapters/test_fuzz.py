@@ -180,22 +180,32 @@ _OWN = {
 def test_mutated_own_csv_files_raise_adaptererror_or_lose_only_the_touched_rows(
     tmp_path: Path, fmt: str
 ) -> None:
-    """One data row per line: a truncated file gives exactly its remaining data lines (the
-    last one possibly cut short but still numeric), a deleted line costs at most one row, a
-    duplicated line adds at most one; ``#`` inserted or flipped in at a line start comments
-    a row out, so a flip or an insertion may lose rows (one per changed byte) but never
-    add one."""
+    """One data row per line: a truncated file is refused, warned about (a last number
+    that may be cut short), or gives exactly its complete remaining data lines, each a row
+    of the whole file (never a cut value); a deleted line costs at most one row, a
+    duplicated line adds at most one; ``#`` inserted or flipped in at a line start
+    comments a row out, so a flip or an insertion may lose rows (one per changed byte) but
+    never add one."""
     raw = _OWN[fmt].encode()
     src = tmp_path / "orig.csv"
     src.write_bytes(raw)
     n0 = _points(READERS[fmt].read(src))
     assert n0 == 18 if fmt == "labbrdf-specular-scan" else n0 == 20
+    whole = _rows(READERS[fmt].read(src))
     target = tmp_path / "mutated.csv"
+    last = raw.rstrip().rfind(b"\n") + 1  # every cut inside the last row, as well
+    for cut in range(last + 1, len(raw)):
+        outcome = _truncation_outcome(READERS[fmt].read, raw, cut, target, whole)
+        assert outcome in ("refused", "warned", "prefix"), f"cut at {cut}: {raw[last:cut]!r}"
 
     @settings(max_examples=60, deadline=None, derandomize=True, database=None)
     @given(data=st.data())
     def run(data: st.DataObject) -> None:
         op, mutated, _ = _mutate(raw, data)
+        if op == "truncate":
+            outcome = _truncation_outcome(READERS[fmt].read, raw, len(mutated), target, whole)
+            assert outcome in ("refused", "warned", "prefix"), f"cut at {len(mutated)}"
+            return
         target.write_bytes(mutated)
         try:
             m = READERS[fmt].read(target)
@@ -203,12 +213,7 @@ def test_mutated_own_csv_files_raise_adaptererror_or_lose_only_the_touched_rows(
             assert str(target) in str(exc)
             return
         n = _points(m)
-        if op == "truncate":  # exactly the data lines kept, the last one maybe partial
-            lines = mutated.splitlines()
-            head = next(i for i, ln in enumerate(lines) if ln.startswith(b"wavelength_nm"))
-            low = high = sum(1 for ln in lines[head + 1 :] if ln.strip())
-        else:
-            low, high = {"delete": (n0 - 1, n0), "duplicate": (n0, n0 + 1)}.get(op, (n0 - 4, n0))
+        low, high = {"delete": (n0 - 1, n0), "duplicate": (n0, n0 + 1)}.get(op, (n0 - 4, n0))
         assert low <= n <= high, f"{op}: {n} points from a file of {n0}"
 
     run()
@@ -252,8 +257,8 @@ def test_reading_never_writes(real_exports: Path, tmp_path: Path, monkeypatch) -
 
 #: text formats cut at byte offsets: those whose readers check the last line of a file cut
 #: short (:func:`labbrdf.adapters._numblock.check_last_field`: UVProbe text, Woollam,
-#: Accurion, SENTECH, declared columns) and those whose files state their point count or
-#: end with a footer or end marker
+#: Accurion, SENTECH, declared columns, labbrdf's own CSV layouts...) and those whose files
+#: state their point count or end with a footer or end marker
 TRUNCATION_FORMATS = (
     "shimadzu-uvprobe-text",
     "woollam-wvase",
@@ -267,11 +272,18 @@ TRUNCATION_FORMATS = (
     "filmsense",
     "jcamp-dx",
     "zemax-bsdf",
+    "labbrdf-specular-scan",
+    "labbrdf-hemispherical-reflectance",
+    "oceanoptics-text",
+    "oceanoptics-jaz",
+    "avantes-avasoft",
 )
 #: the declared columns of the real headerless file
 _COLUMNS_FILES = {"MoS2_fromCzech2015.txt": "wavelength_nm,absorbance"}
 #: cut offsets tried per file (seeded by the file name: the same offsets on every run)
 CUTS = 40
+#: and the cuts in the last bytes of the last line (the last number or two)
+LAST_LINE_CUTS = 24
 
 
 def _rows(m: labbrdf.Measurement) -> set[tuple]:
@@ -307,52 +319,74 @@ def _truncation_outcome(read, raw: bytes, cut: int, target: Path, whole: set[tup
     return "prefix" if _rows(m) <= whole else "changed"
 
 
-def _truncation_cases(real_exports: Path, fmt: str) -> list[tuple[Path, Any]]:
+def _avantes_rows(n: int) -> str:
+    """AvaSoft 8 ASCII rows whose processed column is 100 (S - D) / (R - D), 5 decimals."""
+    rows = []
+    for i in range(n):
+        d, r, s = 1000.0 + i, 31000.0 + 7 * i, 9000.0 + 13 * i
+        rows.append(
+            f"{400 + 0.6 * i:.2f};{s:9.3f};{d:9.3f};{r:9.3f};{100 * (s - d) / (r - d):.5f}\r\n"
+        )
+    return "".join(rows)
+
+
+#: synthetic files of the formats whose only real file is refused whole (irradiance)
+_SYNTHETIC = {
+    "avantes-avasoft": [
+        (
+            "feather_reflection.txt",
+            "\r\nIntegration time [ms]:  84.900\r\nAveraging Nr. [scans]: 10\r\n"
+            "Smoothing Nr. [pixels]: 1\r\nData measured with spectrometer [name]: 1501154U1\r\n"
+            "Wave   ;Sample   ;Dark     ;Reference;Reflectance\r\n"
+            "[nm]   ;[counts] ;[counts] ;[counts] ;[%]\r\n\r\n" + _avantes_rows(40),
+        )
+    ]
+}
+
+
+def _truncation_cases(real_exports: Path, fmt: str) -> list[tuple[str, bytes, Any]]:
+    """(file name, its bytes, the reader) of every real file, fixture or synthetic file."""
     if fmt == "columns":
         return [
-            (real_exports / "generic-columns" / name, lambda p, c=cols: labbrdf.read(p, columns=c))
+            (name, p.read_bytes(), lambda p, c=cols: labbrdf.read(p, columns=c))
             for name, cols in _COLUMNS_FILES.items()
-            if (real_exports / "generic-columns" / name).is_file()
+            if (p := real_exports / "generic-columns" / name).is_file()
         ]  # fmt: skip
     files = [p for p in _real_files(real_exports) if _format_of(p) == fmt]
     files += [p for p in sorted(FIXTURES.glob("*/*")) if p.is_file() and sniff(p) == [fmt]]
-    return [(p, READERS[fmt].read) for p in files]
+    read = READERS[fmt].read
+    cases = [(p.name, p.read_bytes(), read) for p in files]
+    return cases + [(name, text.encode("cp1252"), read) for name, text in _SYNTHETIC.get(fmt, [])]
 
 
 def truncation_sweep(real_exports: Path, fmt: str, tmp: Path, cuts: int = CUTS) -> Counter:
-    """Cut every real file of ``fmt`` at ``cuts`` seeded offsets; count the outcomes."""
+    """Cut every file of ``fmt`` at ``cuts`` seeded offsets and inside its last line; count
+    the outcomes (and the files read whole, ``files``)."""
     counts: Counter = Counter()
-    for path, read in _truncation_cases(real_exports, fmt):
-        raw = path.read_bytes()
+    for name, raw, read in _truncation_cases(real_exports, fmt):
+        src = tmp / "whole" / name
+        src.parent.mkdir(exist_ok=True)
+        src.write_bytes(raw)
         try:
-            whole = _rows(read(path))
+            whole = _rows(read(src))
         except AdapterError:  # refused whole (a layout the reader does not take yet)
             continue
-        rng = random.Random(path.name)
-        offsets = sorted(rng.sample(range(1, len(raw)), min(cuts, len(raw) - 1)))
-        target = tmp / path.name
-        for cut in offsets:
+        counts["files"] += 1
+        rng = random.Random(name)
+        offsets = set(rng.sample(range(1, len(raw)), min(cuts, len(raw) - 1)))
+        body = raw.rstrip()  # and every cut in the end of the last line, where a number ends
+        start = max(body.rfind(b"\n"), body.rfind(b"\r"), len(body) - LAST_LINE_CUTS - 1)
+        offsets |= set(range(start + 2, len(body)))
+        target = tmp / name
+        for cut in sorted(offsets):
             outcome = _truncation_outcome(read, raw, cut, target, whole)
             counts[outcome] += 1
             if outcome == "changed":
-                counts.setdefault("first_changed", f"{path.name} cut at byte {cut}")  # type: ignore[arg-type]
+                counts.setdefault("first_changed", f"{name} cut at byte {cut}")  # type: ignore[arg-type]
     return counts
 
 
-_CARY_FOOTER = pytest.mark.xfail(
-    strict=True,
-    reason="a Cary file cut inside its method footer loses the sphere accessory and reads as "
-    "specular reflectance instead of hemispherical (osr_sphere_cary.csv)",
-)
-
-
-@pytest.mark.parametrize(
-    "fmt",
-    [
-        pytest.param(f, marks=_CARY_FOOTER) if f == "agilent-cary-winuv-csv" else f
-        for f in TRUNCATION_FORMATS
-    ],
-)
+@pytest.mark.parametrize("fmt", TRUNCATION_FORMATS)
 def test_a_file_cut_anywhere_is_refused_warned_or_a_prefix_of_the_whole(
     real_exports: Path, tmp_path: Path, fmt: str
 ) -> None:
@@ -361,4 +395,5 @@ def test_a_file_cut_anywhere_is_refused_warned_or_a_prefix_of_the_whole(
     if not _truncation_cases(real_exports, fmt):
         pytest.skip(f"no real export of {fmt}")
     counts = truncation_sweep(real_exports, fmt, tmp_path)
+    assert counts["files"] > 0, f"no file of {fmt} is read whole"
     assert counts["changed"] == 0, dict(counts)

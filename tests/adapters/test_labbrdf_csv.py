@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import labbrdf
-from labbrdf.adapters import AdapterError
+from labbrdf.adapters import AdapterError, AdapterWarning
 from labbrdf.adapters.labbrdf_csv import read_hemispherical, read_specular_scan
 
 SPEC = "# labbrdf specular-scan v1\n"
@@ -188,3 +189,44 @@ def test_trailing_header_comma_missing_value_and_overflow(tmp_path: Path) -> Non
     text = HEMI + "# unit: 1\nwavelength_nm,value\n400,1e999\n"
     with pytest.raises(AdapterError, match=r"line 4: value: '1e999' overflows a float"):
         read_hemispherical(write(tmp_path, text))
+
+
+# ------------------------------------------------------------------ a file cut short
+
+#: six rows whose sigma is written with 2 decimals (a column with a precision of its own)
+_ROWS = "".join(f"632.8,45,{t},{10 + t}.5,0.{t}1\n" for t in range(40, 46))
+
+
+@pytest.mark.parametrize(
+    ("tail", "match"),
+    [
+        ("632.8,45,46,56.5,0.", r"field 5 '0\.' on the last line, .* ends without its digits"),
+        ("632.8,45,46,56.5,0.4", r"field 5 '0\.4' .* has 1 decimal where every other row"),
+        (
+            "632.8,45,46,56.5,",
+            r"the last line, .* stops after 4 field\(s\) where every other row has at least 5",
+        ),
+    ],
+)
+def test_specular_scan_cut_in_its_last_row_is_refused(
+    tmp_path: Path, tail: str, match: str
+) -> None:
+    """A copy stopped mid-number gave sigma 0 or 0.4 for 0.41, or no sigma at all."""
+    p = write(tmp_path, spec(_ROWS + tail))
+    line = len(spec(_ROWS + tail).splitlines())
+    with pytest.raises(AdapterError, match=rf"scan.csv, line {line}: {match}"):
+        read_specular_scan(p)
+
+
+def test_hemispherical_last_value_written_shorter_is_warned_about(tmp_path: Path) -> None:
+    """Values written with 1 to 3 decimals: a shorter last one may be real, so a warning
+    naming the line, kept in the metadata; with its line end the row is complete."""
+    rows = "300,8.12\n305,8.3\n310,8.475\n315,8.5\n320,8.6"
+    text = HEMI + "# unit: %\nwavelength_nm,value\n" + rows
+    with pytest.warns(AdapterWarning, match=r"scan.csv, line 8: field 2 '8\.6' .* shorter"):
+        m = read_hemispherical(write(tmp_path, text))
+    assert len(m) == 5 and "line 8" in m.meta["warnings"][0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = read_hemispherical(write(tmp_path, text + "\n"))
+    assert "warnings" not in m.meta

@@ -277,3 +277,19 @@ def test_real_pi_file_is_refused_by_name(real_exports: Path, capsys) -> None:
     assert main(["ingest", str(p)]) == 2
     err = capsys.readouterr().err
     assert "oceanoptics-text" in err and "Traceback" not in err and err.count("\n") == 1
+
+
+def test_real_jaz_file_cut_in_its_last_number_is_refused(
+    real_exports: Path, tmp_path: Path
+) -> None:
+    """Without its end marker and cut in the last P, the file still has its 2048 rows and
+    53.1989 agrees with the counts within their rounding: the precision of the column
+    (6 decimals on every row) is what says it is cut."""
+    raw = real_exports.joinpath(*JAZ).read_bytes()
+    body = raw[: raw.index(b">>>>>End")].rstrip()
+    assert body.endswith(b"\t53.198986")
+    p = write(tmp_path, "cut_Reflection.jaz", body[:-2])
+    with pytest.raises(AdapterError, match=r"cut_Reflection.jaz, line 2066: field 5 '53\.1989'"):
+        labbrdf.read(p)
+    m = labbrdf.read(write(tmp_path, "whole_Reflection.jaz", body))  # complete: no doubt
+    assert "warnings" not in m.meta and len(m.meta["counts"]["dark"]) == 2048

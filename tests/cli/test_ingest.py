@@ -64,3 +64,20 @@ def test_channels_cell_names_the_quantity_when_channels_differ():
     assert _channels_cell({"reflectance": ["p"], "transmittance": ["s"]}) == (
         "reflectance:p transmittance:s"
     )
+
+
+def test_ingest_prints_every_readers_notes_with_the_file_name(real_exports: Path, capsys):
+    """The Jaz reader notes the rows it dropped (no reference above dark); ``ingest`` shows
+    it on stderr, one line per note, as it does for the columns reader's skipped lines."""
+    jaz = real_exports / "oceanoptics-jaz" / "oo-reflectance.jaz"
+    if not jaz.is_file():
+        pytest.skip(f"absent: {jaz}")
+    assert main(["ingest", str(jaz)]) == 0
+    err = capsys.readouterr().err.splitlines()
+    notes = [ln for ln in err if ln.startswith(f"labbrdf ingest: note: {jaz}: ")]
+    assert len(notes) == 1 and "11 rows dropped" in notes[0], err
+
+
+def test_ingest_prints_no_note_line_for_a_reader_without_notes(files, capsys):
+    assert main(["ingest", str(files["rp"])]) == 0
+    assert "note:" not in capsys.readouterr().err
