@@ -7,7 +7,6 @@ import json
 import numpy as np
 import pytest
 
-from labbrdf.adapters import AdapterError
 from labbrdf.cli import main
 from labbrdf.dataset import Measurement, make_frame, read, write
 
