@@ -1188,7 +1188,7 @@ def on_measured_points(
     stats : RoughnessStats
         The statistics of the interpolated profile.
     points : (array_like, array_like) or None
-        Measured positions and heights [m] (:attr:`labbrdf.adapters.topography.HeightMap.points`).
+        Measured positions and heights [m] (``HeightMap.points``).
     degree : int
         The levelling degree ``stats`` used.
 

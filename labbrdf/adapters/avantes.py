@@ -35,7 +35,7 @@ Rows and counts
     0`` has no defined ratio: it is dropped, counted in ``meta["dropped_points"]`` and named
     in ``meta["notes"]``; the counts of every row are kept in ``meta["counts"]``. Every row
     must hold as many numbers as there are columns; wavelengths must increase. There is no
-    declared pixel count: at most :data:`~labbrdf.adapters._base.MAX_POINTS` rows are read,
+    declared pixel count: at most ``MAX_POINTS`` rows are read,
     and a larger file is refused from its size before it is read.
 """
 
@@ -117,7 +117,7 @@ def read_avasoft(path: str | os.PathLike[str]) -> Measurement:
     AdapterError
         A mode without a labbrdf quantity (scope, irradiance, ...) or an unknown one, named;
         a row that is not numbers, non-increasing wavelengths, more than
-        :data:`~labbrdf.adapters._base.MAX_POINTS` rows; with the line.
+        ``MAX_POINTS`` rows; with the line.
     """
     check_regular_file(path)
     size = os.stat(path).st_size

@@ -33,7 +33,7 @@ The skipped lines are kept in ``meta["preamble"]`` and counted in ``meta["skippe
 with a note in ``meta["notes"]``. A table whose abscissa returns to its first value is the
 same table twice (files joined) and is refused at the line where the copy starts. A last
 line without line end whose last number is written shorter than its column is refused or
-warned about (:func:`labbrdf.adapters._numblock.check_last_field`).
+warned about (``check_last_field``).
 """
 
 from __future__ import annotations

@@ -27,7 +27,7 @@ Common rules
 7. A last data row without line end whose last number is written shorter than its column
    (a file cut mid-number: ``0.0`` where the column is written ``0.01``) is refused, or
    warned about where the column's writing varies
-   (:func:`labbrdf.adapters._numblock.check_last_field`; the warning is kept in
+   (``check_last_field``; the warning is kept in
    ``meta["warnings"]``).
 
 (a) Specular scan: ``# labbrdf specular-scan v1``

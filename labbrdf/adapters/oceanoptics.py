@@ -48,7 +48,7 @@ Raspberry Pi (``oceanoptics-pi``, ``.pi``, refused)
 
 Checks: the spectral data marker must be present, a declared pixel count (``Number of
 Pixels in Spectrum`` / ``in Processed Spectrum``) must be at most
-:data:`~labbrdf.adapters._base.MAX_POINTS` and fit the file's size, both checked before
+``MAX_POINTS`` and fit the file's size, both checked before
 the data are read, and must equal the number of rows; ``XAxis mode`` (when given) must be
 ``Wavelengths``, and the wavelengths must be strictly increasing.
 """
