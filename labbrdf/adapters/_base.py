@@ -291,6 +291,19 @@ def check_regular_file(path: str | os.PathLike[str]) -> None:
         raise AdapterError(path, f"is {kind}, expected a regular file")
 
 
+def read_head(path: str | os.PathLike[str], n: int = 4096) -> bytes:
+    """The first ``n`` bytes of a regular file; an unreadable or blank file raises AdapterError."""
+    check_regular_file(path)
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(n)
+    except OSError as exc:
+        raise AdapterError(path, f"cannot be read ({exc.strerror or exc})") from None
+    if not head or head.isspace():
+        raise AdapterError(path, "the file is empty")
+    return head
+
+
 def read_bytes(path: str | os.PathLike[str]) -> bytes:
     """Read a whole regular file; anything else, or an empty file, raises AdapterError."""
     check_regular_file(path)

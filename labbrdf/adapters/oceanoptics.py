@@ -72,6 +72,7 @@ from ._base import (
     check_regular_file,
     decode,
     read_bytes,
+    read_head,
     split_lines,
 )
 from ._numblock import check_joined, check_last_row
@@ -675,14 +676,7 @@ def refuse_raspberry_pi(path: str | os.PathLike[str]) -> Measurement:
         Always: the file's raw intensities have no labbrdf quantity (or it is not this
         layout at all).
     """
-    check_regular_file(path)
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(4096)
-    except OSError as exc:
-        raise AdapterError(path, f"cannot be read ({exc.strerror or exc})") from None
-    if not head.strip():
-        raise AdapterError(path, "the file is empty")
+    head = read_head(path)
     if not _sniff_pi(head):
         raise AdapterError(
             path,

@@ -20,7 +20,7 @@ import os
 import re
 
 from ..dataset import Measurement
-from ._base import AdapterError, Format, check_regular_file
+from ._base import AdapterError, Format, read_head
 
 __all__ = [
     "FORMATS",
@@ -56,14 +56,7 @@ def refuse_completeease_se(path: str | os.PathLike[str]) -> Measurement:
         Always: a binary ``.SE`` is named and the text export is suggested; a text file is
         told to be read by its own format.
     """
-    check_regular_file(path)
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(4096)
-    except OSError as exc:
-        raise AdapterError(path, f"cannot be read ({exc.strerror or exc})") from None
-    if not head or head.isspace():
-        raise AdapterError(path, "the file is empty")
+    head = read_head(path)
     if _binary(head):
         raise AdapterError(path, _SE_HINT)
     raise AdapterError(
@@ -76,18 +69,6 @@ def refuse_completeease_se(path: str | os.PathLike[str]) -> Measurement:
 _ZIP = b"PK\x03\x04"
 
 
-def _head(path: str | os.PathLike[str], n: int = 4096) -> bytes:
-    check_regular_file(path)
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(n)
-    except OSError as exc:
-        raise AdapterError(path, f"cannot be read ({exc.strerror or exc})") from None
-    if not head or head.isspace():
-        raise AdapterError(path, "the file is empty")
-    return head
-
-
 def refuse_completeease_sesnap(path: str | os.PathLike[str]) -> Measurement:
     """Refuse a CompleteEASE ``.SEsnap`` snapshot with what to do instead.
 
@@ -97,7 +78,7 @@ def refuse_completeease_sesnap(path: str | os.PathLike[str]) -> Measurement:
         Always: a ZIP archive gets the CompleteEASE text-export advice; anything else is
         told that it is not a snapshot.
     """
-    head = _head(path)
+    head = read_head(path)
     if head.startswith(_ZIP):
         raise AdapterError(
             path,
@@ -140,7 +121,7 @@ def refuse_spectrapen(path: str | os.PathLike[str]) -> Measurement:
         Always: spectral irradiance (or another quantity of the light) has no dataset
         quantity; a file that does not have the SpectraPen layout is told so.
     """
-    head = _head(path)
+    head = read_head(path)
     lines = _psi_lines(head)
     if not _sniff_spectrapen(head):
         raise AdapterError(
@@ -179,7 +160,7 @@ def refuse_speos_bsdf(path: str | os.PathLike[str]) -> Measurement:
         of TIS values) is recognised but not read; the same measurement in the Zemax/Radiant
         ``.bsdf`` exchange format is read by ``zemax-bsdf``.
     """
-    if not _sniff_speos(_head(path)):
+    if not _sniff_speos(read_head(path)):
         raise AdapterError(
             path, f"expected a Speos BSDF file starting {_SPEOS_MAGIC.decode()!r}", 1
         )
