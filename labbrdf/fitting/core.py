@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special
 
 from ..dataset import Measurement
-from ..models import Model, Parameters
+from ..models import Model, ModelError, Parameters
 from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
 from .objective import Objective
@@ -158,9 +158,12 @@ def setup_params(
     """The model's parameters with ``params`` (values or Parameters) and ``fix`` applied.
 
     Internal API of :mod:`labbrdf.fitting`; raises :class:`FitError` naming unknown or
-    inconsistent parameter names.
+    inconsistent parameter names, and a value given in ``params`` or ``fix`` that is not
+    finite or lies outside the parameter's bounds (:meth:`Parameter.check
+    <labbrdf.models.Parameter.check>`: the model's, or those given in ``params``).
     """
     p = _copy_params(model.params)
+    given: list[tuple[str, str, Any]] = []  # (argument, name, value) to check in bounds
     if params is not None:
         for k, v in params.items():
             if k not in p:
@@ -173,17 +176,22 @@ def setup_params(
                 for a in ("value", "min", "max", "vary", "log"):
                     if a in src:
                         setattr(p[k], a, src[a])
+                if "value" in src:
+                    given.append(("params", k, src["value"]))
             else:
-                p[k].value = float(v)
+                given.append(("params", k, v))
     for k, v in (fix or {}).items():
         if k not in p:
             raise FitError(
                 f"fix: model {model.name!r} has no parameter {k!r}; parameters are {list(p)}"
             )
-        if not math.isfinite(float(v)):
-            raise FitError(f"fix: {k}={v!r} must be a finite number")
-        p[k].value = float(v)
+        given.append(("fix", k, v))
         p[k].vary = False
+    for arg, k, v in given:
+        try:
+            p[k].value = p[k].check(v)
+        except ModelError as exc:
+            raise FitError(f"{arg}: model {model.name!r}: {exc}") from None
     for k, q in p.items():
         if not math.isfinite(q.value):
             raise FitError(f"parameter {k!r}: initial value {q.value!r} is not finite")
