@@ -1037,8 +1037,50 @@ def _film_table(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def _one_sample(args: argparse.Namespace, parts: list[Any], data: Any) -> bool:
+    """Whether the files of a film fit are one sample: refused (exit 2) when they are not.
+
+    Files that state different sample names in the selected rows are one sample only by
+    ``--same-sample``; every ``--same-sample`` value is checked against the inputs first
+    (:func:`labbrdf.samples.pair_samples`), whether or not it is needed.
+    """
+    from pathlib import Path
+
+    from .films import FILM_QUANTITIES
+    from .fitting.film import stated_samples
+    from .samples import SampleFile, pair_samples, split_same_sample
+
+    def said(rows: Any) -> dict[str, None]:  # the names of the rows a film fit uses
+        rows = rows[rows["quantity"].astype(str).isin(FILM_QUANTITIES)]
+        return dict.fromkeys(n for names in stated_samples(rows).values() for n in names)
+
+    selected = said(data.data)
+    files = []
+    for path, m in zip(args.files, parts, strict=True):  # each file's own, still selected
+        own = said(m.data)
+        files.append(SampleFile(Path(path), tuple(n for n in own if n in selected)))
+    groups = pair_samples(
+        files,
+        [split_same_sample(v, args.files) for v in args.same_sample or ()],
+        given_as="given with --same-sample",
+    )
+    stating = [g for g in groups if any(f.names and f.path in g.paths for f in files)]
+    if len(stating) < 2:
+        return True
+    listing = "; ".join(
+        f"{f.path} states {', '.join(map(repr, f.names))}" for f in files if f.names
+    )
+    spelt = ",".join(str(f.path) for f in files if f.names)
+    raise UsageError(
+        f"the files state different samples ({listing}); a film fit is of one sample: fit "
+        f"each on its own (or select one with --sample), or, if they are one sample, say "
+        f"so with --same-sample {spelt}"
+    )
+
+
 def cmd_film(args: argparse.Namespace) -> int:
     from . import adapters, films
+    from .dataset import concat
     from .outputs import atomic_output, csv_safe_frame
 
     fm = _film_model(args)
@@ -1054,7 +1096,8 @@ def cmd_film(args: argparse.Namespace) -> int:
                 "0 <= MIN < MAX [nm]"
             )
         wl_range = (r.lo, r.hi)
-    data = _selected(args, adapters.read_many(args.files))
+    parts = [adapters.read(p) for p in args.files]
+    data = _selected(args, concat(parts))
     res = films.fit_film(
         fm,
         data,
@@ -1063,6 +1106,7 @@ def cmd_film(args: argparse.Namespace) -> int:
         method=args.method,
         seed=args.seed,
         ci=args.ci,
+        one_sample=_one_sample(args, parts, data),
     )
     summary = res.summary()
     if args.output:
@@ -1620,6 +1664,14 @@ def _film_parser(sub: Any) -> None:
         action="append",
         metavar="QUANTITY=VALUE",
         help="sigma for rows whose file gives none (e.g. reflectance=0.005)",
+    )
+    s.add_argument(
+        "--same-sample",
+        action="append",
+        # not an InputPath: every name must be one of the FILE inputs (refused otherwise)
+        metavar="A,B[,...]",
+        help="these FILE inputs are one sample although they state different sample names "
+        "(files that do are refused without it)",
     )
     s.add_argument(
         "--ci",
