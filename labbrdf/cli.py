@@ -229,6 +229,19 @@ def _range(text: str) -> str:
     return text
 
 
+def _fit_seed(text: str) -> int:
+    """The argparse type of a fit's ``--seed``: an integer in [0, MAX_SEED]."""
+    from .fitting.core import MAX_SEED
+
+    try:
+        x = int(text)
+    except ValueError:
+        x = -1
+    if not 0 <= x <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected an integer in [0, {MAX_SEED}]")
+    return x
+
+
 def _wavelength_value(text: str) -> float:
     """The argparse type of ``--wavelength NM``: one wavelength [nm]."""
     try:
@@ -1529,7 +1542,7 @@ def _fit_parser(sub: Any) -> None:
     s.add_argument("--model", required=True)
     s.add_argument("--by", default="sample,wavelength_nm", help="comma-separated group columns")
     s.add_argument("--method", default=METHOD, help="nlopt GLOBAL[+LOCAL]")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=_fit_seed, default=0, help="the optimiser's seed")
     s.add_argument(
         "--replicates",
         type=int,
@@ -1680,7 +1693,7 @@ def _film_parser(sub: Any) -> None:
         help="95%% intervals from the profile of chi2 (default) or the covariance",
     )
     s.add_argument("--method", default=METHOD, help="nlopt stages")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=_fit_seed, default=0, help="the optimiser's seed")
     s.add_argument(
         "-o",
         "--output",

@@ -18,7 +18,7 @@ from .. import parallel  # imports only labbrdf.errors: usable from every layer
 from ..dataset import Measurement
 from ..models import Model
 from ..models import get as get_model
-from .core import METHOD, fit, parse_method, setup_params
+from .core import METHOD, check_seed, fit, parse_method, setup_params
 from .data import FitData, FitError, select_rows, several_groups_message
 from .replicates import check_replicates
 from .result import FitResult
@@ -255,6 +255,7 @@ def fit_many(
         None if isinstance(model, Model) else model
     )
     parse_method(method)
+    check_seed(seed)
     if isinstance(data, Measurement):
         data = data.data
     if not isinstance(data, pd.DataFrame):

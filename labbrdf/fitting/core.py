@@ -30,8 +30,10 @@ __all__ = [
     "EXACT_RTOL",
     "CONSTRAINED",
     "LOCAL_ROUNDS",
+    "MAX_SEED",
     "METHOD",
     "RELATIVE_FLOOR",
+    "check_seed",
     "fit",
     "parse_method",
     "setup_params",
@@ -145,6 +147,20 @@ def _energy_rho(
     except ImportError as exc:  # pragma: no cover - integrate ships with labbrdf
         raise FitError("energy_constraint=True needs labbrdf.integrate") from exc
     return lambda vals, th: np.asarray(hemispherical_reflectance(model, vals, th), float)
+
+
+#: the largest seed of a fit: nlopt's ``srand`` takes an unsigned long, 32 bits on some
+#: platforms, so seeds are integers in [0, MAX_SEED] everywhere
+MAX_SEED = 2**32 - 1
+
+
+def check_seed(seed: Any) -> int:
+    """``seed`` as an int, if it is an integer in ``[0, MAX_SEED]``; else :class:`FitError`."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise FitError(f"seed must be an integer in [0, {MAX_SEED}]; got {seed!r}")
+    if not 0 <= seed <= MAX_SEED:
+        raise FitError(f"seed must be an integer in [0, {MAX_SEED}]; got {seed}")
+    return int(seed)
 
 
 def _copy_params(p: Parameters) -> Parameters:
@@ -448,7 +464,8 @@ def fit(
         nlopt algorithm names joined by ``+``, run in turn, each from the best point of the
         previous one. Global stages need finite bounds on every varying parameter.
     seed : int
-        Passed to ``nlopt.srand`` before every stage: the fit is reproducible.
+        Passed to ``nlopt.srand`` before every stage: the fit is reproducible. An integer
+        in ``[0, MAX_SEED]``.
     params : Parameters or mapping, optional
         Initial values (name -> value) or per-parameter settings
         (name -> {"value", "min", "max", "vary", "log"}) overriding the model's defaults.
@@ -509,6 +526,7 @@ def fit(
     """
     # every argument but the model, the data and the count: the same for each replicate
     kw = {k: v for k, v in locals().items() if k not in ("model", "data", "replicates")}
+    check_seed(seed)
     model = get_model(model) if isinstance(model, str) else model
     R = getattr(model, "default_replicates", 1) if replicates is None else replicates
     if R != 1:  # a non-Model is refused by _problem

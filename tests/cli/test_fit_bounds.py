@@ -118,3 +118,18 @@ def test_replicates_beyond_the_cap_exit_2_before_reading(data_file, capsys, coun
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert f"--replicates must be an integer in [1, 1000]; got {count}" in err
+
+
+@pytest.mark.parametrize("command", ["fit", "film"])
+@pytest.mark.parametrize("seed", ["-5", str(2**32), "99999999999999999999999", "1.5"])
+def test_a_seed_outside_the_optimisers_range_exits_2_naming_the_option(
+    data_file, capsys, command, seed
+):
+    """nlopt's srand takes an unsigned long: such seeds once ended in an OverflowError."""
+    argv = [command, str(data_file), "--seed", seed]
+    argv += ["--model", "smooth3"] if command == "fit" else []
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "--seed" in err and "expected an integer in [0, 4294967295]" in err

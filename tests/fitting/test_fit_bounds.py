@@ -120,3 +120,11 @@ def test_fit_refuses_layered_alpha_top_below_its_bounds_before_tracing(monkeypat
         fit(model, _brdf_rows(), fix={"alpha_top": -1.0})
     with pytest.raises(FitError, match="alpha_top=-1 is outside its bounds"):
         fit_many(_brdf_rows(), model, fix={"alpha_top": -1.0}, executor="serial")
+
+
+@pytest.mark.parametrize("seed", [-1, 2**32, 1.5, True])
+def test_fit_and_fit_many_refuse_a_seed_outside_the_optimisers_range(seed):
+    with pytest.raises(FitError, match=r"seed must be an integer in \[0, 4294967295\]"):
+        fit("smooth3", _brdf_rows(), seed=seed)
+    with pytest.raises(FitError, match=r"seed must be an integer in \[0, 4294967295\]"):
+        fit_many(_brdf_rows(), "smooth3", seed=seed, executor="serial")
