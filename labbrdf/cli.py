@@ -242,6 +242,17 @@ def _fit_seed(text: str) -> int:
     return x
 
 
+def _open_fraction(text: str) -> float:
+    """The argparse type of a fraction in (0, 1) (``--relative-floor``)."""
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not (text.strip().isascii() and 0 < x < 1):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a number in (0, 1)")
+    return x
+
+
 def _wavelength_value(text: str) -> float:
     """The argparse type of ``--wavelength NM``: one wavelength [nm]."""
     try:
@@ -1586,7 +1597,7 @@ def _fit_parser(sub: Any) -> None:
     )
     s.add_argument(
         "--relative-floor",
-        type=float,
+        type=_open_fraction,
         default=1e-3,
         help="floor of --weighting relative, a fraction of the largest absolute value",
     )

@@ -133,3 +133,12 @@ def test_a_seed_outside_the_optimisers_range_exits_2_naming_the_option(
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert "--seed" in err and "expected an integer in [0, 4294967295]" in err
+
+
+@pytest.mark.parametrize("floor", ["nan", "-1", "0", "1", "inf", "2"])
+def test_a_relative_floor_outside_0_1_exits_2_before_reading(data_file, capsys, floor):
+    """Once every group failed one by one ("not fitted"), exit 3, after reading the data."""
+    with pytest.raises(SystemExit) as exc:
+        main(["fit", str(data_file), "--model", "smooth3", "--relative-floor", floor])
+    assert exc.value.code == 2
+    assert "--relative-floor" in capsys.readouterr().err
