@@ -202,15 +202,19 @@ def _emit_json(obj: Any) -> None:
 
 
 def _parse_assignments(items: Sequence[str] | None, what: str) -> dict[str, float]:
+    """``NAME=VALUE`` options (``--fix``, ``--sigma``): names and finite numbers."""
     out: dict[str, float] = {}
     for item in items or ():
         name, sep, value = item.partition("=")
-        if not sep or not name:
+        if not sep or not name.strip():
             raise UsageError(f"{what} {item!r}: expected NAME=VALUE")
         try:
-            out[name.strip()] = float(value)
+            x = float(value)
         except ValueError:
             raise UsageError(f"{what} {item!r}: {value!r} is not a number") from None
+        if not (value.strip().isascii() and math.isfinite(x)):
+            raise UsageError(f"{what} {item!r}: expected a finite ASCII number")
+        out[name.strip()] = x
     return out
 
 
@@ -244,7 +248,10 @@ def _split_params(
         name = name.strip()
         if not sep or not name:
             raise UsageError(f"--param {item!r}: expected NAME=VALUE")
-        v = _value(raw)
+        try:
+            v = _value(raw)
+        except UsageError as exc:
+            raise UsageError(f"--param {name}: {exc}") from None
         if name in opts_names:
             options[name] = v
         elif isinstance(v, float):
@@ -262,6 +269,30 @@ def _range(text: str) -> str:
             "left open: 400: or :700)"
         )
     return text
+
+
+def _fit_seed(text: str) -> int:
+    """The argparse type of a fit's ``--seed``: an integer in [0, MAX_SEED]."""
+    from .fitting.core import MAX_SEED
+
+    try:
+        x = int(text)
+    except ValueError:
+        x = -1
+    if not 0 <= x <= MAX_SEED:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected an integer in [0, {MAX_SEED}]")
+    return x
+
+
+def _open_fraction(text: str) -> float:
+    """The argparse type of a fraction in (0, 1) (``--relative-floor``)."""
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not (text.strip().isascii() and 0 < x < 1):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a number in (0, 1)")
+    return x
 
 
 def _wavelength_value(text: str) -> float:
@@ -720,34 +751,168 @@ def _option_errors() -> Iterator[None]:
         raise UsageError(f"--nk-from {exc}") from None
 
 
-@_executor_errors
-def cmd_fit(args: argparse.Namespace) -> int:
-    from . import adapters, models
-    from .fitting import auto_weighting, fit_many, fit_many_nk, fit_records
+def _fit_settings(args: argparse.Namespace) -> tuple[Any, dict[str, Any], dict[str, Any]]:
+    """The model (None with ``--nk-from``), its options and the fit keywords of the options.
 
-    if args.replicates is not None and args.replicates < 1:
-        raise UsageError(f"--replicates must be an integer >= 1; got {args.replicates}")
-    executor = _executor(args, progress=not args.json)
-    data = _selected(args, adapters.read_many(args.files))
+    Everything that can be refused without the data is refused here, before any work:
+    counts, names, and every ``--fix`` and ``--param`` value outside the bounds the model
+    declares (:meth:`labbrdf.models.Model.check_value`).
+    """
+    from . import models
+    from .fitting.replicates import MAX_REPLICATES
+
+    if args.replicates is not None and not 1 <= args.replicates <= MAX_REPLICATES:
+        raise UsageError(
+            f"--replicates must be an integer in [1, {MAX_REPLICATES}]; got {args.replicates}"
+        )
+    if args.wavelength is not None and not args.nk_from:
+        raise UsageError(
+            "--wavelength NM is the wavelength of --nk-from's n, k; select a range of "
+            "rows with --wavelength-range MIN:MAX"
+        )
     fix = _parse_assignments(args.fix, "--fix")
     options, start = _split_params(args.model, args.param)
-    by = [c.strip() for c in args.by.split(",") if c.strip()]
+    model = None
+    if args.nk_from:
+        bounds = _bounds_model(args.model, options, start)
+    else:
+        try:
+            model = bounds = _starts_taken(args.model, options, start)
+        except models.ModelError as exc:
+            raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
+        if (args.replicates or 1) > 1 and not model.stochastic:
+            raise UsageError(
+                f"--replicates {args.replicates}: model {args.model!r} is deterministic (no "
+                "Monte Carlo seed), every replicate would be the same fit; leave --replicates out"
+            )
+    _check_values(bounds, fix, start, args.free)
     params: dict[str, Any] = {k: {"value": v} for k, v in start.items()}
     for name in args.free or ():
         params.setdefault(name, {})["vary"] = True
+    kw: dict[str, Any] = {"fix": fix or None, "params": params or None}
+    if args.replicates is not None:
+        kw["replicates"] = args.replicates
+    return model, options, kw
+
+
+def _starts_taken(name: str, options: dict[str, Any], start: dict[str, float]) -> Any:
+    """The model ``name`` built with ``options``, less the names it has as parameters.
+
+    A name can be both an option and, with other options, a parameter (layered's
+    ``thickness_nm``: the incoherent coating's thickness, and a fitted parameter with
+    ``coherent=true``, when the option is unused): there it is the parameter's start value,
+    moved from ``options`` into ``start`` (checked against its bounds like any other),
+    never an option that is silently ignored. Raises :class:`labbrdf.models.ModelError`
+    as the model does.
+    """
+    from . import models
+
+    taken = [k for k in options if k in _parameter_names(name, options)]
+    for k in taken:
+        v = options.pop(k)
+        if not isinstance(v, float):
+            raise UsageError(f"--param {k}={v}: a parameter of this model: expected a number")
+        start[k] = v
+    return models.get(name, **options)
+
+
+def _parameter_names(name: str, options: dict[str, Any]) -> set[str]:
+    """The parameters of the model ``name`` with ``options`` (empty if none can be built).
+
+    The words and flags among the options (``coherent``, ``base``, ``diffuse``) choose the
+    parameters, not the numbers; so where the numbers are refused (a start value given as
+    an option), the model is built without them, with a stand-in index if it needs one.
+    """
+    from . import models
+
+    words = {k: v for k, v in options.items() if not isinstance(v, float)}
+    for opts in (options, words, {**words, "n": 1.5, "k": 0.0}):
+        try:
+            return set(models.get(name, **opts).params)
+        except (models.ModelError, TypeError):
+            continue
+    return set()
+
+
+def _bounds_model(name: str, options: dict[str, Any], start: dict[str, float]) -> Any:
+    """The model of ``--nk-from`` with a stand-in index, for its parameters' bounds.
+
+    A model's parameters and bounds do not depend on the index n, k (only on options such
+    as ``diffuse`` or ``base``); None where even that model cannot be built (the fit says
+    why, per wavelength, before any group is fitted).
+    """
+    from . import models
+
+    stand_in = {**options, "n": 1.5, "k": 0.0}
+    try:
+        model = _starts_taken(name, stand_in, start)
+    except (models.ModelError, TypeError):
+        return None
+    for k in [k for k in options if k not in stand_in]:
+        del options[k]
+    return model
+
+
+def _check_values(
+    model: Any, fix: dict[str, float], start: dict[str, float], free: Sequence[str] | None
+) -> None:
+    """Every ``--fix``, ``--param`` value and ``--free`` name checked against ``model``."""
+    from .models import ModelError
+
+    if model is None:
+        return
+    for option, values in (("--fix", fix), ("--param", start)):
+        for name, v in values.items():
+            try:
+                model.check_value(name, v)
+            except ModelError as exc:
+                raise UsageError(f"{option} {name}={v:g}: {exc}") from None
+    for name in free or ():
+        if name not in model.params:
+            raise UsageError(
+                f"--free {name}: model {model.name!r} has no parameter {name!r}; parameters "
+                f"are {list(model.params)}"
+            )
+
+
+def _residual_groups(args: argparse.Namespace, data: Any, by: list[str]) -> None:
+    """``--residual-maps`` draws one group: refuse several before any fit runs."""
+    from .fitting.batch import group_keys
+
+    if not args.residual_maps:
+        return
+    keys = group_keys(data, [*by, "wavelength_nm"] if args.nk_from else by)
+    if len(keys) == 1:
+        return
+    shown = "; ".join(", ".join(f"{k}={v}" for k, v in key.items()) for key in keys[:4])
+    more = f" and {len(keys) - 4} more" if len(keys) > 4 else ""
+    raise UsageError(
+        f"--residual-maps {args.residual_maps}: draws one fitted group; the data hold "
+        f"{len(keys)} ({shown}{more}); select one, e.g. with --sample and --wavelength-range, "
+        "or leave --residual-maps out"
+    )
+
+
+@_executor_errors
+def cmd_fit(args: argparse.Namespace) -> int:
+    from . import adapters
+    from .fitting import auto_weighting, fit_many, fit_many_nk, fit_records
+
+    model, options, settings = _fit_settings(args)
+    by = [c.strip() for c in args.by.split(",") if c.strip()]
+    data = _selected(args, adapters.read_many(args.files))
+    _residual_groups(args, data, by)
+    executor = _executor(args, progress=not args.json)
     kw: dict[str, Any] = {
+        **settings,
         "by": by,
         "method": args.method,
         "seed": args.seed,
-        "fix": fix or None,
-        "params": params or None,
         "executor": executor,
         "return_results": True,
         "mask_zeros": not args.keep_zeros,
         "relative_floor": args.relative_floor,
     }
-    if args.replicates is not None:
-        kw["replicates"] = args.replicates
     weighting = args.weighting if args.weighting != "auto" else auto_weighting(data)
     if weighting is not None:
         kw["weighting"] = weighting
@@ -759,23 +924,9 @@ def cmd_fit(args: argparse.Namespace) -> int:
                 args.nk_from,
                 options=options,
                 wavelength_nm=args.wavelength,
-                **{**kw, "by": by},
+                **kw,
             )
     else:
-        if args.wavelength is not None:
-            raise UsageError(
-                "--wavelength NM is the wavelength of --nk-from's n, k; select a range of "
-                "rows with --wavelength-range MIN:MAX"
-            )
-        try:
-            model = models.get(args.model, **options)
-        except models.ModelError as exc:
-            raise UsageError(f"--model {args.model}: {exc} (give options with --param)") from None
-        if (args.replicates or 1) > 1 and not model.stochastic:
-            raise UsageError(
-                f"--replicates {args.replicates}: model {args.model!r} is deterministic (no "
-                "Monte Carlo seed), every replicate would be the same fit; leave --replicates out"
-            )
         table, results = fit_many(data, model, **kw)
     if args.output:
         from .outputs import atomic_output, csv_safe_frame
@@ -799,15 +950,20 @@ def cmd_fit(args: argparse.Namespace) -> int:
 
 
 def _residual_maps(args: argparse.Namespace, data: Any, results: list) -> None:
-    """``--residual-maps PNG``: the maps of the one fitted group (refused for several)."""
+    """``--residual-maps PNG``: the maps of the one group (checked before the fit).
+
+    A group that could not be fitted has no maps: said on stderr (the exit code is 3).
+    """
     from . import models
     from .report.figures import fit_maps_figure, save_png
 
-    if len(results) != 1:
-        raise UsageError(
-            f"--residual-maps draws one fitted group; {len(results)} were fitted "
-            "(select one sample and wavelength, e.g. with --sample and --wavelength)"
+    if not results:
+        print(
+            f"labbrdf fit: --residual-maps {args.residual_maps}: not drawn, the group was "
+            "not fitted",
+            file=sys.stderr,
         )
+        return
     key, res = results[0]
     rows = data.data
     for col, v in key.items():
@@ -1009,8 +1165,50 @@ def _film_table(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def _one_sample(args: argparse.Namespace, parts: list[Any], data: Any) -> bool:
+    """Whether the files of a film fit are one sample: refused (exit 2) when they are not.
+
+    Files that state different sample names in the selected rows are one sample only by
+    ``--same-sample``; every ``--same-sample`` value is checked against the inputs first
+    (:func:`labbrdf.samples.pair_samples`), whether or not it is needed.
+    """
+    from pathlib import Path
+
+    from .films import FILM_QUANTITIES
+    from .fitting.film import stated_samples
+    from .samples import SampleFile, pair_samples, split_same_sample
+
+    def said(rows: Any) -> dict[str, None]:  # the names of the rows a film fit uses
+        rows = rows[rows["quantity"].astype(str).isin(FILM_QUANTITIES)]
+        return dict.fromkeys(n for names in stated_samples(rows).values() for n in names)
+
+    selected = said(data.data)
+    files = []
+    for path, m in zip(args.files, parts, strict=True):  # each file's own, still selected
+        own = said(m.data)
+        files.append(SampleFile(Path(path), tuple(n for n in own if n in selected)))
+    groups = pair_samples(
+        files,
+        [split_same_sample(v, args.files) for v in args.same_sample or ()],
+        given_as="given with --same-sample",
+    )
+    stating = [g for g in groups if any(f.names and f.path in g.paths for f in files)]
+    if len(stating) < 2:
+        return True
+    listing = "; ".join(
+        f"{f.path} states {', '.join(map(repr, f.names))}" for f in files if f.names
+    )
+    spelt = ",".join(str(f.path) for f in files if f.names)
+    raise UsageError(
+        f"the files state different samples ({listing}); a film fit is of one sample: fit "
+        f"each on its own (or select one with --sample), or, if they are one sample, say "
+        f"so with --same-sample {spelt}"
+    )
+
+
 def cmd_film(args: argparse.Namespace) -> int:
     from . import adapters, films
+    from .dataset import concat
     from .outputs import atomic_output, csv_safe_frame
 
     fm = _film_model(args)
@@ -1026,7 +1224,8 @@ def cmd_film(args: argparse.Namespace) -> int:
                 "0 <= MIN < MAX [nm]"
             )
         wl_range = (r.lo, r.hi)
-    data = _selected(args, adapters.read_many(args.files))
+    parts = [adapters.read(p) for p in args.files]
+    data = _selected(args, concat(parts))
     res = films.fit_film(
         fm,
         data,
@@ -1035,6 +1234,7 @@ def cmd_film(args: argparse.Namespace) -> int:
         method=args.method,
         seed=args.seed,
         ci=args.ci,
+        one_sample=_one_sample(args, parts, data),
     )
     summary = res.summary()
     if args.output:
@@ -1480,7 +1680,7 @@ def _fit_parser(sub: Any) -> None:
     s.add_argument("--model", required=True)
     s.add_argument("--by", default="sample,wavelength_nm", help="comma-separated group columns")
     s.add_argument("--method", default=METHOD, help="nlopt GLOBAL[+LOCAL]")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=_fit_seed, default=0, help="the optimiser's seed")
     s.add_argument(
         "--replicates",
         type=int,
@@ -1524,7 +1724,7 @@ def _fit_parser(sub: Any) -> None:
     )
     s.add_argument(
         "--relative-floor",
-        type=float,
+        type=_open_fraction,
         default=1e-3,
         help="floor of --weighting relative, a fraction of the largest absolute value",
     )
@@ -1622,13 +1822,21 @@ def _film_parser(sub: Any) -> None:
         help="sigma for rows whose file gives none (e.g. reflectance=0.005)",
     )
     s.add_argument(
+        "--same-sample",
+        action="append",
+        # not an InputPath: every name must be one of the FILE inputs (refused otherwise)
+        metavar="A,B[,...]",
+        help="these FILE inputs are one sample although they state different sample names "
+        "(files that do are refused without it)",
+    )
+    s.add_argument(
         "--ci",
         choices=("wald", "profile"),
         default="profile",
         help="95%% intervals from the profile of chi2 (default) or the covariance",
     )
     s.add_argument("--method", default=METHOD, help="nlopt stages")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=_fit_seed, default=0, help="the optimiser's seed")
     s.add_argument(
         "-o",
         "--output",

@@ -316,11 +316,24 @@ def _warn(msg: str) -> None:
     sys.stderr.flush()
 
 
-def _workers(workers: int | None) -> int:
+#: the most worker processes this machine starts (``processes``, ``local``), per core:
+#: each is a Python with NumPy and its own tracer tables (about 100 MB), so a count far
+#: beyond the cores buys no speed and can exhaust memory. A remote scheduler's count is not
+#: capped: its workers run elsewhere
+MAX_WORKERS_PER_CORE = 4
+
+
+def _workers(workers: int | None, scheduler: str | None = None) -> int:
     if workers is None:
         return max(1, os.cpu_count() or 1)
     if int(workers) < 1:
         raise ValueError(f"workers must be >= 1, got {workers}")
+    cap = MAX_WORKERS_PER_CORE * max(1, os.cpu_count() or 1)
+    if scheduler in ("processes", "local") and int(workers) > cap:
+        raise ValueError(
+            f"workers must be at most {cap} ({MAX_WORKERS_PER_CORE} per core) on this "
+            f"machine, got {workers}"
+        )
     return int(workers)
 
 
@@ -418,7 +431,7 @@ def _dask_client(scheduler: str, workers: int | None, retries: int) -> tuple[Any
         return client, True
     sec = _security()
     dash = _dashboard_wanted()
-    key = (_workers(workers), int(retries), _tls_files(), dash)
+    key = (_workers(workers, "local"), int(retries), _tls_files(), dash)
     with _LOCAL_LOCK:
         client = _LOCAL.get("client")
         if client is not None and _LOCAL.get("key") == key and client.status == "running":
@@ -664,7 +677,7 @@ def imap(
             yield func(it)
             bar.update()
         return
-    n = _workers(workers)
+    n = _workers(workers, scheduler)
     if window is not None and int(window) < 1:
         raise ValueError(f"window must be >= 1, got {window}")
     if scheduler == "processes":
@@ -914,7 +927,7 @@ class Executor:
         )
         check_scheduler(self.scheduler)
         if self.workers is not None:
-            _workers(self.workers)
+            _workers(self.workers, self.scheduler)
         if int(self.retries) < 0:
             raise ValueError(f"retries must be >= 0, got {self.retries}")
 
@@ -926,7 +939,7 @@ class Executor:
     @property
     def nworkers(self) -> int:
         """Worker processes a run is planned for (1 when serial; the core count by default)."""
-        return 1 if self.serial else _workers(self.workers)
+        return 1 if self.serial else _workers(self.workers, self.scheduler)
 
     def imap(
         self,

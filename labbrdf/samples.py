@@ -367,18 +367,50 @@ def split_same_sample(
     -------
     list
         The paths, as the inputs spell them where they match one.
+
+    Notes
+    -----
+    A piece can only be an input if it holds as many commas as some spelling of one (as
+    given, absolute, resolved), so at each comma only those few piece lengths are tried:
+    the work grows linearly with the number of commas (times the number of distinct comma
+    counts among the inputs), whatever the value holds. Where several splits work, each
+    piece is the shortest that leaves a splittable rest before it.
     """
     known = {_key(p): p for p in inputs}
+    commas = sorted(
+        {
+            os.fspath(s).count(",")
+            for p in inputs
+            for s in (p, os.path.abspath(os.fspath(p)), _key(p))
+        }
+    )
     parts = text.split(",")
     n = len(parts)
-    # best[i]: the matched pieces of parts[:i], or None when parts[:i] cannot be split
-    best: list[list[str | os.PathLike[str]] | None] = [[]] + [None] * n
+    # offset[i]: where parts[i] starts in text, so a piece is one slice, not a join
+    offset = [0] * (n + 1)
+    for i, part in enumerate(parts):
+        offset[i + 1] = offset[i] + len(part) + 1
+    # start[end]: where the last piece of a split of parts[:end] starts (-1: no split)
+    start = [0] + [-1] * n
+    match: dict[str, str | os.PathLike[str] | None] = {}
     for end in range(1, n + 1):
-        for start in range(end - 1, -1, -1):
-            prev = best[start]
-            piece = ",".join(parts[start:end])
-            if prev is not None and piece and _key(piece) in known:
-                best[end] = [*prev, known[_key(piece)]]
+        for s in (end - 1 - c for c in commas):
+            if s < 0 or start[s] < 0:
+                continue
+            piece = text[offset[s] : offset[end] - 1]
+            if piece not in match:
+                match[piece] = known.get(_key(piece)) if piece and "\0" not in piece else None
+            if match[piece] is not None:
+                start[end] = s
                 break
-    found = best[n]
-    return found if found is not None else [p for p in parts if p]
+    if start[n] < 0:
+        return [p for p in parts if p]
+    found: list[str | os.PathLike[str]] = []
+    end = n
+    while end > 0:
+        s = start[end]
+        hit = match[text[offset[s] : offset[end] - 1]]
+        assert hit is not None
+        found.append(hit)
+        end = s
+    return found[::-1]

@@ -115,6 +115,20 @@ def test_executor_has_one_default_and_converts_scheduler_names_once():
     assert parallel.Executor("processes", workers=3).nworkers == 3
 
 
+@pytest.mark.parametrize("scheduler", ["processes", "local"])
+def test_local_workers_are_capped_per_core(scheduler, monkeypatch):
+    """A local count far beyond the cores is refused before a process starts."""
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    cap = parallel.MAX_WORKERS_PER_CORE * 2
+    assert parallel.Executor(scheduler, workers=cap).nworkers == cap
+    with pytest.raises(ValueError, match=f"workers must be at most {cap} .4 per core"):
+        parallel.Executor(scheduler, workers=100_000)
+    with pytest.raises(ValueError, match=f"workers must be at most {cap}"):
+        parallel.run(abs, [1], scheduler=scheduler, workers=cap + 1)
+    # a remote scheduler's workers run elsewhere: not capped by this machine's cores
+    assert parallel.Executor("tcp://127.0.0.1:1", workers=100_000).nworkers == 100_000
+
+
 def test_executor_refuses_bad_options_at_construction():
     with pytest.raises(ValueError, match="unknown scheduler 'gpu'"):
         parallel.Executor("gpu")

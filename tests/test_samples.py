@@ -226,3 +226,56 @@ def test_split_same_sample_falls_back_to_every_comma(tmp_path, monkeypatch):
     assert parts == ["b.di", "nope.dat"]
     with pytest.raises(PairingError, match="nope.dat is not among the input files"):
         pair_samples(["b.di"], [parts])
+
+
+def _counted_keys(monkeypatch) -> list[str]:
+    """Every path :func:`split_same_sample` resolves, recorded (the costly step)."""
+    import labbrdf.samples as samples
+
+    seen: list[str] = []
+    real = samples._key
+
+    def key(p):
+        seen.append(os.fspath(p))
+        return real(p)
+
+    monkeypatch.setattr(samples, "_key", key)
+    return seen
+
+
+def test_split_same_sample_resolves_a_bounded_number_of_pieces(tmp_path, monkeypatch):
+    """2,000 commas: the split is right and resolves O(commas) pieces, not O(commas^2).
+
+    The old split tried every piece (2 million resolutions and joins of up to 2,000 parts:
+    over two minutes); each comma now tries only the piece lengths an input can have.
+    """
+    monkeypatch.chdir(tmp_path)
+    inputs = ["a.dat", "b,c.di", "d,e,f.csv"]
+    seen = _counted_keys(monkeypatch)
+    n = 2_000
+    text = ",".join(inputs[i % 3] for i in range(n))
+    got = split_same_sample(text, inputs)
+    assert got == [inputs[i % 3] for i in range(n)]
+    commas = text.count(",")
+    assert commas > 3_900
+    # distinct comma counts among the inputs (0, 1, 2): at most 3 pieces per comma (each
+    # distinct piece is resolved once: here a handful), besides the inputs' own spellings
+    assert len(seen) <= 3 * len(inputs) + 3 * (commas + 1)
+
+
+def test_split_same_sample_of_2000_unknown_pieces_falls_back_at_once(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    seen = _counted_keys(monkeypatch)
+    text = ",".join(f"x{i}" for i in range(2_000))
+    assert split_same_sample(text, ["b.di"]) == [f"x{i}" for i in range(2_000)]
+    assert len(seen) <= 3 + 2_000
+
+
+def test_split_same_sample_takes_a_comma_spelt_by_an_absolute_path(tmp_path, monkeypatch):
+    """The input relative, the value absolute through a folder with commas in its name."""
+    folder = tmp_path / "run 1,2"
+    folder.mkdir()
+    monkeypatch.chdir(folder)
+    inputs = ["a.dat", "b,c.di"]
+    text = f"{folder / 'b,c.di'},a.dat"
+    assert split_same_sample(text, inputs) == ["b,c.di", "a.dat"]

@@ -18,12 +18,12 @@ from .. import parallel  # imports only labbrdf.errors: usable from every layer
 from ..dataset import Measurement
 from ..models import Model
 from ..models import get as get_model
-from .core import METHOD, fit, parse_method, setup_params
+from .core import METHOD, check_seed, fit, parse_method, setup_params
 from .data import FitData, FitError, select_rows, several_groups_message
 from .replicates import check_replicates
 from .result import FitResult
 
-__all__ = ["auto_weighting", "fit_many", "fit_many_nk", "fit_records"]
+__all__ = ["auto_weighting", "fit_many", "fit_many_nk", "fit_records", "group_keys"]
 
 
 def _sort_key(key: Any) -> tuple[Any, ...]:
@@ -123,6 +123,47 @@ def _todo(
     return todo
 
 
+def group_keys(
+    data: Measurement | pd.DataFrame,
+    by: Sequence[str] = ("sample", "wavelength_nm"),
+    *,
+    quantity: str | None = None,
+    unit: str | None = None,
+) -> list[dict[str, Any]]:
+    """The groups :func:`fit_many` would fit, without fitting any: one key per table row.
+
+    Parameters
+    ----------
+    data : Measurement or DataFrame
+        Dataset-schema rows.
+    by : sequence of str
+        Grouping columns, as for :func:`fit_many`.
+    quantity, unit : str, optional
+        As for :func:`fit_many` (which rows are fittable).
+
+    Returns
+    -------
+    list of dict
+        ``{column: value}`` of ``by`` for every group, in :func:`fit_many`'s table order
+        (groups that cannot be fitted, e.g. of several samples, included).
+
+    Raises
+    ------
+    FitError
+        An unknown column in ``by``, or no fittable rows.
+    """
+    df = data.data if isinstance(data, Measurement) else data
+    by = [by] if isinstance(by, str) else list(by)
+    missing = [c for c in by if c not in getattr(df, "columns", ())]
+    if missing:
+        raise FitError(f"by: unknown column(s) {missing}; columns are {list(df.columns)}")
+    d, _, _ = select_rows(df, quantity, unit)
+    keys = sorted(d.groupby(by, sort=True, dropna=False).indices, key=_sort_key)
+    return [
+        dict(zip(by, map(_plain, k if isinstance(k, tuple) else (k,)), strict=True)) for k in keys
+    ]
+
+
 def _param_names(todo: list[tuple[int, Model, FitData]]) -> list[str]:
     """The parameter names of the groups' models, in first-seen order."""
     names: dict[str, None] = {}
@@ -214,6 +255,7 @@ def fit_many(
         None if isinstance(model, Model) else model
     )
     parse_method(method)
+    check_seed(seed)
     if isinstance(data, Measurement):
         data = data.data
     if not isinstance(data, pd.DataFrame):

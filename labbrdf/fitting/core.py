@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special
 
 from ..dataset import Measurement
-from ..models import Model, Parameters
+from ..models import Model, ModelError, Parameters
 from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
 from .objective import Objective
@@ -30,8 +30,10 @@ __all__ = [
     "EXACT_RTOL",
     "CONSTRAINED",
     "LOCAL_ROUNDS",
+    "MAX_SEED",
     "METHOD",
     "RELATIVE_FLOOR",
+    "check_seed",
     "fit",
     "parse_method",
     "setup_params",
@@ -147,6 +149,20 @@ def _energy_rho(
     return lambda vals, th: np.asarray(hemispherical_reflectance(model, vals, th), float)
 
 
+#: the largest seed of a fit: nlopt's ``srand`` takes an unsigned long, 32 bits on some
+#: platforms, so seeds are integers in [0, MAX_SEED] everywhere
+MAX_SEED = 2**32 - 1
+
+
+def check_seed(seed: Any) -> int:
+    """``seed`` as an int, if it is an integer in ``[0, MAX_SEED]``; else :class:`FitError`."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise FitError(f"seed must be an integer in [0, {MAX_SEED}]; got {seed!r}")
+    if not 0 <= seed <= MAX_SEED:
+        raise FitError(f"seed must be an integer in [0, {MAX_SEED}]; got {seed}")
+    return int(seed)
+
+
 def _copy_params(p: Parameters) -> Parameters:
     """A copy whose Parameter objects are new (fields are immutable or replaced, not mutated)."""
     return Parameters({k: copy.copy(q) for k, q in p.items()})
@@ -158,9 +174,12 @@ def setup_params(
     """The model's parameters with ``params`` (values or Parameters) and ``fix`` applied.
 
     Internal API of :mod:`labbrdf.fitting`; raises :class:`FitError` naming unknown or
-    inconsistent parameter names.
+    inconsistent parameter names, and a value given in ``params`` or ``fix`` that is not
+    finite or lies outside the parameter's bounds (:meth:`Parameter.check
+    <labbrdf.models.Parameter.check>`: the model's, or those given in ``params``).
     """
     p = _copy_params(model.params)
+    given: list[tuple[str, str, Any]] = []  # (argument, name, value) to check in bounds
     if params is not None:
         for k, v in params.items():
             if k not in p:
@@ -173,17 +192,22 @@ def setup_params(
                 for a in ("value", "min", "max", "vary", "log"):
                     if a in src:
                         setattr(p[k], a, src[a])
+                if "value" in src:
+                    given.append(("params", k, src["value"]))
             else:
-                p[k].value = float(v)
+                given.append(("params", k, v))
     for k, v in (fix or {}).items():
         if k not in p:
             raise FitError(
                 f"fix: model {model.name!r} has no parameter {k!r}; parameters are {list(p)}"
             )
-        if not math.isfinite(float(v)):
-            raise FitError(f"fix: {k}={v!r} must be a finite number")
-        p[k].value = float(v)
+        given.append(("fix", k, v))
         p[k].vary = False
+    for arg, k, v in given:
+        try:
+            p[k].value = p[k].check(v)
+        except ModelError as exc:
+            raise FitError(f"{arg}: model {model.name!r}: {exc}") from None
     for k, q in p.items():
         if not math.isfinite(q.value):
             raise FitError(f"parameter {k!r}: initial value {q.value!r} is not finite")
@@ -440,7 +464,8 @@ def fit(
         nlopt algorithm names joined by ``+``, run in turn, each from the best point of the
         previous one. Global stages need finite bounds on every varying parameter.
     seed : int
-        Passed to ``nlopt.srand`` before every stage: the fit is reproducible.
+        Passed to ``nlopt.srand`` before every stage: the fit is reproducible. An integer
+        in ``[0, MAX_SEED]``.
     params : Parameters or mapping, optional
         Initial values (name -> value) or per-parameter settings
         (name -> {"value", "min", "max", "vary", "log"}) overriding the model's defaults.
@@ -501,6 +526,7 @@ def fit(
     """
     # every argument but the model, the data and the count: the same for each replicate
     kw = {k: v for k, v in locals().items() if k not in ("model", "data", "replicates")}
+    check_seed(seed)
     model = get_model(model) if isinstance(model, str) else model
     R = getattr(model, "default_replicates", 1) if replicates is None else replicates
     if R != 1:  # a non-Model is refused by _problem

@@ -30,12 +30,13 @@ from ..dataset import Measurement
 from ..films import FILM_QUANTITIES, NK_REPORT_NM, FilmError, FilmModel, Stack, load_model
 from ..jsonsafe import jsonable
 from ..models import Model, Parameters
+from ..samples import SampleFile, stated_names
 from .core import METHOD, fit
 from .data import FitData, FitError
 from .result import FitResult
 from .uncertainty import CORREL_MAX
 
-__all__ = ["FilmFit", "fit_film", "woollam_mse"]
+__all__ = ["FilmFit", "fit_film", "stated_samples", "woollam_mse"]
 
 
 class _FilmFitModel(Model):
@@ -184,6 +185,37 @@ def _film_rows(
                 )
     df["sigma"] = sig
     return df.reset_index(drop=True), code
+
+
+def stated_samples(rows: pd.DataFrame) -> dict[str, tuple[str, ...]]:
+    """The sample names each file of ``rows`` states: ``source`` -> names, in row order.
+
+    A name is stated when the file says it, not when its reader took the file's name
+    (:func:`labbrdf.samples.stated_names`); files that state none are left out.
+    """
+    if "sample" not in rows.columns or "source" not in rows.columns:
+        return {}
+    out: dict[str, tuple[str, ...]] = {}
+    for src, g in rows.groupby(rows["source"].astype(str), sort=False):
+        names = tuple(dict.fromkeys(g["sample"].astype(str)))
+        said = stated_names(SampleFile(Path(str(src)), names))
+        if said:
+            out[str(src)] = said
+    return out
+
+
+def _check_one_sample(rows: pd.DataFrame) -> None:
+    """Refuse rows whose files state different samples (a film fit is of one sample)."""
+    said = stated_samples(rows)
+    names = list(dict.fromkeys(n for v in said.values() for n in v))
+    if len(names) < 2:
+        return
+    listing = "; ".join(f"{src} states {', '.join(map(repr, v))}" for src, v in said.items())
+    raise FilmError(
+        f"data: the files state {len(names)} different samples ({listing}); a film fit is "
+        "of one sample: fit each sample on its own (select its rows), or, if they are one "
+        "sample, say so with one_sample=True (CLI: --same-sample FILE,FILE)"
+    )
 
 
 def _check_coverage(fm: FilmModel, wl: NDArray) -> None:
@@ -570,6 +602,7 @@ def fit_film(
     seed: int = 0,
     ci: str = "wald",
     maxeval: int | Sequence[int | None] | None = None,
+    one_sample: bool = False,
 ) -> FilmFit:
     """Fit a film stack's thicknesses and dispersion parameters to measured data.
 
@@ -593,6 +626,10 @@ def fit_film(
         As :func:`labbrdf.fitting.fit` (global then local; seeded).
     ci : {"wald", "profile"}
         95 % intervals from the covariance or from the profile of chi-square.
+    one_sample : bool
+        The caller says that the files are one sample although they state different
+        sample names (a relabelled sample, a typo in a header). Without it such data are
+        refused: a joint fit of two samples is no sample's film.
 
     Returns
     -------
@@ -601,7 +638,9 @@ def fit_film(
     Raises
     ------
     FilmError
-        No usable rows, a row without sigma, a table that does not cover the data.
+        No usable rows, a row without sigma, a table that does not cover the data, files
+        that state different sample names (without ``one_sample``; naming the files and
+        their names).
     FitError
         From the core (too few points, unknown method, ...).
     """
@@ -624,6 +663,8 @@ def fit_film(
                        fm.wavelength_range_nm, fm.source)  # fmt: skip
     wl_range = wavelength_range_nm or fm.wavelength_range_nm
     rows, codes = _film_rows(data, wl_range, default_sigma)
+    if not one_sample:
+        _check_one_sample(rows)
     wl = rows["wavelength_nm"].to_numpy(float)
     _check_coverage(fm, wl)
     for k, (lo, hi) in fm.free.items():

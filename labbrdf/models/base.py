@@ -80,6 +80,35 @@ class Parameter:
         if self.log and not self.min > 0:
             raise ModelError(f"parameter {self.name!r}: log scale needs min > 0")
 
+    def check(self, value: Any) -> float:
+        """``value`` as a float, if it is a finite number within ``[min, max]``.
+
+        Parameters
+        ----------
+        value : float
+            A value for this parameter (fixed, or a start), in its units.
+
+        Returns
+        -------
+        float
+
+        Raises
+        ------
+        ModelError
+            ``value`` is not a number, is NaN or infinite, or lies outside the bounds;
+            the message names the parameter and the allowed range.
+        """
+        allowed = f"{self.min:g} <= {self.name} <= {self.max:g}"
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise ModelError(f"{self.name}={value!r}: expected a number, {allowed}") from None
+        if not math.isfinite(v):
+            raise ModelError(f"{self.name}={v!r}: expected a finite number, {allowed}")
+        if not self.min <= v <= self.max:
+            raise ModelError(f"{self.name}={v:g} is outside its bounds: expected {allowed}")
+        return v
+
     def as_dict(self) -> dict[str, Any]:
         """JSON-safe dict."""
         return {
@@ -296,6 +325,40 @@ class Model(ABC):
                     )
                 vals[k] = float(v.value if isinstance(v, Parameter) else v)
         return vals
+
+    def check_value(self, name: str, value: Any) -> float:
+        """``value`` for the parameter ``name``, checked against its declared bounds.
+
+        Every value a caller fixes or starts a parameter at goes through this check (the
+        fitting core's :func:`~labbrdf.fitting.core.setup_params`), so a value the model
+        was not made for never reaches its formula.
+
+        Parameters
+        ----------
+        name : str
+            A parameter of this model.
+        value : float
+            Its value, in the parameter's units.
+
+        Returns
+        -------
+        float
+
+        Raises
+        ------
+        ModelError
+            An unknown name, or a value that is not finite or lies outside
+            ``[min, max]`` (the message names the model, the parameter and the range).
+        """
+        if name not in self.params:
+            raise ModelError(
+                f"model {self.name!r} has no parameter {name!r}; parameters are "
+                f"{list(self.params)}"
+            )
+        try:
+            return self.params[name].check(value)
+        except ModelError as exc:
+            raise ModelError(f"model {self.name!r}: {exc}") from None
 
     def evaluate(
         self,

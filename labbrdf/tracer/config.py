@@ -18,6 +18,9 @@ TERMINATION = ("threshold", "roulette")
 ESTIMATORS = ("auto", "evaluated", "counting")
 # each batch holds (n_bins x 16) float64 sums: 4.2 MB on the 1-degree grid
 MAX_BATCHES = 64
+#: the most rays of one run: a run keeps per-block sums (16 floats per ``block_rays``
+#: rays), so memory stays small below it, and at about 1e6 rays/s it is already hours
+MAX_RAYS = 1_000_000_000
 
 
 def _check(cond: bool, name: str, expected: str, value: Any) -> None:
@@ -380,9 +383,11 @@ class TraceConfig:
             self.theta_i_deg,
         )
         _check(
-            isinstance(self.rays, int) and not isinstance(self.rays, bool) and self.rays > 0,
+            isinstance(self.rays, int)
+            and not isinstance(self.rays, bool)
+            and 0 < self.rays <= MAX_RAYS,
             "rays",
-            "a positive integer",
+            f"a positive integer at most {MAX_RAYS:.0e}",
             self.rays,
         )
         _check(

@@ -282,7 +282,8 @@ def nee_exit(
                     contrib = np.einsum("ikn,kjn->nij", T, rows) * w[i, a, b]
                     for bb in range(nb):
                         acc[bb, q] += contrib[batch == bb].sum(axis=0)
-    n_b = np.bincount(np.arange(cfg.rays) % nb, minlength=nb).astype(float)
+    # rays per batch (ray j in batch j % nb), counted without an array of all rays
+    n_b = (cfg.rays // nb + (np.arange(nb) < cfg.rays % nb)).astype(float)
     per = acc / n_b[:, None, None, None]
     mean = acc.sum(axis=0) / cfg.rays
     var = (n_b[:, None, None, None] * (per - mean) ** 2).sum(axis=0) / cfg.rays / (nb - 1)

@@ -235,3 +235,77 @@ def test_a_nan_thickness_names_the_model_file_and_line(film_file, tmp_path, caps
     assert main(["film", str(film_file), "--model", str(model)]) == 2
     err = capsys.readouterr().err
     assert f"{model}, line 6: thickness_nm: expected a finite number" in err, err
+
+
+def _sample_file(folder, name: str, sample: str, angle: float):
+    """Psi/Delta of :data:`TRUE` at one angle, stating the sample name ``sample``."""
+    wl = np.linspace(300, 1000, 30)
+    psi, delta = TRUE.psi_delta(wl, np.full(wl.size, angle))
+    parts = [
+        pd.DataFrame(
+            {
+                "sample": sample,
+                "instrument": "sim",
+                "source": name,
+                "quantity": q,
+                "value": v,
+                "sigma": s,
+                "unit": "deg",
+                "wavelength_nm": wl,
+                "theta_i_deg": angle,
+                "theta_r_deg": angle,
+                "phi_r_deg": 180.0,
+            }
+        )
+        for q, v, s in (("psi", psi, 0.02), ("delta", np.mod(delta, 360.0), 0.05))
+    ]
+    df = pd.concat(parts, ignore_index=True)
+    df["quantity"] = df["quantity"].astype("category")
+    path = folder / name
+    write(Measurement(df, {}), path)
+    return path
+
+
+@pytest.fixture
+def two_samples(tmp_path):
+    """Two files of the same stack that state different sample names."""
+    return (
+        _sample_file(tmp_path, "a.parquet", "wafer-A", 60.0),
+        _sample_file(tmp_path, "b.parquet", "wafer-B", 70.0),
+    )
+
+
+LAYER = ["--layer", "film:cauchy:0..300:A=1.3..1.8:B=0.004", "--ci", "wald"]
+
+
+def test_film_refuses_files_that_state_different_samples(two_samples, tmp_path, capsys):
+    a, b = two_samples
+    out = tmp_path / "nk.csv"
+    assert main(["film", str(a), str(b), *LAYER, "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert f"{a} states 'wafer-A'" in err and f"{b} states 'wafer-B'" in err
+    assert f"--same-sample {a},{b}" in err
+    assert not out.exists()
+
+
+def test_film_fits_files_said_to_be_one_sample_jointly(two_samples, capsys):
+    a, b = two_samples
+    assert main(["film", str(a), str(b), *LAYER, "--same-sample", f"{a},{b}", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["ndata"] == 4 * 30  # psi and Delta of both files
+    assert doc["layers"][0]["parameters"]["thickness_nm"]["value"] == pytest.approx(105, abs=0.5)
+
+
+def test_film_of_one_selected_sample_of_two_files_is_fitted(two_samples, capsys):
+    a, b = two_samples
+    assert main(["film", str(a), str(b), *LAYER, "--sample", "wafer-B", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["ndata"] == 2 * 30
+
+
+def test_film_same_sample_must_name_the_inputs(two_samples, tmp_path, capsys):
+    a, b = two_samples
+    other = tmp_path / "c.parquet"
+    assert main(["film", str(a), str(b), *LAYER, "--same-sample", f"{a},{other}"]) == 2
+    err = capsys.readouterr().err
+    assert f"{other} is not among the input files" in err and "Traceback" not in err

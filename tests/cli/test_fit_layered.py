@@ -94,10 +94,21 @@ def test_residual_maps_are_drawn_for_the_fitted_group(microfacet_bsdf, tmp_path,
     assert png.stat().st_size > 10_000
 
 
-def test_residual_maps_refuse_several_groups(microfacet_bsdf, tmp_path, capsys):
-    png = tmp_path / "maps.png"
+def test_residual_maps_refuse_several_groups_before_any_fit(
+    microfacet_bsdf, tmp_path, capsys, monkeypatch
+):
+    """Several groups and one map: refused at once, nothing fitted, -o not written."""
+    import labbrdf.fitting
+
+    def no_fit(*a, **k):
+        raise AssertionError("a fit ran before --residual-maps was refused")
+
+    monkeypatch.setattr(labbrdf.fitting, "fit_many", no_fit)
+    png, table = tmp_path / "maps.png", tmp_path / "table.csv"
     argv = ["fit", str(microfacet_bsdf), "--model", "microfacet", *AL, "--by", "theta_i_deg"]
-    argv += ["--residual-maps", str(png)]
+    argv += ["--residual-maps", str(png), "-o", str(table)]
     assert main(argv) == 2
-    assert "--residual-maps draws one fitted group; 2 were fitted" in capsys.readouterr().err
-    assert not png.exists()
+    err = capsys.readouterr().err
+    assert "draws one fitted group; the data hold 2 (theta_i_deg=30.0; theta_i_deg=50.0)" in err
+    assert "--residual-maps" in err and "Traceback" not in err
+    assert not png.exists() and not table.exists()

@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from labbrdf.dataset import Measurement, make_frame
 from labbrdf.dispersion import Cauchy
 from labbrdf.films import FilmError, FilmModel, Layer, Stack, fit_film, load_model, woollam_mse
 
@@ -225,3 +226,41 @@ def test_cross_polarisation_rows_are_left_out_and_odd_channels_refused():
     odd = _rows("reflectance", np.array([500.0]), 60.0, np.array([0.3]), 0.01, "x")
     with pytest.raises(FilmError, match="channel \\['x'\\]; expected s, p or none"):
         fit_film(FilmModel(TRUE, box), [data, odd])
+
+
+def test_fit_film_refuses_files_that_state_different_samples_unless_told():
+    """Two files, two stated sample names: no joint fit unless ``one_sample=True``."""
+    wl = np.linspace(400.0, 900.0, 12)
+    stack = Stack([Layer(Cauchy(A=1.46, B=0.004), 100.0, "film")], "si")
+
+    def rows(sample: str, source: str, angle: float) -> Measurement:
+        psi, delta = stack.psi_delta(wl, np.full(wl.size, angle))
+        return Measurement(
+            pd.concat(
+                [
+                    make_frame(
+                        sample=sample,
+                        instrument="sim",
+                        source=source,
+                        quantity=q,
+                        value=v,
+                        unit="deg",
+                        wavelength_nm=wl,
+                        sigma=0.05,
+                        theta_i_deg=angle,
+                    )
+                    for q, v in (("psi", psi), ("delta", np.mod(delta, 360.0)))
+                ],
+                ignore_index=True,
+            ),
+            {},
+        )
+
+    data = [rows("wafer-A", "a.dat", 60.0), rows("wafer-B", "b.dat", 70.0)]
+    with pytest.raises(FilmError, match=r"a.dat states 'wafer-A'; b.dat states 'wafer-B'"):
+        fit_film(stack, data, method="LN_BOBYQA")
+    fit = fit_film(stack, data, method="LN_BOBYQA", one_sample=True)
+    assert fit.sources == ["a.dat", "b.dat"]
+    # a reader's file-name fallback is no stated name: a.dat's rows named "b" pair anyway
+    same = [rows("wafer-A", "a.dat", 60.0), rows("b", "b.dat", 70.0)]
+    assert fit_film(stack, same, method="LN_BOBYQA").sources == ["a.dat", "b.dat"]

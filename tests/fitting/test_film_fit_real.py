@@ -48,8 +48,10 @@ def test_ta2o5_trio_fits_on_tantalum_and_its_psi_delta_stack_predicts_r_p(real_e
         "ta2o5.B": (0.0, 0.08),
         "ta2o5.C": (-0.005, 0.01),
     }
-    on_ta = fit_film(FilmModel(Stack([layer], ta), box), data, wavelength_range_nm=(350, 1450))
-    on_si = fit_film(FilmModel(Stack([layer], "si"), box), data, wavelength_range_nm=(350, 1450))
+    # one wafer whose three headers name it three ways ("... p-pol refl"): said to be one
+    one = {"wavelength_range_nm": (350, 1450), "one_sample": True}
+    on_ta = fit_film(FilmModel(Stack([layer], ta), box), data, **one)
+    on_si = fit_film(FilmModel(Stack([layer], "si"), box), data, **one)
     alone = fit_film(  # psi/Delta alone: the reflectance below is then a prediction
         FilmModel(Stack([layer], ta), box), ellipsometry, wavelength_range_nm=(350, 1450)
     )

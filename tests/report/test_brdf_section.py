@@ -192,9 +192,12 @@ def test_no_brdf_rows_skipped(fixtures_dir: Path, tmp_path: Path) -> None:
 
 
 def test_energy_check_fails_for_a_model_above_one(tmp_path: Path) -> None:
-    """A file made from a microfacet with rho > 1 (scale 30 held fixed, kd 0.5) fails the check."""
+    """A file made from a microfacet with rho > 1 (scale 10 held fixed, kd 1) fails the check.
+
+    Scale 10 is the top of its bounds: a start beyond them is refused.
+    """
     m = models.get("microfacet", **MICRO)
-    p = {"alpha": 0.3, "scale": 30.0, "kd": 0.5}
+    p = {"alpha": 0.3, "scale": 10.0, "kd": 1.0}
     rho = float(integrate_rho(m, p, 30.0))
     assert rho > 1.0
     path = model_to_bsdf(
@@ -205,7 +208,7 @@ def test_energy_check_fails_for_a_model_above_one(tmp_path: Path) -> None:
         radial_deg=np.arange(0.0, 85.0, 10.0),
         azimuth_deg=np.arange(0.0, 181.0, 30.0),
     )
-    res = _report([path], tmp_path / "o", start={"scale": 30.0})
+    res = _report([path], tmp_path / "o", start={"scale": 10.0})
     assert _check(res, "brdf.energy")["status"] == "fail"
 
 

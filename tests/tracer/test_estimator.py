@@ -422,6 +422,8 @@ def test_auto_estimator_is_evaluated_only_where_it_applies():
         ({"batches": 1}, "batches must be an integer in"),
         ({"batches": True}, "batches must be an integer in"),
         ({"batches": 10**6}, "batches must be an integer in"),
+        ({"rays": 10**9 + 1}, "rays must be a positive integer at most 1e"),
+        ({"rays": 10**13}, "rays must be a positive integer at most 1e"),
     ],
 )
 def test_bad_estimator_config_raises_naming_the_field(kwargs, match):
