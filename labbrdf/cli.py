@@ -481,9 +481,6 @@ def _executor_errors(cmd: Any) -> Any:
             return cmd(args)
         except ParallelError as exc:
             raise UsageError(str(exc)) from None
-        except KeyboardInterrupt:
-            print(f"labbrdf {args.command}: interrupted; the run is abandoned", file=sys.stderr)
-            raise
 
     return wrapper
 
@@ -2141,15 +2138,20 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 @contextlib.contextmanager
-def _adapter_warnings(command: str) -> Iterator[None]:
-    """Print a reader's doubts (:class:`~labbrdf.adapters.AdapterWarning`) as one line each."""
+def _labbrdf_warnings(command: str) -> Iterator[None]:
+    """Print labbrdf's own warnings as one line each, without Python's source-line dump.
+
+    A reader's doubts (:class:`~labbrdf.adapters.AdapterWarning`, always shown), a tracer
+    cache file that was rebuilt, an ill-conditioned inversion: every warning class defined
+    in labbrdf. Other libraries' warnings keep Python's format.
+    """
     from .adapters import AdapterWarning
 
     with warnings.catch_warnings():
         original = warnings.showwarning
 
         def show(message: Any, category: Any, *rest: Any, **kw: Any) -> None:
-            if issubclass(category, AdapterWarning):
+            if category.__module__.partition(".")[0] == "labbrdf":
                 print(f"labbrdf {command}: warning: {message}", file=sys.stderr)
             else:
                 original(message, category, *rest, **kw)
@@ -2161,10 +2163,14 @@ def _adapter_warnings(command: str) -> Iterator[None]:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code."""
-    parser = build_parser()
+    try:
+        parser = build_parser()
+    except KeyboardInterrupt:
+        print("labbrdf: interrupted", file=sys.stderr)
+        return 130
     args = parser.parse_args(argv)
     try:
-        with _checked_outputs(args), _adapter_warnings(args.command):
+        with _checked_outputs(args), _labbrdf_warnings(args.command):
             return int(args.func(args))
     except UsageError as exc:
         print(f"labbrdf {args.command}: {exc}", file=sys.stderr)
@@ -2186,7 +2192,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except MemoryError:
         print(f"labbrdf {args.command}: out of memory (is an input a huge file?)", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:  # pragma: no cover
+    except KeyboardInterrupt:
+        print(f"labbrdf {args.command}: interrupted; the run is abandoned", file=sys.stderr)
         return 130
 
 

@@ -314,3 +314,34 @@ def test_report_command_records_an_unreadable_file_as_a_failed_check(tmp_path, c
     results = json.loads((out / "results.json").read_text())
     assert results["summary"]["fail"] == 1 and results["summary"]["pass"] == 0
     assert "bad.xyz: " in (out / "index.html").read_text()
+
+
+def test_labbrdf_warnings_print_as_one_line_and_others_keep_their_format(monkeypatch, capsys):
+    import warnings
+
+    from labbrdf import cli
+    from labbrdf.tracer.cache import CacheWarning
+
+    def formats(args):
+        warnings.warn("cache file x.op was rebuilt: digest mismatch", CacheWarning, stacklevel=1)
+        warnings.warn("a library's own words", UserWarning, stacklevel=1)
+        return 0
+
+    monkeypatch.setattr(cli, "cmd_formats", formats)
+    with pytest.warns(UserWarning, match="a library's own words") as seen:
+        assert main(["formats"]) == 0
+    err = capsys.readouterr().err
+    assert err == "labbrdf formats: warning: cache file x.op was rebuilt: digest mismatch\n"
+    assert [w.category for w in seen] == [UserWarning]  # handed on in Python's own way
+
+
+def test_ctrl_c_while_the_parser_is_built_exits_130_without_traceback(monkeypatch, capsys):
+    from labbrdf import cli
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "build_parser", interrupted)
+    assert main(["formats"]) == 130
+    err = capsys.readouterr().err
+    assert err == "labbrdf: interrupted\n"
