@@ -148,7 +148,8 @@ def user_report(
     ValueError
         No paths, an unknown model name or option, a film model file with an error
         (naming the file and the line), a ``same_sample`` mapping that cannot hold
-        (:class:`labbrdf.samples.PairingError`), an unknown ``prediction_slopes``, or an
+        (:class:`labbrdf.samples.PairingError`), a ``start`` value outside its parameter's
+        bounds, an unknown ``prediction_slopes``, or an
         output folder that is refused
         (:class:`labbrdf.outputs.OutputError`), all before any work.
     """
@@ -160,6 +161,7 @@ def user_report(
             f"prediction_slopes: expected one of {', '.join(SLOPES)}, got {prediction_slopes!r}"
         )
     paths, model_file, opts = _refused_early(paths, model, options, out, film_model, same_sample)
+    _check_start(model, opts, start)
     film, film_how = film_model_of(film_model)
     meta = {"model": model, "options": opts, "method": method, "seed": seed}
     meta.update(files=[str(p) for p in paths], film_model=film_how or None)
@@ -221,6 +223,16 @@ def _refused_early(
     except Exception as exc:
         raise ValueError(f"model: {exc}") from None
     return files, model_file, opts
+
+
+def _check_start(model: str, opts: Mapping[str, Any], start: Mapping[str, float] | None) -> None:
+    """Refuse a start value outside its parameter's bounds before any work (ValueError)."""
+    m = models.get(model, **opts)
+    for name, value in (start or {}).items():
+        try:
+            m.check_value(name, value)
+        except ValueError as exc:
+            raise ValueError(f"start: {exc}") from None
 
 
 def _ingest(

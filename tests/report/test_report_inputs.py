@@ -151,3 +151,28 @@ def test_an_unreadable_file_leaves_the_rest_of_the_report_as_without_it(
     assert both["code"] == 1 and alone["code"] == 0
     rest = {k: v["status"] for k, v in c.items() if k != "ingest.unreadable"}
     assert rest == {x["id"]: x["status"] for x in alone["checks"]}
+
+
+def test_a_start_value_outside_its_bounds_is_refused_before_any_work(
+    tmp_path: Path, specular_scan: Path
+) -> None:
+    from labbrdf.cli import main
+    from labbrdf.report import user_report
+
+    out = tmp_path / "r"
+    with pytest.raises(
+        ValueError, match=r"start: model 'microfacet': scale=30 is outside its bounds"
+    ):
+        user_report(
+            [specular_scan],
+            "microfacet",
+            out,
+            options={"ideal_mirror": True},
+            start={"scale": 30.0},
+            progress=False,
+        )
+    assert not out.exists()
+    argv = ["report", str(specular_scan), "--model", "microfacet", "--param", "ideal_mirror=true"]
+    argv += ["--param", "scale=30"]
+    assert main([*argv, "-o", str(out)]) == 2
+    assert not out.exists()
