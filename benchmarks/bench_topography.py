@@ -20,10 +20,10 @@ import sys
 import time
 import tracemalloc
 
+from labbrdf.microfacet import TabulatedNDF
 from labbrdf.surface import gaussian_surface
 from labbrdf.topography import roughness_statistics
 from labbrdf.tracer import Substrate, TraceConfig, trace
-from labbrdf.tracer.sampling import TabulatedNDF
 
 
 def _median_seconds(func, repeats: int) -> float:

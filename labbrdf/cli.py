@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from .jsonsafe import jsonable
+from .microfacet import DISTRIBUTIONS
 
 __all__ = ["main"]
 
@@ -1455,7 +1456,7 @@ def cmd_surface(args: argparse.Namespace) -> int:
     if d["kind"] == "areal":
         row("anisotropy c_major/c_minor", "anisotropy_ratio", 1.0, "")
     fits = d["slope_fits"]
-    for name in ("ggx", "beckmann"):
+    for name in DISTRIBUTIONS:
         f = fits[name]
         print(f"{name + ' alpha (ML)':<38} {f['alpha']:.4g}  KS {f['ks']:.3g}  AIC {f['aic']:.6g}")
     print(f"best description of the slopes: {fits['best']}")
@@ -1986,7 +1987,7 @@ def _trace_parser(sub: Any) -> None:
     )
     s.add_argument(
         "--distribution",
-        choices=("ggx", "beckmann"),
+        choices=tuple(DISTRIBUTIONS),
         default="ggx",
         help="microfacet distribution of the interfaces given by an alpha (measured maps "
         "always use their own slope table)",

@@ -64,11 +64,11 @@ from numpy.typing import NDArray
 from .adapters import zemax_bsdf
 from .bsdf_geometry import scatter_to_angles, scatter_to_direction
 from .integrate import grid_integral
+from .microfacet import TabulatedNDF
 from .nk import coating_of_stack, combined_table, nk_at, ordinary_psi_delta
 from .specular_dop import specular_dop
 from .topography import SlopeFit, fit_slope_distribution, level, slopes
 from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
-from .tracer.sampling import TabulatedNDF
 
 __all__ = [
     "DEFAULT_RAYS",

@@ -54,6 +54,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import fft as sfft
 from scipy import ndimage, optimize, special
 
+from .microfacet import DISTRIBUTIONS
+
 __all__ = [
     "C_MIN_PIXELS",
     "GAUSS_ALPHA",
@@ -455,56 +457,45 @@ class SlopeFit:
 
 @dataclass(frozen=True)
 class SlopeFits:
-    """GGX and Beckmann fits to one slope sample; ``best`` has the smaller AIC."""
+    """The fits of every registered distribution to one slope sample.
 
-    ggx: SlopeFit
-    beckmann: SlopeFit
+    Attributes
+    ----------
+    fits : dict of str to SlopeFit
+        One fit per name of :data:`labbrdf.microfacet.DISTRIBUTIONS`, in registry order;
+        also readable as attributes (``fits.ggx``, ``fits.beckmann``).
+    best : str
+        The name with the smallest AIC (the first of equal ones).
+    warning : str or None
+        Set when no distribution describes the slopes (every KS distance above
+        ``ks_threshold``).
+    ks_threshold : float
+        :data:`KS_WARN`.
+    """
+
+    fits: dict[str, SlopeFit]
     best: str
     warning: str | None
     ks_threshold: float = KS_WARN
 
+    def __getattr__(self, name: str) -> SlopeFit:
+        fits = self.__dict__.get("fits", {})
+        if name in fits:
+            return fits[name]
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
     def to_dict(self) -> dict[str, Any]:
-        """JSON-safe dict (NaN -> None, tuples -> lists)."""
-        return _json_safe(asdict(self))
-
-
-def _ggx_s(q: NDArray, frac: float) -> float:
-    """Root in s = alpha^2 of ``mean(s / (s + q)) = frac`` (GGX score equation).
-
-    The left side increases with s; the root is bracketed by stepping a factor 4 from the
-    mean of q (one temporary of q's size per evaluation), then polished by Brent's method
-    to a relative 1e-13 inside the bracket.
-    """
-    qpos = q[q > 0]
-    if qpos.size == 0:
-        return 0.0
-    lo_lim, hi_lim = float(np.min(qpos)) * 1e-6, float(np.max(q)) * 1e6
-    del qpos
-    # q and the scratch array live in a list emptied at the end: brentq leaves g in a
-    # reference cycle, which would otherwise keep both alive until the next GC
-    arrays = [q, np.empty_like(q)]
-
-    def g(s: float) -> float:
-        qq, t = arrays
-        np.add(qq, s, out=t)
-        np.divide(s, t, out=t)
-        return float(np.mean(t)) - frac
-
-    s0 = min(max(float(np.mean(q)), lo_lim), hi_lim)
-    lo = hi = s0
-    if g(s0) < 0:
-        while g(hi) < 0 and hi < hi_lim:
-            lo, hi = hi, min(hi * 4.0, hi_lim)
-    else:
-        while g(lo) > 0 and lo > lo_lim:
-            lo, hi = max(lo / 4.0, lo_lim), lo
-    root = float(optimize.brentq(g, lo, hi, xtol=1e-300, rtol=1e-13))
-    arrays.clear()
-    return root
+        """JSON-safe dict: one entry per distribution, then best, warning, ks_threshold."""
+        d: dict[str, Any] = {name: asdict(fit) for name, fit in self.fits.items()}
+        d.update(best=self.best, warning=self.warning, ks_threshold=self.ks_threshold)
+        return _json_safe(d)
 
 
 def _fit_core(x: NDArray, y: NDArray | None) -> dict[str, float]:
-    """ML alphas, log-likelihoods and KS distances (no uncertainties).
+    """ML alphas, log-likelihoods and KS distances (no uncertainties) of every distribution.
+
+    Keys ``"<name>_alpha"``, ``"<name>_loglik"``, ``"<name>_ks"`` and ``"<name>_s"``
+    (``s = alpha^2``) for each name of :data:`labbrdf.microfacet.DISTRIBUTIONS`.
 
     Raises
     ------
@@ -512,82 +503,63 @@ def _fit_core(x: NDArray, y: NDArray | None) -> dict[str, float]:
         All slopes are zero (a map without roughness at the pixel scale).
     """
     n = x.size
+    areal = y is not None
+    q = x * x
     if y is not None:
-        q = x * x
         q += y * y
-        # 2-D: log P22 = ln s - 2 ln(s + q) - ln pi (GGX); -ln(pi s) - q/s (Beckmann)
-        sg = _ggx_s(q, 0.5)
-        _check_slopes(sg)
-        sb = float(q.mean())
-        llg = float(n * math.log(sg) - 2 * _sum_log(q, sg) - n * math.log(math.pi))
-        llb = float(-n * math.log(math.pi * sb) - np.sum(q) / sb)
+    s = {name: dist.ml_s(q, areal) for name, dist in DISTRIBUTIONS.items()}
+    _check_slopes(s)
+    ll = {name: dist.log_likelihood(q, s[name], n, areal) for name, dist in DISTRIBUTIONS.items()}
+    if areal:  # KS of the squared radial slope
         q.sort()
-        ksg = _ks_sorted(q, lambda v: v / (sg + v))
-        ksb = _ks_sorted(q, lambda v: -np.expm1(-v / sb))
-    else:
-        q = x * x
-        # 1-D marginals: P2 = 1 / (2 a (1 + x^2/a^2)^(3/2)) (GGX); exp(-x^2/s)/sqrt(pi s)
-        sg = _ggx_s(q, 2.0 / 3.0)
-        _check_slopes(sg)
-        sb = float(2 * q.mean())
-        llg = float(n * math.log(sg) - 1.5 * _sum_log(q, sg) - n * math.log(2.0))
-        llb = float(-0.5 * n * math.log(math.pi * sb) - np.sum(q) / sb)
+        sample = q
+    else:  # KS of the slope itself
         del q
-        xs = np.sort(x)
-        ksg = _ks_sorted(xs, lambda v: 0.5 + 0.5 * v / np.sqrt(sg + v * v))
-        ksb = _ks_sorted(xs, lambda v: 0.5 * (1 + special.erf(v / math.sqrt(sb))))
-    return {
-        "ggx_alpha": math.sqrt(sg),
-        "beckmann_alpha": math.sqrt(sb),
-        "ggx_loglik": llg,
-        "beckmann_loglik": llb,
-        "ggx_ks": ksg,
-        "beckmann_ks": ksb,
-        "ggx_s": sg,
-        "beckmann_s": sb,
-    }
+        sample = np.sort(x)
+    out: dict[str, float] = {}
+    for name, dist in DISTRIBUTIONS.items():
+        out[name + "_alpha"] = math.sqrt(s[name])
+        out[name + "_loglik"] = ll[name]
+        out[name + "_ks"] = _ks_sorted(sample, dist.ks_cdf(s[name], areal))
+        out[name + "_s"] = s[name]
+    return out
 
 
-def _check_slopes(sg: float) -> None:
-    if not sg > 0:
+def _check_slopes(s: dict[str, float]) -> None:
+    if not all(v > 0 for v in s.values()):
         raise ValueError("all slopes are zero: the heights do not change between pixels")
 
 
-def _sum_log(q: NDArray, s: float) -> float:
-    """``sum(ln(s + q))`` with one temporary."""
-    t = q + s
-    np.log(t, out=t)
-    return float(np.sum(t))
-
-
-def _fisher_u(x: NDArray, y: NDArray | None, core: dict[str, float]) -> tuple[float, float]:
+def _fisher_u(x: NDArray, y: NDArray | None, core: dict[str, float]) -> dict[str, float]:
     """Observed-information standard uncertainties of the ML alphas (independent slopes)."""
     n = x.size
-    sg, sb = core["ggx_s"], core["beckmann_s"]
     q = x * x + (y * y if y is not None else 0.0)
-    k = 2.0 if y is not None else 1.5
-    jg = n / sg**2 - k * float(np.sum(1.0 / (sg + q) ** 2))
-    jb = n / sb**2 if y is not None else n / (2 * sb**2)
-    # alpha = sqrt(s): u(alpha) = u(s) / (2 alpha)
-    ug = (1.0 / math.sqrt(jg)) / (2 * math.sqrt(sg)) if jg > 0 else float("nan")
-    ub = (1.0 / math.sqrt(jb)) / (2 * math.sqrt(sb))
-    return ug, ub
+    out = {}
+    for name, dist in DISTRIBUTIONS.items():
+        s = core[name + "_s"]
+        j = dist.fisher_information(q, s, n, y is not None)
+        # alpha = sqrt(s): u(alpha) = u(s) / (2 alpha)
+        out[name] = (1.0 / math.sqrt(j)) / (2 * math.sqrt(s)) if j > 0 else float("nan")
+    return out
 
 
-def _make_fits(core: dict[str, float], ug: float, ub: float, n: int) -> SlopeFits:
+def _make_fits(core: dict[str, float], u: dict[str, float], n: int) -> SlopeFits:
     fits = {}
-    for m, u in (("ggx", ug), ("beckmann", ub)):
+    for m in DISTRIBUTIONS:
         ll = core[m + "_loglik"]
-        fits[m] = SlopeFit(m, core[m + "_alpha"], u, ll, 2.0 - 2.0 * ll, core[m + "_ks"], n)
-    best = "ggx" if fits["ggx"].aic <= fits["beckmann"].aic else "beckmann"
+        fits[m] = SlopeFit(m, core[m + "_alpha"], u[m], ll, 2.0 - 2.0 * ll, core[m + "_ks"], n)
+    best = next(iter(fits))
+    for m in fits:  # the first of the smallest AIC
+        if not fits[best].aic <= fits[m].aic:
+            best = m
     warning = None
-    if min(fits["ggx"].ks, fits["beckmann"].ks) > KS_WARN:
+    if min(f.ks for f in fits.values()) > KS_WARN:
+        each = " nor ".join(f"{DISTRIBUTIONS[m].LABEL} (KS {f.ks:.3f})" for m, f in fits.items())
         warning = (
-            f"neither GGX (KS {fits['ggx'].ks:.3f}) nor Beckmann (KS "
-            f"{fits['beckmann'].ks:.3f}) describes the slope distribution: both KS "
-            f"distances exceed {KS_WARN}"
+            f"neither {each} describes the slope distribution: "
+            f"{'both' if len(fits) == 2 else 'all'} KS distances exceed {KS_WARN}"
         )
-    return SlopeFits(fits["ggx"], fits["beckmann"], best, warning)
+    return SlopeFits(fits, best, warning)
 
 
 def fit_slope_distribution(x: ArrayLike, y: ArrayLike | None = None) -> SlopeFits:
@@ -626,8 +598,7 @@ def fit_slope_distribution(x: ArrayLike, y: ArrayLike | None = None) -> SlopeFit
     if xa.size < 2 or not np.any(xa != 0) and (ya is None or not np.any(ya != 0)):
         raise ValueError("need at least 2 finite, not all zero slopes")
     core = _fit_core(xa, ya)
-    ug, ub = _fisher_u(xa, ya, core)
-    return _make_fits(core, ug, ub, xa.size)
+    return _make_fits(core, _fisher_u(xa, ya, core), xa.size)
 
 
 # ------------------------------------------------------------------------ statistics
@@ -684,7 +655,9 @@ class RoughnessStats:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe dict (NaN -> None, tuples -> lists)."""
-        return _json_safe(asdict(self))
+        d = asdict(self)
+        d["slope_fits"] = self.slope_fits.to_dict()
+        return _json_safe(d)
 
 
 def _json_safe(obj: Any) -> Any:
@@ -785,8 +758,8 @@ def _core(
         out["_fisher"] = _fisher_u(sx, sy, fc)
     del sx, sy
     out["alpha_ggx_ml"] = fc["ggx_alpha"]
-    out["ggx_alpha"] = fc["ggx_alpha"]
-    out["beckmann_alpha"] = fc["beckmann_alpha"]
+    for name in DISTRIBUTIONS:
+        out[name + "_alpha"] = fc[name + "_alpha"]
 
     rho = autocorrelation(lz, valid, hole=hole)
     centre = tuple(n // 2 for n in rho.shape)
@@ -1135,10 +1108,10 @@ def roughness_statistics(
         progress(1, 1 + len(tiles))
     unc = _jackknife(z, valid, px, degree, tiles, full, progress)
     if tiles:
-        ug, ub = unc.get("ggx_alpha", _NAN), unc.get("beckmann_alpha", _NAN)
+        u = {name: unc.get(name + "_alpha", _NAN) for name in DISTRIBUTIONS}
     else:
-        ug, ub = full["_fisher"]
-    fits = _make_fits(full["_fit"], ug, ub, full["_n_slopes"])
+        u = full["_fisher"]
+    fits = _make_fits(full["_fit"], u, full["_n_slopes"])
     notes = _stats_notes(z, valid, px, degree, full, fits)
     if n_eroded:
         notes.append(f"mask eroded by {erode} pixels around dropouts: {n_eroded} points dropped")

@@ -26,9 +26,9 @@ from typing import Any, Literal
 
 from .adapters.topography import HeightMap, read_height_map
 from .errors import SetupError, escaped
+from .microfacet import DISTRIBUTIONS, TabulatedNDF
 from .nk import NkError, bulk_index_at, coating_from_fit, read_nk
 from .tracer.config import Coating, Substrate, TraceConfig
-from .tracer.sampling import TabulatedNDF
 
 __all__ = ["trace_config_from_inputs"]
 
@@ -68,16 +68,19 @@ def _pitch(hm: HeightMap) -> float | tuple[float, float]:
 
 
 def _analytic_table(distribution: str, alpha: float) -> TabulatedNDF | None:
-    """The slope table of an analytic distribution: None for GGX (the tracer's own)."""
-    if distribution == "ggx":
+    """The slope table of an analytic distribution.
+
+    None for a distribution the tracer samples in closed form (GGX).
+    """
+    if distribution not in DISTRIBUTIONS:
+        expected = " or ".join(repr(name) for name in DISTRIBUTIONS)
+        raise SetupError(f"{{distribution}} {escaped(repr(distribution))}: expected {expected}")
+    dist = DISTRIBUTIONS[distribution]
+    if dist.TRACED_IN_CLOSED_FORM:
         return None
-    if distribution != "beckmann":
-        raise SetupError(
-            f"{{distribution}} {escaped(repr(distribution))}: expected 'ggx' or 'beckmann'"
-        )
     if not alpha > 0:
-        raise SetupError("{distribution} beckmann needs a roughness alpha > 0")
-    return TabulatedNDF.beckmann(alpha)
+        raise SetupError(f"{{distribution}} {dist.NAME} needs a roughness alpha > 0")
+    return TabulatedNDF.of(dist, alpha)
 
 
 def _substrate(

@@ -15,9 +15,9 @@ import pytest
 from labbrdf import tracer_setup
 from labbrdf.adapters.topography import HeightMap
 from labbrdf.errors import SetupError
+from labbrdf.microfacet import TabulatedNDF
 from labbrdf.nk import bulk_index_at, read_nk
 from labbrdf.tracer import Coating, Substrate, TraceConfig
-from labbrdf.tracer.sampling import TabulatedNDF
 from labbrdf.tracer_setup import trace_config_from_inputs
 
 TA = "woollam-wvase-ascii/w2_10102006.dat"

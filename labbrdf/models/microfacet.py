@@ -1,7 +1,7 @@
 """GGX microfacet BRDF with separable Smith shadowing and the exact complex Fresnel factor.
 
 Physics layer: numpy only (the Fresnel amplitudes and the ellipsometric inversion come from
-:mod:`labbrdf.optics`).
+:mod:`labbrdf.optics`, D and G1 from :mod:`labbrdf.microfacet.ggx`).
 
 ``f = scale * F(theta_d) D(h) G1(w_i) G1(w_o) / (4 cos theta_i cos theta_r)`` [sr^-1], where
 h is the half vector, theta_d the local incidence angle on the facet (cos = w_i.h), D the
@@ -21,7 +21,6 @@ References
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -29,67 +28,17 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..ellipsometry import nk_from_psi_delta
+from ..microfacet import ggx
 from ..optics import fresnel_cos
 from .base import Model, ModelError, Parameters, lambert
 
-__all__ = ["Microfacet", "ggx_distribution", "smith_g1_ggx", "stokes_from_jones"]
+__all__ = ["Microfacet", "stokes_from_jones"]
 
 _SHADOWING = ("smith", "none")
 
 # coherency vector (Es Es*, Es Ep*, Ep Es*, Ep Ep*) -> Stokes (S0, S1, S2, S3), LB convention
 _A = np.array([[1, 0, 0, 1], [1, 0, 0, -1], [0, 1, 1, 0], [0, 1j, -1j, 0]], dtype=complex)
 _A_INV = np.linalg.inv(_A)
-
-
-def ggx_distribution(cos_m: ArrayLike, alpha: float) -> NDArray[np.float64]:
-    """GGX / Trowbridge-Reitz normal distribution D(m) [sr^-1], eq. (33) of [1]_.
-
-    ``D = alpha^2 / (pi cos^4 theta_m (alpha^2 + tan^2 theta_m)^2)
-    = alpha^2 / (pi (1 + (alpha^2 - 1) cos^2 theta_m)^2)``, normalised so that
-    ``int D cos theta_m d omega_m = 1``.
-
-    Parameters
-    ----------
-    cos_m : array_like
-        Cosine of the facet-normal polar angle [1], in (0, 1].
-    alpha : float
-        GGX roughness [1] (not an RMS slope), > 0.
-
-    Returns
-    -------
-    ndarray
-        D [sr^-1]; 0 where ``cos_m <= 0``.
-
-    Notes
-    -----
-    The 2022 paper's eq. (14) misses alpha^2 in the numerator (``docs/errata.md``).
-    """
-    c2 = np.asarray(cos_m, dtype=float) ** 2
-    d = alpha**2 / (math.pi * (1.0 + (alpha**2 - 1.0) * c2) ** 2)
-    return np.where(np.asarray(cos_m) > 0, d, 0.0)
-
-
-def smith_g1_ggx(cos_v: ArrayLike, alpha: float) -> NDArray[np.float64]:
-    """Smith masking function of GGX, ``G1 = 2 / (1 + sqrt(1 + alpha^2 tan^2 theta_v))``.
-
-    Eq. (34) of [1]_.
-
-    Parameters
-    ----------
-    cos_v : array_like
-        Cosine of the direction's polar angle [1].
-    alpha : float
-        GGX roughness [1].
-
-    Returns
-    -------
-    ndarray
-        G1 [1] in [0, 1]; 0 where ``cos_v <= 0``.
-    """
-    c = np.asarray(cos_v, dtype=float)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tan2 = np.where(c > 0, (1.0 - c * c) / (c * c), np.inf)
-        return np.where(c > 0, 2.0 / (1.0 + np.sqrt(1.0 + alpha**2 * tan2)), 0.0)
 
 
 def stokes_from_jones(jones: NDArray) -> NDArray[np.float64]:
@@ -276,9 +225,9 @@ class Microfacet(Model):
             raise ModelError(f"microfacet parameter 'alpha' must be > 0; got {alpha!r}")
         ci, co = np.cos(ti), np.cos(tr)
         up = (ci > 0) & (co > 0)
-        d = ggx_distribution(cos_h, alpha)
+        d = ggx.d(cos_h, alpha)
         g = (
-            smith_g1_ggx(ci, alpha) * smith_g1_ggx(co, alpha)
+            ggx.smith_g1_closed(ci, alpha) * ggx.smith_g1_closed(co, alpha)
             if self._shadowing == "smith"
             else np.ones_like(d)
         )

@@ -423,6 +423,7 @@ def surface_figure(
     profile shows dz/dx against the 1-D densities of its fits, GGX
     ``1 / (2 a (1 + x^2/a^2)^(3/2))`` and Beckmann ``exp(-x^2/a^2) / (a sqrt(pi))``.
     """
+    from labbrdf.microfacet import DISTRIBUTIONS
     from labbrdf.topography import autocorrelation, slopes
 
     z = np.asarray(heights_m, float)
@@ -478,23 +479,15 @@ def surface_figure(
         lo = 0.0 if areal else -hi
         ax.hist(q, bins=60, range=(lo, hi), density=True, color="0.75", label="measured")
         x = np.linspace(lo, hi, 400)
-        for fit, style in ((fits.ggx, "-"), (fits.beckmann, "--")):
+        for i, fit in enumerate(fits.fits.values()):
+            style = ("-", "--", ":", "-.")[i % 4]
             a = fit.alpha
             if not (np.isfinite(a) and a > 0):
                 continue
-            t = (x / a) ** 2
-            if areal:  # density of the slope magnitude |grad z| for the 2-D fit
-                d = (
-                    2 * x / a**2 / (1 + t) ** 2
-                    if fit.model == "ggx"
-                    else 2 * x / a**2 * np.exp(-t)
-                )
-            else:  # 1-D marginal density of the fit to a profile
-                d = (
-                    1 / (2 * a * (1 + t) ** 1.5)
-                    if fit.model == "ggx"
-                    else np.exp(-t) / (a * np.sqrt(np.pi))
-                )
+            dist = DISTRIBUTIONS[fit.model]
+            # the density of the slope magnitude |grad z| for the 2-D fit, the 1-D marginal
+            # density for the fit to a profile
+            d = dist.radial_density(x, a) if areal else dist.p2(x, a)
             ax.plot(x, d, style, label=f"{fit.model} \u03b1 = {a:.3g} (KS {fit.ks:.2f})")
     ax.set_xlabel("slope magnitude |grad z| [1]" if areal else "slope dz/dx [1]")
     ax.set_ylabel("density")

@@ -14,7 +14,7 @@ implemented):
   reconstructs an FFT surface (sec. 2.1, :mod:`labbrdf.surface`) but its algorithm samples
   facet normals from the distribution D, and so do we;
 * GGX normals (eq. (14) corrected) sampled as *visible* normals, Smith masking
-  (:mod:`.sampling`); ``scattering="single"`` = one facet event per interface with the
+  (:mod:`labbrdf.microfacet.ggx`); ``scattering="single"`` = one facet event per interface with the
   separable Smith G1 G1 (the model of the SCATMECH/Mitsuba oracles), ``"multiple"`` = the
   Heitz et al. 2016 random walk on each microsurface (energy conserving; its first order
   carries the height-correlated Smith G2);

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from labbrdf.tracer.sampling import TabulatedNDF
+from labbrdf.microfacet import TabulatedNDF
 
 __all__ = ["Coating", "Substrate", "TraceConfig"]
 

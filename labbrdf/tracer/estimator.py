@@ -16,11 +16,11 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from ..microfacet import ggx
 from .binning import Grid
 from .config import TraceConfig
 from .evaluate import bin_nodes, reflection_mueller, transmission_mueller
 from .operator import PARITY, exit_operator
-from .sampling import ggx_d, smith_g1
 from .walk import _Setup
 
 __all__ = [
@@ -180,8 +180,8 @@ def _scalar_abcs(abcs):  # noqa: ANN001, ANN202
 
 def _ggx(alpha: float, what: str):  # noqa: ANN202
     if what == "d":
-        return lambda m: ggx_d(m[2], alpha)
-    return lambda v: smith_g1(v[2], alpha)
+        return lambda m: ggx.d(m[2], alpha)
+    return lambda v: ggx.smith_g1(v[2], alpha)
 
 
 def exit_map(

@@ -35,12 +35,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from ..microfacet import ggx
 from . import cache as _cache
 from .binning import Grid
 from .cache import cache_dir
 from .evaluate import bin_nodes, cell_centroids, transmission_mueller
 from .interfaces import fresnel_abcs
-from .sampling import ggx_d, smith_g1
 
 __all__ = ["ExitOperator", "build_exit_operator", "cache_dir", "exit_operator", "memory_cache"]
 
@@ -156,10 +156,10 @@ def build_exit_operator(
         return fresnel_abcs(n_below, n_above, c)[1]
 
     def d_of(m: NDArray[np.float64]) -> NDArray[np.float64]:
-        return ggx_d(m[2], alpha)
+        return ggx.d(m[2], alpha)
 
     def g1_of(v: NDArray[np.float64]) -> NDArray[np.float64]:
-        return smith_g1(v[2], alpha)
+        return ggx.smith_g1(v[2], alpha)
 
     # per output row: every (node, cell row, azimuth difference in [0, 180] deg) point
     grids = np.meshgrid(np.arange(ni * nj), np.arange(nt), np.arange(half), indexing="ij")

@@ -56,10 +56,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from ..microfacet import ggx
+from ..microfacet.height import sample_height
 from .binning import Grid, bin_exits
 from .config import TraceConfig
 from .interfaces import apply_fresnel, fresnel_abcs, rotate_frame, s_axis
-from .sampling import sample_height, sample_vndf, smith_g1, smith_lambda
 
 __all__ = ["BlockTally", "GroupTally", "run_unit", "trace_block", "trace_group"]
 
@@ -127,7 +128,7 @@ class _Setup:
         below: NDArray[np.bool_] | None = None,
     ) -> NDArray[np.float64]:
         """Smith Lambda of the travel directions (GGX, or the interfaces' tables)."""
-        lam = smith_lambda(kz_loc, alpha)
+        lam = ggx.smith_lambda(kz_loc, alpha)
         if self.ndf_sub is not None and on_sub.any():
             # the substrate is always seen from above: its local frame is the global one
             lam[on_sub] = self.ndf_sub.smith_lambda(k[:, on_sub])
@@ -159,7 +160,7 @@ class _Setup:
         below: NDArray[np.bool_] | None = None,
     ) -> NDArray[np.float64]:
         """Smith G1 of the travel directions (GGX, or the interfaces' tables)."""
-        g = smith_g1(kz_loc, alpha)
+        g = ggx.smith_g1(kz_loc, alpha)
         if self.ndf_sub is not None and on_sub.any():
             g[on_sub] = self.ndf_sub.smith_g1(k[:, on_sub])
         if self.ndf_top is not None and not on_sub.all():
@@ -430,7 +431,7 @@ def _facet_hit(su: _Setup, rng: np.random.Generator, rays: _Rays) -> _Hit:
     a = np.where(on_top, su.alpha_top, su.alpha_sub)
     wi = -k
     wi[2] = np.where(below, k[2], wi[2])
-    m = sample_vndf(wi, a, u[0], u[1])
+    m = ggx.sample_visible(wi, a, u[0], u[1])
     if su.ndf_sub is not None and not on_top.all():
         on_sub = ~on_top
         m[:, on_sub] = su.ndf_sub.sample_visible(wi[:, on_sub], rng)

@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 from scipy import integrate, stats
 
+from labbrdf.microfacet import TabulatedNDF
 from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
-from labbrdf.tracer.sampling import TabulatedNDF
 from labbrdf.tracer.walk import _base_event
 
 K = 4.0

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from labbrdf.cli import main
+from labbrdf.microfacet import TabulatedNDF
 from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
-from labbrdf.tracer.sampling import TabulatedNDF
 
 MIN_COUNT = 400
 

@@ -286,9 +286,9 @@ def test_evaluated_white_furnace_smooth_mirror_under_lossless_rough_coating():
 
 
 def test_operator_has_the_mirror_symmetry_it_assumes():
+    from labbrdf.microfacet import ggx
     from labbrdf.tracer.evaluate import transmission_mueller
     from labbrdf.tracer.interfaces import fresnel_abcs
-    from labbrdf.tracer.sampling import ggx_d, smith_g1
 
     rng = np.random.default_rng(3)
     n = 200
@@ -303,8 +303,8 @@ def test_operator_has_the_mirror_symmetry_it_assumes():
         1.5,
         1.0,
         lambda c: fresnel_abcs(1.5, 1.0, c)[1],
-        lambda m: ggx_d(m[2], 0.3),
-        lambda v: smith_g1(v[2], 0.3),
+        lambda m: ggx.d(m[2], 0.3),
+        lambda v: ggx.smith_g1(v[2], 0.3),
     )
     a = transmission_mueller(ku, wo(1), *args)
     b = transmission_mueller(ku, wo(-1), *args)
@@ -333,8 +333,8 @@ def test_operator_transmittance_equals_a_sampled_facet_average():
     """The operator's hemispherical integral for one internal direction equals the mean
     over sampled visible normals of the Fresnel transmittance times G1(w_o): Walter's
     BTDF, its Jacobian and the Smith factors against the sampling the walk uses."""
+    from labbrdf.microfacet import ggx
     from labbrdf.tracer.interfaces import fresnel_abcs
-    from labbrdf.tracer.sampling import sample_vndf, smith_g1
 
     alpha, nc = 0.3, 1.5
     grid = Grid(2.0, 2.0)
@@ -350,7 +350,7 @@ def test_operator_transmittance_equals_a_sampled_facet_average():
         tu = cell_centroids(grid)[iu]
         n = 400_000
         wi = np.tile([[-np.sin(tu)], [0.0], [np.cos(tu)]], (1, n))  # -k_u seen from below
-        m = sample_vndf(wi, alpha, rng.random(n), rng.random(n))
+        m = ggx.sample_visible(wi, alpha, rng.random(n), rng.random(n))
         m[2] = -m[2]
         k = np.tile([[np.sin(tu)], [0.0], [np.cos(tu)]], (1, n))
         cos_i = np.clip(-(k * m).sum(axis=0), 0, 1)
@@ -358,7 +358,7 @@ def test_operator_transmittance_equals_a_sampled_facet_average():
         eta = nc
         kt = eta * k + (eta * cos_i - cos_t) * m
         kt /= np.linalg.norm(kt, axis=0)
-        w = np.where(tr[0] > 0, tr[0] * smith_g1(kt[2], alpha), 0.0)
+        w = np.where(tr[0] > 0, tr[0] * ggx.smith_g1(kt[2], alpha), 0.0)
         mc, se = w.mean(), w.std() / np.sqrt(n)
         # 2-degree cells and bins: the discretisation bias is below 1e-3
         assert integral == pytest.approx(mc, abs=4 * se + 2e-3), iu

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from labbrdf import optics
+from labbrdf.microfacet import ggx
 from labbrdf.tracer import (
     Coating,
     Grid,
@@ -23,13 +24,6 @@ from labbrdf.tracer import (
     trace_block,
     trace_summary,
     work_units,
-)
-from labbrdf.tracer.sampling import (
-    ggx_d,
-    sample_ggx_cos,
-    sample_vndf,
-    smith_g1,
-    smith_lambda,
 )
 
 K = 4.0
@@ -51,7 +45,7 @@ def test_ggx_d_is_normalised_over_projected_hemisphere(alpha):
     u = 0.5 * (x + 1)  # u in (0, 1) -> theta = arctan(alpha sqrt(u/(1-u))) covers [0, pi/2)
     theta = np.arctan(alpha * np.sqrt(u / (1 - u)))
     dtheta_du = alpha / (2 * np.sqrt(u) * (1 - u) ** 1.5) * np.cos(theta) ** 2
-    integrand = ggx_d(np.cos(theta), alpha) * np.cos(theta) * np.sin(theta) * 2 * np.pi
+    integrand = ggx.d(np.cos(theta), alpha) * np.cos(theta) * np.sin(theta) * 2 * np.pi
     assert np.sum(0.5 * w * integrand * dtheta_du) == pytest.approx(1.0, rel=1e-10)
 
 
@@ -60,9 +54,9 @@ def test_smith_g1_matches_closed_form_and_lambda_symmetry():
     theta = np.radians([0.0, 10.0, 45.0, 80.0, 89.0])
     wz = np.cos(theta)
     g1 = 2 / (1 + np.sqrt(1 + alpha**2 * np.tan(theta) ** 2))
-    np.testing.assert_allclose(smith_g1(wz, alpha), g1, rtol=1e-14)
-    np.testing.assert_allclose(smith_lambda(-wz, alpha), -1 - smith_lambda(wz, alpha))
-    assert smith_g1(-0.5, alpha) == 0.0
+    np.testing.assert_allclose(ggx.smith_g1(wz, alpha), g1, rtol=1e-14)
+    np.testing.assert_allclose(ggx.smith_lambda(-wz, alpha), -1 - ggx.smith_lambda(wz, alpha))
+    assert ggx.smith_g1(-0.5, alpha) == 0.0
 
 
 @pytest.mark.parametrize("alpha", [0.1, 0.2, 0.4])
@@ -73,7 +67,11 @@ def test_mirror_albedo_at_normal_incidence_is_one_over_one_plus_alpha2(alpha, sa
     n = 400_000
     u1, u2 = rng.random(n), rng.random(n)
     wi = np.tile(np.array([[0.0], [0.0], [1.0]]), (1, n))
-    m = sample_ggx_cos(alpha, u1, u2) if sampler == "ggx_cos" else sample_vndf(wi, alpha, u1, u2)
+    m = (
+        ggx.sample_cos(alpha, u1, u2)
+        if sampler == "ggx_cos"
+        else ggx.sample_visible(wi, alpha, u1, u2)
+    )
     wo_z = -wi[2] + 2 * m[2] * (wi * m).sum(axis=0)
     p = 1 / (1 + alpha**2)
     assert np.mean(wo_z > 0) == pytest.approx(p, abs=K * np.sqrt(p * (1 - p) / n))
@@ -87,8 +85,8 @@ def test_vndf_moments_match_reweighted_ggx_samples(theta_deg):
     t = np.radians(theta_deg)
     wi1 = np.array([np.sin(t), 0.0, np.cos(t)])
     rng = np.random.default_rng(12)
-    mv = sample_vndf(np.repeat(wi1[:, None], n, 1), alpha, rng.random(n), rng.random(n))
-    mg = sample_ggx_cos(alpha, rng.random(n), rng.random(n))
+    mv = ggx.sample_visible(np.repeat(wi1[:, None], n, 1), alpha, rng.random(n), rng.random(n))
+    mg = ggx.sample_cos(alpha, rng.random(n), rng.random(n))
     w = np.maximum(0.0, wi1 @ mg) / mg[2]
     for f in (lambda m: m[0], lambda m: m[2], lambda m: m[0] ** 2, lambda m: m[1] ** 2):
         a, b = f(mv), f(mg)
@@ -105,9 +103,9 @@ def test_projected_area_identity_links_lambda_to_d(theta_deg):
     t = np.radians(theta_deg)
     wi = np.array([np.sin(t), 0.0, np.cos(t)])
     rng = np.random.default_rng(13)
-    m = sample_ggx_cos(alpha, rng.random(n), rng.random(n))
+    m = ggx.sample_cos(alpha, rng.random(n), rng.random(n))
     x = np.maximum(0.0, wi @ m) / m[2]
-    expected = np.cos(t) * (1 + smith_lambda(np.cos(t), alpha))
+    expected = np.cos(t) * (1 + ggx.smith_lambda(np.cos(t), alpha))
     assert x.mean() == pytest.approx(expected, abs=K * x.std() / np.sqrt(n))
 
 
@@ -502,15 +500,17 @@ def test_first_order_of_height_walk_is_height_correlated_smith(alpha, theta):
     t = np.radians(theta)
     wi = np.repeat(np.array([[np.sin(t)], [0.0], [np.cos(t)]]), n, 1)
     rng = np.random.default_rng(31)
-    m = sample_vndf(wi, alpha, rng.random(n), rng.random(n))
+    m = ggx.sample_visible(wi, alpha, rng.random(n), rng.random(n))
     wo_z = -wi[2] + 2 * m[2] * (wi * m).sum(axis=0)
-    lam_i = smith_lambda(np.cos(t), alpha)
+    lam_i = ggx.smith_lambda(np.cos(t), alpha)
     up = wo_z > 0
-    x = np.where(up, (1 + lam_i) / (1 + lam_i + smith_lambda(np.where(up, wo_z, 1.0), alpha)), 0)
+    x = np.where(
+        up, (1 + lam_i) / (1 + lam_i + ggx.smith_lambda(np.where(up, wo_z, 1.0), alpha)), 0
+    )
     se = np.hypot(res.albedo_stderr(), x.std() / np.sqrt(n))
     assert res.albedo() == pytest.approx(x.mean(), abs=K * se)
     if alpha == 1.0:  # rough and grazing: distinct from the separable form G1(wo)
-        sep = np.where(up, smith_g1(np.where(up, wo_z, 1.0), alpha), 0.0).mean()
+        sep = np.where(up, ggx.smith_g1(np.where(up, wo_z, 1.0), alpha), 0.0).mean()
         assert abs(sep - x.mean()) > 10 * se
 
 

@@ -204,7 +204,7 @@ def _fit_rows(st: Any) -> list[dict[str, Any]]:
             "best": "yes" if f.best == fit.model else "",
             "describes": "yes" if fit.ks <= f.ks_threshold else "no",
         }
-        for fit in (f.ggx, f.beckmann)
+        for fit in f.fits.values()
     ]
 
 
