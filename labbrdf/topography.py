@@ -462,7 +462,7 @@ class SlopeFits:
     Attributes
     ----------
     fits : dict of str to SlopeFit
-        One fit per name of :data:`labbrdf.microfacet.DISTRIBUTIONS`, in registry order;
+        One fit per name of :data:`labbrdf.microfacet.registry.DISTRIBUTIONS`, in registry order;
         also readable as attributes (``fits.ggx``, ``fits.beckmann``).
     best : str
         The name with the smallest AIC (the first of equal ones).
@@ -495,7 +495,7 @@ def _fit_core(x: NDArray, y: NDArray | None) -> dict[str, float]:
     """ML alphas, log-likelihoods and KS distances (no uncertainties) of every distribution.
 
     Keys ``"<name>_alpha"``, ``"<name>_loglik"``, ``"<name>_ks"`` and ``"<name>_s"``
-    (``s = alpha^2``) for each name of :data:`labbrdf.microfacet.DISTRIBUTIONS`.
+    (``s = alpha^2``) for each name of :data:`labbrdf.microfacet.registry.DISTRIBUTIONS`.
 
     Raises
     ------

@@ -189,7 +189,7 @@ class TabulatedNDF:
         Parameters
         ----------
         distribution : module
-            A distribution of :data:`labbrdf.microfacet.DISTRIBUTIONS` (its ``p22``).
+            A distribution of :data:`labbrdf.microfacet.registry.DISTRIBUTIONS` (its ``p22``).
         alpha : float
             Roughness [1], > 0.
         n : int
