@@ -54,6 +54,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import fft as sfft
 from scipy import ndimage, optimize, special
 
+from .jsonsafe import jsonable
+
 __all__ = [
     "C_MIN_PIXELS",
     "GAUSS_ALPHA",
@@ -465,7 +467,7 @@ class SlopeFits:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe dict (NaN -> None, tuples -> lists)."""
-        return _json_safe(asdict(self))
+        return jsonable(asdict(self))
 
 
 def _ggx_s(q: NDArray, frac: float) -> float:
@@ -684,20 +686,7 @@ class RoughnessStats:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe dict (NaN -> None, tuples -> lists)."""
-        return _json_safe(asdict(self))
-
-
-def _json_safe(obj: Any) -> Any:
-    if isinstance(obj, dict):
-        return {str(k): _json_safe(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_json_safe(v) for v in obj]
-    if isinstance(obj, float | np.floating):
-        v = float(obj)
-        return v if math.isfinite(v) else None
-    if isinstance(obj, np.integer):
-        return int(obj)
-    return obj
+        return jsonable(asdict(self))
 
 
 _NAN = float("nan")
