@@ -25,6 +25,10 @@ so that ``import labbrdf`` stays cheap, and ``dir(labbrdf)`` lists them all:
   together, named in the message)
 
 The subpackages and modules (``labbrdf.optics``, ``labbrdf.nk``, ...) are attributes too.
+The public face is written once, in the tables ``_LAZY`` (names) and ``_MODULES``
+(modules) below: ``__all__``, ``dir(labbrdf)`` and the attribute look-up follow from them.
+The plumbing modules (``_PLUMBING``: ``cli``, ``jsonsafe``, ``outputs``, ``provenance``,
+``richrepr``) are not offered; import them by path.
 """
 
 from __future__ import annotations
@@ -76,12 +80,11 @@ _LAZY: dict[str, tuple[str, str]] = {
     "SetupError": ("labbrdf.errors", "SetupError"),
 }
 
-#: subpackages and modules reachable as attributes of the package
+#: subpackages and modules offered as attributes of the package
 _MODULES = (
     "adapters",
     "bsdf_export",
     "bsdf_geometry",
-    "cli",
     "dataset",
     "dispersion",
     "ellipsometry",
@@ -89,17 +92,13 @@ _MODULES = (
     "films",
     "fitting",
     "integrate",
-    "jsonsafe",
     "microfacet",
     "models",
     "nk",
     "optics",
-    "outputs",
     "parallel",
     "prediction",
-    "provenance",
     "report",
-    "richrepr",
     "samples",
     "selection",
     "smoothness",
@@ -111,14 +110,20 @@ _MODULES = (
     "tracer_setup",
 )
 
+#: plumbing the modules above share (the command line, JSON sanitising, output safety,
+#: provenance, rich displays): importable by path (``import labbrdf.cli``), not offered
+_PLUMBING = ("cli", "jsonsafe", "outputs", "provenance", "richrepr")
+
+#: the public face, derived from the two tables above; ``dir(labbrdf)`` lists it
 __all__ = ["__version__", *_LAZY, *_MODULES]
 
-if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__ imports
+# What a type checker and an IDE see of the two tables (at run time __getattr__ imports);
+# tests/test_public_api.py checks that it mirrors them entry for entry.
+if TYPE_CHECKING:
     from . import (
         adapters,
         bsdf_export,
         bsdf_geometry,
-        cli,
         dataset,
         dispersion,
         ellipsometry,
@@ -126,17 +131,13 @@ if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__
         films,
         fitting,
         integrate,
-        jsonsafe,
         microfacet,
         models,
         nk,
         optics,
-        outputs,
         parallel,
         prediction,
-        provenance,
         report,
-        richrepr,
         samples,
         selection,
         smoothness,
@@ -177,4 +178,5 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
+    """The public face (:data:`__all__`), sorted."""
     return sorted(__all__)

@@ -681,7 +681,7 @@ def cmd_formats(args: argparse.Namespace) -> int:
         _emit_json(fmts)
     else:
         for f in fmts:
-            print(f"{f['name']:<28} {' '.join(f['extensions']):<18} {f['description']}")
+            print(f)
     return 0
 
 

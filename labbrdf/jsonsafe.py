@@ -1,9 +1,9 @@
 """JSON-safe copies of plain results, and the check of a JSON file labbrdf reads back.
 
-:func:`jsonable` is the one sanitiser of the CLI, the fits and the report;
-:func:`check_schema` checks a document against a small explicit schema (the fit JSON of
-:mod:`labbrdf.films`) before any value of it is used, so that a hand-edited file is
-refused by its key, never met as a ``TypeError`` deep inside.
+:func:`jsonable` is the one sanitiser of the CLI, the fits, the report and the
+height-map statistics; :func:`check_schema` checks a document against a small explicit
+schema (the fit JSON of :mod:`labbrdf.films`) before any value of it is used, so that a
+hand-edited file is refused by its key, never met as a ``TypeError`` deep inside.
 
 Low-level: imports numpy only, so that every layer may use it.
 """

@@ -54,6 +54,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import fft as sfft
 from scipy import ndimage, optimize, special
 
+from .jsonsafe import jsonable
 from .microfacet import DISTRIBUTIONS
 
 __all__ = [
@@ -488,7 +489,7 @@ class SlopeFits:
         """JSON-safe dict: one entry per distribution, then best, warning, ks_threshold."""
         d: dict[str, Any] = {name: asdict(fit) for name, fit in self.fits.items()}
         d.update(best=self.best, warning=self.warning, ks_threshold=self.ks_threshold)
-        return _json_safe(d)
+        return jsonable(d)
 
 
 def _fit_core(x: NDArray, y: NDArray | None) -> dict[str, float]:
@@ -657,20 +658,7 @@ class RoughnessStats:
         """JSON-safe dict (NaN -> None, tuples -> lists)."""
         d = asdict(self)
         d["slope_fits"] = self.slope_fits.to_dict()
-        return _json_safe(d)
-
-
-def _json_safe(obj: Any) -> Any:
-    if isinstance(obj, dict):
-        return {str(k): _json_safe(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_json_safe(v) for v in obj]
-    if isinstance(obj, float | np.floating):
-        v = float(obj)
-        return v if math.isfinite(v) else None
-    if isinstance(obj, np.integer):
-        return int(obj)
-    return obj
+        return jsonable(d)
 
 
 _NAN = float("nan")

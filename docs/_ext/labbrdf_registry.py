@@ -13,7 +13,7 @@ from sphinx.util.docutils import SphinxDirective
 
 
 class FormatsTable(SphinxDirective):
-    """Insert one row per registered export format: name, extensions, what it reads."""
+    """Insert one row per registered format: name, kind, extensions, what it reads."""
 
     has_content = False
 
@@ -23,19 +23,22 @@ class FormatsTable(SphinxDirective):
 
         rows = adapters.formats()
         table = nodes.table()
-        group = nodes.tgroup(cols=4)
+        group = nodes.tgroup(cols=5)
         table += group
-        for width in (18, 14, 48, 20):
+        for width in (18, 8, 14, 44, 16):
             group += nodes.colspec(colwidth=width)
         head = nodes.thead()
         group += head
-        head += self._row(["format (--format)", "file endings", "what it reads", "quantities"])
+        head += self._row(
+            ["format (--format)", "kind", "file endings", "what it reads", "quantities"]
+        )
         body = nodes.tbody()
         group += body
         for row in rows:
             body += self._row(
                 [
                     row["name"],
+                    row["kind"],
                     ", ".join(row["extensions"]) or "-",
                     row["description"],
                     ", ".join(row["quantities"]),

@@ -57,15 +57,17 @@ from ._base import AdapterError, Example, Format, check_regular_file
 from ._numblock import AdapterWarning
 from ._ole2 import is_ole2
 from .columns import read_columns as _read_columns
-from .topography import height_map_format
+from .topography import HEIGHT_MAP_FORMATS, height_map_format
 
 __all__ = [
     "AdapterError",
     "AdapterWarning",
     "Example",
     "Format",
+    "FormatRow",
     "InputFile",
     "Inputs",
+    "KINDS",
     "READERS",
     "formats",
     "input_kind",
@@ -129,17 +131,52 @@ _NUMBERS_ONLY = re.compile(rb"\A(?:[ \t]*(?:#[^\r\n]*)?\r?\n)*(?:" + _NUMBER_LIN
 _NUMBERS_AFTER_TEXT = re.compile(rb"\A((?:[^\r\n]*\r?\n){1,60}?)(?:" + _NUMBER_LINE + rb"){3,}")
 
 
-def formats() -> list[dict[str, Any]]:
-    """The supported formats: name, description, extensions, quantities."""
-    return [
-        {
-            "name": f.name,
-            "description": f.description,
-            "extensions": list(f.extensions),
-            "quantities": list(f.quantities),
-        }
+#: the kinds of input a format holds, as :func:`formats` names them
+KINDS = {"optical": "optical", "height_map": "height map"}
+
+
+class FormatRow(dict[str, Any]):
+    """One supported format: a dict (``name``, ``kind``, ``description``, ``extensions``,
+    ``quantities``) that prints as one line of ``labbrdf formats``."""
+
+    def __str__(self) -> str:
+        exts = " ".join(self["extensions"])
+        return f"{self['name']:<28} {self['kind']:<10} {exts:<18} {self['description']}"
+
+
+def formats() -> list[FormatRow]:
+    """The supported formats: optical exports, then height maps.
+
+    Returns
+    -------
+    list of FormatRow
+        Per format: ``name`` (the registry key; ``--format`` takes the optical ones),
+        ``kind`` (``"optical"`` or ``"height map"``, :data:`KINDS`), ``description``,
+        ``extensions`` (lower case, with the dot; for a height map also those it shares
+        with optical exports, where its content decides) and ``quantities`` (a height map
+        holds ``"height"``). ``str()`` of a row is its line in ``labbrdf formats``.
+    """
+    optical = [
+        FormatRow(
+            name=f.name,
+            kind=KINDS["optical"],
+            description=f.description,
+            extensions=list(f.extensions),
+            quantities=list(f.quantities),
+        )
         for f in READERS.values()
     ]
+    maps = [
+        FormatRow(
+            name=f.name,
+            kind=KINDS["height_map"],
+            description=f.description,
+            extensions=[*f.extensions, *f.shared_extensions],
+            quantities=["height"],
+        )
+        for f in HEIGHT_MAP_FORMATS
+    ]
+    return optical + maps
 
 
 def _by_extension(path: Path) -> list[str]:

@@ -13,12 +13,14 @@ Two inputs of one file name in different folders cannot be told apart by their r
 
 from __future__ import annotations
 
+import os
+from collections.abc import Sequence
 from pathlib import Path
 
-from ..samples import SampleGroup, pair_samples
+from ..samples import PairingError, SampleGroup, pair_samples, sample_file
 from .context import Context
 
-__all__ = ["how_to_pair", "same_sample", "sample_groups_of"]
+__all__ = ["how_to_pair", "same_sample", "sample_groups", "sample_groups_of"]
 
 
 def sample_groups_of(ctx: Context) -> list[SampleGroup]:
@@ -73,4 +75,58 @@ def how_to_pair(ctx: Context, files: list[str]) -> str:
     return (
         f"if they are one sample, give the mapping: labbrdf report --same-sample "
         f"{','.join(spelt)} (Python: same_sample=[{spelt!r}])"
+    )
+
+
+def sample_groups(
+    ctx: Context,
+    paths: Sequence[str | os.PathLike[str]],
+    same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
+    given_as: str = "given with --same-sample",
+) -> None:
+    """Group the input files by sample (``ctx.samples``) and show the groups with reasons.
+
+    The names are those the readers found (``ctx.files``; height maps carry none), the
+    mapping is the user's (:func:`labbrdf.samples.pair_samples`). A mapping that the files'
+    own sample names contradict fails the check ``ingest.samples`` and pairs nothing.
+    """
+    names = {str(f["path"]): tuple(f.get("samples", ())) for f in ctx.files}
+    maps = {str(hm.path): sample_file(hm.path, hm).names for hm in ctx.height_maps}
+    files = [(p, names.get(str(p), maps.get(str(p), ()))) for p in paths]
+    try:
+        groups = pair_samples(files, same_sample, given_as=given_as)
+    except PairingError as exc:
+        ctx.b.check(
+            "ingest.samples",
+            "the files' sample names agree with the given sample mapping",
+            False,
+            against="the sample names stated in the files",
+            reason=str(exc),
+            substantive=False,
+        )
+        return
+    ctx.samples[:] = groups
+    rows = [
+        {
+            "sample": g.name,
+            "files": ", ".join(Path(p).name for p in g.paths),
+            "n": len(g.paths),
+            "reason": g.reason,
+        }
+        for g in groups
+    ]
+    ctx.b.table(
+        "sample_groups",
+        "Files grouped by sample",
+        [
+            ("sample", "sample", ""),
+            ("files", "files", ""),
+            ("n", "files [n]", "d"),
+            ("reason", "why these files are one sample", ""),
+        ],
+        rows,
+        caption="Files are one sample when they state the same sample name (a name that is "
+        "only the file's own name does not count) or when the user says so (--same-sample); "
+        "never because their wavelengths overlap. Predictions made from one file (e.g. a "
+        "height map's roughness) are set against measurements of the same sample only.",
     )

@@ -24,12 +24,13 @@ from ..provenance import versions
 from . import html
 from .builder import Builder, Unavailable, write_report
 from .context import Context
+from .inputs import ingest_inputs
+from .pairing import sample_groups
 from .sections import Section, run
 from .sections.brdf import brdf_section
 from .sections.colour import colour_section
 from .sections.film import film_model_of, film_section
 from .sections.fits import fits_section
-from .sections.ingest import ingest_inputs, sample_groups
 from .sections.measured import measured_section
 from .sections.nk import nk_section
 from .sections.physics import physics_section

@@ -38,7 +38,9 @@ from .sections.hemispherical import hemispherical_section
 from .sections.ingest import fixture_files, fixtures_section
 from .sections.model_measurement import model_measurement_section
 from .sections.physics import physics_section
+from .sections.prediction import prediction_section
 from .sections.scans import scans_section
+from .sections.smoothness import smoothness_section
 from .sections.spectra import spectra_section
 from .sections.surface import gaussian_acf_section
 from .sections.tracer import factor_maps_section, validation_section
@@ -102,6 +104,10 @@ def _compare(ctx: Context) -> None:
     compare_section(ctx, 45.0, sample="OSR")
 
 
+def _model_measurement(ctx: Context) -> None:
+    model_measurement_section(ctx, smoothness_section, prediction_section)
+
+
 #: the validation report's sections in page order: (id, title, function of the Context)
 SECTIONS: list[Section] = [
     ("ingest", "Ingested files", fixtures_section),
@@ -134,7 +140,7 @@ SECTIONS: list[Section] = [
     (
         "model_measurement",
         "Model against measurement: roughness, specular DOP and BRDF predicted with no fit",
-        model_measurement_section,
+        _model_measurement,
     ),
     ("errata", "Paper errata this report depends on", errata_section),
 ]

@@ -238,6 +238,38 @@ def test_every_registered_format_is_listed_with_its_extensions() -> None:
     assert names["columns"]["extensions"] == []
 
 
+def test_formats_list_the_height_maps_too_with_their_kind() -> None:
+    from labbrdf.adapters.topography import HEIGHT_MAP_FORMATS
+
+    rows = labbrdf.adapters.formats()
+    kinds = {f["name"]: f["kind"] for f in rows}
+    assert {n: kinds.get(n) for n in labbrdf.adapters.READERS} == dict.fromkeys(
+        labbrdf.adapters.READERS, "optical"
+    )
+    by_name = {f["name"]: f for f in rows}
+    for hm in HEIGHT_MAP_FORMATS:
+        assert by_name[hm.name]["kind"] == "height map"
+        assert by_name[hm.name]["extensions"] == [*hm.extensions, *hm.shared_extensions]
+        assert by_name[hm.name]["quantities"] == ["height"]
+    assert len(rows) == len(labbrdf.adapters.READERS) + len(HEIGHT_MAP_FORMATS)
+
+
+def test_a_format_row_prints_as_its_line() -> None:
+    row = {f["name"]: f for f in labbrdf.adapters.formats()}["nanoscope"]
+    line = str(row)
+    assert line.split()[:3] == ["nanoscope", "height", "map"]
+    assert ".spm" in line and row["description"] in line
+
+
+def test_cli_formats_lists_the_height_map_formats(capsys) -> None:
+    from labbrdf.cli import main
+
+    assert main(["formats"]) == 0
+    lines = {ln.split()[0]: ln for ln in capsys.readouterr().out.splitlines()}
+    assert "height map" in lines["surfacetopography"] and ".sdf" in lines["surfacetopography"]
+    assert "height map" in lines["zygo-metropro"] and "optical" in lines["woollam-wvase"]
+
+
 def test_cli_formats_lists_the_new_formats(capsys) -> None:
     from labbrdf.cli import main
 

@@ -124,8 +124,9 @@ def test_ingest_unknown_format_lists_formats(dataset_files, capsys):
 
 def test_formats_json(capsys):
     assert main(["formats", "--json"]) == 0
-    names = [f["name"] for f in json.loads(capsys.readouterr().out)]
-    assert "labbrdf-parquet" in names
+    kinds = {f["name"]: f["kind"] for f in json.loads(capsys.readouterr().out)}
+    assert kinds["labbrdf-parquet"] == "optical"
+    assert kinds["bruker-opdx"] == "height map"
 
 
 def test_dataset_csv_is_read_without_format(dataset_files, tmp_path, capsys):

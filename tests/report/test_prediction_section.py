@@ -10,7 +10,8 @@ import pytest
 
 from labbrdf.report.builder import Builder, Unavailable
 from labbrdf.report.context import Context
-from labbrdf.report.sections.ingest import ingest_inputs, sample_groups
+from labbrdf.report.inputs import ingest_inputs
+from labbrdf.report.pairing import sample_groups
 from labbrdf.report.sections.prediction import prediction_section
 
 pytest.importorskip("SurfaceTopography")

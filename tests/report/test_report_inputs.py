@@ -14,7 +14,7 @@ from labbrdf.adapters import inputs as inputs_mod
 from labbrdf.adapters import topography
 from labbrdf.report.builder import Builder
 from labbrdf.report.context import Context
-from labbrdf.report.sections.ingest import ingest_inputs
+from labbrdf.report.inputs import ingest_inputs
 from labbrdf.surface import gaussian_surface
 
 

@@ -12,9 +12,9 @@ from labbrdf import films
 from labbrdf.dataset import Measurement, make_frame, write_csv
 from labbrdf.report.builder import Builder
 from labbrdf.report.context import Context
-from labbrdf.report.pairing import how_to_pair, same_sample, sample_groups_of
+from labbrdf.report.inputs import ingest_files
+from labbrdf.report.pairing import how_to_pair, same_sample, sample_groups, sample_groups_of
 from labbrdf.report.sections.film import film_section
-from labbrdf.report.sections.ingest import ingest_files, sample_groups
 from labbrdf.report.sections.nk import nk_section
 
 WL = np.arange(400.0, 901.0, 25.0)

@@ -13,7 +13,8 @@ from labbrdf.adapters.topography import HeightMap
 from labbrdf.dataset import make_frame
 from labbrdf.report.builder import Builder
 from labbrdf.report.context import Context
-from labbrdf.report.sections.smoothness import rayleigh_flags, smoothness_section
+from labbrdf.report.roughness import rayleigh_flags
+from labbrdf.report.sections.smoothness import smoothness_section
 from labbrdf.samples import pair_samples
 from labbrdf.surface import gaussian_surface
 

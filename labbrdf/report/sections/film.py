@@ -25,16 +25,15 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 
 from ... import films
 from ... import nk as nkmod
 from .. import figures
+from ..agreement import P_AGREE, chi_square
 from ..builder import Unavailable, slug
 from ..context import Context
+from ..inputs import file_frames
 from ..pairing import how_to_pair, same_sample
-from .measured import file_frames
-from .nk import P_AGREE
 
 __all__ = ["default_film_model", "film_model_of", "film_section"]
 
@@ -229,10 +228,7 @@ def _reflectance(
     pred, pred_sigma = cmp["predicted"].to_numpy(float), cmp["predicted_sigma"].to_numpy(float)
     diff, dsig = cmp["difference"].to_numpy(float), cmp["difference_sigma"].to_numpy(float)
     z = cmp["z"].to_numpy(float)
-    ok = np.isfinite(z)
-    nz = int(ok.sum())
-    chi2 = float(np.sum(z[ok] ** 2))
-    p = float(stats.chi2.sf(chi2, nz)) if nz else float("nan")
+    nz, chi2, p = chi_square(z)
     chans = sorted({c for c in ch if c})
     kind = f"R_{'/'.join(chans)}" if chans else "(R_s + R_p)/2"
     series_m, series_d = [], []

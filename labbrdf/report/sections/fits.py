@@ -15,7 +15,7 @@ from scipy import stats
 from ..builder import num, wl_label
 from ..context import Context, FitRecord, rmse_abs, rmse_paper, run_fits
 from ..published import published_params
-from .smoothness import rayleigh_flags
+from ..roughness import rayleigh_flags
 
 __all__ = ["fits_section"]
 

@@ -11,7 +11,6 @@ BRDF rows against the detector angle.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -20,8 +19,9 @@ import pandas as pd
 from .. import figures
 from ..builder import Unavailable, slug
 from ..context import Context
+from ..inputs import file_frames
 
-__all__ = ["QUANTITY_LABELS", "file_frames", "measured_section", "read_failures"]
+__all__ = ["QUANTITY_LABELS", "measured_section", "read_failures"]
 
 #: axis labels of the known quantities (the unit column is appended in brackets)
 QUANTITY_LABELS = {
@@ -40,19 +40,6 @@ QUANTITY_LABELS = {
 MAX_SERIES = 12
 #: stage positions closer than this are one spot [mm]
 SPOT_TOL_MM = 0.5
-
-
-def file_frames(ctx: Context) -> list[tuple[str, pd.DataFrame, Mapping[str, Any]]]:
-    """``(source, rows, reader meta)`` per ingested file, in the order read."""
-    metas: dict[str, Mapping[str, Any]] = {}
-    for rec in ctx.files:
-        metas.setdefault(Path(str(rec.get("path", ""))).name, rec.get("meta") or {})
-    out = []
-    for f in ctx.frames:
-        for src, g in f.groupby("source", sort=False, observed=True):
-            g = g.assign(quantity=g["quantity"].astype(str)).reset_index(drop=True)
-            out.append((str(src), g, metas.get(str(src), {})))
-    return out
 
 
 def read_failures(ctx: Context) -> list[tuple[str, str]]:

@@ -22,6 +22,7 @@ it; this module adds checks that can fail:
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -31,11 +32,9 @@ from ... import adapters
 from ...prediction import predict_brdf, roughness_alpha
 from ..builder import Builder, Unavailable, slug
 from ..context import Context
-from .ingest import ingest_read, sample_groups
-from .prediction import prediction_section, rays_of
-from .smoothness import smoothness_section
-from .surface import ingest_height_maps
-from .tracer import _map
+from ..inputs import ingest_height_maps, ingest_read
+from ..pairing import sample_groups
+from ..tracing import rays_of, tracer_map
 
 __all__ = [
     "CONTROL_FILE",
@@ -131,8 +130,20 @@ def formula_deviations(rows: list[dict[str, Any]]) -> tuple[float, list[str]]:
     return worst, wrong
 
 
-def model_measurement_section(ctx: Context) -> None:
-    """Smoothness and prediction on the bundled set, with checks and a wrong-index control."""
+def model_measurement_section(
+    ctx: Context,
+    smoothness: Callable[[Context], object],
+    prediction: Callable[[Context], object],
+) -> None:
+    """Smoothness and prediction on the bundled set, with checks and a wrong-index control.
+
+    Parameters
+    ----------
+    ctx : Context
+    smoothness, prediction : callable
+        The user report's sections ``smoothness`` and ``prediction``, run here on the set
+        (the workflow passes them: a section does not import another).
+    """
     if ctx.fixtures is None:
         raise Unavailable("no fixture folder given")
     d = ctx.fixtures / SET_DIR
@@ -176,10 +187,10 @@ def model_measurement_section(ctx: Context) -> None:
     )
     bulk_nk(sub)
     b.heading("Roughness against wavelength", anchor="model_measurement_smoothness")
-    smoothness_section(sub)
+    smoothness(sub)
     _smoothness_checks(b, sub)
     b.heading("Predict, then measure", anchor="model_measurement_prediction")
-    prediction_section(sub)
+    prediction(sub)
     b.heading("Control: the psi/Delta of a wrong index", anchor="model_measurement_control")
     _control(sub, d)
 
@@ -263,7 +274,7 @@ def _control(ctx: Context, d: Path) -> None:
     if not hms:
         raise Unavailable(f"{SET_FILES[0]} was not read as a height map")
     fit = roughness_alpha(hms[0])
-    p = predict_brdf(bsdf, control, fit, rays=rays_of(ctx), seed=ctx.seed, map=_map(ctx))
+    p = predict_brdf(bsdf, control, fit, rays=rays_of(ctx), seed=ctx.seed, map=tracer_map(ctx))
     b.text(
         f"The same height map and {bsdf.name}, but n + ik = {p.n:.4g} + {p.k:.4g}i from "
         f"{CONTROL_FILE} (written for 1.5 + 3i, a poorer metal). {p.verdict()}"

@@ -15,21 +15,18 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 
 from ... import ellipsometry as ell
 from ... import nk as nkmod
 from .. import figures
+from ..agreement import P_AGREE, chi_square
 from ..builder import Unavailable, slug
 from ..context import Context
+from ..inputs import file_frames
 from ..pairing import how_to_pair, same_sample
-from .measured import file_frames
-from .smoothness import SpecularLoss, specular_loss_for
+from ..roughness import SpecularLoss, specular_loss_for
 
-__all__ = ["P_AGREE", "nk_section"]
-
-#: significance level of the reflectance-agreement check (chi-square test of the z scores)
-P_AGREE = 1e-3
+__all__ = ["nk_section"]
 
 _SERIES = ("time_s", "x_mm", "y_mm")
 
@@ -91,10 +88,7 @@ def _compare(
     if rough is not None:
         cmp = rough[0]
     z = cmp["z"].to_numpy(float)
-    ok = np.isfinite(z)
-    nz = int(ok.sum())
-    chi2 = float(np.sum(z[ok] ** 2))
-    p = float(stats.chi2.sf(chi2, nz)) if nz else float("nan")
+    nz, chi2, p = chi_square(z)
     has_sigma = bool(cmp["measured_sigma"].notna().any())
     chan = sorted({str(x) for x in cmp["channel"] if x is not None and str(x) not in ("", "nan")})
     kind = f"R_{'/'.join(chan)}" if chan else "(R_s + R_p)/2"
@@ -188,7 +182,7 @@ def _with_roughness(
     """The comparison against Fresnel times the specular loss of the paired height map.
 
     None when no height map is of the same sample as ``rsrc``. The loss is the smoothness
-    section's (:func:`~labbrdf.report.sections.smoothness.specular_loss_for`); its 1-sigma
+    section's (:func:`~labbrdf.report.roughness.specular_loss_for`); its 1-sigma
     (from sigma's) joins the prediction's in quadrature. Rows outside the map's band are
     dropped (no loss predicted there).
     """

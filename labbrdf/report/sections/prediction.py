@@ -39,7 +39,6 @@ import numpy as np
 import pandas as pd
 
 from ...prediction import (
-    DEFAULT_RAYS,
     BrdfPrediction,
     DopComparison,
     PredictionError,
@@ -51,19 +50,14 @@ from ...prediction import (
 from .. import figures
 from ..builder import Unavailable, slug
 from ..context import Context
-from .tracer import _map
+from ..tracing import rays_of, tracer_map
 
-__all__ = ["SLOPES", "prediction_section", "rays_of", "sample_inputs"]
+__all__ = ["SLOPES", "prediction_section", "sample_inputs"]
 
 #: |z| above which a tracer DOP is called inconsistent with the ellipsometer's
 DOP_Z_MAX = 3.0
 #: the roughness models the section offers (module docstring)
 SLOPES = ("ggx", "measured")
-
-
-def rays_of(ctx: Context) -> int:
-    """Tracer rays per run: the report's ``scale["prediction"]`` (validation), else the default."""
-    return int(ctx.scale.get("prediction", DEFAULT_RAYS))
 
 
 def _frame_of(ctx: Context, path: Path) -> pd.DataFrame | None:
@@ -231,7 +225,7 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
     else:
         try:
             dop = specular_dop_comparison(
-                frame, fit.alpha, rays=rays_of(ctx), seed=ctx.seed, map=_map(ctx)
+                frame, fit.alpha, rays=rays_of(ctx), seed=ctx.seed, map=tracer_map(ctx)
             )
         except PredictionError as exc:
             b.note("specular DOP not predicted", str(exc))
@@ -247,7 +241,7 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
                 ndf=ndf,
                 rays=rays_of(ctx),
                 seed=ctx.seed,
-                map=_map(ctx),
+                map=tracer_map(ctx),
             )
         except (PredictionError, ValueError) as exc:
             b.note(f"{path.name} not predicted", str(exc))

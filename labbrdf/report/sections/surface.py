@@ -26,22 +26,21 @@ eqs. (1)-(2) and the text after eq. (15) (alpha = sqrt(2) sigma / c).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ...adapters.inputs import InputFile
 from ...adapters.topography import HeightMap
 from ...surface import gaussian_surface
 from ...topography import autocorrelation, level, on_measured_points, roughness_statistics
 from ...tracer import Substrate, TraceConfig, TraceResult
+from ...tracer.result import SHOW_COUNT
 from .. import figures
 from ..builder import Builder, Unavailable, slug
 from ..context import Context
-from .tracer import SHOW_COUNT, _robust_max, _run, maps
+from ..tracing import maps, robust_max, run_trace
 
 __all__ = [
     "ACF_CASES",
@@ -50,7 +49,6 @@ __all__ = [
     "TRACE_RAYS",
     "acf_deviation",
     "gaussian_acf_section",
-    "ingest_height_maps",
     "printed_psd_surface",
     "surface_section",
 ]
@@ -63,79 +61,6 @@ TRACE_THETA_I_DEG = 45.0
 #: rays per tracer run (albedo standard error <= 0.5 / sqrt(N) ~ 1.1e-3) and map bin [deg]
 TRACE_RAYS = 200_000
 TRACE_STEP_DEG = 2.0
-
-
-# --------------------------------------------------------------------------- ingest
-
-
-def _height_map_row(f: InputFile) -> dict[str, Any]:
-    """The table row of one height-map file: what it holds, or why it was not read."""
-    name = Path(f.path).name
-    if f.height_map is None:
-        return {"file": name, "status": "error", "error": f.error}
-    hm = f.height_map
-    s = hm.summary()
-    return {
-        "file": name,
-        "status": "read",
-        "kind": s["kind"],
-        "reader": s["reader"],
-        "channel": s["channel"],
-        "points": " x ".join(str(n) for n in s["points"]),
-        "size_um": " x ".join(f"{v:.4g}" for v in s["size_um"]),
-        "pixel_nm": " x ".join(f"{v:.4g}" for v in s["pixel_nm"]),
-        "missing": s["missing"],
-        "error": "",
-    }
-
-
-def ingest_height_maps(ctx: Context, files: Sequence[InputFile]) -> None:
-    """The height maps among the read input files: to ``ctx.height_maps``, a table, a check.
-
-    Parameters
-    ----------
-    ctx : Context
-    files : sequence of InputFile
-        The report's inputs as :func:`labbrdf.adapters.read_inputs` read them; those of kind
-        ``"height_map"`` (read or not) are listed, and a check fails for every one that
-        could not be read, with the reason.
-    """
-    maps = [f for f in files if f.kind == "height_map"]
-    if not maps:
-        return
-    ctx.height_maps.extend(f.height_map for f in maps if f.height_map is not None)
-    rows = [_height_map_row(f) for f in maps]
-    failures = [f"{Path(f.path).name}: {f.error}" for f in maps if f.error]
-    ctx.b.table(
-        "ingested_height_maps",
-        "Ingested height maps and profiles (topography files)",
-        [
-            ("file", "file", ""),
-            ("status", "status", ""),
-            ("kind", "kind", ""),
-            ("reader", "reader (SurfaceTopography)", ""),
-            ("channel", "channel", ""),
-            ("points", "points", ""),
-            ("size_um", "size [\u00b5m]", ""),
-            ("pixel_nm", "pixel [nm]", ""),
-            ("missing", "missing points", "d"),
-            ("error", "error", ""),
-        ],
-        rows,
-        caption="Topography files (profilometer, AFM, interferometer), read with "
-        "SurfaceTopography and converted to metres; they appear in the section "
-        "'Measured surface topography', not in the fits.",
-    )
-    ctx.b.check(
-        "ingest.topography",
-        "every topography file reads as a height map",
-        not failures,
-        against="labbrdf.adapters.topography.read_height_map (SurfaceTopography)",
-        value=len(rows) - len(failures),
-        tolerance=len(rows),
-        justification="value = height maps read, tolerance = topography files given",
-        reason="; ".join(failures)[:2000],
-    )
 
 
 # --------------------------------------------------------------------------- user section
@@ -225,8 +150,8 @@ def _trace_pair(
         phi_step_deg=TRACE_STEP_DEG,
     )
     ggx_alpha = min(alpha, 10.0)
-    r_meas = _run(ctx, cfg)
-    r_ggx = _run(ctx, cfg.replace(substrate=Substrate(n=n, k=k, alpha=ggx_alpha)))
+    r_meas = run_trace(ctx, cfg)
+    r_ggx = run_trace(ctx, cfg.replace(substrate=Substrate(n=n, k=k, alpha=ggx_alpha)))
     return r_meas, r_ggx, ggx_alpha
 
 
@@ -411,7 +336,7 @@ def _tracer_part(
             mp[0]["theta_edges"],
             mp[0]["phi_edges"],
             title=name,
-            s0_max=[_robust_max(r, m["s0"]) for (_, r), m in zip(pair, mp, strict=True)],
+            s0_max=[robust_max(r, m["s0"]) for (_, r), m in zip(pair, mp, strict=True)],
         ),
     )
     if ggx_alpha < math.tan(math.radians(TRACE_STEP_DEG)):

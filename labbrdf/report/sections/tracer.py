@@ -20,7 +20,6 @@ are upper bounds of the true errors, so the checks can only be stricter in reali
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -28,13 +27,14 @@ import numpy as np
 import pandas as pd
 
 from ... import optics
-from ...tracer import Substrate, TraceConfig, TraceResult, trace
+from ...tracer import Substrate, TraceConfig, TraceResult
 from ...tracer import studies as st
 from ...tracer.result import DOP_SE_MAX, MIN_COUNT, SHOW_COUNT
 from .. import figures
 from ..context import Context
+from ..tracing import maps, robust_max, run_trace, tracer_map
 
-__all__ = ["factor_maps_section", "maps", "validation_section"]
+__all__ = ["factor_maps_section", "validation_section"]
 
 #: in-plane comparison: 1-degree bins grouped by 5 in theta_r (statistics), oracle point
 #: values at the bin centres averaged with the same cos-solid-angle weights (midpoint rule
@@ -42,33 +42,7 @@ __all__ = ["factor_maps_section", "maps", "validation_section"]
 GROUP = 5
 
 
-def _robust_max(res: TraceResult, s0: np.ndarray) -> float | None:
-    ok = res.counts >= MIN_COUNT
-    return float(s0[ok].max()) if ok.any() else None
-
-
 # --------------------------------------------------------------------------- helpers
-
-
-def _map(ctx: Context) -> Callable[..., Iterable[Any]]:
-    """The ordered ``map`` that runs tracer work units on the report's executor (no bar)."""
-    return ctx.executor.with_progress(False)
-
-
-def _run(ctx: Context, config: TraceConfig) -> TraceResult:
-    return trace(config, map=_map(ctx))
-
-
-def maps(result: TraceResult) -> dict[str, np.ndarray]:
-    """S0 [sr^-1] and DOP [1] maps for unpolarized input, bin edges and centres [deg]."""
-    return {
-        "s0": result.s0(),
-        "dop": result.dop(),
-        "theta_edges": result.theta_r_edges_deg,
-        "phi_edges": result.phi_r_edges_deg,
-        "theta": result.theta_r_deg,
-        "phi": result.phi_r_deg,
-    }
 
 
 def _ledger_error(result: TraceResult) -> float:
@@ -86,7 +60,7 @@ def factor_maps_section(ctx: Context) -> None:
     rays = int(ctx.scale["factor"])
     step = float(ctx.scale.get("grid_step_deg", 1))
     b.log(f"  factor studies at {rays} rays per run")
-    runs = st.factor_studies(rays=rays, seed=0, step=step, map=_map(ctx))
+    runs = st.factor_studies(rays=rays, seed=0, step=step, map=tracer_map(ctx))
     ctx.factor_runs = runs
     studies: dict[str, list[tuple[str, TraceResult]]] = {}
     for study, label, res in runs:
@@ -140,7 +114,7 @@ def factor_maps_section(ctx: Context) -> None:
                 mp[0]["theta_edges"],
                 mp[0]["phi_edges"],
                 title=study,
-                s0_max=[_robust_max(r, m["s0"]) for (_, r), m in zip(items, mp, strict=True)],
+                s0_max=[robust_max(r, m["s0"]) for (_, r), m in zip(items, mp, strict=True)],
             ),
         )
     b.table(
@@ -199,7 +173,7 @@ def _evaluated_maps(ctx: Context, rays: int, step: float) -> list[dict[str, Any]
         if study in ("incidence", "roughness")
     ]
     b.log(f"  evaluated single-scattering maps at {n_ev} rays per run")
-    runs = [(study, label, _run(ctx, cfg)) for study, label, cfg in cfgs]
+    runs = [(study, label, run_trace(ctx, cfg)) for study, label, cfg in cfgs]
     rows: list[dict[str, Any]] = []
     for study in ("incidence", "roughness"):
         items = [(lab, r) for s_, lab, r in runs if s_ == study]
@@ -261,7 +235,7 @@ def _evaluated_maps(ctx: Context, rays: int, step: float) -> list[dict[str, Any]
     )
     # the evaluated map against counting in the mean, on the paper's case
     paper = next(r for s_, lab, r in runs if s_ == "incidence" and lab == "theta_i=60")
-    ct = _run(ctx, paper.config.replace(rays=rays * 4, seed=1, estimator="counting"))
+    ct = run_trace(ctx, paper.config.replace(rays=rays * 4, seed=1, estimator="counting"))
     ok = (ct.counts >= 400)[..., None, None] & (ct.mueller_stderr > 0)
     se = np.sqrt(paper.mueller_stderr**2 + ct.mueller_stderr**2)
     z = ((paper.mueller - ct.mueller) / np.where(ok, se, 1.0))[ok]
@@ -419,7 +393,7 @@ def _smooth_limit(
     """1. The smooth limit (alpha = 0) against Fresnel: albedo and specular Mueller matrix."""
     b = ctx.b
     M_ref, src = _smooth_reference(shared)
-    res = _run(
+    res = run_trace(
         ctx,
         TraceConfig(
             wavelength_nm=650.0,
@@ -474,7 +448,7 @@ def _smooth_limit(
 
 def _white_furnace(ctx: Context, n: int, ledger: list[float], rows: list[dict[str, Any]]) -> None:
     """2. White furnace: a lossless microsurface with multiple scattering returns all."""
-    res = _run(
+    res = run_trace(
         ctx,
         TraceConfig(
             wavelength_nm=650.0,
@@ -624,7 +598,7 @@ def _rough_oracles(
     zs_f: list[float] = []
     series: list[dict[str, Any]] = []
     for k, ti in enumerate((30.0, 60.0)):
-        res = _run(
+        res = run_trace(
             ctx,
             TraceConfig(
                 wavelength_nm=650.0,
