@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from labbrdf import cli
-from labbrdf.cli import build_parser, main
+import labbrdf
+from labbrdf.cli import _options, build_parser, main
 
-SCAN = Path(cli.__file__).parent / "data" / "fixtures" / "specular" / "osr_specular.csv"
+SCAN = Path(labbrdf.__file__).parent / "data" / "fixtures" / "specular" / "osr_specular.csv"
 TRACE = ["trace", "--substrate", "1.5+7j", "--alpha", "0.2", "--theta-i", "45", "--rays", "10"]
 
 
@@ -28,10 +28,10 @@ def test_every_command_gives_each_wavelength_option_one_meaning() -> None:
         assert sp.allow_abbrev is False, name
         for a in sp._actions:
             for opt in set(a.option_strings) & set(seen):
-                kind = type(a).__name__ if isinstance(a, cli._Renamed) else a.type
+                kind = type(a).__name__ if isinstance(a, _options._Renamed) else a.type
                 seen[opt].add(kind)
-    assert seen["--wavelength"] == {cli._wavelength_value, "_Renamed"}
-    assert seen["--wavelength-range"] == {cli._range}
+    assert seen["--wavelength"] == {_options._wavelength_value, "_Renamed"}
+    assert seen["--wavelength-range"] == {_options._range}
 
 
 def exit_2(argv: list[str], capsys) -> str:
