@@ -133,6 +133,33 @@ def _wavelength_value(text: str) -> float:
     return x
 
 
+def _angle_value(text: str) -> float:
+    """The argparse type of ``--theta-i DEG``: an angle of incidence [deg]."""
+    try:
+        x = float(text)
+    except ValueError:
+        x = math.nan
+    if not (text.strip().isascii() and math.isfinite(x)):
+        hint = "; a range of rows is --theta-i-range MIN:MAX" if ":" in text else ""
+        raise argparse.ArgumentTypeError(f"{text!r}: expected an angle of incidence [deg]{hint}")
+    return x
+
+
+def _row_range(text: str) -> str:
+    """The argparse type of ``--theta-i-range``: ``MIN:MAX``, ``MIN:``, ``:MAX`` or one value.
+
+    Checked here with :func:`labbrdf.selection.parse_range` (a bad range is refused before
+    any file is read) and handed on as text, which the selection parses the same way.
+    """
+    from ..selection import SelectionError, parse_range
+
+    try:
+        parse_range(text, "--theta-i-range")
+    except SelectionError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("--theta-i-range ")) from None
+    return text
+
+
 class _Renamed(argparse.Action):
     """An old option spelling: refused, naming the new one."""
 
@@ -163,9 +190,19 @@ _WAVELENGTH_IS_ONE = (
     "select a range of rows with --wavelength-range MIN:MAX"
 )
 
+#: what ``--theta-i`` says in a command that selects rows (it has no single angle)
+_THETA_I_IS_AN_ANGLE = (
+    "--theta-i DEG is an angle of incidence (export, hemispherical, trace); "
+    "select a range of rows with --theta-i-range MIN:MAX"
+)
+
 
 def _add_selection(p: argparse.ArgumentParser, *, wavelength_taken: bool = False) -> None:
-    """The row-selection options; ``--wavelength`` is refused unless the command has one."""
+    """The row-selection options; ``--wavelength`` is refused unless the command has one.
+
+    ``--theta-i`` is always refused here, naming ``--theta-i-range``: in the commands that
+    have one it is an angle of incidence, never a range of rows.
+    """
     g = p.add_argument_group("selection")
     g.add_argument(
         "--wavelength-range",
@@ -176,7 +213,14 @@ def _add_selection(p: argparse.ArgumentParser, *, wavelength_taken: bool = False
     )
     if not wavelength_taken:
         g.add_argument("--wavelength", action=_Renamed, new=_WAVELENGTH_IS_ONE)
-    g.add_argument("--theta-i", default=None, metavar="MIN:MAX", help="[deg], e.g. 40:60")
+    g.add_argument(
+        "--theta-i-range",
+        type=_row_range,
+        default=None,
+        metavar="MIN:MAX",
+        help="[deg], e.g. 40:60 (or one angle, e.g. 45)",
+    )
+    g.add_argument("--theta-i", action=_Renamed, new=_THETA_I_IS_AN_ANGLE)
     g.add_argument("--theta-r", default=None, metavar="MIN:MAX", help="[deg], e.g. :70")
     g.add_argument("--quantity", default=None, help="comma-separated quantities")
     g.add_argument("--sample", default=None, help="comma-separated sample names")
@@ -196,7 +240,7 @@ def _selected(args: argparse.Namespace, m: Any) -> Any:
 #: the selection options: argparse destination -> :func:`labbrdf.selection.select` keyword
 SELECTION_KEYS = {
     "wavelength_range": "wavelength",
-    "theta_i": "theta_i",
+    "theta_i_range": "theta_i",
     "theta_r": "theta_r",
     "quantity": "quantity",
     "sample": "sample",

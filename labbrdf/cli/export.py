@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from ._options import UsageError, _model_from_args, _wavelength_value
+from ._options import UsageError, _angle_value, _model_from_args, _wavelength_value
 from ._paths import InputPath, OutputPath, _add_overwrite
 
 
@@ -108,7 +108,7 @@ def add_parser(sub: Any) -> None:
         metavar="NM",
         help="[nm] for --nk-from",
     )
-    s.add_argument("--theta-i", type=float, nargs="+", default=None, metavar="DEG")
+    s.add_argument("--theta-i", type=_angle_value, nargs="+", default=None, metavar="DEG")
     s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")
     s.add_argument("--azimuth", default="0:180:5", help="START:STOP:STEP [deg]")
     s.add_argument("-o", "--output", action=OutputPath, suffixes=(".bsdf",), required=True)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from ._options import _emit_json, _model_from_args, _wavelength_value
+from ._options import _angle_value, _emit_json, _model_from_args, _wavelength_value
 from ._paths import InputPath
 
 
@@ -34,7 +34,7 @@ def add_parser(sub: Any) -> None:
     s = sub.add_parser("hemispherical", help="directional-hemispherical reflectance of a model")
     s.add_argument("--model", required=True)
     s.add_argument("--param", action="append", metavar="NAME=VALUE")
-    s.add_argument("--theta-i", type=float, nargs="+", required=True, metavar="DEG")
+    s.add_argument("--theta-i", type=_angle_value, nargs="+", required=True, metavar="DEG")
     s.add_argument(
         "--nk-from", action=InputPath, default=None, metavar="FILE", help="n, k from psi/Delta"
     )

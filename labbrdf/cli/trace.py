@@ -11,6 +11,7 @@ from ._executor import _add_scheduler, _executor, _executor_errors
 from ._options import (
     UsageError,
     _add_geometry,
+    _angle_value,
     _channel,
     _emit_json,
     _option_errors,
@@ -141,7 +142,7 @@ def add_parser(sub: Any) -> None:
         help="microfacet distribution of the interfaces given by an alpha (measured maps "
         "always use their own slope table)",
     )
-    s.add_argument("--theta-i", type=float, required=True, help="[deg]")
+    s.add_argument("--theta-i", type=_angle_value, required=True, help="[deg]")
     s.add_argument(
         "--wavelength", type=_wavelength_value, required=True, metavar="NM", help="[nm]"
     )
