@@ -93,54 +93,6 @@ def _film_model(args: argparse.Namespace) -> Any:
     return films.FilmModel(stack, free, None, "--layer")
 
 
-def _film_table(summary: dict[str, Any]) -> str:
-    """The text table of a film fit summary."""
-
-    def fmt(p: dict[str, Any]) -> str:
-        v = p["value"]
-        if not p.get("vary"):
-            return f"{v:.6g} (fixed)"
-        se, ci = p.get("stderr"), p.get("ci95")
-        out = f"{v:.6g}"
-        if se is not None:
-            out += f" +- {se:.2g}"
-        if ci:
-            out += f"  [{ci[0]:.6g}, {ci[1]:.6g}]"
-        sc = p.get("ci95_scaled")
-        if sc:
-            out += f"  scaled [{sc[0]:.6g}, {sc[1]:.6g}]"
-        if p.get("flags"):
-            out += "  " + ",".join(p["flags"])
-        return out
-
-    lines = []
-    for lay in summary["layers"]:
-        mat = lay["material"].get("model", "?")
-        lines.append(f"layer {lay['name']} ({mat})")
-        for k, p in lay["parameters"].items():
-            lines.append(f"  {k:<14s} {fmt(p)}")
-        nk = lay.get("nk_at_633nm")
-        if nk:
-            n_se = nk.get("n_stderr")
-            k_se = nk.get("k_stderr")
-            n_txt = f"{nk['n']:.5f}" + (f" +- {n_se:.2g}" if n_se is not None else "")
-            k_txt = f"{nk['k']:.5f}" + (f" +- {k_se:.2g}" if k_se is not None else "")
-            lines.append(f"  n, k at 633 nm: {n_txt}, {k_txt}")
-    lines.append(f"substrate ({summary['substrate']['material'].get('model', '?')})")
-    wl = summary["wavelength_range_nm"]
-    lines.append(
-        f"fit: {summary['ndata']} values, {wl[0]:g}-{wl[1]:g} nm, {summary['nvarys']} free; "
-        f"chi2/nu = {summary['redchi']:.4g}, MSE = {summary['mse']:.4g} (Woollam); "
-        f"{summary['nfev']} evaluations, {summary['method']}, seed {summary['seed']}, "
-        f"intervals: {summary['ci_method']}"
-    )
-    if not summary["success"]:
-        lines.append(f"fit did not converge: {summary['message']}")
-    lines.extend(f"note: {n}" for n in summary["notes"])
-    lines.extend(f"warning: {w}" for w in summary["warnings"])
-    return "\n".join(lines)
-
-
 def _one_sample(args: argparse.Namespace, parts: list[Any], data: Any) -> bool:
     """Whether the files of a film fit are one sample: refused (exit 2) when they are not.
 
@@ -213,16 +165,15 @@ def cmd_film(args: argparse.Namespace) -> int:
         ci=args.ci,
         one_sample=_one_sample(args, parts, data),
     )
-    summary = res.summary()
     if args.output:
         with atomic_output(args.output) as tmp:
             csv_safe_frame(res.nk_table()).to_csv(tmp, index=False)
     if args.fit_json:
         res.save_json(args.fit_json)
     if args.json:
-        _emit_json(summary)
+        _emit_json(res.summary())
     else:
-        print(_film_table(summary))
+        print(res.fit_report())
     return 0
 
 
