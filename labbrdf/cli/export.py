@@ -75,20 +75,13 @@ def _export_trace(args: argparse.Namespace) -> int:
 
 
 def _grid(text: str, option: str) -> Any:
-    """``START:STOP:STEP`` (inclusive) or a comma-separated list, as an array [deg]."""
-    import numpy as np
+    """``--radial`` or ``--azimuth``: :func:`labbrdf.bsdf_export.angle_grid` of the text."""
+    from ..bsdf_export import angle_grid
 
     try:
-        if ":" in text:
-            a, b, c = (float(x) for x in text.split(":"))
-            if not c > 0 or b < a:
-                raise ValueError
-            return np.round(np.arange(a, b + c / 2, c), 9)
-        return np.array([float(x) for x in text.split(",")], float)
-    except ValueError:
-        raise UsageError(
-            f"{option} {text!r}: expected START:STOP:STEP or a comma-separated list"
-        ) from None
+        return angle_grid(text)
+    except ValueError as exc:
+        raise UsageError(f"{option} {text!r}: {exc}") from None
 
 
 def add_parser(sub: Any) -> None:
