@@ -165,7 +165,7 @@ def film_fit_panels(fit: FilmFit) -> list[dict[str, Any]]:
     Returns
     -------
     list of dict
-        Panels as :func:`labbrdf._plotting.draw_panel` draws them, against wavelength
+        Panels as ``labbrdf._plotting.draw_panel`` draws them, against wavelength
         [nm]; one colour per angle of incidence (the first seven angles of a channel).
         The fit at a point is the value less the fit's residual there (Delta's residual
         is wrapped into [-180, 180) deg).
