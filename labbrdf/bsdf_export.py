@@ -23,7 +23,7 @@ from .bsdf_geometry import SYMMETRIES, scatter_to_angles
 from .dataset import atomic_output
 from .integrate import grid_integral
 
-__all__ = ["binned_to_bsdf", "model_to_bsdf", "write_bsdf"]
+__all__ = ["angle_grid", "binned_to_bsdf", "model_to_bsdf", "write_bsdf"]
 
 
 def _fmt(v: float, digits: int) -> str:
@@ -362,3 +362,25 @@ def binned_to_bsdf(
         digits=digits,
         overwrite=overwrite,
     )
+
+
+def angle_grid(text: str) -> NDArray[np.float64]:
+    """The angles [deg] of ``START:STOP:STEP`` (STOP included) or of ``A,B,...``.
+
+    The text form of a scatter grid's radial or azimuth angles (``labbrdf export
+    --radial 0:80:2``), for :func:`model_to_bsdf` and :func:`binned_to_bsdf`.
+
+    Raises
+    ------
+    ValueError
+        Not numbers in one of the two forms, a step that is not positive or STOP < START.
+    """
+    try:
+        if ":" in text:
+            a, b, c = (float(x) for x in text.split(":"))
+            if not c > 0 or b < a:
+                raise ValueError
+            return np.round(np.arange(a, b + c / 2, c), 9)
+        return np.array([float(x) for x in text.split(",")], float)
+    except ValueError:
+        raise ValueError("expected START:STOP:STEP or a comma-separated list") from None

@@ -1,7 +1,7 @@
 """Row selection on a dataset, as the command line's selection options do it.
 
-The ``--wavelength-range``, ``--theta-i``, ``--theta-r``, ``--quantity`` and ``--sample``
-options, as one function.
+The ``--wavelength-range``, ``--theta-i-range``, ``--theta-r``, ``--quantity`` and
+``--sample`` options, as one function.
 
 Ranges are closed intervals ``MIN:MAX`` (either end may be left open, ``400:`` or ``:700``);
 a single number selects that value to 1e-6. Selection never changes a value; a selection
@@ -123,7 +123,7 @@ def select(
     keep = np.ones(len(df), bool)
     for col, rng, opt in (
         ("wavelength_nm", wavelength, "--wavelength-range"),
-        ("theta_i_deg", theta_i, "--theta-i"),
+        ("theta_i_deg", theta_i, "--theta-i-range"),
         ("theta_r_deg", theta_r, "--theta-r"),
     ):
         if rng is None:

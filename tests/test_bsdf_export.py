@@ -83,3 +83,18 @@ def test_the_geometry_is_numpy_only():
         "numpy.typing.ArrayLike",
         "numpy.typing.NDArray",
     }
+
+
+@pytest.mark.parametrize(
+    ("text", "angles"),
+    [("0:80:20", [0, 20, 40, 60, 80]), ("0:1:0.1", np.round(np.arange(11) * 0.1, 9)),
+     ("0,45,90", [0, 45, 90]), ("5", [5])],
+)  # fmt: skip
+def test_angle_grid_reads_start_stop_step_with_the_stop_or_a_list(text, angles):
+    np.testing.assert_array_equal(bx.angle_grid(text), angles)
+
+
+@pytest.mark.parametrize("text", ["0:x:1", "0:80", "0:80:0", "80:0:5", "0:80:-1", "a,b", ""])
+def test_angle_grid_refuses_other_text(text):
+    with pytest.raises(ValueError, match="expected START:STOP:STEP or a comma-separated list"):
+        bx.angle_grid(text)

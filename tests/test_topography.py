@@ -403,7 +403,7 @@ def test_progress_reports_every_pass_and_chunking_leaves_results_unchanged(monke
 
 
 def test_cli_progress_goes_to_stderr_only_after_the_delay(capsys):
-    from labbrdf.cli import _progress_printer
+    from labbrdf.cli.surface import _progress_printer
 
     _progress_printer("labbrdf surface: f.dat", after_s=3600)(2, 26)
     assert capsys.readouterr().err == ""

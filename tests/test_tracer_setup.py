@@ -102,7 +102,7 @@ def test_an_index_outside_the_file_names_it(real_exports: Path) -> None:
     ],
 )  # fmt: skip
 def test_arguments_that_do_not_fit_are_named(kw, keywords, options) -> None:
-    from labbrdf.cli import OPTION_NAMES
+    from labbrdf.cli._options import OPTION_NAMES
 
     with pytest.raises(SetupError) as info:
         trace_config_from_inputs(633.0, 45.0, **kw)

@@ -590,6 +590,41 @@ class FilmFit:
             cols[f"{name}_k"] = v.imag
         return pd.DataFrame(cols)
 
+    def fit_report(self) -> str:
+        """Text report: each layer's parameters and n, k, the substrate, the fit, notes.
+
+        What ``labbrdf film`` prints (:func:`labbrdf.fitting.film_display.film_fit_report`
+        of :meth:`summary`).
+        """
+        from .film_display import film_fit_report
+
+        return film_fit_report(self.summary())
+
+    def __str__(self) -> str:
+        return self.fit_report()
+
+    def _repr_html_(self) -> str:
+        from .film_display import film_fit_html
+
+        return film_fit_html(self.summary())
+
+    def plot(self, ax: Any = None) -> Any:
+        """Data with 1-sigma bars and the fit per channel against wavelength, residuals below.
+
+        Parameters
+        ----------
+        ax : sequence of matplotlib Axes, optional
+            Two per channel present (psi, Delta, R, T ...): the data and the residual
+            axes; default a new figure, one column per channel.
+
+        Returns
+        -------
+        matplotlib Figure
+        """
+        from .film_display import film_fit_plot
+
+        return film_fit_plot(self, ax)
+
 
 def fit_film(
     stack_or_model: Stack | FilmModel | str | os.PathLike[str],

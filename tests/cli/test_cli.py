@@ -320,7 +320,7 @@ def test_report_command_records_an_unreadable_file_as_a_failed_check(tmp_path, c
 def test_labbrdf_warnings_print_as_one_line_and_others_keep_their_format(monkeypatch, capsys):
     import warnings
 
-    from labbrdf import cli
+    import labbrdf.cli.formats as cli_formats
     from labbrdf.tracer.cache import CacheWarning
 
     def formats(args):
@@ -328,7 +328,7 @@ def test_labbrdf_warnings_print_as_one_line_and_others_keep_their_format(monkeyp
         warnings.warn("a library's own words", UserWarning, stacklevel=1)
         return 0
 
-    monkeypatch.setattr(cli, "cmd_formats", formats)
+    monkeypatch.setattr(cli_formats, "cmd_formats", formats)
     with pytest.warns(UserWarning, match="a library's own words") as seen:
         assert main(["formats"]) == 0
     err = capsys.readouterr().err
@@ -337,12 +337,12 @@ def test_labbrdf_warnings_print_as_one_line_and_others_keep_their_format(monkeyp
 
 
 def test_ctrl_c_while_the_parser_is_built_exits_130_without_traceback(monkeypatch, capsys):
-    from labbrdf import cli
+    import labbrdf.cli._run as cli_run
 
     def interrupted():
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cli, "build_parser", interrupted)
+    monkeypatch.setattr(cli_run, "build_parser", interrupted)
     assert main(["formats"]) == 130
     err = capsys.readouterr().err
     assert err == "labbrdf: interrupted\n"

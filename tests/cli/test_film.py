@@ -309,3 +309,16 @@ def test_film_same_sample_must_name_the_inputs(two_samples, tmp_path, capsys):
     assert main(["film", str(a), str(b), *LAYER, "--same-sample", f"{a},{other}"]) == 2
     err = capsys.readouterr().err
     assert f"{other} is not among the input files" in err and "Traceback" not in err
+
+
+def test_film_prints_the_fits_own_report(film_file, capsys):
+    """`labbrdf film` prints :meth:`FilmFit.fit_report` of the same fit, nothing else."""
+    from labbrdf import read
+    from labbrdf.films import FilmModel, fit_film
+
+    argv = ["film", str(film_file), "--layer", "film:cauchy:0..300:A=1.3..1.8:B=0..0.02"]
+    assert main([*argv, "--ci", "wald"]) == 0
+    box = {"film.thickness_nm": (0.0, 300.0), "film.A": (1.3, 1.8), "film.B": (0.0, 0.02)}
+    stack = Stack([Layer(Cauchy(A=1.55, B=0.01), 150.0, "film")], "si")
+    fit = fit_film(FilmModel(stack, box), read(film_file), ci="wald")
+    assert capsys.readouterr().out == fit.fit_report() + "\n"

@@ -57,7 +57,7 @@ def test_fit_table_lists_aic_and_bic_for_every_model(microfacet_bsdf, capsys):
 
 def test_fit_layered_incoherent_reports_how_the_monte_carlo_noise_entered(microfacet_bsdf, capsys):
     """The traced (incoherent) model on one incidence: the weighting names the MC error."""
-    argv = ["fit", str(microfacet_bsdf), "--model", "layered", *AL, "--theta-i", "29:31"]
+    argv = ["fit", str(microfacet_bsdf), "--model", "layered", *AL, "--theta-i-range", "29:31"]
     argv += ["--param", "rays=2000", "--param", "grid=3x6", "--fix", "alpha_sub=0.25"]
     argv += ["--method", "LN_BOBYQA", "--json", "--replicates", "1"]  # one seed: cheaper
     assert main(argv) == 0

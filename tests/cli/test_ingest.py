@@ -58,7 +58,7 @@ def test_ingest_table_has_a_channel_column_and_says_wavelength_not_stated(files,
 
 
 def test_channels_cell_names_the_quantity_when_channels_differ():
-    from labbrdf.cli import _channels_cell
+    from labbrdf.cli.ingest import _channels_cell
 
     assert _channels_cell({}) == "-"
     assert _channels_cell({"reflectance": ["p"], "transmittance": ["s"]}) == (

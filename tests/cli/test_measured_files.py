@@ -247,10 +247,8 @@ def test_trace_needs_an_index_and_a_roughness(capsys, argv, message):
 def test_ingest_selects_rows_and_refuses_an_empty_selection(fixtures_dir: Path, tmp_path, capsys):
     scan = str(fixtures_dir / "specular" / "osr_specular.csv")
     out = tmp_path / "sel.csv"
-    assert (
-        main(["ingest", scan, "--wavelength-range", "500:560", "--theta-i", "45", "-o", str(out)])
-        == 0
-    )
+    argv = ["ingest", scan, "--wavelength-range", "500:560", "--theta-i-range", "45"]
+    assert main([*argv, "-o", str(out)]) == 0
     d = labbrdf.read(out).data
     assert set(d.wavelength_nm) == {500.0, 550.0} and set(d.theta_i_deg) == {45.0}
     assert len(d) == 2 * 21
@@ -286,8 +284,8 @@ def test_new_writers_refuse_inputs_and_wrong_suffixes(real_exports, tmp_path, ca
 def test_report_takes_model_options_and_a_selection(real_exports: Path, tmp_path: Path):
     out = tmp_path / "r"
     argv = ["report", str(real_exports / BSDF), "--model", "microfacet", "--param", "n=1.5",
-            "--param", "k=0", "--param", "diffuse=true", "--theta-i", "40:50", "-o", str(out),
-            "--quiet"]  # fmt: skip
+            "--param", "k=0", "--param", "diffuse=true", "--theta-i-range", "40:50",
+            "-o", str(out), "--quiet"]  # fmt: skip
     assert main(argv) == 0
     res = json.loads((out / "results.json").read_text())
     checks = {c["id"]: c["status"] for c in res["checks"]}

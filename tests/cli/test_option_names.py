@@ -1,6 +1,7 @@
 """One meaning per option name: --wavelength NM is one wavelength, --wavelength-range MIN:MAX
-a range of rows, in every subcommand; old spellings fail naming the new one; no
-abbreviations (a prefix never stands for an option)."""
+a range of rows; --theta-i DEG an angle of incidence, --theta-i-range MIN:MAX a range of
+rows, in every subcommand; old spellings fail naming the new one; no abbreviations (a
+prefix never stands for an option)."""
 
 from __future__ import annotations
 
@@ -9,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from labbrdf import cli
-from labbrdf.cli import build_parser, main
+import labbrdf
+from labbrdf.cli import _options, build_parser, main
 
-SCAN = Path(cli.__file__).parent / "data" / "fixtures" / "specular" / "osr_specular.csv"
+SCAN = Path(labbrdf.__file__).parent / "data" / "fixtures" / "specular" / "osr_specular.csv"
 TRACE = ["trace", "--substrate", "1.5+7j", "--alpha", "0.2", "--theta-i", "45", "--rays", "10"]
 
 
@@ -22,16 +23,54 @@ def subparsers() -> dict[str, argparse.ArgumentParser]:
     return dict(sub.choices)
 
 
-def test_every_command_gives_each_wavelength_option_one_meaning() -> None:
-    seen = {"--wavelength": set(), "--wavelength-range": set()}
+def test_every_command_gives_each_wavelength_and_angle_option_one_meaning() -> None:
+    seen = {
+        "--wavelength": set(),
+        "--wavelength-range": set(),
+        "--theta-i": set(),
+        "--theta-i-range": set(),
+    }
     for name, sp in subparsers().items():
         assert sp.allow_abbrev is False, name
         for a in sp._actions:
             for opt in set(a.option_strings) & set(seen):
-                kind = type(a).__name__ if isinstance(a, cli._Renamed) else a.type
+                kind = type(a).__name__ if isinstance(a, _options._Renamed) else a.type
                 seen[opt].add(kind)
-    assert seen["--wavelength"] == {cli._wavelength_value, "_Renamed"}
-    assert seen["--wavelength-range"] == {cli._range}
+    assert seen["--wavelength"] == {_options._wavelength_value, "_Renamed"}
+    assert seen["--wavelength-range"] == {_options._range}
+    assert seen["--theta-i"] == {_options._angle_value, "_Renamed"}
+    assert seen["--theta-i-range"] == {_options._row_range}
+
+
+@pytest.mark.parametrize("command", ["ingest", "nk", "film", "fit"])
+def test_the_old_angle_row_range_spelling_names_the_new_one(command, capsys) -> None:
+    err = exit_2([command, str(SCAN), "--theta-i", "40:60"], capsys)
+    assert "--theta-i-range MIN:MAX" in err
+
+
+def test_report_old_angle_row_range_spelling_names_the_new_one(tmp_path: Path, capsys) -> None:
+    argv = ["report", str(SCAN), "-o", str(tmp_path / "r"), "--theta-i", "40:60"]
+    assert "--theta-i-range MIN:MAX" in exit_2(argv, capsys)
+    assert not (tmp_path / "r").exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["trace", "--substrate", "1.5+7j", "--wavelength", "650", "--theta-i", "40:60"],
+        ["hemispherical", "--model", "smooth3", "--theta-i", "40:60"],
+        ["export", "--model", "smooth3", "--theta-i", "40:60", "-o", "x.bsdf"],
+    ],
+)
+def test_an_angle_given_as_a_range_names_the_row_range(argv, capsys) -> None:
+    assert "a range of rows is --theta-i-range MIN:MAX" in exit_2(argv, capsys)
+
+
+def test_the_angle_row_range_selects_rows_and_is_checked_first(capsys) -> None:
+    assert main(["ingest", str(SCAN), "--theta-i-range", "40:50", "--json"]) == 0
+    assert '"theta_i_deg": [\n      45.0' in capsys.readouterr().out
+    err = exit_2(["ingest", str(SCAN), "--theta-i-range", "60:40"], capsys)
+    assert "MIN must not exceed MAX" in err
 
 
 def exit_2(argv: list[str], capsys) -> str:
@@ -133,5 +172,5 @@ def test_report_passes_the_row_range_to_the_library(monkeypatch, tmp_path: Path)
 
     monkeypatch.setattr(labbrdf.report, "user_report", fake_report)
     argv = ["report", str(SCAN), "-o", str(tmp_path / "r"), "--scheduler", "serial"]
-    assert main([*argv, "--wavelength-range", "400:700", "--theta-i", "45"]) == 0
+    assert main([*argv, "--wavelength-range", "400:700", "--theta-i-range", "45"]) == 0
     assert seen == {"wavelength": "400:700", "theta_i": "45"}

@@ -322,10 +322,10 @@ def writers(tmp_path, monkeypatch, fixtures_dir, trace_cmd):
     ``surface`` reads a synthetic height map (the readers are tested elsewhere) and
     ``validate`` is a stand-in that goes through the real report writer.
     """
-    import labbrdf.cli
+    import labbrdf.cli.surface
     import labbrdf.report
 
-    monkeypatch.setattr(labbrdf.cli, "_height_map", _fake_height_map)
+    monkeypatch.setattr(labbrdf.cli.surface, "_height_map", _fake_height_map)
     monkeypatch.setattr(labbrdf.report, "validate", _fake_validate)
     data = small_dataset(tmp_path / "in" / "scan.csv")
     hm = tmp_path / "in" / "afm.di"
@@ -465,13 +465,14 @@ def test_two_outputs_of_one_command_may_not_be_the_same_file(tmp_path):
     # today every command's outputs differ in suffix; the check is for a later command
     import argparse
 
-    from labbrdf import cli
+    from labbrdf.cli._options import UsageError
+    from labbrdf.cli._paths import OutputPath, _checked_outputs
 
     p = str(tmp_path / "x.png")
-    png = cli.OutputPath(["--png"], "png", suffixes=(".png",))
-    maps = cli.OutputPath(["--maps"], "maps", suffixes=(".png",))
+    png = OutputPath(["--png"], "png", suffixes=(".png",))
+    maps = OutputPath(["--maps"], "maps", suffixes=(".png",))
     args = argparse.Namespace(path_actions=(png, maps), png=p, maps=p)
-    with pytest.raises(cli.UsageError, match=r"--maps .*x.png: also given to --png"):
-        with cli._checked_outputs(args):
+    with pytest.raises(UsageError, match=r"--maps .*x.png: also given to --png"):
+        with _checked_outputs(args):
             pass  # pragma: no cover
     assert not os.path.exists(p)

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from labbrdf import cli
+import labbrdf
 from labbrdf.cli import main
 
-SCAN = Path(cli.__file__).parent / "data" / "fixtures" / "specular" / "osr_specular.csv"
+SCAN = Path(labbrdf.__file__).parent / "data" / "fixtures" / "specular" / "osr_specular.csv"
 BASE = ["trace", "--theta-i", "45", "--wavelength", "633", "--rays", "10", "--json"]
 
 

@@ -36,7 +36,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import labbrdf.report
-from labbrdf.cli import InputPath, OutputPath, build_parser, main, path_actions
+from labbrdf.cli import build_parser, main
+from labbrdf.cli._paths import InputPath, OutputPath, path_actions
 from labbrdf.dataset import Measurement, make_frame, write
 from labbrdf.outputs import replace_dir
 from labbrdf.report.builder import write_report

@@ -1,0 +1,109 @@
+"""``labbrdf export``: a model's BRDF or a trace's S0 as a Zemax BSDF file."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from ._options import UsageError, _angle_value, _model_from_args, _wavelength_value
+from ._paths import InputPath, OutputPath, _add_overwrite
+
+
+def cmd_export(args: argparse.Namespace) -> int:
+    """Write ``--model``'s BRDF or ``--trace``'s S0 as a Zemax BSDF file."""
+    import numpy as np
+
+    from ..bsdf_export import model_to_bsdf
+
+    if args.format != "zemax-bsdf":
+        raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
+    if (args.model is None) == (args.trace is None):
+        raise UsageError("export a model (--model NAME --param ...) or a trace (--trace RUN.npz)")
+    if args.trace is not None:
+        return _export_trace(args)
+    if args.theta_i is None:
+        raise UsageError("--model needs --theta-i DEG [DEG ...]")
+    model, values = _model_from_args(args)
+    unknown = [k for k in values if k not in model.params]
+    if unknown:
+        raise UsageError(f"--param {unknown}: {args.model} parameters are {list(model.params)}")
+    out = Path(args.output)  # checked with the inputs by _checked_outputs
+    model_to_bsdf(
+        model,
+        values,
+        out,
+        theta_i_deg=np.asarray(args.theta_i, float),
+        radial_deg=_grid(args.radial, "--radial"),
+        azimuth_deg=_grid(args.azimuth, "--azimuth"),
+        overwrite=args.overwrite,
+    )
+    print(f"wrote {out}")
+    return 0
+
+
+def _export_trace(args: argparse.Namespace) -> int:
+    """``export --trace RUN.npz``: the tracer's unpolarized S0 on the scatter grid."""
+    from ..bsdf_export import binned_to_bsdf
+    from ..tracer import TraceResult
+
+    out = Path(args.output)  # checked with the inputs by _checked_outputs
+    if args.theta_i is not None or args.param or args.nk_from:
+        raise UsageError(
+            "--trace takes its angle and material from the run; drop --theta-i/--param"
+        )
+    try:
+        res = TraceResult.load(args.trace)
+    except (OSError, KeyError, ValueError) as exc:
+        raise UsageError(f"--trace {args.trace}: not a labbrdf trace file ({exc})") from None
+    cfg = res.config
+    binned_to_bsdf(
+        out,
+        theta_i_deg=cfg.theta_i_deg,
+        values=res.s0(),
+        theta_edges_deg=res.theta_r_edges_deg,
+        phi_edges_deg=res.phi_r_edges_deg,
+        radial_deg=_grid(args.radial, "--radial"),
+        azimuth_deg=_grid(args.azimuth, "--azimuth"),
+        wavelength_nm=cfg.wavelength_nm,
+        symmetry="Asymmetrical",
+        comments=(f"labbrdf trace S0 (unpolarized), {res.rays} rays, seed {cfg.seed}",),
+        overwrite=args.overwrite,
+    )
+    print(f"wrote {out}")
+    return 0
+
+
+def _grid(text: str, option: str) -> Any:
+    """``--radial`` or ``--azimuth``: :func:`labbrdf.bsdf_export.angle_grid` of the text."""
+    from ..bsdf_export import angle_grid
+
+    try:
+        return angle_grid(text)
+    except ValueError as exc:
+        raise UsageError(f"{option} {text!r}: {exc}") from None
+
+
+def add_parser(sub: Any) -> None:
+    """The ``export`` subcommand's options."""
+    s = sub.add_parser("export", help="write a model BRDF in an exchange format")
+    s.add_argument("--format", default="zemax-bsdf", help="zemax-bsdf")
+    s.add_argument("--model", default=None, help="a model (with --param) ...")
+    s.add_argument(
+        "--trace", action=InputPath, default=None, metavar="RUN.npz", help="... or a trace's S0"
+    )
+    s.add_argument("--param", action="append", metavar="NAME=VALUE")
+    s.add_argument("--nk-from", action=InputPath, default=None, metavar="FILE")
+    s.add_argument(
+        "--wavelength",
+        type=_wavelength_value,
+        default=None,
+        metavar="NM",
+        help="[nm] for --nk-from",
+    )
+    s.add_argument("--theta-i", type=_angle_value, nargs="+", default=None, metavar="DEG")
+    s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")
+    s.add_argument("--azimuth", default="0:180:5", help="START:STOP:STEP [deg]")
+    s.add_argument("-o", "--output", action=OutputPath, suffixes=(".bsdf",), required=True)
+    _add_overwrite(s)
+    s.set_defaults(func=cmd_export)

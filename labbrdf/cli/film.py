@@ -1,0 +1,260 @@
+"""``labbrdf film``: fit a thin-film stack to psi/Delta, R and T of one sample."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+from typing import Any
+
+from ._options import (
+    UsageError,
+    _add_selection,
+    _emit_json,
+    _fit_seed,
+    _parse_assignments,
+    _selected,
+)
+from ._paths import InputPath, OutputPath, _add_overwrite, _layer_files
+
+
+def _film_value(text: str, what: str) -> tuple[float, tuple[float, float] | None]:
+    """``V`` (fixed) or ``LO..HI`` (fitted, started mid-box) of a --layer field."""
+    lo_s, sep, hi_s = text.partition("..")
+    try:
+        if not sep:
+            return float(text), None
+        lo, hi = float(lo_s), float(hi_s)
+    except ValueError:
+        raise UsageError(f"{what}: {text!r} is not a number or LO..HI") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise UsageError(f"{what}: impossible bounds {text!r} (need LO < HI)")
+    return (lo + hi) / 2, (lo, hi)
+
+
+def _film_model(args: argparse.Namespace) -> Any:
+    """The FilmModel of --model FILE, or of --substrate and --layer, or the default."""
+    from .. import films
+    from ..nk import tabulated_from_file
+
+    if args.model is not None:
+        if args.layer or args.substrate:
+            raise UsageError("give --model FILE or --substrate/--layer, not both")
+        return films.load_model(args.model)
+    if not args.layer:
+        if args.substrate not in (None, "si"):
+            raise UsageError("--substrate without --layer: give the layers with --layer")
+        return films.FilmModel.cauchy_on_silicon()
+    sub_text = args.substrate or "si"
+    try:
+        sub = (
+            films.as_material(sub_text)
+            if not os.path.exists(sub_text)
+            else tabulated_from_file(sub_text)
+        )
+    except ValueError as exc:
+        raise UsageError(f"--substrate {sub_text}: {exc}") from None
+    layers, free = [], {}
+    for j, spec in enumerate(args.layer, 1):
+        fields = spec.split(":")
+        if len(fields) < 3:
+            raise UsageError(
+                f"--layer {spec!r}: expected NAME:MATERIAL:THICKNESS[:PARAM=V|LO..HI ...], "
+                "e.g. oxide:cauchy:0..20:A=1.3..1.7"
+            )
+        name, mat, thick = fields[0] or f"layer{j}", fields[1], fields[2]
+        d, dbox = _film_value(thick, f"--layer {name}: thickness")
+        try:
+            m = tabulated_from_file(mat) if _layer_files(spec) else films.as_material(mat)
+        except ValueError as exc:
+            raise UsageError(f"--layer {name}: {exc}") from None
+        values = {}
+        for item in fields[3:]:
+            key, sep, val = item.partition("=")
+            if not sep or key not in m.params:
+                raise UsageError(
+                    f"--layer {name}: {item!r}: expected PARAM=V or PARAM=LO..HI with PARAM "
+                    f"one of {sorted(m.params) or 'none (a table)'}"
+                )
+            values[key], box = _film_value(val, f"--layer {name}: {key}")
+            if box is not None:
+                free[f"{name}.{key}"] = box
+        try:
+            m = films._with_params(m, values)
+            layers.append(films.Layer(m, d, name))
+        except ValueError as exc:
+            raise UsageError(f"--layer {name}: {exc}") from None
+        if dbox is not None:
+            free[f"{name}.thickness_nm"] = dbox
+    try:
+        stack = films.Stack(layers, sub)
+    except ValueError as exc:
+        raise UsageError(f"--layer: {exc}") from None
+    return films.FilmModel(stack, free, None, "--layer")
+
+
+def _one_sample(args: argparse.Namespace, parts: list[Any], data: Any) -> bool:
+    """Whether the files of a film fit are one sample: refused (exit 2) when they are not.
+
+    Files that state different sample names in the selected rows are one sample only by
+    ``--same-sample``; every ``--same-sample`` value is checked against the inputs first
+    (:func:`labbrdf.samples.pair_samples`), whether or not it is needed.
+    """
+    from pathlib import Path
+
+    from ..films import FILM_QUANTITIES
+    from ..fitting.film import stated_samples
+    from ..samples import SampleFile, pair_samples, split_same_sample
+
+    def said(rows: Any) -> dict[str, None]:  # the names of the rows a film fit uses
+        rows = rows[rows["quantity"].astype(str).isin(FILM_QUANTITIES)]
+        return dict.fromkeys(n for names in stated_samples(rows).values() for n in names)
+
+    selected = said(data.data)
+    files = []
+    for path, m in zip(args.files, parts, strict=True):  # each file's own, still selected
+        own = said(m.data)
+        files.append(SampleFile(Path(path), tuple(n for n in own if n in selected)))
+    groups = pair_samples(
+        files,
+        [split_same_sample(v, args.files) for v in args.same_sample or ()],
+        given_as="given with --same-sample",
+    )
+    stating = [g for g in groups if any(f.names and f.path in g.paths for f in files)]
+    if len(stating) < 2:
+        return True
+    listing = "; ".join(
+        f"{f.path} states {', '.join(map(repr, f.names))}" for f in files if f.names
+    )
+    spelt = ",".join(str(f.path) for f in files if f.names)
+    raise UsageError(
+        f"the files state different samples ({listing}); a film fit is of one sample: fit "
+        f"each on its own (or select one with --sample), or, if they are one sample, say "
+        f"so with --same-sample {spelt}"
+    )
+
+
+def cmd_film(args: argparse.Namespace) -> int:
+    """Fit the film model of the options to the files; print the layers and the fit."""
+    from .. import adapters, films
+    from ..dataset import concat
+    from ..outputs import atomic_output, csv_safe_frame
+
+    fm = _film_model(args)
+    sigma = _parse_assignments(args.sigma, "--sigma")
+    wl_range = None
+    if args.wavelength_range is not None:  # the rows, and the range that replaces the file's
+        from ..selection import parse_range
+
+        r = parse_range(args.wavelength_range, "--wavelength-range")
+        if not 0 <= r.lo < r.hi:
+            raise UsageError(
+                f"--wavelength-range {args.wavelength_range}: expected MIN:MAX with "
+                "0 <= MIN < MAX [nm]"
+            )
+        wl_range = (r.lo, r.hi)
+    parts = [adapters.read(p) for p in args.files]
+    data = _selected(args, concat(parts))
+    res = films.fit_film(
+        fm,
+        data,
+        wavelength_range_nm=wl_range,
+        default_sigma=sigma or None,
+        method=args.method,
+        seed=args.seed,
+        ci=args.ci,
+        one_sample=_one_sample(args, parts, data),
+    )
+    if args.output:
+        with atomic_output(args.output) as tmp:
+            csv_safe_frame(res.nk_table()).to_csv(tmp, index=False)
+    if args.fit_json:
+        res.save_json(args.fit_json)
+    if args.json:
+        _emit_json(res.summary())
+    else:
+        print(res.fit_report())
+    return 0
+
+
+def add_parser(sub: Any) -> None:
+    """The ``film`` subcommand's options."""
+    from ..fitting.core import METHOD
+
+    s = sub.add_parser(
+        "film",
+        help="fit a thin-film stack (thicknesses, n, k) to psi/Delta, R and T of one sample",
+    )
+    s.add_argument(
+        "files",
+        nargs="+",
+        action=InputPath,
+        metavar="FILE",
+        help="files of one sample (joint fit)",
+    )
+    s.add_argument(
+        "--model",
+        action=InputPath,
+        inside="model",
+        default=None,
+        metavar="MODEL.toml",
+        help="a film model file",
+    )
+    s.add_argument(
+        "--substrate",
+        action=InputPath,
+        default=None,
+        metavar="NAME|FILE",
+        help="si, sio2, a dispersion model, or an n,k or ellipsometer file (default si)",
+    )
+    s.add_argument(
+        "--layer",
+        action="append",
+        default=[],
+        metavar="NAME:MATERIAL:THICKNESS[:P=V|LO..HI]",
+        help="a layer, top first (repeat); LO..HI values are fitted, e.g. "
+        "oxide:cauchy:0..20:A=1.3..1.7:B=0.004 (no --model/--layer: one Cauchy layer on Si)",
+    )
+    s.add_argument(
+        "--sigma",
+        action="append",
+        metavar="QUANTITY=VALUE",
+        help="sigma for rows whose file gives none (e.g. reflectance=0.005)",
+    )
+    s.add_argument(
+        "--same-sample",
+        action="append",
+        # not an InputPath: every name must be one of the FILE inputs (refused otherwise)
+        metavar="A,B[,...]",
+        help="these FILE inputs are one sample although they state different sample names "
+        "(files that do are refused without it)",
+    )
+    s.add_argument(
+        "--ci",
+        choices=("wald", "profile"),
+        default="profile",
+        help="95%% intervals from the profile of chi2 (default) or the covariance",
+    )
+    s.add_argument("--method", default=METHOD, help="nlopt stages")
+    s.add_argument("--seed", type=_fit_seed, default=0, help="the optimiser's seed")
+    s.add_argument(
+        "-o",
+        "--output",
+        action=OutputPath,
+        suffixes=(".csv",),
+        default=None,
+        metavar="NK.csv",
+        help="write each layer's n, k on the fitted wavelengths",
+    )
+    s.add_argument(
+        "--fit-json",
+        action=OutputPath,
+        suffixes=(".json",),
+        default=None,
+        metavar="FIT.json",
+        help="write the fit (best-fit stack, intervals) as JSON",
+    )
+    _add_overwrite(s)
+    s.add_argument("--json", action="store_true")
+    _add_selection(s)
+    s.set_defaults(func=cmd_film)

@@ -1,0 +1,91 @@
+"""``labbrdf report``: the HTML report of the user's own files."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from ._executor import _add_scheduler, _executor, _executor_errors
+from ._options import _add_selection, _selection, _split_params
+from ._paths import InputPath, OutputPath, _add_overwrite
+
+
+@_executor_errors
+def cmd_report(args: argparse.Namespace) -> int:
+    """Write the HTML report of the files; exit 1 if a check failed."""
+    from ..report import user_report
+    from ..report.sections.film import default_film_model
+    from ..samples import split_same_sample
+
+    executor = _executor(args, progress=not args.quiet)
+    options, start = _split_params(args.model, args.param)
+    selection = _selection(args)
+    return int(
+        user_report(
+            args.files,
+            args.model,
+            args.output,
+            options=options,
+            start=start,
+            selection=selection,
+            progress=not args.quiet,
+            film_model=default_film_model() if args.film_default else args.film_model,
+            executor=executor,
+            same_sample=[split_same_sample(v, args.files) for v in args.same_sample or ()],
+            prediction_slopes=args.prediction_slopes,
+        )
+    )
+
+
+def add_parser(sub: Any) -> None:
+    """The ``report`` subcommand's options."""
+    s = sub.add_parser("report", help="HTML report for your own files")
+    s.add_argument(
+        "files",
+        nargs="+",
+        action=InputPath,
+        metavar="DATA",
+        help="instrument exports, .bsdf files, datasets and height maps (.di, .opdx, ...)",
+    )
+    s.add_argument("--model", default="smooth3")
+    s.add_argument(
+        "--param",
+        action="append",
+        metavar="NAME=VALUE",
+        help="a model option (microfacet n=, k=, diffuse=true) or a parameter's start value",
+    )
+    s.add_argument("-o", "--output", action=OutputPath, kind="dir", required=True, metavar="DIR")
+    _add_overwrite(s)
+    film = s.add_mutually_exclusive_group()
+    film.add_argument(
+        "--film-model",
+        default=None,
+        action=InputPath,
+        inside="model",
+        metavar="FILE.toml",
+        help="fit this film stack to psi/Delta files whose angles disagree",
+    )
+    film.add_argument(
+        "--film-default",
+        action="store_true",
+        help="... or the stated default: one transparent Cauchy layer on c-Si, thickness free",
+    )
+    s.add_argument(
+        "--same-sample",
+        action="append",
+        # not an InputPath: every name must be one of the DATA inputs (refused otherwise)
+        metavar="A,B[,...]",
+        help="these DATA inputs are one sample (repeatable; inputs stating one sample name "
+        "are paired anyway)",
+    )
+    s.add_argument(
+        "--prediction-slopes",
+        choices=("ggx", "measured"),
+        default="ggx",
+        help="roughness of the section prediction: the GGX alpha of the height map's slopes "
+        "(default) or their measured table (as trace --surface)",
+    )
+    s.add_argument("--quiet", action="store_true", help="no progress lines")
+    _add_selection(s)
+    _add_scheduler(s)
+    s.set_defaults(func=cmd_report)
