@@ -219,10 +219,10 @@ def check_last_field(
     written ``0,322``; ``4.522`` or ``4.522E-0`` where it is written ``4.522E-02``).
     Warned (the column's own writing varies, so a shorter value may be a real one, e.g.
     ``0.13`` beside ``0.1308`` from a writer that drops trailing zeros): the field has fewer
-    decimals than some other row, fewer significant digits than every other row or (where
-    the decimals vary, as a writer of significant digits writes ``0.00152198`` beside
-    ``2.78913``) than some other row, or no exponent where other rows have one; or no other
-    row has the column to compare with.
+    significant digits than some other row (a cut always removes significant digits), or
+    no exponent where other rows have one; or no other row has the column to compare with.
+    Fewer decimals alone is no sign of a cut where the decimals vary: a writer of
+    significant digits writes ``0.278168`` beside ``0.0775003``.
 
     Parameters
     ----------
@@ -293,13 +293,14 @@ def check_last_field(
             f"the file looks truncated ({fix})",
             line,
         )
+    # where the decimals vary, the writer keeps significant digits (%g: 0.0775003 beside
+    # 0.278168) or drops trailing zeros (0.13 beside 0.1308): a cut value has fewer
+    # significant digits than the most any row has, while a complete one may well have
+    # fewer decimals than another row (0.278168 is not short beside 0.0775003)
     short = (
-        f.decimals < max(decimals)
-        or (f.exponent is None and exps)
+        (f.exponent is None and exps)
         or (f.exponent is not None and exps and f.exponent < min(exps))
-        or f.digits < min(r.digits for r in ref)
-        # a writer of significant digits (%g: 0.00152198 beside 2.78913): fewer of them
-        or (not fixed and f.digits < max(r.digits for r in ref))
+        or f.digits < max(r.digits for r in ref)
     )
     if not short:
         return None

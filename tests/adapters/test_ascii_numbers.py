@@ -144,3 +144,29 @@ def test_every_block_reader_refuses_or_warns_on_a_last_number_missing_a_digit(
     assert texts and re.search(rf"line {line}: .*may be truncated", texts[0]), texts
     body_line = body.decode("latin-1").splitlines()[-1]
     assert body_line[-1].isdigit(), body_line
+
+
+def test_a_complete_last_value_of_a_significant_digits_writer_is_not_doubted(
+    tmp_path: Path,
+) -> None:
+    """WVASE writes sigmas with 6 significant digits (``0.0775003`` beside ``0.278168``): a
+    last value with all six is complete even with fewer decimals than another row; one with
+    five is doubted (a cut always removes significant digits)."""
+    from labbrdf.adapters._numblock import check_last_field
+
+    rows = ["1.0\t0.0775003", "2.0\t0.0935513", "3.0\t0.106933", "4.0\t0.145151", "5.0\t0.171798"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert check_last_field(tmp_path / "f.dat", "6.0\t0.278168", rows, 7, "\t") is None
+    with pytest.warns(AdapterWarning, match="line 7: .*'0.27816'.* may be truncated"):
+        check_last_field(tmp_path / "f.dat", "6.0\t0.27816", rows, 7, "\t")
+
+
+def test_the_real_wvase_file_without_a_final_line_end_reads_without_a_doubt(
+    real_exports: Path,
+) -> None:
+    p = real_exports / "woollam-wvase-ascii" / "w2_10102006.dat"
+    assert not p.read_bytes().endswith(b"\n")  # the case: its last line has no line end
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", AdapterWarning)
+        assert len(READERS["woollam-wvase"].read(p)) > 0
