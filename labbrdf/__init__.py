@@ -56,7 +56,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "hemispherical_reflectance": ("labbrdf.integrate", "hemispherical_reflectance"),
     "Stack": ("labbrdf.films", "Stack"),
     "Layer": ("labbrdf.films", "Layer"),
-    "fit_film": ("labbrdf.films", "fit_film"),
+    "fit_film": ("labbrdf.fitting.film", "fit_film"),
     "FilmFit": ("labbrdf.fitting.film", "FilmFit"),
     "read_height_map": ("labbrdf.adapters.topography", "read_height_map"),
     "roughness_statistics": ("labbrdf.topography", "roughness_statistics"),
@@ -103,7 +103,6 @@ _MODULES = (
     "selection",
     "smoothness",
     "specular_dop",
-    "stack",
     "surface",
     "topography",
     "tracer",
@@ -139,7 +138,6 @@ if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__
         selection,
         smoothness,
         specular_dop,
-        stack,
         surface,
         topography,
         tracer,
@@ -149,9 +147,9 @@ if TYPE_CHECKING:  # what a type checker and an IDE see; at run time __getattr__
     from .adapters.topography import read_height_map
     from .dataset import DatasetError, Measurement
     from .errors import LabbrdfError, SetupError
-    from .films import Layer, Stack, fit_film
+    from .films import Layer, Stack
     from .fitting import FitError, FitResult, fit, fit_many, fit_many_nk, fit_records
-    from .fitting.film import FilmFit
+    from .fitting.film import FilmFit, fit_film
     from .integrate import hemispherical_reflectance
     from .models import ModelError
     from .nk import NkError, bulk_index_at, combined_table, model_with_nk, nk_table, read_nk

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from labbrdf import optics
+from labbrdf.films import onefilm
 
 EPS = np.finfo(float).eps
 N_AL = 1.55 + 7.71j
@@ -388,14 +389,14 @@ def test_absentee_half_wave_film_equals_the_bare_substrate_at_normal_incidence()
     # n_f d = lambda/2: exp(2 i beta) = exp(2 pi i) = 1 up to the rounding of 2 pi d n/lambda
     wl = 650.0
     for n_film, n_sub in ((1.5, N_AL), (2.1, 1.5), (1.38, N_SI)):
-        rs, rp = optics.film_amplitudes(1.0, n_film, n_sub, wl / (2 * n_film), wl, 0.0)
+        rs, rp = onefilm.film_amplitudes(1.0, n_film, n_sub, wl / (2 * n_film), wl, 0.0)
         r0s, r0p, _, _ = optics.fresnel(1.0, n_sub, 0.0)
         assert abs(rs - r0s) <= 32 * EPS
         assert abs(rp - r0p) <= 32 * EPS
 
 
 def test_zero_thickness_film_is_the_bare_substrate_at_every_angle():
-    rs, rp = optics.film_amplitudes(1.0, 1.5, N_AL, 0.0, 650.0, THETA)
+    rs, rp = onefilm.film_amplitudes(1.0, 1.5, N_AL, 0.0, 650.0, THETA)
     r0s, r0p, _, _ = optics.fresnel(1.0, N_AL, THETA)
     np.testing.assert_allclose(rs, r0s, rtol=0, atol=16 * EPS)
     np.testing.assert_allclose(rp, r0p, rtol=0, atol=16 * EPS)
@@ -404,7 +405,7 @@ def test_zero_thickness_film_is_the_bare_substrate_at_every_angle():
 def test_quarter_wave_antireflection_film_cancels_reflection_at_normal_incidence():
     # n_f = sqrt(n_s), n_f d = lambda/4: r = 0 (Born and Wolf 1.6.4)
     n_sub = 2.25
-    rs, rp = optics.film_amplitudes(1.0, 1.5, n_sub, 650.0 / (4 * 1.5), 650.0, 0.0)
+    rs, rp = onefilm.film_amplitudes(1.0, 1.5, n_sub, 650.0 / (4 * 1.5), 650.0, 0.0)
     assert abs(rs) <= 16 * EPS and abs(rp) <= 16 * EPS
 
 
@@ -415,7 +416,7 @@ def test_free_standing_lossless_film_follows_the_fabry_perot_formula(theta):
     # R = 4 R01 sin^2(beta) / ((1 - R01)^2 + 4 R01 sin^2(beta)), for s and p separately
     n_film, wl = 2.0, 600.0
     d = np.linspace(0.0, 1000.0, 101)
-    rs, rp = optics.film_amplitudes(1.0, n_film, 1.0, d, wl, theta)
+    rs, rp = onefilm.film_amplitudes(1.0, n_film, 1.0, d, wl, theta)
     r01s, r01p = optics.reflectance(1.0, n_film, theta)
     cos1 = np.sqrt(1 - (np.sin(np.radians(theta)) / n_film) ** 2)
     s2 = np.sin(2 * np.pi * d * n_film * cos1 / wl) ** 2
@@ -427,13 +428,13 @@ def test_free_standing_lossless_film_follows_the_fabry_perot_formula(theta):
 
 
 def test_incoherent_lossless_film_does_not_depend_on_thickness():
-    a = optics.film_reflectance_incoherent(1.0, 1.5, N_AL, 10.0, 650.0, THETA)
-    b = optics.film_reflectance_incoherent(1.0, 1.5, N_AL, 1e5, 650.0, THETA)
+    a = onefilm.film_reflectance_incoherent(1.0, 1.5, N_AL, 10.0, 650.0, THETA)
+    b = onefilm.film_reflectance_incoherent(1.0, 1.5, N_AL, 1e5, 650.0, THETA)
     np.testing.assert_allclose(a, b, rtol=0, atol=4 * EPS)
 
 
 def test_incoherent_film_index_matched_to_ambient_is_the_bare_substrate():
-    Rs, Rp = optics.film_reflectance_incoherent(1.0, 1.0, N_CU, 500.0, 650.0, THETA)
+    Rs, Rp = onefilm.film_reflectance_incoherent(1.0, 1.0, N_CU, 500.0, 650.0, THETA)
     r0s, r0p = optics.reflectance(1.0, N_CU, THETA)
     np.testing.assert_allclose(Rs, r0s, rtol=0, atol=8 * EPS)
     np.testing.assert_allclose(Rp, r0p, rtol=0, atol=8 * EPS)
@@ -441,7 +442,7 @@ def test_incoherent_film_index_matched_to_ambient_is_the_bare_substrate():
 
 def test_thick_absorbing_incoherent_film_hides_the_substrate():
     # k = 0.1, d = 100 um: round trip attenuation exp(-4 pi k 2 d / lambda) underflows
-    Rs, Rp = optics.film_reflectance_incoherent(1.0, 1.5 + 0.1j, N_AL, 1e5, 650.0, THETA)
+    Rs, Rp = onefilm.film_reflectance_incoherent(1.0, 1.5 + 0.1j, N_AL, 1e5, 650.0, THETA)
     r01s, r01p = optics.reflectance(1.0, 1.5 + 0.1j, THETA)
     np.testing.assert_array_equal(Rs, r01s)
     np.testing.assert_array_equal(Rp, r01p)
@@ -478,14 +479,14 @@ def test_incoherent_film_mueller_equals_the_explicit_series_of_interface_mueller
         for _ in range(400):
             total += m_t10 @ path
             path = a * m_r12 @ m_r10 @ path
-        expected = optics.film_mueller_incoherent(n0, n1, n2, d, wl, theta)
+        expected = onefilm.film_mueller_incoherent(n0, n1, n2, d, wl, theta)
         # the remaining tail after 400 round trips is < (0.93 * 0.04)^400, i.e. 0
         np.testing.assert_allclose(total, expected, rtol=0, atol=64 * EPS)
 
 
 def test_incoherent_film_mueller_depolarises_and_matches_its_reflectances():
-    m = optics.film_mueller_incoherent(1.0, 1.5, N_AL, 500.0, 650.0, THETA[1:-1])
-    Rs, Rp = optics.film_reflectance_incoherent(1.0, 1.5, N_AL, 500.0, 650.0, THETA[1:-1])
+    m = onefilm.film_mueller_incoherent(1.0, 1.5, N_AL, 500.0, 650.0, THETA[1:-1])
+    Rs, Rp = onefilm.film_reflectance_incoherent(1.0, 1.5, N_AL, 500.0, 650.0, THETA[1:-1])
     np.testing.assert_allclose(m[:, 0, 0], (Rs + Rp) / 2, rtol=4 * EPS)
     np.testing.assert_allclose(m[:, 0, 1], (Rs - Rp) / 2, rtol=0, atol=4 * EPS)
     # |C|^2 <= Rs Rp (Cauchy-Schwarz over the paths), strictly for oblique incidence
@@ -509,11 +510,11 @@ _CASES = {
     "transmittance": lambda n, t: optics.transmittance(1.0, n, t),
     "psi_delta": lambda n, t: optics.psi_delta(n, t),
     "berger": lambda n, t: optics.berger_reflectances(np.real(n), np.imag(n), t),
-    "film_amplitudes": lambda n, t: optics.film_amplitudes(1.0, 1.38, n, 120.0, 600.0, t),
-    "film_incoherent": lambda n, t: optics.film_reflectance_incoherent(
+    "film_amplitudes": lambda n, t: onefilm.film_amplitudes(1.0, 1.38, n, 120.0, 600.0, t),
+    "film_incoherent": lambda n, t: onefilm.film_reflectance_incoherent(
         1.0, 1.38, n, 120.0, 600.0, t
     ),
-    "film_mueller": lambda n, t: (optics.film_mueller_incoherent(1.0, 1.38, n, 120.0, 600.0, t),),
+    "film_mueller": lambda n, t: (onefilm.film_mueller_incoherent(1.0, 1.38, n, 120.0, 600.0, t),),
     "mueller_reflection": lambda n, t: (
         optics.mueller_reflection(*optics.fresnel(1.0, n, t)[:2]),
     ),
@@ -559,7 +560,7 @@ def test_no_runtime_warning_at_the_edges_of_the_valid_domain():
         optics.psi_delta(4.0j, [0.0, 90.0])
         optics.berger_reflectances(1.0, 0.0, [0.0, 90.0])
         optics.berger_reflectances(0.0, 3.0, [0.0, 90.0])
-        optics.film_mueller_incoherent(1.0, 1.5, N_AL, [0.0, 1e7], 650.0, 90.0)
+        onefilm.film_mueller_incoherent(1.0, 1.5, N_AL, [0.0, 1e7], 650.0, 90.0)
 
 
 # --------------------------------------------------------------------------------------
@@ -605,22 +606,22 @@ def test_no_runtime_warning_at_the_edges_of_the_valid_domain():
         (lambda: optics.berger_reflectances(0.0, 0.0, 30.0), r"n, k: the index N = n \+ ik"),
         (lambda: optics.berger_reflectances(1.0, 1.0, 90.5), r"theta_deg: expected an angle"),
         (
-            lambda: optics.film_amplitudes(1, 1.5, 2, -1.0, 600, 0),
+            lambda: onefilm.film_amplitudes(1, 1.5, 2, -1.0, 600, 0),
             r"thickness_nm: expected values >= 0",
         ),
         (
-            lambda: optics.film_amplitudes(1, 1.5, 2, 10, 0.0, 0),
+            lambda: onefilm.film_amplitudes(1, 1.5, 2, 10, 0.0, 0),
             r"wavelength_nm: expected values > 0",
         ),
-        (lambda: optics.film_amplitudes(1, 1.5 - 1j, 2, 10, 600, 0), r"n_film: the extinction"),
-        (lambda: optics.film_amplitudes(1, 1.5, -2, 10, 600, 0), r"n_substrate: the real part"),
-        (lambda: optics.film_amplitudes(0, 1.5, 2, 10, 600, 0), r"n_ambient: the index"),
+        (lambda: onefilm.film_amplitudes(1, 1.5 - 1j, 2, 10, 600, 0), r"n_film: the extinction"),
+        (lambda: onefilm.film_amplitudes(1, 1.5, -2, 10, 600, 0), r"n_substrate: the real part"),
+        (lambda: onefilm.film_amplitudes(0, 1.5, 2, 10, 600, 0), r"n_ambient: the index"),
         (
-            lambda: optics.film_amplitudes(1, 1.5, 2, 10, 600, 120),
+            lambda: onefilm.film_amplitudes(1, 1.5, 2, 10, 600, 120),
             r"theta_i_deg: expected an angle",
         ),
-        (lambda: optics.film_reflectance_incoherent(1, 1.5, 2, np.nan, 600, 0), r"thickness_nm"),
-        (lambda: optics.film_mueller_incoherent(1, 1.5, 2, 10, -600, 0), r"wavelength_nm"),
+        (lambda: onefilm.film_reflectance_incoherent(1, 1.5, 2, np.nan, 600, 0), r"thickness_nm"),
+        (lambda: onefilm.film_mueller_incoherent(1, 1.5, 2, 10, -600, 0), r"wavelength_nm"),
     ],
 )
 def test_invalid_input_raises_value_error_naming_the_argument(call, match):

@@ -7,7 +7,8 @@ import pytest
 
 from labbrdf import adapters
 from labbrdf.dispersion import Cauchy
-from labbrdf.films import FilmModel, Layer, Stack, fit_film
+from labbrdf.films import FilmModel, Layer, Stack
+from labbrdf.fitting.film import fit_film
 from labbrdf.nk import tabulated_from_file
 
 pytestmark = pytest.mark.shared
