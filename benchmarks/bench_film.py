@@ -26,9 +26,9 @@ import time
 import numpy as np
 import pandas as pd
 
-from labbrdf.dispersion import Cauchy
 from labbrdf.films import FilmModel, Layer, Stack
 from labbrdf.fitting.film import fit_film
+from labbrdf.nk.dispersion import Cauchy
 
 TRUE = Stack([Layer(Cauchy(A=1.46, B=0.004), 105.0, "film")], "si")
 BOX = {"film.thickness_nm": (0.0, 300.0), "film.A": (1.3, 1.8), "film.B": (0.0, 0.02)}

@@ -5,7 +5,7 @@ transfer matrices, the one coherent multilayer) and :mod:`~labbrdf.films.onefilm
 on a substrate, coherent and incoherent) build on :mod:`labbrdf.optics`;
 :mod:`~labbrdf.films.materials` and :mod:`~labbrdf.films.layers` make the
 :class:`Stack` (:mod:`~labbrdf.films.stack`), which computes psi/Delta, reflectance and
-transmittance from :mod:`labbrdf.dispersion` materials; :mod:`~labbrdf.films.model` adds the
+transmittance from :mod:`labbrdf.nk.dispersion` materials; :mod:`~labbrdf.films.model` adds the
 search box of a fit, :mod:`~labbrdf.films.modelfile` reads it from TOML,
 :mod:`~labbrdf.films.fitjson` checks a fit's JSON, :mod:`~labbrdf.films.coating` turns a
 fitted one-layer stack into the tracer's coating, and :mod:`~labbrdf.films.limits` holds

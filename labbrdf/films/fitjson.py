@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from .. import dispersion as disp
 from ..jsonsafe import SchemaError, check_schema
+from ..nk import dispersion as disp
 from ..outputs import InputFileError, read_input_file
 from .limits import (
     MAX_FIT_JSON_BYTES,

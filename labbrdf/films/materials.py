@@ -1,6 +1,6 @@
 """A layer's material: a dispersion model, a reference or file table, a number, or roughness.
 
-:func:`as_material` turns what a user writes (a :class:`~labbrdf.dispersion.Dispersion`,
+:func:`as_material` turns what a user writes (a :class:`~labbrdf.nk.dispersion.Dispersion`,
 a number, a name, a dict) into one; :class:`Roughness` is the Bruggeman effective medium of
 the material below and the ambient.
 """
@@ -12,7 +12,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from .. import dispersion as disp
+from ..nk import dispersion as disp
 from .limits import FilmError
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from .. import dispersion as disp
+from ..nk import dispersion as disp
 from .layers import Layer
 from .stack import Stack
 
@@ -47,7 +47,7 @@ class FilmModel:
         """The default fit of a stack.
 
         Vary every layer's thickness and every parametric layer material's parameters
-        (default boxes of :mod:`labbrdf.dispersion`); the substrate and tables stay fixed.
+        (default boxes of :mod:`labbrdf.nk.dispersion`); the substrate and tables stay fixed.
         Thickness box: [0, max(3 d, 20 nm)] unless ``thickness_max_nm`` is given.
         """
         free: dict[str, tuple[float, float]] = {}

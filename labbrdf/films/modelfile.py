@@ -15,7 +15,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from .. import dispersion as disp
+from ..nk import dispersion as disp
 from ..outputs import InputFileError, read_input_file
 from .fitjson import _fit_doc
 from .layers import Layer

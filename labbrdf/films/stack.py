@@ -2,7 +2,7 @@
 
 A :class:`Stack` of :class:`~labbrdf.films.Layer` s over a substrate computes psi/Delta,
 reflectance and transmittance with the transfer matrices of :mod:`labbrdf.films.matrices`
-(the one coherent multilayer) from :mod:`labbrdf.dispersion` materials. A stack is read
+(the one coherent multilayer) from :mod:`labbrdf.nk.dispersion` materials. A stack is read
 back from a film fit's JSON by :func:`read_fit_json` (:mod:`labbrdf.films.fitjson` checks it).
 
 Parameter names are ``"<layer>.<parameter>"``: ``"oxide.thickness_nm"``, ``"oxide.A"``,
@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .. import dispersion as disp
+from ..nk import dispersion as disp
 from . import matrices as stk
 from .fitjson import _check_indices, _fit_doc, _tabulated
 from .layers import Layer

@@ -24,12 +24,12 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 from scipy import special
 
-from .. import dispersion as disp
 from ..dataset import Measurement
 from ..films import FILM_QUANTITIES, NK_REPORT_NM, FilmError, FilmModel, Stack, load_model
 from ..films import matrices as stk
 from ..jsonsafe import jsonable
 from ..models import Model, Parameters
+from ..nk import dispersion as disp
 from ..samples import SampleFile, stated_names
 from .core import METHOD, fit
 from .data import FitData, FitError
@@ -50,7 +50,7 @@ class _FilmFitModel(Model):
 
     name = "film"
     reference = (
-        "coherent transfer matrices (labbrdf.films.matrices) with labbrdf.dispersion materials"
+        "coherent transfer matrices (labbrdf.films.matrices) with labbrdf.nk.dispersion materials"
     )
 
     _CH = {"psi": 0, "delta": 1, "rs": 2, "rp": 3, "r": 4, "ts": 5, "tp": 6, "t": 7}

@@ -2,7 +2,7 @@
 
 :func:`read_nk` reads a file's pseudo-constants (a table written by ``labbrdf nk`` or any
 ellipsometer export), :func:`tabulated_from_file` a material's ``n, k`` as a
-:class:`~labbrdf.dispersion.Tabulated` (a text table, or an ellipsometer file combined over
+:class:`~labbrdf.nk.dispersion.Tabulated` (a text table, or an ellipsometer file combined over
 its angles of incidence); below the film objects, which read their table files through it.
 """
 
@@ -16,8 +16,8 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from .. import adapters
-from .. import dispersion as disp
 from ..errors import LabbrdfError
+from . import dispersion as disp
 from .tables import combined_table
 
 #: largest n,k table (or ellipsometer file) that :func:`tabulated_from_file` reads [bytes]:
@@ -70,7 +70,7 @@ def tabulated_from_file(
     ----------
     path : path-like
         A text table ``wavelength_nm n [k]`` (comma, semicolon or whitespace separated,
-        ``#`` comments, an optional header line; :func:`labbrdf.dispersion.parse_nk_table`),
+        ``#`` comments, an optional header line; :func:`labbrdf.nk.dispersion.parse_nk_table`),
         or any ellipsometer export labbrdf reads: its psi/Delta are inverted to two-phase
         pseudo-constants (:func:`nk_table`) and averaged over the angles of incidence with
         the inverse-variance weights of :func:`combined_table` (a bare, smooth substrate:
@@ -80,12 +80,12 @@ def tabulated_from_file(
 
     Returns
     -------
-    labbrdf.dispersion.Tabulated
+    labbrdf.nk.dispersion.Tabulated
         Keyed ``file:PATH`` (its ``to_dict`` names the file).
 
     Raises
     ------
-    labbrdf.dispersion.DispersionError
+    labbrdf.nk.dispersion.DispersionError
         The file cannot be read as either, is not a regular file (a device, a FIFO: refused
         before it is opened) or is larger than :data:`MAX_TABLE_BYTES`; names the file (and
         the line of a table).

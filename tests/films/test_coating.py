@@ -11,9 +11,9 @@ import pytest
 
 from labbrdf import films
 from labbrdf.cli import main
-from labbrdf.dispersion import Cauchy
 from labbrdf.films import coating_from_fit
 from labbrdf.fitting.film import fit_film
+from labbrdf.nk.dispersion import Cauchy
 
 CAUCHY = {"A": 1.52, "B": 0.006, "C": 0.0}
 D_NM = 250.0

@@ -8,7 +8,6 @@ import os
 import numpy as np
 import pytest
 
-from labbrdf.dispersion import Cauchy, Sellmeier, Tabulated
 from labbrdf.films import (
     MAX_LAYERS,
     FilmError,
@@ -20,6 +19,7 @@ from labbrdf.films import (
     read_fit_json,
 )
 from labbrdf.films import matrices as stk
+from labbrdf.nk.dispersion import Cauchy, Sellmeier, Tabulated
 
 
 def _oxide_on_si(d=100.0):
