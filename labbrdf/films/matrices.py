@@ -2,7 +2,7 @@
 
 Pure NumPy (physics layer). One implementation of the coherent multilayer: every other
 coherent film computation in labbrdf (:func:`labbrdf.films.onefilm.film_amplitudes`,
-the :class:`~labbrdf.films.Stack`) calls :func:`amplitudes`.
+the :class:`~labbrdf.Stack`) calls :func:`amplitudes`.
 
 Conventions are those of :mod:`labbrdf.optics` (docs/conventions.md): ``exp(-i omega t)``,
 ``N = n + ik`` with ``k >= 0``, LB interface amplitudes

@@ -1,6 +1,6 @@
 """The thin-film stack: layers over a substrate, its indices, psi/Delta, R and T.
 
-A :class:`Stack` of :class:`~labbrdf.films.Layer` s over a substrate computes psi/Delta,
+A :class:`Stack` of :class:`~labbrdf.Layer` s over a substrate computes psi/Delta,
 reflectance and transmittance with the transfer matrices of :mod:`labbrdf.films.matrices`
 (the one coherent multilayer) from :mod:`labbrdf.nk.dispersion` materials. A stack is read
 back from a film fit's JSON by :func:`read_fit_json` (:mod:`labbrdf.films.fitjson` checks it).
