@@ -6,7 +6,7 @@ Synthetic data (a 105 nm Cauchy film, A = 1.46, B = 0.004 um^2, on Green's c-Si)
 300-1000 nm and 55/65/75 deg, with Gaussian noise of 0.01 deg (psi) and 0.03 deg (Delta),
 the sigmas of a WVASE file in the visible. Prints, for
 
-* ``labbrdf``: :func:`labbrdf.films.fit_film` (GN_CRS2_LM global stage inside the box, then
+* ``labbrdf``: :func:`labbrdf.fitting.film.fit_film` (GN_CRS2_LM global stage inside the box, then
   LN_BOBYQA; Wald intervals), from the box [0, 300] nm x [1.3, 1.8] x [0, 0.02];
 * ``pyElli``: pyElli's own forward model (``Structure.evaluate`` with its 2x2 solver and
   its ``Cauchy`` dispersion) minimised by ``scipy.optimize.least_squares`` from the box
@@ -26,8 +26,9 @@ import time
 import numpy as np
 import pandas as pd
 
-from labbrdf.dispersion import Cauchy
-from labbrdf.films import FilmModel, Layer, Stack, fit_film
+from labbrdf.films import FilmModel, Layer, Stack
+from labbrdf.fitting.film import fit_film
+from labbrdf.nk.dispersion import Cauchy
 
 TRUE = Stack([Layer(Cauchy(A=1.46, B=0.004), 105.0, "film")], "si")
 BOX = {"film.thickness_nm": (0.0, 300.0), "film.A": (1.3, 1.8), "film.B": (0.0, 0.02)}

@@ -60,7 +60,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "hemispherical_reflectance": ("labbrdf.integrate", "hemispherical_reflectance"),
     "Stack": ("labbrdf.films", "Stack"),
     "Layer": ("labbrdf.films", "Layer"),
-    "fit_film": ("labbrdf.films", "fit_film"),
+    "fit_film": ("labbrdf.fitting.film", "fit_film"),
     "FilmFit": ("labbrdf.fitting.film", "FilmFit"),
     "read_height_map": ("labbrdf.adapters.topography", "read_height_map"),
     "roughness_statistics": ("labbrdf.topography", "roughness_statistics"),
@@ -86,7 +86,6 @@ _MODULES = (
     "bsdf_export",
     "bsdf_geometry",
     "dataset",
-    "dispersion",
     "ellipsometry",
     "errors",
     "films",
@@ -103,7 +102,6 @@ _MODULES = (
     "selection",
     "smoothness",
     "specular_dop",
-    "stack",
     "surface",
     "topography",
     "tracer",
@@ -125,7 +123,6 @@ if TYPE_CHECKING:
         bsdf_export,
         bsdf_geometry,
         dataset,
-        dispersion,
         ellipsometry,
         errors,
         films,
@@ -142,7 +139,6 @@ if TYPE_CHECKING:
         selection,
         smoothness,
         specular_dop,
-        stack,
         surface,
         topography,
         tracer,
@@ -152,9 +148,9 @@ if TYPE_CHECKING:
     from .adapters.topography import read_height_map
     from .dataset import DatasetError, Measurement
     from .errors import LabbrdfError, SetupError
-    from .films import Layer, Stack, fit_film
+    from .films import Layer, Stack
     from .fitting import FitError, FitResult, fit, fit_many, fit_many_nk, fit_records
-    from .fitting.film import FilmFit
+    from .fitting.film import FilmFit, fit_film
     from .integrate import hemispherical_reflectance
     from .models import ModelError
     from .nk import NkError, bulk_index_at, combined_table, model_with_nk, nk_table, read_nk

@@ -63,9 +63,10 @@ from numpy.typing import NDArray
 
 from .adapters import zemax_bsdf
 from .bsdf_geometry import scatter_to_angles, scatter_to_direction
+from .films import coating_of_stack
 from .integrate import grid_integral
 from .microfacet import TabulatedNDF
-from .nk import coating_of_stack, combined_table, nk_at, ordinary_psi_delta
+from .nk import combined_table, nk_at, ordinary_psi_delta
 from .specular_dop import specular_dop
 from .topography import SlopeFit, fit_slope_distribution, level, slopes
 from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
@@ -293,7 +294,7 @@ def film_coating(
 
     The layer's index at ``wavelength_nm`` and its fitted thickness become the
     :class:`~labbrdf.Coating` (as ``labbrdf trace --coating-from`` does with a saved fit,
-    :func:`labbrdf.nk.coating_of_stack`), the fit's substrate index the substrate's.
+    :func:`labbrdf.films.coating_of_stack`), the fit's substrate index the substrate's.
 
     Parameters
     ----------
@@ -456,7 +457,7 @@ def specular_dop_comparison(
     wavelengths_nm : sequence of float, optional
         Wavelengths to trace [nm]; default ``max_wavelengths`` measured ones evenly spread.
     coating : Coating, optional
-        A coating over the substrate (e.g. :func:`labbrdf.nk.coating_from_fit`); the
+        A coating over the substrate (e.g. :func:`labbrdf.films.coating_from_fit`); the
         psi/Delta then still give the substrate.
     rays, seed, step_deg :
         Tracer rays per run, seed and bin width [deg] (the specular bin is the one holding

@@ -9,7 +9,7 @@ The objects layer over :mod:`labbrdf.tracer` (which reads no file):
 - the substrate roughness: a GGX or Beckmann alpha, or the slope table of a measured
   areal height map (:meth:`labbrdf.Substrate.from_surface`);
 - an optional coating: index and thickness values, or the one layer of a film fit at the
-  traced wavelength (:func:`labbrdf.nk.coating_from_fit`), with its top's roughness as an
+  traced wavelength (:func:`labbrdf.films.coating_from_fit`), with its top's roughness as an
   alpha (default: the substrate's) or a measured map.
 
 ``labbrdf trace`` is this function behind its options. Arguments that do not fit together
@@ -26,8 +26,9 @@ from typing import Any, Literal
 
 from .adapters.topography import HeightMap, read_height_map
 from .errors import SetupError, escaped
+from .films import coating_from_fit
 from .microfacet import DISTRIBUTIONS, TabulatedNDF
-from .nk import NkError, bulk_index_at, coating_from_fit, read_nk
+from .nk import NkError, bulk_index_at, read_nk
 from .tracer.config import Coating, Substrate, TraceConfig
 
 __all__ = ["trace_config_from_inputs"]
@@ -229,7 +230,7 @@ def trace_config_from_inputs(
         Coating index [1], with ``thickness_nm`` ...
     coating_from : path-like, optional
         ... or a one-layer film fit's JSON: the layer's index at ``wavelength_nm`` and
-        its thickness (:func:`labbrdf.nk.coating_from_fit`). At most one of the two; none:
+        its thickness (:func:`labbrdf.films.coating_from_fit`). At most one of the two; none:
         no coating.
     thickness_nm : float, optional
         Coating thickness [nm] (with ``coating_index``).

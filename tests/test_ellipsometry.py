@@ -15,6 +15,7 @@ from scipy import optimize
 import labbrdf
 from labbrdf import ellipsometry as ell
 from labbrdf import optics
+from labbrdf.films import onefilm
 
 # --------------------------------------------------------------------------------------
 # an independent two-phase inversion: forward Fresnel written here, solved numerically
@@ -505,7 +506,7 @@ def test_a_non_finite_condition_number_counts_as_ill_conditioned():
 
 
 def _film_psi_delta(n_film, n_sub, d_nm, wl_nm, theta):
-    rs, rp = optics.film_amplitudes(1.0, n_film, n_sub, d_nm, wl_nm, theta)
+    rs, rp = onefilm.film_amplitudes(1.0, n_film, n_sub, d_nm, wl_nm, theta)
     psi = np.degrees(np.arctan2(np.abs(rp), np.abs(rs)))
     delta = np.mod(np.degrees(np.angle(rs * np.conj(rp))), 360.0)
     return psi, delta

@@ -24,6 +24,7 @@ import pandas as pd
 import pytest
 
 from labbrdf import ellipsometry, optics
+from labbrdf.films import onefilm
 
 pytestmark = pytest.mark.shared
 
@@ -149,7 +150,7 @@ def test_nk_from_psi_delta_recovers_the_true_index_from_pyelli_psi_delta(roundtr
 def test_film_amplitudes_match_coherent_coated_smooth_rows(coated, source):
     d = coated[coated["source"] == source]
     assert len(d) == 6 * 90
-    rs, rp = optics.film_amplitudes(
+    rs, rp = onefilm.film_amplitudes(
         1.0, 1.5, N_AL, d["d_exact"].to_numpy(), 650.0, d["theta_i_deg"].to_numpy()
     )
     assert_printed(rs.real, d["rs_re"], "rs_re")
@@ -166,7 +167,7 @@ def test_film_amplitudes_match_coherent_coated_smooth_rows(coated, source):
 def test_film_reflectance_incoherent_matches_incoherent_rows(coated, source):
     d = coated[coated["source"] == source]
     assert len(d) == 6 * 90
-    Rs, Rp = optics.film_reflectance_incoherent(
+    Rs, Rp = onefilm.film_reflectance_incoherent(
         1.0, 1.5, N_AL, d["d_exact"].to_numpy(), 650.0, d["theta_i_deg"].to_numpy()
     )
     assert_printed(Rs, d["Rs"], "Rs")
@@ -176,7 +177,7 @@ def test_film_reflectance_incoherent_matches_incoherent_rows(coated, source):
 
 def test_film_mueller_incoherent_matches_own_inc_series_all_16_elements(coated):
     d = coated[coated["source"] == "own_inc_series"]
-    m = optics.film_mueller_incoherent(
+    m = onefilm.film_mueller_incoherent(
         1.0, 1.5, N_AL, d["d_exact"].to_numpy(), 650.0, d["theta_i_deg"].to_numpy()
     )
     for name in ELEMENTS:
@@ -189,7 +190,7 @@ def test_coated_selected_values_of_the_oracle_readme(coated):
     # README section 5: coherent optical lambda/2 is an absentee layer (0.906 at 0 deg,
     # bare Al), incoherent R_unpol 0.8655 / 0.8648 / 0.8711 at 0 / 45 / 80 deg (3-4 digits
     # printed there: half a unit of the last digit).
-    rs, rp = optics.film_amplitudes(1.0, 1.5, N_AL, 650.0 / 3.0, 650.0, 0.0)
+    rs, rp = onefilm.film_amplitudes(1.0, 1.5, N_AL, 650.0 / 3.0, 650.0, 0.0)
     assert abs(float(np.abs(rs) ** 2) - 0.906) <= 5e-4
-    Rs, Rp = optics.film_reflectance_incoherent(1.0, 1.5, N_AL, 100.0, 650.0, [0, 45, 80])
+    Rs, Rp = onefilm.film_reflectance_incoherent(1.0, 1.5, N_AL, 100.0, 650.0, [0, 45, 80])
     np.testing.assert_allclose((Rs + Rp) / 2, [0.8655, 0.8648, 0.8711], rtol=0, atol=5e-5)

@@ -88,7 +88,7 @@ def test_the_installed_wheel_ships_the_reference_nk_tables(wheel: Path, tmp_path
     site = tmp_path / "site"
     zipfile.ZipFile(wheel).extractall(site)
     code = (
-        "from labbrdf.dispersion import Tabulated\n"
+        "from labbrdf.nk.dispersion import Tabulated\n"
         "print(Tabulated.reference('si').nk(630.0), Tabulated.reference('sio2').range_nm)\n"
     )
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}

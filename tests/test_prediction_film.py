@@ -10,8 +10,8 @@ import pandas as pd
 import pytest
 
 from labbrdf.adapters.topography import read_height_map
-from labbrdf.dispersion import Cauchy
 from labbrdf.films import Layer, Roughness, Stack
+from labbrdf.nk.dispersion import Cauchy
 from labbrdf.prediction import (
     PredictionError,
     film_coating,

@@ -80,7 +80,7 @@ def _film_model(args: argparse.Namespace) -> Any:
             if box is not None:
                 free[f"{name}.{key}"] = box
         try:
-            m = films._with_params(m, values)
+            m = films.materials._with_params(m, values)
             layers.append(films.Layer(m, d, name))
         except ValueError as exc:
             raise UsageError(f"--layer {name}: {exc}") from None
@@ -136,8 +136,9 @@ def _one_sample(args: argparse.Namespace, parts: list[Any], data: Any) -> bool:
 
 def cmd_film(args: argparse.Namespace) -> int:
     """Fit the film model of the options to the files; print the layers and the fit."""
-    from .. import adapters, films
+    from .. import adapters
     from ..dataset import concat
+    from ..fitting.film import fit_film
     from ..outputs import atomic_output, csv_safe_frame
 
     fm = _film_model(args)
@@ -155,7 +156,7 @@ def cmd_film(args: argparse.Namespace) -> int:
         wl_range = (r.lo, r.hi)
     parts = [adapters.read(p) for p in args.files]
     data = _selected(args, concat(parts))
-    res = films.fit_film(
+    res = fit_film(
         fm,
         data,
         wavelength_range_nm=wl_range,

@@ -34,10 +34,10 @@ among them in its own ``__all__``. They may change without notice.
 from __future__ import annotations
 
 from .batch import auto_weighting, fit_many, fit_many_nk, fit_records
-from .core import ALGORITHMS, CONSTRAINED, METHOD, fit, parse_method
+from .core import ALGORITHMS, CONSTRAINED, METHOD, fit, fit_replicates, parse_method
 from .data import FITTABLE_QUANTITIES, FitData, FitError
 from .objective import Objective
-from .replicates import combine_replicates, fit_replicates
+from .replicates import combine_replicates
 from .result import FitResult
 from .uncertainty import AT_BOUND_FRAC, COND_MAX, CORREL_MAX, REL_STDERR_MAX, REL_STDERR_POOR
 

@@ -15,12 +15,13 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special
 
+from .. import parallel
 from ..dataset import Measurement
 from ..models import Model, ModelError, Parameters
 from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
 from .objective import Objective
-from .replicates import ONE_SEED_WARNING
+from .replicates import ONE_SEED_WARNING, run_replicates
 from .result import FitResult
 from .uncertainty import AT_BOUND_FRAC, jacobian, noise_meat, uncertainties
 
@@ -35,6 +36,7 @@ __all__ = [
     "RELATIVE_FLOOR",
     "check_seed",
     "fit",
+    "fit_replicates",
     "parse_method",
     "setup_params",
 ]
@@ -530,8 +532,6 @@ def fit(
     model = get_model(model) if isinstance(model, str) else model
     R = getattr(model, "default_replicates", 1) if replicates is None else replicates
     if R != 1:  # a non-Model is refused by _problem
-        from .replicates import fit_replicates
-
         return fit_replicates(model, data, R, **kw)
     t0 = time.perf_counter()
     pb = _problem(model, data, **{k: v for k, v in kw.items() if k != "seed"})
@@ -571,6 +571,47 @@ class _Problem:
     def nfree(self) -> int:
         """Degrees of freedom: points less varying parameters."""
         return len(self.fd) - len(self.varying)
+
+
+def fit_replicates(
+    model: Model | str,
+    data: Any,
+    replicates: int,
+    *,
+    executor: parallel.Executor | str | None = "serial",
+    **fit_kw: Any,
+) -> FitResult:
+    """Fit a stochastic model with ``replicates`` model seeds and combine the estimates.
+
+    Replicate r (0-based) fits ``model.reseeded(s0 + r)``, s0 the model's own seed
+    (option ``seed``, 0 when absent), with every other :func:`fit` argument unchanged;
+    :func:`labbrdf.fitting.combine_replicates` makes the result.
+
+    Parameters
+    ----------
+    model : Model or str
+        A stochastic model (``model.stochastic``) or its registry name.
+    data :
+        As for :func:`fit`.
+    replicates : int
+        R >= 2 independent seeds.
+    executor : Executor or str, optional
+        Where the R fits run (:class:`labbrdf.parallel.Executor` or a scheduler name;
+        default serial). Each task carries its seed, so the result does not depend on it.
+    **fit_kw
+        Any other :func:`fit` keyword (``ci`` must be ``"wald"``).
+
+    Returns
+    -------
+    FitResult
+        See :func:`labbrdf.fitting.combine_replicates`.
+
+    Raises
+    ------
+    FitError
+        ``replicates`` not an integer >= 2, a deterministic model, or ``ci="profile"``.
+    """
+    return run_replicates(fit, model, data, replicates, executor=executor, **fit_kw)
 
 
 def _problem(

@@ -5,8 +5,8 @@ transmittance rows of one sample (one or several files, fitted jointly) into res
 components with the files' sigmas, and fits the free parameters of a
 :class:`~labbrdf.films.FilmModel` with :func:`labbrdf.fitting.fit` (global then local,
 seeded): no second fitter. :class:`FilmFit` reports thicknesses and n, k with intervals,
-chi2/nu beside Woollam's MSE, correlations and identifiability notes. Re-exported by
-:mod:`labbrdf.films`.
+chi2/nu beside Woollam's MSE, correlations and identifiability notes. The film objects
+(:mod:`labbrdf.films`) do not import it: the fit is a workflow above them.
 """
 
 from __future__ import annotations
@@ -24,12 +24,12 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 from scipy import special
 
-from .. import dispersion as disp
-from .. import stack as stk
 from ..dataset import Measurement
 from ..films import FILM_QUANTITIES, NK_REPORT_NM, FilmError, FilmModel, Stack, load_model
+from ..films import matrices as stk
 from ..jsonsafe import jsonable
 from ..models import Model, Parameters
+from ..nk import dispersion as disp
 from ..samples import SampleFile, stated_names
 from .core import METHOD, fit
 from .data import FitData, FitError
@@ -49,7 +49,9 @@ class _FilmFitModel(Model):
     """
 
     name = "film"
-    reference = "coherent transfer matrices (labbrdf.stack) with labbrdf.dispersion materials"
+    reference = (
+        "coherent transfer matrices (labbrdf.films.matrices) with labbrdf.nk.dispersion materials"
+    )
 
     _CH = {"psi": 0, "delta": 1, "rs": 2, "rp": 3, "r": 4, "ts": 5, "tp": 6, "t": 7}
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -22,7 +23,7 @@ from ..models import get as get_model
 from .data import FitError
 from .result import FitResult
 
-__all__ = ["MAX_REPLICATES", "check_replicates", "combine_replicates", "fit_replicates"]
+__all__ = ["MAX_REPLICATES", "check_replicates", "combine_replicates", "run_replicates"]
 
 #: the most seed replicates of one fit: each replicate is a whole fit of a Monte Carlo model
 #: (its traces, its result), made and kept at once, so the count is bounded; the seed spread
@@ -36,10 +37,12 @@ ONE_SEED_WARNING = (
 )
 
 
-def _fit_one(task: tuple[Model, Any, dict[str, Any]]) -> FitResult:
-    from .core import fit
+#: one fit of one replicate: ``fit(model, data, replicates=1, **kw)``
+FitOne = Callable[..., FitResult]
 
-    model, data, kw = task
+
+def _fit_one(task: tuple[FitOne, Model, Any, dict[str, Any]]) -> FitResult:
+    fit, model, data, kw = task
     return fit(model, data, replicates=1, **kw)
 
 
@@ -64,7 +67,8 @@ def check_replicates(replicates: Any, model: Model | None) -> None:
         )
 
 
-def fit_replicates(
+def run_replicates(
+    fit: FitOne,
     model: Model | str,
     data: Any,
     replicates: int,
@@ -72,25 +76,18 @@ def fit_replicates(
     executor: parallel.Executor | str | None = "serial",
     **fit_kw: Any,
 ) -> FitResult:
-    """Fit a stochastic model with ``replicates`` model seeds and combine the estimates.
+    """Fit ``model`` with ``replicates`` model seeds through ``fit`` and combine the estimates.
 
-    Replicate r (0-based) fits ``model.reseeded(s0 + r)``, s0 the model's own seed
-    (option ``seed``, 0 when absent), with every other :func:`labbrdf.fitting.fit`
-    argument unchanged; :func:`combine_replicates` makes the result.
+    The engine of :func:`labbrdf.fitting.fit_replicates`, which passes
+    :func:`labbrdf.fitting.fit` as ``fit``: this module stays below the fitting core.
 
     Parameters
     ----------
-    model : Model or str
-        A stochastic model (``model.stochastic``) or its registry name.
-    data :
-        As for :func:`labbrdf.fitting.fit`.
-    replicates : int
-        R >= 2 independent seeds.
-    executor : Executor or str, optional
-        Where the R fits run (:class:`labbrdf.parallel.Executor` or a scheduler name;
-        default serial). Each task carries its seed, so the result does not depend on it.
-    **fit_kw
-        Any other :func:`labbrdf.fitting.fit` keyword (``ci`` must be ``"wald"``).
+    fit : callable
+        ``fit(model, data, replicates=1, **fit_kw)`` -> FitResult, a module-level function
+        (it is sent to the executor's workers).
+    model, data, replicates, executor, **fit_kw :
+        As for :func:`labbrdf.fitting.fit_replicates`.
 
     Returns
     -------
@@ -110,7 +107,7 @@ def fit_replicates(
         raise FitError("seed replicates combine Wald errors: use ci='wald' with replicates > 1")
     t0 = time.perf_counter()
     s0 = int(m.options.get("seed", 0))
-    tasks = [(m.reseeded(s0 + r), data, fit_kw) for r in range(int(replicates))]
+    tasks = [(fit, m.reseeded(s0 + r), data, fit_kw) for r in range(int(replicates))]
     results = parallel.as_executor(executor).map(_fit_one, tasks)
     out = combine_replicates(list(results), [s0 + r for r in range(int(replicates))])
     out.elapsed_s = time.perf_counter() - t0  # wall time of the R fits

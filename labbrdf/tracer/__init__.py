@@ -46,7 +46,7 @@ through Beer-Lambert absorption, so for the paper's lossless varnish the result 
 depend on it and the paper's lambda/4 maximum (its Fig. 13) cannot appear. The option
 ``coherent=True`` models coating + substrate as one rough interface whose facets carry a
 conformal film of the coating's thickness, reflecting with the coherent Airy amplitudes of
-:func:`labbrdf.optics.film_amplitudes` at the local angle. Its limits: film and substrate
+:func:`labbrdf.films.onefilm.film_amplitudes` at the local angle. Its limits: film and substrate
 share every facet (the coating's roughness is used for both, the top and bottom
 interfaces are perfectly correlated), there is no scattering inside the film, no
 refraction-shifted exit direction and no multiple scattering between differently oriented

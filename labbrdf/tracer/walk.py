@@ -183,7 +183,7 @@ class _Setup:
         self, cos_i: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray]:
         if self.coherent:
-            from ..optics import film_amplitudes
+            from ..films.onefilm import film_amplitudes
 
             theta = np.degrees(np.arccos(np.clip(cos_i, 0.0, 1.0)))
             coat = self.coat

@@ -10,8 +10,8 @@ import pytest
 
 from labbrdf.cli import main
 from labbrdf.dataset import Measurement, write
-from labbrdf.dispersion import Cauchy
 from labbrdf.films import Layer, Stack
+from labbrdf.nk.dispersion import Cauchy
 
 TRUE = Stack([Layer(Cauchy(A=1.46, B=0.004), 105.0, "film")], "si")
 

@@ -9,8 +9,9 @@ import pandas as pd
 import pytest
 
 from labbrdf.dataset import Measurement, make_frame
-from labbrdf.dispersion import Cauchy
-from labbrdf.films import FilmError, FilmModel, Layer, Stack, fit_film, load_model, woollam_mse
+from labbrdf.films import FilmError, FilmModel, Layer, Stack, load_model
+from labbrdf.fitting.film import fit_film, woollam_mse
+from labbrdf.nk.dispersion import Cauchy
 
 WL = np.linspace(300, 1000, 60)
 THETA = np.array([55.0, 65.0, 75.0])

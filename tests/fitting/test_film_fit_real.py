@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from labbrdf import adapters
-from labbrdf.dispersion import Cauchy
-from labbrdf.films import FilmModel, Layer, Stack, fit_film
+from labbrdf.films import FilmModel, Layer, Stack
+from labbrdf.fitting.film import fit_film
 from labbrdf.nk import tabulated_from_file
+from labbrdf.nk.dispersion import Cauchy
 
 pytestmark = pytest.mark.shared
 

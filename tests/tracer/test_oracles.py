@@ -20,6 +20,7 @@ import numpy as np
 import pytest
 
 from labbrdf import optics
+from labbrdf.films import onefilm
 from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
 
 pd = pytest.importorskip("pandas")
@@ -135,7 +136,7 @@ def test_absorbing_smooth_coating_equals_beer_lambert_film_series():
     lossless = _beer_lambert_film_series(theta, 1.5, 0.0, 1.55 + 7.71j, d, 650.0)
     np.testing.assert_allclose(
         lossless,
-        optics.film_mueller_incoherent(1.0, 1.5, 1.55 + 7.71j, d, 650.0, theta),
+        onefilm.film_mueller_incoherent(1.0, 1.5, 1.55 + 7.71j, d, 650.0, theta),
         atol=1e-12,
     )
     assert res.albedo() < lossless[0, 0] - K * res.albedo_stderr()  # absorption is visible

@@ -28,6 +28,7 @@ import pandas as pd
 
 from ... import films
 from ... import nk as nkmod
+from ...fitting.film import FilmFit, fit_film
 from .. import figures
 from ..agreement import P_AGREE, chi_square
 from ..builder import Unavailable, slug
@@ -64,7 +65,7 @@ def default_film_model() -> films.FilmModel:
 
 
 def _propagated(
-    fit: films.FilmFit, curve: Callable[[films.Stack], np.ndarray]
+    fit: FilmFit, curve: Callable[[films.Stack], np.ndarray]
 ) -> tuple[np.ndarray, np.ndarray]:
     """``curve`` of the best-fit stack and its first-order 1-sigma from the covariance."""
     res = fit.result
@@ -129,7 +130,7 @@ def _break_at_wraps(x: np.ndarray, delta: np.ndarray) -> tuple[np.ndarray, np.nd
     return np.insert(x, jumps, np.nan), np.insert(delta, jumps, np.nan)
 
 
-def _psi_delta_figure(fit: films.FilmFit) -> str:
+def _psi_delta_figure(fit: FilmFit) -> str:
     d = fit.data
     ell = d[d["quantity"].astype(str).isin(["psi", "delta"])]
     th_all = sorted(ell["theta_i_deg"].round(2).unique())
@@ -177,7 +178,7 @@ def _psi_delta_figure(fit: films.FilmFit) -> str:
     return figures.panels_figure(panels, ncols=2, panel_size=(5.6, 3.4))
 
 
-def _nk_figure(fit: films.FilmFit) -> str:
+def _nk_figure(fit: FilmFit) -> str:
     wl_all = np.unique(fit.data["wavelength_nm"].to_numpy(float))
     wl = np.linspace(wl_all.min(), wl_all.max(), min(_NK_POINTS, len(wl_all)))
     names = [lay.name for lay in fit.stack.layers] + ["substrate"]
@@ -205,7 +206,7 @@ def _nk_figure(fit: films.FilmFit) -> str:
 
 
 def _reflectance(
-    ctx: Context, tag: str, src: str, fit: films.FilmFit, rsrc: str, rows: pd.DataFrame
+    ctx: Context, tag: str, src: str, fit: FilmFit, rsrc: str, rows: pd.DataFrame
 ) -> dict[str, Any] | None:
     """Measured reflectance of ``rsrc`` against the fitted stack's R_s, R_p (or mean)."""
     b = ctx.b
@@ -292,7 +293,7 @@ def _reflectance(
     }
 
 
-def _fit_range(fit: films.FilmFit) -> tuple[float, float]:
+def _fit_range(fit: FilmFit) -> tuple[float, float]:
     w = fit.data["wavelength_nm"].to_numpy(float)
     return float(w.min()), float(w.max())
 
@@ -332,7 +333,7 @@ def _model_text(ctx: Context, model: films.FilmModel, how: str) -> None:
 
 
 def _fit_shown(
-    ctx: Context, tag: str, src: str, verdict: nkmod.AngleVerdict, fit: films.FilmFit
+    ctx: Context, tag: str, src: str, verdict: nkmod.AngleVerdict, fit: FilmFit
 ) -> None:
     """One fit: its summary in words, the parameter table, psi/Delta and n, k figures."""
     b = ctx.b
@@ -408,7 +409,7 @@ def _fit_file(
     tag = f"{i}_{slug(src)}"
     b.heading(f"{src}: film fit", anchor=f"film_{tag}")
     try:
-        fit = films.fit_film(model, nkmod.ordinary_psi_delta(g), method=ctx.method, seed=ctx.seed)
+        fit = fit_film(model, nkmod.ordinary_psi_delta(g), method=ctx.method, seed=ctx.seed)
     except ValueError as exc:
         b.note("no film fit", f"{src}: {exc}")
         b.check(

@@ -1,4 +1,4 @@
-"""The tracer's coating from a film fit: labbrdf.nk.coating_from_fit and trace --coating-from."""
+"""The tracer's coating from a film fit: films.coating_from_fit and trace --coating-from."""
 
 from __future__ import annotations
 
@@ -11,8 +11,9 @@ import pytest
 
 from labbrdf import films
 from labbrdf.cli import main
-from labbrdf.dispersion import Cauchy
-from labbrdf.nk import coating_from_fit
+from labbrdf.films import coating_from_fit
+from labbrdf.fitting.film import fit_film
+from labbrdf.nk.dispersion import Cauchy
 
 CAUCHY = {"A": 1.52, "B": 0.006, "C": 0.0}
 D_NM = 250.0
@@ -35,7 +36,7 @@ def fit_json(tmp_path_factory: pytest.TempPathFactory) -> Path:
             )  # fmt: skip
     start = truth.with_values({"coat.thickness_nm": 200.0, "coat.A": 1.5})
     model = films.FilmModel(start, {"coat.thickness_nm": (150.0, 350.0), "coat.A": (1.4, 1.7)})
-    fit = films.fit_film(model, pd.concat(rows, ignore_index=True))
+    fit = fit_film(model, pd.concat(rows, ignore_index=True))
     return fit.save_json(tmp_path_factory.mktemp("fit") / "fit.json")
 
 

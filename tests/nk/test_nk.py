@@ -12,6 +12,7 @@ import labbrdf
 from labbrdf import ellipsometry as ell
 from labbrdf import nk, optics
 from labbrdf.dataset import Measurement
+from labbrdf.films import onefilm
 
 
 def _synthetic(big_n=(2.0 + 3.0j), wl=(400.0, 500.0, 600.0), theta=(65.0, 70.0, 75.0), sig=0.02):
@@ -153,7 +154,7 @@ def _film_rows(wl=(400.0, 500.0, 600.0, 700.0), theta=(60.0, 65.0, 70.0, 75.0), 
     rows = []
     for w in wl:
         for t in theta:
-            rs, rp = optics.film_amplitudes(1.0, 2.1, 3.9 + 0.02j, 100.0, w, t)
+            rs, rp = onefilm.film_amplitudes(1.0, 2.1, 3.9 + 0.02j, 100.0, w, t)
             rho = complex(rp / rs)
             psi = float(np.degrees(np.arctan(abs(rho))))
             delta = -float(np.degrees(np.angle(rho))) % 360.0  # Nebraska, as optics

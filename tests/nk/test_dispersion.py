@@ -6,8 +6,10 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from labbrdf import dispersion as disp
-from labbrdf.dispersion import (
+from labbrdf.films import as_material
+from labbrdf.nk import dispersion as disp
+from labbrdf.nk import tabulated_from_file
+from labbrdf.nk.dispersion import (
     HC_EV_NM,
     Cauchy,
     DispersionError,
@@ -17,8 +19,6 @@ from labbrdf.dispersion import (
     Tabulated,
     TaucLorentz,
 )
-from labbrdf.films import as_material
-from labbrdf.nk import tabulated_from_file
 
 EXAMPLES = [
     Cauchy(A=1.9, B=0.02, C=0.001, k_amp=0.01, exponent=2.0, band_edge=4.0),
@@ -210,3 +210,34 @@ def test_pseudo_constants_of_a_stack_are_refused_as_a_table(real_exports) -> Non
     coated = real_exports / "woollam-wvase-ascii" / "w1_12082006.dat"
     with pytest.raises(DispersionError, match="pseudo-constants of a stack"):
         tabulated_from_file(coated)
+
+
+def test_every_model_module_of_the_package_is_in_the_registry():
+    import importlib
+    import inspect
+    import pkgutil
+
+    from labbrdf.nk import dispersion as package
+    from labbrdf.nk.dispersion import registry
+
+    defined = {}
+    for info in pkgutil.iter_modules(package.__path__):
+        mod = importlib.import_module(f"{package.__name__}.{info.name}")
+        for cls in vars(mod).values():
+            if (
+                inspect.isclass(cls)
+                and issubclass(cls, disp.Dispersion)
+                and cls is not disp.Dispersion
+                and cls.__module__ == mod.__name__
+            ):
+                defined[info.name] = cls.__name__
+    assert defined == registry._MODULES
+    assert list(disp.MODELS) == [
+        "constant",
+        "cauchy",
+        "sellmeier",
+        "tauc_lorentz",
+        "drude",
+        "lorentz",
+        "tabulated",
+    ]

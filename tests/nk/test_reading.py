@@ -3,30 +3,42 @@
 from __future__ import annotations
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 import labbrdf
-from labbrdf import dispersion as disp
 from labbrdf.films import as_material
+from labbrdf.nk import dispersion as disp
 from labbrdf.nk import tabulated_from_file
 
-DISPERSION = Path(disp.__file__)
+DISPERSION = Path(disp.__file__).parent
 
 
-def test_the_dispersion_module_imports_nothing_that_reads_files() -> None:
-    tree = ast.parse(DISPERSION.read_text(encoding="utf-8"))
+def test_the_dispersion_models_import_nothing_that_reads_files() -> None:
     imported = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            imported |= {a.name for a in node.names}
-        elif isinstance(node, ast.ImportFrom):
-            mod = ("." * node.level) + (node.module or "")
-            imported |= {f"{mod}.{a.name}" if node.level else mod for a in node.names}
-    upper = ("pandas", ".adapters", ".dataset", ".nk", ".films", "labbrdf")
+    for f in sorted(DISPERSION.glob("*.py")):
+        for node in ast.walk(ast.parse(f.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                imported |= {a.name for a in node.names}
+            elif isinstance(node, ast.ImportFrom):
+                mod = ("." * node.level) + (node.module or "")
+                imported |= {f"{mod}.{a.name}" if node.level else mod for a in node.names}
+    upper = ("pandas", "..", "labbrdf")  # nothing from outside the package of models
     assert not [m for m in imported if m.startswith(upper)], imported
     assert not hasattr(disp.Tabulated, "from_file")
+
+
+def test_the_dispersion_models_load_without_pandas_or_the_readers() -> None:
+    code = (
+        "import sys\nfrom labbrdf.nk.dispersion import MODELS\n"
+        "print(sorted(m for m in sys.modules if m == 'pandas' or m.startswith("
+        "('labbrdf.adapters', 'labbrdf.nk.reading', 'labbrdf.films'))))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.stdout.strip() == "[]", done.stderr
 
 
 def test_a_table_file_gives_the_table_of_its_text(tmp_path: Path) -> None:

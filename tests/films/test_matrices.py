@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from labbrdf import optics, stack
+from labbrdf import optics
+from labbrdf.films import matrices as stack
+from labbrdf.films import onefilm
 
 TOL = 1e-10  # both peers and labbrdf are exact to round-off for these well-conditioned stacks
 
@@ -114,7 +116,7 @@ def test_grid_broadcasting_gives_one_value_per_wavelength_and_angle():
 
 def test_optics_film_amplitudes_is_the_stack_with_one_layer():
     args = (1.0, 1.7 + 0.01j, 3.6 + 0.1j, 120.0, np.array([450.0, 700.0]), 63.0)
-    rs, rp = optics.film_amplitudes(*args)
+    rs, rp = onefilm.film_amplitudes(*args)
     s = stack.amplitudes([args[0], args[1], args[2]], [args[3]], args[4], args[5])
     np.testing.assert_array_equal(rs, s[0])
     np.testing.assert_array_equal(rp, s[1])

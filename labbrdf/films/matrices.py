@@ -1,8 +1,8 @@
-"""Coherent optics of a layer stack: ambient / N layers / substrate.
+"""Transfer matrices of a layer stack: ambient / N layers / substrate.
 
 Pure NumPy (physics layer). One implementation of the coherent multilayer: every other
-coherent film computation in labbrdf (:func:`labbrdf.optics.film_amplitudes`, the film
-model of :mod:`labbrdf.films`) calls :func:`amplitudes`.
+coherent film computation in labbrdf (:func:`labbrdf.films.onefilm.film_amplitudes`,
+the :class:`~labbrdf.Stack`) calls :func:`amplitudes`.
 
 Conventions are those of :mod:`labbrdf.optics` (docs/conventions.md): ``exp(-i omega t)``,
 ``N = n + ik`` with ``k >= 0``, LB interface amplitudes
@@ -35,7 +35,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .optics import _amplitudes, _angle, _index, _nonneg, _physical_root
+from ..optics import _amplitudes, _angle, _index, _nonneg, _physical_root
 
 __all__ = [
     "amplitudes",
