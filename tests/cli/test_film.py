@@ -314,7 +314,8 @@ def test_film_same_sample_must_name_the_inputs(two_samples, tmp_path, capsys):
 def test_film_prints_the_fits_own_report(film_file, capsys):
     """`labbrdf film` prints :meth:`FilmFit.fit_report` of the same fit, nothing else."""
     from labbrdf import read
-    from labbrdf.films import FilmModel, fit_film
+    from labbrdf.films import FilmModel
+    from labbrdf.fitting.film import fit_film
 
     argv = ["film", str(film_file), "--layer", "film:cauchy:0..300:A=1.3..1.8:B=0..0.02"]
     assert main([*argv, "--ci", "wald"]) == 0

@@ -7,8 +7,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from labbrdf.dispersion import Cauchy
-from labbrdf.films import FilmModel, Layer, Stack, fit_film
+from labbrdf.films import FilmModel, Layer, Stack
+from labbrdf.fitting.film import fit_film
+from labbrdf.nk.dispersion import Cauchy
 
 matplotlib.use("Agg")
 
