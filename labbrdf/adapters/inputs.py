@@ -100,7 +100,7 @@ def _kind_of(
     columns: str | Sequence[str] | None,
 ) -> str:
     """The kind to read ``path`` as: forced, implied by ``format``/``columns``, or sniffed."""
-    from . import _head, _kind
+    from .registry import _head, _kind
 
     if kind is not None:
         return kind
@@ -117,7 +117,7 @@ def _read_as(
     height_map_kw: dict[str, Any],
 ) -> InputFile:
     """Read one path as ``kind``; raise what the reader raises."""
-    from . import _dispatch, _head, read
+    from .registry import _dispatch, _head, read
 
     if kind == "height_map":
         return InputFile(str(path), kind, height_map=read_height_map(path, **height_map_kw))

@@ -263,30 +263,6 @@ class TabulatedNDF:
         kw.setdefault("name", f"measured({x.size // (2 if symmetrize else 1)} slopes)")
         return cls(edges, edges, h, **kw)
 
-    @classmethod
-    def from_heights(
-        cls,
-        heights: ArrayLike,
-        pixel_size: float | tuple[float, float],
-        *,
-        degree: int = 1,
-        **kw: Any,
-    ) -> TabulatedNDF:
-        """Table of the forward-difference slopes of a levelled height map [m].
-
-        Levelling and slopes as :func:`labbrdf.topography.level` and
-        :func:`labbrdf.topography.slopes`; other keywords go to :meth:`from_slopes`.
-        """
-        from labbrdf.topography import level, slopes
-
-        z = level(heights, degree)
-        if z.ndim != 2:
-            raise ValueError("a slope table needs an areal height map (2-D), got a profile")
-        px = tuple(np.broadcast_to(np.asarray(pixel_size, dtype=float), (2,)))
-        sx, sy = slopes(z, px)
-        assert sy is not None  # an areal map has slopes along y
-        return cls.from_slopes(sx, sy, **kw)
-
     # -- serialisation ----------------------------------------------------------------
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe dict (the edges and the normalised masses as lists)."""
