@@ -37,8 +37,7 @@ from . import (
     woollam,
     zemax_bsdf,
 )
-from ._base import AdapterError, Example, Format, check_regular_file
-from ._numblock import AdapterWarning
+from ._base import AdapterError, Format, check_regular_file
 from ._ole2 import is_ole2
 from .columns import read_columns as _read_columns
 from .topography import HEIGHT_MAP_FORMATS, height_map_format

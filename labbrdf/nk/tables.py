@@ -39,6 +39,7 @@ import pandas as pd
 
 from .. import ellipsometry as ell
 from ..dataset import Measurement
+from ..jsonsafe import jsonable
 
 __all__ = [
     "POSITION_TOL_MM",
@@ -468,20 +469,6 @@ def angle_verdict(combined: pd.DataFrame, *, alpha: float = ell.P_ANGLE_DEPENDEN
     )
 
 
-def _json_value(v: Any) -> Any:
-    if isinstance(v, (bool, np.bool_)):
-        return bool(v)
-    if isinstance(v, (int, np.integer)):
-        return int(v)
-    if isinstance(v, (float, np.floating)):
-        return None if not math.isfinite(float(v)) else float(v)
-    return v
-
-
-def _json_list(s: pd.Series) -> list:
-    return [_json_value(v) for v in s.tolist()]
-
-
 def nk_json(
     data: Measurement | pd.DataFrame,
     *,
@@ -518,10 +505,10 @@ def nk_json(
     for (sample, source), g in table.groupby(["sample", "source"], sort=False):
         cg = combined[(combined["sample"] == sample) & (combined["source"] == source)]
         obj: dict[str, Any] = {
-            c: _json_list(g[c])
+            c: jsonable(g[c].tolist())
             for c in ["wavelength_nm", "theta_i_deg", "n", "k", "n_sigma", "k_sigma"] + extra
         }
-        obj["combined"] = {c: _json_list(cg[c]) for c in _JSON_COMBINED + extra}
+        obj["combined"] = {c: jsonable(cg[c].tolist()) for c in _JSON_COMBINED + extra}
         groups.append({"sample": sample, "source": source, "data": obj})
     if len(groups) == 1:
         return groups[0]["data"]
