@@ -13,18 +13,23 @@ VINYL = "zemax-bsdf/test_13_planesymmetric_brdf_zemax.bsdf"
 
 @pytest.mark.slow
 def test_vinyl_coating_roughness_agrees_with_the_facet_model(real_exports):
-    """Incidences 15, 45, 75 deg, theta_r <= 70 deg (beyond, the sphere vignettes).
+    """Incidence 45 deg, theta_r <= 70 deg (beyond, the sphere vignettes).
 
     Both models put GGX facets on a 1.5-index surface for the first-surface reflection;
     the rest is a broad, smooth term (the coating's diffuse base, or a Lambertian floor).
     So the coating's top roughness must agree with the facet model's alpha within their
-    combined standard errors (measured: 0.2864 +- 0.0034 and 0.2874 +- 0.0035), and the
+    combined standard errors (measured: 0.2751 +- 0.0043 and 0.2756 +- 0.0032), and the
     base's albedo must sit where the data's floor puts it: 0.035-0.06 sr^-1 under a
     1.5-index layer is about pi n^2 x floor = 0.25-0.42 before the layer's losses, so
     0.15-0.5, inside its bounds.
+
+    One incidence keeps the suite within its time on a loaded 2-core machine (the three
+    incidences 15, 45, 75 deg took 12 minutes there, a third of the whole suite; measured
+    then: 0.2864 +- 0.0034 against 0.2874 +- 0.0035). The three-incidence fit is timed and
+    reported by ``benchmarks/bench_layered.py --incidences 15,45,75 --rays 5000``.
     """
     df = adapters.read(real_exports / VINYL).data
-    keep = df["theta_i_deg"].isin([15.0, 45.0, 75.0]) & (df["theta_r_deg"] <= 70.0)
+    keep = (df["theta_i_deg"] == 45.0) & (df["theta_r_deg"] <= 70.0)
     df = df[keep & (df["value"] != 0)]
     # 5000 rays and the model's three seed replicates: the seed spread is in the errors
     lay = fit(models.get("layered", base="diffuse", rays=5000), df, weighting="relative")
