@@ -1,0 +1,1 @@
+"""Surface roughness beyond microfacets: height-map statistics, power spectra and their models."""
