@@ -15,7 +15,8 @@ so that ``import labbrdf`` stays cheap, and ``dir(labbrdf)`` lists them all:
   :func:`hemispherical_reflectance`
 - films: :class:`Stack`, :class:`Layer`, :func:`fit_film`, :class:`FilmFit` (thin-film
   stacks fitted to psi/Delta and reflectance)
-- roughness: :func:`read_height_map`, :func:`roughness_statistics`
+- roughness: :func:`read_height_map`, :func:`roughness_statistics`, :func:`psd` (power
+  spectra of height maps, their composite and a PSD model fit)
 - the tracer: :func:`trace`, :class:`TraceConfig`, :class:`Substrate`, :class:`Coating`,
   :class:`TraceResult`, :func:`trace_config_from_inputs` (a run from values and files)
 - reports: :func:`user_report` (the validation report: :func:`labbrdf.report.validate`)
@@ -64,6 +65,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "FilmFit": ("labbrdf.fitting.film", "FilmFit"),
     "read_height_map": ("labbrdf.adapters.topography", "read_height_map"),
     "roughness_statistics": ("labbrdf.topography", "roughness_statistics"),
+    "psd": ("labbrdf.roughness.psd_result", "psd"),
     "trace": ("labbrdf.tracer", "trace"),
     "TraceConfig": ("labbrdf.tracer", "TraceConfig"),
     "TraceResult": ("labbrdf.tracer", "TraceResult"),
@@ -98,6 +100,7 @@ _MODULES = (
     "parallel",
     "prediction",
     "report",
+    "roughness",
     "samples",
     "selection",
     "smoothness",
@@ -135,6 +138,7 @@ if TYPE_CHECKING:
         parallel,
         prediction,
         report,
+        roughness,
         samples,
         selection,
         smoothness,
@@ -155,6 +159,7 @@ if TYPE_CHECKING:
     from .models import ModelError
     from .nk import NkError, bulk_index_at, combined_table, model_with_nk, nk_table, read_nk
     from .report import user_report
+    from .roughness.psd_result import psd
     from .selection import select
     from .topography import roughness_statistics
     from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace

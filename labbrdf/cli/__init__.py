@@ -1,7 +1,7 @@
 """The ``labbrdf`` command: a thin argparse layer over the library.
 
 Subcommands: ``ingest``, ``formats``, ``fit``, ``nk``, ``film``, ``surface``, ``export``,
-``hemispherical``, ``trace``, ``validate``, ``report``, ``cache``; each is one module of
+``psd``, ``hemispherical``, ``trace``, ``validate``, ``report``, ``cache``; each is one module of
 this package, its parser (``add_parser``) beside its command (``cmd_<name>``). Every
 subcommand returns an exit code: 0 success, 1 a check of a report (``validate``,
 ``report``) failed, 2 a usage, input or output error (unreadable file, unknown name, an

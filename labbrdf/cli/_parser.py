@@ -14,6 +14,7 @@ from . import (
     hemispherical,
     ingest,
     nk,
+    psd,
     report,
     surface,
     trace,
@@ -22,8 +23,8 @@ from . import (
 from ._paths import path_actions
 
 #: the commands in the order ``labbrdf --help`` lists them
-COMMANDS = (ingest, formats, fit, nk, film, surface, export, hemispherical, trace, validate,
-            report, cache)  # fmt: skip
+COMMANDS = (ingest, formats, fit, nk, film, surface, psd, export, hemispherical, trace,
+            validate, report, cache)  # fmt: skip
 
 
 class _Parser(argparse.ArgumentParser):

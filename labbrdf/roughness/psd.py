@@ -615,6 +615,16 @@ def _overlap(
     )
 
 
+def _gaps(spectra: list[Spectrum]) -> list[str]:
+    """Frequency ranges inside the union of the bands that no spectrum covers."""
+    out, reach = [], 0.0
+    for lo, hi in sorted(s.band for s in spectra):
+        if reach and lo > reach:
+            out.append(f"no map covers {reach:.3g}-{lo:.3g} 1/m (a gap in the composite)")
+        reach = max(reach, hi)
+    return out
+
+
 def composite(
     spectra: list[Spectrum], *, per_decade: int = 10, label: str = "composite"
 ) -> tuple[Spectrum, list[Overlap]]:
@@ -670,7 +680,7 @@ def composite(
             if o is not None:
                 overlaps.append(o)
     members = "; ".join(f"{s.label or '?'} {s.band[0]:.3g}-{s.band[1]:.3g} 1/m" for s in spectra)
-    notes = (f"members: {members}", *(o.sentence() for o in overlaps))
+    notes = (f"members: {members}", *(o.sentence() for o in overlaps), *_gaps(spectra))
     comp = Spectrum(
         centres[keep],
         mean,

@@ -91,6 +91,8 @@ class PSDFit:
         name -> identifiability remarks.
     success : bool
     message : str
+    notes : tuple of str
+        What the data do not determine (a knee outside the band).
     """
 
     model: str
@@ -109,6 +111,7 @@ class PSDFit:
     flags: dict[str, list[str]] = field(default_factory=dict)
     success: bool = True
     message: str = ""
+    notes: tuple[str, ...] = ()
 
     def curve(self, f: Any) -> NDArray[np.float64]:
         """The fitted PSD at ``f`` [1/m], in the fitted form (1-D [m^3] or 2-D [m^4])."""
@@ -133,7 +136,7 @@ class PSDFit:
             f"chi^2/dof {self.redchi:.3g}; sigma over the band {self.sigma_band * 1e9:.4g} nm"
         )
         body = [f"  {n} = {v} {u}  95 % {i}" for n, v, i, u in self.rows()]
-        return "\n".join([head, *body])
+        return "\n".join([head, *body, *(f"  note: {n}" for n in self.notes)])
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe dict."""
@@ -155,6 +158,7 @@ class PSDFit:
                 "flags": self.flags,
                 "success": self.success,
                 "message": self.message,
+                "notes": list(self.notes),
             }
         )
 
@@ -306,6 +310,10 @@ def _as_2d_level(m: PSDModel, p: NDArray, f: NDArray) -> NDArray:
     return p / (2.0 * f)
 
 
+def _exp(v: float) -> float:
+    return math.exp(v) if v < 709.0 else math.inf
+
+
 def _jacobian(obj: _LogObjective, x: NDArray) -> NDArray:
     r0 = obj.residual(x)
     J = np.empty((r0.size, x.size))
@@ -339,7 +347,7 @@ def _finish(
             stderr[k], interval[k] = None, (math.nan, math.nan)
         elif obj.is_log[j]:
             stderr[k] = v * s
-            interval[k] = (math.exp(x[j] - tq * s), math.exp(x[j] + tq * s))
+            interval[k] = (_exp(x[j] - tq * s), _exp(x[j] + tq * s))
         else:
             stderr[k] = s
             interval[k] = (v - tq * s, v + tq * s)
@@ -347,6 +355,7 @@ def _finish(
     flags = {k: [r for r in rs if "correl" in r or "singular" in r] for k, rs in reasons.items()}
     flags = {k: r for k, r in flags.items() if r}
     params = tuple(values.values())
+    notes = _knee_notes(m.name, values, band)
     return PSDFit(
         model=m.name,
         kind=kind,
@@ -364,4 +373,25 @@ def _finish(
         flags=flags,
         success=bool(np.isfinite(chisqr)),
         message="converged" if np.isfinite(chisqr) else "non-finite chi-square",
+        notes=notes,
     )
+
+
+def _knee_notes(name: str, values: dict[str, float], band: tuple[float, float]) -> tuple[str, ...]:
+    """Say so when a correlation model's knee lies outside the fitted band."""
+    length = {"k-correlation": "B", "gaussian": "corr_length", "exponential": "corr_length"}
+    if name not in length:
+        return ()
+    knee = 1.0 / values[length[name]]
+    if knee < band[0]:
+        return (
+            f"the knee 1/{length[name]} = {knee:.3g} 1/m lies below the fitted band "
+            f"({band[0]:.3g}-{band[1]:.3g} 1/m): the data show only the power-law side; "
+            "the plateau and the correlation length are not determined (fit 'fractal')",
+        )
+    if knee > band[1]:
+        return (
+            f"the knee 1/{length[name]} = {knee:.3g} 1/m lies above the fitted band: the data "
+            "show only the plateau; the slope is not determined",
+        )
+    return ()
