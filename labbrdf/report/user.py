@@ -35,6 +35,7 @@ from .sections.measured import measured_section
 from .sections.nk import nk_section
 from .sections.physics import physics_section
 from .sections.prediction import SLOPES, prediction_section
+from .sections.psd import psd_section
 from .sections.scans import scans_section
 from .sections.smoothness import smoothness_section
 from .sections.spectra import spectra_section
@@ -326,6 +327,7 @@ def _sections(
         ),
         ("colour", "Sample colour from spectrophotometer reflectance", colour_section),
         ("surface", "Measured surface topography", surface_section),
+        ("psd", "Surface power spectral density", psd_section),
         (
             "smoothness",
             "Roughness against wavelength: Rayleigh criterion and specular loss",

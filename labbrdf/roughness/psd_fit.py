@@ -347,12 +347,21 @@ def _finish(
             stderr[k], interval[k] = None, (math.nan, math.nan)
         elif obj.is_log[j]:
             stderr[k] = v * s
-            interval[k] = (_exp(x[j] - tq * s), _exp(x[j] + tq * s))
+            # beyond a factor e per standard error the interval says nothing (the core's
+            # "not identifiable" limit, stderr > |value|): left undetermined
+            interval[k] = (
+                (_exp(x[j] - tq * s), _exp(x[j] + tq * s)) if s <= 1.0 else (math.nan, math.nan)
+            )
+            if s > 1.0:
+                reasons[k] = [*reasons[k], f"not identifiable: stderr of ln({k}) is {s:.3g} > 1"]
         else:
             stderr[k] = s
             interval[k] = (v - tq * s, v + tq * s)
     # remarks about log parameters speak of ln(value): keep only the structural ones
-    flags = {k: [r for r in rs if "correl" in r or "singular" in r] for k, rs in reasons.items()}
+    flags = {
+        k: [r for r in rs if "correl" in r or "singular" in r or f"ln({k})" in r]
+        for k, rs in reasons.items()
+    }
     flags = {k: r for k, r in flags.items() if r}
     params = tuple(values.values())
     notes = _knee_notes(m.name, values, band)

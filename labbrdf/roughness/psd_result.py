@@ -237,7 +237,8 @@ def draw_psd(ax: Any, result: PSDResult) -> None:
         )
     c = result.composite
     if len(result.spectra) > 1:
-        ax.plot(c.f, c.psd, "-", color="0.3", lw=1.5, label="composite")
+        f, p = _broken_at_gaps(c.f, c.psd)
+        ax.plot(f, p, "-", color="0.3", lw=1.5, label="composite")
     if result.fit is not None:
         f = np.geomspace(*result.fit.band, 200)
         ax.plot(
@@ -254,8 +255,21 @@ def draw_psd(ax: Any, result: PSDResult) -> None:
     ax.legend(fontsize="small")
 
 
+def _broken_at_gaps(f: Any, p: Any) -> tuple[Any, Any]:
+    """``f``, ``p`` with a NaN between bins further apart than 1.5 grid steps (no line)."""
+    if f.size < 3:
+        return f, p
+    r = np.diff(np.log(f))
+    step = float(np.median(r))
+    cut = np.flatnonzero(r > 1.5 * step) + 1
+    return np.insert(f.astype(float), cut, np.nan), np.insert(p.astype(float), cut, np.nan)
+
+
 def _fit_label(fit: PSDFit) -> str:
-    vals = ", ".join(f"{k}={v:.3g}" for k, v in fit.values.items())
+    vals = ", ".join(
+        f"{k}={v:.3g}" + (f" {u}" if u != "1" else "")
+        for (k, v), u in zip(fit.values.items(), fit.units.values(), strict=True)
+    )
     return f"{fit.model} fit: {vals}"
 
 

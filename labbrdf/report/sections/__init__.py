@@ -24,6 +24,7 @@ module                     section id(s)
 :mod:`.tracer`             ``tracer_maps``, ``tracer_validation``
 :mod:`.errata`             ``errata``
 :mod:`.surface`            ``surface`` (user: height maps; validation: Gaussian ACF)
+:mod:`.psd`                ``psd`` (user: PSD of each sample's height maps, composite, fit)
 :mod:`.smoothness`         ``smoothness`` (user: a height map against one sample's reflectance)
 :mod:`.prediction`         ``prediction`` (user: tracer prediction beside a measured BRDF)
 :mod:`.model_measurement`  ``model_measurement`` (validation: the two above on a bundled set)
