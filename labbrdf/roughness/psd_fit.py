@@ -339,7 +339,9 @@ def _finish(
     _, se_x, _, reasons, _ = uncertainties(J, names, search_vals, max(1.0, redchi), nfree)
     tq = float(special.stdtrit(nfree, 0.975))
     vals = obj.values(x)
-    values, stderr, interval = {}, {}, {}
+    values: dict[str, float] = {}
+    stderr: dict[str, float | None] = {}
+    interval: dict[str, tuple[float, float]] = {}
     for j, k in enumerate(names):
         v, s = float(vals[j]), se_x[k]
         values[k] = v

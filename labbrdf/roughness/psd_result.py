@@ -384,8 +384,9 @@ def psd(
     opts = {"window": window, "degree": degree, "per_decade": per_decade}
     spectra = [_spectrum(hm, k, opts) for hm in maps]
     warnings = [f"{hm.path}: {w}" for hm in maps for w in getattr(hm, "warnings", ())]
+    overlaps: list[Overlap] = []
     if len(spectra) == 1:
-        comp, overlaps = spectra[0], []
+        comp = spectra[0]
     else:
         comp, overlaps = composite(spectra, per_decade=per_decade)
         warnings += [o.sentence() for o in overlaps if not o.agree]
