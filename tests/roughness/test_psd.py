@@ -180,3 +180,26 @@ def test_profile_of_generated_profile_matches_model(synth):
     expect = np.bincount(ib, weights=k_correlation_1d(fq, *KC) * w)
     z = (s.psd - expect) / s.u
     assert abs(z.mean()) < 4 / math.sqrt(z.size) + 0.1
+
+
+def test_composite_band_sigma_matches_its_members_and_skips_gaps(synth):
+    """The composite's trapezoid sigma over one map's band is that map's Parseval sigma."""
+    fine = P.map_psd(
+        synth.surface("k-correlation", KC, 128, DX, 2), DX, window="none", degree=0, label="f"
+    )
+    far = P.map_psd(
+        synth.surface("k-correlation", KC, 64, 100 * DX, 1),
+        100 * DX,
+        window="none",
+        degree=0,
+        label="far",
+    )
+    comp, overlaps = P.composite([far, fine])
+    assert overlaps == [] and any("no map covers" in n for n in comp.notes)
+    lo, hi = fine.f[0], fine.f[-1]
+    # bins of 1/10 decade against the exact sum: within the trapezoid error (a few %)
+    assert comp.band_sigma(lo, hi) == pytest.approx(fine.band_sigma(lo, hi), rel=0.05, abs=0)
+    # across the gap nothing is added
+    both = comp.band_sigma(far.f[0], hi) ** 2
+    parts = comp.band_sigma(far.f[0], far.f[-1]) ** 2 + comp.band_sigma(lo, hi) ** 2
+    assert both == pytest.approx(parts, rel=1e-12, abs=0)

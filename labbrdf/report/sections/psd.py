@@ -180,7 +180,8 @@ def _fit_table(ctx: Context, sid: str, res: PSDResult) -> None:
         rows,
         caption=f"{fit.ndata} bins, chi^2/dof {fit.redchi:.3g} (log residuals; the "
         "covariance is scaled by it when above 1). The model's sigma over the fitted band: "
-        f"{fit.sigma_band * 1e9:.4g} nm; over all frequencies: "
+        f"{fit.sigma_band * 1e9:.4g} nm (the measured PSD's over the same band: "
+        f"{res.composite.band_sigma(lo, hi) * 1e9:.4g} nm); over all frequencies: "
         + (f"{fit.sigma_total * 1e9:.4g} nm." if math.isfinite(fit.sigma_total) else "diverges.")
         + " Blank interval: not determined by the data.",
     )
