@@ -102,7 +102,7 @@ def add_parser(sub: Any) -> None:
         choices=("auto", "2d", "1d"),
         default="auto",
         help="2d: azimuthal average of the 2-D PSD (areal maps); 1d: profile PSD (map rows "
-        "averaged); auto: 2d unless a file is a profile",
+        "averaged); auto: 2d unless one of the maps is a profile",
     )
     s.add_argument("--fit", choices=FIT_MODELS, default=None, help="PSD model to fit")
     s.add_argument(

@@ -239,7 +239,7 @@ class Spectrum:
         the profile: the continuum derivative. ``difference=True``: the forward difference
         over one pixel that ``labbrdf surface`` takes, whose power gain is
         ``(2 sin(pi fx dx) / dx)^2 (+ the same along y)`` instead of ``(2 pi f)^2``
-        (40 % less at the Nyquist frequency); with the full band and no window this is
+        (4 / pi^2, 60 % less, at the Nyquist frequency); with the full band and no window this is
         the RMS of the periodic forward differences exactly.
         """
         return math.sqrt(self._moment(2, f_min, f_max, difference))

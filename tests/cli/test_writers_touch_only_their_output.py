@@ -281,6 +281,8 @@ NOT_PATHS = {
     ("film", "sigma"),
     ("surface", "pixel_size"),
     ("surface", "unit"),
+    ("psd", "pixel_size"),
+    ("psd", "unit"),
     ("trace", "pixel_size"),
     ("trace", "unit"),
     ("report", "prediction_slopes"),

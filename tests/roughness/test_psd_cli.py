@@ -53,6 +53,7 @@ def test_cli_writes_csv_png_and_json(txt_maps, tmp_path, capsys):
         ("small", [], "too small for a PSD"),
         ("gaps", [], "1 undefined height points"),
         ("gaps", ["--kind", "1d"], "1 undefined height points"),
+        ("ok", ["--unit", "furlong"], "unit 'furlong' unknown"),
         ("ok", ["--fit-band", "1e6"], "F_MIN:F_MAX"),
         ("ok", ["--fit-band", "1e5:1e6"], "--fit-band needs --fit"),
     ],
