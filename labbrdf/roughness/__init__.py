@@ -1,0 +1,1 @@
+"""Surface roughness beyond the microfacet distributions: spectra and perturbation scatter."""
