@@ -1,0 +1,225 @@
+"""Rayleigh-Rice BRDF model: a smooth surface's scatter from a PSD model and its index.
+
+Physics layer: numpy only (the scatter is :mod:`labbrdf.roughness.rayleigh_rice`). The
+parameters are those of the surface's isotropic 2-D PSD; the substrate's index ``n + ik``
+is an option (given, or from an ellipsometer file with ``labbrdf fit --nk-from``). Fitted to
+a measured BRDF, it is the scatterometer's inverse problem: the PSD over the spatial
+frequencies the measured directions see. Derivation and conventions:
+``docs/rayleigh-rice.md``.
+
+References
+----------
+.. [1] T. A. Germer, Appl. Opt. 36, 8798-8805 (1997), eqs. (3)-(7). doi:10.1364/AO.36.008798
+.. [2] E. L. Church, P. Z. Takacs, T. A. Leonard, "The prediction of BRDFs from surface
+   profile measurements", Proc. SPIE 1165, 136-150 (1989) (the K-correlation, or ABC, PSD).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..roughness.rayleigh_rice import POLARIZATIONS, brdf, mueller_brdf
+from .base import Model, ModelError, Parameters
+
+__all__ = ["PSD_FORMS", "RayleighRice", "psd_function"]
+
+#: PSD forms the model fits: name -> parameter names (lengths in um, A in um^4)
+PSD_FORMS: dict[str, tuple[str, ...]] = {
+    "k-correlation": ("A", "B", "C"),
+    "gaussian": ("sigma", "ell"),
+}
+
+_UM = 1e-6
+
+
+def psd_function(
+    form: str, p: Mapping[str, float]
+) -> Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]:
+    """The 2-D PSD ``psd2d(fx, fy)`` [m^4] of fx, fy [cycles/m] for the model's parameters.
+
+    ``k-correlation``: ``A / (1 + B^2 f^2)^(C/2)`` (Church, Takacs & Leonard 1989; A in
+    um^4, B in um, SCATMECH's ``ABC_PSD_Function``); ``gaussian``: ``pi sigma^2 ell^2
+    exp(-(pi ell f)^2)`` (sigma, ell in um; integral sigma^2).
+    """
+    if form == "k-correlation":
+        a, b, c = p["A"] * _UM**4, p["B"] * _UM, p["C"]
+
+        def kc(fx: NDArray, fy: NDArray) -> NDArray[np.float64]:
+            return a / (1.0 + b * b * (fx * fx + fy * fy)) ** (c / 2.0)
+
+        return kc
+    if form == "gaussian":
+        s, ell = p["sigma"] * _UM, p["ell"] * _UM
+
+        def ga(fx: NDArray, fy: NDArray) -> NDArray[np.float64]:
+            return math.pi * (s * ell) ** 2 * np.exp(-((math.pi * ell) ** 2) * (fx * fx + fy * fy))
+
+        return ga
+    raise ModelError(f"PSD form {form!r} unknown; forms are {list(PSD_FORMS)}")
+
+
+class RayleighRice(Model):
+    """First-order vector perturbation (Rayleigh-Rice) BRDF of a smooth surface [sr^-1].
+
+    ``f = (16 pi^2 / lambda^4) cos ti cos tr Q PSD2(fx, fy)`` with Germer's (1997)
+    polarization factors for the incident ``polarization`` (all scattered light detected).
+
+    Other Parameters
+    ----------------
+    n, k : float
+        Substrate index ``N = n + ik`` (ambient 1); ``labbrdf fit --nk-from FILE`` sets
+        them from an ellipsometer file.
+    psd : {"k-correlation", "gaussian"}, default "k-correlation"
+        The PSD form whose parameters are fitted.
+    wavelength_nm : float, optional
+        The vacuum wavelength [nm]; default: the data's (a ``.bsdf`` file states one only in
+        a comment, so give it where the file does not).
+    polarization : {"unpolarized", "s", "p"}, default "unpolarized"
+
+    Parameters: k-correlation ``A`` [um^4] in [1e-12, 1e4] (log), ``B`` [um] in
+    [1e-2, 1e4] (log), ``C`` [1] in [1.05, 8]; gaussian ``sigma`` [um] in [1e-5, 0.1]
+    (log), ``ell`` [um] in [1e-2, 1e3] (log).
+
+    Notes
+    -----
+    Valid for ``4 pi sigma cos theta / lambda << 1`` (the Rayleigh criterion's smooth side)
+    and small slopes; the specular beam is not part of it (points at the specular
+    direction of a measured file include it: mask them). Reciprocal (Mueller transpose
+    rule, ``docs/rayleigh-rice.md``). The index does not depend on wavelength: fit one
+    wavelength at a time.
+    """
+
+    name = "rayleigh_rice"
+    reference = (
+        "Rayleigh-Rice first-order vector perturbation theory: Germer, Appl. Opt. 36, 8798 "
+        "(1997); Stover, Optical Scattering 3rd ed. (2012) ch. 5; K-correlation PSD: Church, "
+        "Takacs & Leonard, Proc. SPIE 1165 (1989)"
+    )
+    doi = "10.1364/AO.36.008798"
+    reciprocity_note = (
+        "rayleigh_rice is reciprocal: f(i, r) = f(r, i) for unpolarized light (Q and "
+        "cos\u03b8i cos\u03b8r PSD(|f|) are symmetric)."
+    )
+
+    def __init__(
+        self,
+        n: float | None = None,
+        k: float | None = None,
+        psd: str = "k-correlation",
+        wavelength_nm: float | None = None,
+        polarization: str = "unpolarized",
+        **options: Any,
+    ) -> None:
+        if options:
+            raise ModelError(
+                f"model 'rayleigh_rice' got unknown options {sorted(options)}; options are "
+                "['n', 'k', 'psd', 'wavelength_nm', 'polarization']"
+            )
+        if psd not in PSD_FORMS:
+            raise ModelError(
+                f"rayleigh_rice option 'psd' must be one of {list(PSD_FORMS)}; got {psd!r}"
+            )
+        if polarization not in POLARIZATIONS:
+            raise ModelError(
+                f"rayleigh_rice option 'polarization' must be one of {list(POLARIZATIONS)}; "
+                f"got {polarization!r}"
+            )
+        if n is None:
+            raise ModelError(
+                "rayleigh_rice needs the substrate index: n= (and k=), or --nk-from FILE"
+            )
+        kk = 0.0 if k is None else float(k)
+        if not (math.isfinite(n) and math.isfinite(kk) and n >= 0 and kk >= 0 and n + kk > 0):
+            raise ModelError(
+                f"rayleigh_rice options n, k must be finite, >= 0 and not both 0; got n={n!r}, "
+                f"k={k!r}"
+            )
+        if wavelength_nm is not None and not (math.isfinite(wavelength_nm) and wavelength_nm > 0):
+            raise ModelError(
+                f"rayleigh_rice option 'wavelength_nm' must be > 0 [nm]; got {wavelength_nm!r}"
+            )
+        self.N = complex(float(n), kk)
+        self._psd = psd
+        self._wl = None if wavelength_nm is None else float(wavelength_nm)
+        self._pol = polarization
+        opts: dict[str, Any] = {"n": float(n), "k": kk, "psd": psd, "polarization": polarization}
+        if self._wl is not None:
+            opts["wavelength_nm"] = self._wl
+        super().__init__(**opts)
+
+    def default_params(self) -> Parameters:
+        """K-correlation A 1e-4 um^4, B 10 um, C 2.5; Gaussian sigma 1 nm, ell 5 um."""
+        p = Parameters()
+        if self._psd == "k-correlation":
+            p.add("A", 1e-4, 1e-12, 1e4, units="um4", log=True, description="PSD amplitude")
+            p.add("B", 10.0, 1e-2, 1e4, units="um", log=True, description="correlation length")
+            p.add("C", 2.5, 1.05, 8.0, units="1", description="PSD power-law exponent")
+        else:
+            p.add("sigma", 1e-3, 1e-5, 0.1, units="um", log=True, description="RMS height")
+            p.add("ell", 5.0, 1e-2, 1e3, units="um", log=True, description="correlation length")
+        return p
+
+    def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:
+        """True for unpolarized light (module docstring)."""
+        return self._pol == "unpolarized"
+
+    def psd2d(
+        self, params: Mapping[str, float] | None = None
+    ) -> Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]:
+        """The PSD [m^4] of fx, fy [cycles/m] for ``params`` (default: current values)."""
+        return psd_function(self._psd, self.values(params))
+
+    def _wavelength_m(self, wavelength: NDArray | None) -> NDArray[np.float64]:
+        if self._wl is not None:
+            return np.asarray(self._wl * 1e-9)
+        wl = None if wavelength is None else np.asarray(wavelength, float)
+        if wl is None or wl.size == 0 or not np.all(np.isfinite(wl) & (wl > 0)):
+            raise ModelError(
+                "rayleigh_rice needs the wavelength: the data state none; give the option "
+                "wavelength_nm=NM"
+            )
+        return wl * 1e-9
+
+    def _evaluate(
+        self,
+        p: Mapping[str, float],
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray,
+        wavelength: NDArray | None,
+    ) -> NDArray:
+        lam = np.broadcast_to(self._wavelength_m(wavelength), np.shape(theta_r))
+        psd = psd_function(self._psd, p)
+        up = (theta_i >= 0) & (theta_i <= math.pi / 2) & (theta_r >= 0) & (theta_r <= math.pi / 2)
+        out = np.zeros(np.shape(theta_r))
+        for w in np.unique(lam):
+            sel = up & (lam == w)
+            out[sel] = brdf(
+                theta_i[sel],
+                theta_r[sel],
+                phi_r[sel],
+                float(w),
+                self.N,
+                psd,
+                self._pol,  # type: ignore[arg-type]
+            )
+        return out
+
+    def mueller(
+        self,
+        theta_i: NDArray,
+        theta_r: NDArray,
+        phi_r: NDArray | float = math.pi,
+        wavelength_nm: float | None = None,
+        params: Mapping[str, float] | None = None,
+    ) -> NDArray[np.float64]:
+        """The Mueller BRDF (..., 4, 4) [sr^-1], LB convention (:func:`mueller_brdf`)."""
+        lam = float(
+            self._wavelength_m(None if wavelength_nm is None else np.asarray(wavelength_nm))
+        )
+        return mueller_brdf(theta_i, theta_r, phi_r, lam, self.N, self.psd2d(params))
