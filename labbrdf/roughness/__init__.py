@@ -1,1 +1,1 @@
-"""Surface roughness beyond the microfacet distributions: spectra and perturbation scatter."""
+"""Surface roughness beyond microfacets: height-map statistics, power spectra and their models."""
