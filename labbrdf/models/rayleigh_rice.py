@@ -23,18 +23,27 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from ..roughness import psd_models
 from ..roughness.rayleigh_rice import POLARIZATIONS, brdf, mueller_brdf
 from .base import Model, ModelError, Parameters
 
 __all__ = ["PSD_FORMS", "RayleighRice", "psd_function"]
 
-#: PSD forms the model fits: name -> parameter names (lengths in um, A in um^4)
-PSD_FORMS: dict[str, tuple[str, ...]] = {
-    "k-correlation": ("A", "B", "C"),
-    "gaussian": ("sigma", "ell"),
-}
+#: PSD forms the model fits (:data:`labbrdf.roughness.psd_models.PSD_MODELS`); the fractal
+#: has no finite sigma and a unit that depends on its exponent, so it is left out
+PSD_FORMS: tuple[str, ...] = ("k-correlation", "gaussian", "exponential")
 
-_UM = 1e-6
+#: fitted unit of each PSD unit, and its factor to SI: lengths in um, areas^2 in um^4
+_FIT_UNITS = {"m^4": ("um4", 1e-24), "m": ("um", 1e-6), "1": ("1", 1.0)}
+
+#: (start, min, max, log) of each fitted parameter, in the fitted units
+_RANGES: dict[str, tuple[float, float, float, bool]] = {
+    "A": (1e-4, 1e-12, 1e4, True),
+    "B": (10.0, 1e-2, 1e4, True),
+    "C": (1.5, 0.05, 8.0, False),
+    "sigma": (1e-3, 1e-5, 0.1, True),
+    "corr_length": (5.0, 1e-2, 1e3, True),
+}
 
 
 def psd_function(
@@ -42,25 +51,22 @@ def psd_function(
 ) -> Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64]]:
     """The 2-D PSD ``psd2d(fx, fy)`` [m^4] of fx, fy [cycles/m] for the model's parameters.
 
-    ``k-correlation``: ``A / (1 + B^2 f^2)^(C/2)`` (Church, Takacs & Leonard 1989; A in
-    um^4, B in um, SCATMECH's ``ABC_PSD_Function``); ``gaussian``: ``pi sigma^2 ell^2
-    exp(-(pi ell f)^2)`` (sigma, ell in um; integral sigma^2).
+    The form's 2-D PSD of :mod:`labbrdf.roughness.psd_models` (``k-correlation``:
+    ``A / (1 + (B f)^2)^((C+1)/2)``; ``gaussian``, ``exponential``: sigma and correlation
+    length), with the fitted parameters in um (A in um^4) converted to SI.
     """
-    if form == "k-correlation":
-        a, b, c = p["A"] * _UM**4, p["B"] * _UM, p["C"]
+    if form not in PSD_FORMS:
+        raise ModelError(f"PSD form {form!r} unknown; forms are {list(PSD_FORMS)}")
+    m = psd_models.get(form)
+    args = tuple(
+        float(p[name]) * _FIT_UNITS[unit][1]
+        for name, unit in zip(m.param_names, m.units, strict=True)
+    )
 
-        def kc(fx: NDArray, fy: NDArray) -> NDArray[np.float64]:
-            return a / (1.0 + b * b * (fx * fx + fy * fy)) ** (c / 2.0)
+    def psd2d(fx: NDArray, fy: NDArray) -> NDArray[np.float64]:
+        return m.psd_2d(np.hypot(fx, fy), *args)
 
-        return kc
-    if form == "gaussian":
-        s, ell = p["sigma"] * _UM, p["ell"] * _UM
-
-        def ga(fx: NDArray, fy: NDArray) -> NDArray[np.float64]:
-            return math.pi * (s * ell) ** 2 * np.exp(-((math.pi * ell) ** 2) * (fx * fx + fy * fy))
-
-        return ga
-    raise ModelError(f"PSD form {form!r} unknown; forms are {list(PSD_FORMS)}")
+    return psd2d
 
 
 class RayleighRice(Model):
@@ -74,16 +80,16 @@ class RayleighRice(Model):
     n, k : float
         Substrate index ``N = n + ik`` (ambient 1); ``labbrdf fit --nk-from FILE`` sets
         them from an ellipsometer file.
-    psd : {"k-correlation", "gaussian"}, default "k-correlation"
-        The PSD form whose parameters are fitted.
+    psd : {"k-correlation", "gaussian", "exponential"}, default "k-correlation"
+        The PSD form whose parameters are fitted (:mod:`labbrdf.roughness.psd_models`).
     wavelength_nm : float, optional
         The vacuum wavelength [nm]; default: the data's (a ``.bsdf`` file states one only in
         a comment, so give it where the file does not).
     polarization : {"unpolarized", "s", "p"}, default "unpolarized"
 
     Parameters: k-correlation ``A`` [um^4] in [1e-12, 1e4] (log), ``B`` [um] in
-    [1e-2, 1e4] (log), ``C`` [1] in [1.05, 8]; gaussian ``sigma`` [um] in [1e-5, 0.1]
-    (log), ``ell`` [um] in [1e-2, 1e3] (log).
+    [1e-2, 1e4] (log), ``C`` [1] in [0.05, 8]; gaussian and exponential ``sigma`` [um] in
+    [1e-5, 0.1] (log), ``corr_length`` [um] in [1e-2, 1e3] (log).
 
     Notes
     -----
@@ -153,15 +159,12 @@ class RayleighRice(Model):
         super().__init__(**opts)
 
     def default_params(self) -> Parameters:
-        """K-correlation A 1e-4 um^4, B 10 um, C 2.5; Gaussian sigma 1 nm, ell 5 um."""
+        """The PSD form's parameters in um (A in um^4), log-scaled where positive."""
         p = Parameters()
-        if self._psd == "k-correlation":
-            p.add("A", 1e-4, 1e-12, 1e4, units="um4", log=True, description="PSD amplitude")
-            p.add("B", 10.0, 1e-2, 1e4, units="um", log=True, description="correlation length")
-            p.add("C", 2.5, 1.05, 8.0, units="1", description="PSD power-law exponent")
-        else:
-            p.add("sigma", 1e-3, 1e-5, 0.1, units="um", log=True, description="RMS height")
-            p.add("ell", 5.0, 1e-2, 1e3, units="um", log=True, description="correlation length")
+        m = psd_models.get(self._psd)
+        for name, unit in zip(m.param_names, m.units, strict=True):
+            start, lo, hi, log = _RANGES[name]
+            p.add(name, start, lo, hi, units=_FIT_UNITS[unit][0], log=log, description=name)
         return p
 
     def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:

@@ -16,7 +16,7 @@ from labbrdf.cli import main
 from labbrdf.fitting import fit
 from labbrdf.roughness import rayleigh_rice as rr
 
-TRUE = {"A": 3e-4, "B": 12.0, "C": 2.6}
+TRUE = {"A": 3e-4, "B": 12.0, "C": 1.6}
 WL_NM = 633.0
 AL = {"n": 1.55, "k": 7.71}
 
@@ -26,8 +26,7 @@ def noisy_bsdf(tmp_path_factory):
     """A .bsdf of known K-correlation parameters on Al with 2 % Gaussian noise (seeded).
 
     Radial angles 0.5 to 60 deg see spatial frequencies ~1e4 to 2.5e6 cycles/m, both
-    sides of the knee 1/(2 pi B) ~ 1.3e4 and the power-law slope: A, B and C are all
-    identified.
+    sides of the knee 1/B ~ 8e4 and the power-law slope: A, B and C are all identified.
     """
     m = models.get("rayleigh_rice", **AL)
     ti = np.array([20.0, 50.0])
@@ -70,7 +69,7 @@ def test_registry_and_evaluate_matches_physics():
 
 def test_gaussian_psd_integrates_to_sigma_squared():
     m = models.get("rayleigh_rice", **AL, psd="gaussian")
-    psd = m.psd2d({"sigma": 2e-3, "ell": 4.0})
+    psd = m.psd2d({"sigma": 2e-3, "corr_length": 4.0})
     f = np.linspace(0.0, 3.0 / (math.pi * 4e-6), 20001)
     s2 = np.trapezoid(2 * math.pi * f * psd(f, 0.0 * f), f)
     assert s2 == pytest.approx((2e-9) ** 2, rel=1e-6)

@@ -15,6 +15,7 @@ from scipy import integrate
 
 from labbrdf import smoothness
 from labbrdf.optics import fresnel
+from labbrdf.roughness import psd_models
 from labbrdf.roughness import rayleigh_rice as rr
 
 LAM = 633e-9
@@ -158,19 +159,28 @@ def test_tis_small_roughness_limit(index, theta_i_deg):
     )
 
 
-def test_parseval_sigma_from_brdf():
-    """sigma^2 of the band recovered from the integrated BRDF: the inverse of the TIS law.
-
-    A perfect conductor at normal incidence, band sin ts < 0.1, where the weight
-    (cos + 1/cos)/2 differs from 1 by < 1.3e-5: sigma_band^2 = TIS (lambda / 4 pi)^2.
+@pytest.mark.parametrize(
+    "form, params",
+    [
+        ("k-correlation", (1e-31, 1e-5, 1.6)),
+        ("gaussian", (2e-9, 4e-6)),
+        ("exponential", (2e-9, 3e-6)),
+    ],
+)
+def test_parseval_sigma_from_brdf(form, params):
+    """sigma^2 of the band recovered from the integrated BRDF, against the PSD model's
+    closed-form band sigma (labbrdf.roughness.psd_models.band_sigma): Parseval through
+    the scatter. A perfect conductor at normal incidence, band sin ts < 0.1, where the
+    weight (cos + 1/cos)/2 differs from 1 by < 1.3e-5: sigma_band^2 = TIS (lambda/4 pi)^2.
     """
-    a, b, c = 1e-31, 1e-5, 2.6
-    psd = kcorr_psd(a, b, c)
-    fmax = 0.1 / LAM
-    # closed form of int_0^fmax 2 pi f A (1 + B^2 f^2)^(-C/2) df
-    sig2 = math.pi * a / (b * b) * (1 - (1 + (b * fmax) ** 2) ** (1 - c / 2)) / (c / 2 - 1)
+    model = psd_models.get(form)
+
+    def psd(fx, fy):
+        return model.psd_2d(np.hypot(fx, fy), *params)
+
+    sig = psd_models.band_sigma(form, params, 0.0, 0.1 / LAM)
     t = rr.tis(0.0, LAM, 1e9j, psd, theta_max=math.asin(0.1), n_theta=300, n_phi=16)
-    assert t * (LAM / (4 * math.pi)) ** 2 == pytest.approx(sig2, rel=2e-5)
+    assert math.sqrt(t) * LAM / (4 * math.pi) == pytest.approx(sig, rel=1e-5)
 
 
 def test_bad_input():
