@@ -20,11 +20,12 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .adapters import zemax_bsdf
 from .adapters.topography import HeightMap
@@ -33,7 +34,15 @@ from .integrate import grid_integral
 from .prediction import PredictionError, _checked_table, substrate_nk
 from .roughness.rayleigh_rice import bragg_frequencies, brdf
 
-__all__ = ["MapPsd", "RrPrediction", "map_psd", "predict_rr_brdf"]
+__all__ = [
+    "MapPsd",
+    "PsdAgreement",
+    "RrPrediction",
+    "bragg_band",
+    "map_psd",
+    "predict_rr_brdf",
+    "psd_agreement",
+]
 
 
 @dataclass(frozen=True)
@@ -249,3 +258,99 @@ def predict_rr_brdf(
         tis_measured=grid_integral(meas[None, None], **geo)["integral"][0, 0],
         tis_predicted=grid_integral(pred[None, None], **geo)["integral"][0, 0],
     )
+
+
+@dataclass(frozen=True)
+class PsdAgreement:
+    """A PSD recovered from a BRDF (a ``rayleigh_rice`` fit) beside a height map's PSD.
+
+    Attributes
+    ----------
+    f : ndarray
+        The map's frequencies [cycles/m] inside the common band.
+    psd_map, psd_brdf : ndarray
+        The map's PSD and the fitted model's at ``f`` [m^4].
+    f_lo, f_hi : float
+        The common band [cycles/m]: the map's band intersected with the frequencies the
+        fitted BRDF points see.
+    form : str
+        The fitted PSD form.
+    source : str
+        The height map's file.
+    """
+
+    f: NDArray[np.float64]
+    psd_map: NDArray[np.float64]
+    psd_brdf: NDArray[np.float64]
+    f_lo: float
+    f_hi: float
+    form: str
+    source: str
+
+    def ratio_quantiles(self) -> tuple[float, float, float]:
+        """10 %, 50 % and 90 % quantiles of PSD(BRDF) / PSD(map) over the common band."""
+        if self.f.size == 0:
+            return (math.nan, math.nan, math.nan)
+        r = self.psd_brdf / self.psd_map
+        lo, med, hi = np.quantile(r, [0.1, 0.5, 0.9])
+        return float(lo), float(med), float(hi)
+
+    def sentence(self) -> str:
+        """How the two PSDs agree, in numbers."""
+        if self.f.size == 0:
+            return (
+                "The height map's band and the spatial frequencies the BRDF sees do not "
+                "overlap: the two PSDs cannot be compared."
+            )
+        lo, med, hi = self.ratio_quantiles()
+        return (
+            f"Over their common frequencies, {self.f_lo:.3g} to {self.f_hi:.3g} cycles/m "
+            f"({self.f.size} of the map's frequency bins), the PSD recovered from the BRDF "
+            f"({self.form}) is {med:.3g} times the height map's (median; 10 to 90 % of the "
+            f"bins: {lo:.3g} to {hi:.3g})."
+        )
+
+    def plot(self, ax: Any = None) -> Any:
+        """Both PSDs on log-log axes over the common band; returns the matplotlib Figure."""
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(5.5, 3.8)) if ax is None else ax.figure
+        ax = fig.add_subplot(1, 1, 1) if ax is None else ax
+        ax.loglog(self.f, self.psd_map, "o", ms=3, label=f"height map ({Path(self.source).name})")
+        ax.loglog(self.f, self.psd_brdf, "-", label=f"from the BRDF ({self.form} fit)")
+        ax.set_xlabel("spatial frequency f [cycles/m]")
+        ax.set_ylabel("isotropic 2-D PSD [m$^4$]")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        return fig
+
+
+def bragg_band(
+    theta_i_deg: ArrayLike, theta_r_deg: ArrayLike, phi_r_deg: ArrayLike, wavelength_nm: float
+) -> tuple[float, float]:
+    """Smallest and largest |f| [cycles/m] that measured directions see (Bragg)."""
+    fx, fy = bragg_frequencies(
+        np.radians(np.asarray(theta_i_deg, float)),
+        np.radians(np.asarray(theta_r_deg, float)),
+        np.radians(np.asarray(phi_r_deg, float)),
+        wavelength_nm * 1e-9,
+    )
+    fr = np.hypot(fx, fy)
+    fr = fr[fr > 0]
+    if fr.size == 0:
+        raise PredictionError("no measured direction off the specular one")
+    return float(fr.min()), float(fr.max())
+
+
+def psd_agreement(psd2d: Any, form: str, psd: MapPsd, band: tuple[float, float]) -> PsdAgreement:
+    """Compare a fitted PSD (``psd2d(fx, fy)`` [m^4]) with a map's over their common band.
+
+    ``band`` is what the BRDF sees (:func:`bragg_band`); the common band is its
+    intersection with the map's ``[f_min, f_max]``.
+    """
+    lo, hi = max(band[0], psd.f_min), min(band[1], psd.f_max)
+    sel = (psd.f >= lo) & (psd.f <= hi)
+    f = psd.f[sel]
+    fit = np.asarray(psd2d(f, np.zeros_like(f)), dtype=float)
+    return PsdAgreement(f, psd.psd[sel], fit, lo, hi, form, psd.source)
