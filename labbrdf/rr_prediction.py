@@ -147,15 +147,14 @@ class RrPrediction:
     predicted: NDArray[np.float64]
     tis_measured: NDArray[np.float64]
     tis_predicted: NDArray[np.float64]
+    band_measured: NDArray[np.float64]
+    band_predicted: NDArray[np.float64]
 
     def table(self) -> pd.DataFrame:
         """Per incidence: both grid TIS, their ratio, how many points the map's band sees."""
         rows = []
         for a, ti in enumerate(self.theta_i_deg):
             m = self.above[a] & (self.measured[a] > 0)
-            ib = m & self.in_band[a]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                lr = np.log10(self.predicted[a][ib] / self.measured[a][ib])
             rows.append(
                 {
                     "theta_i_deg": float(ti),
@@ -165,8 +164,10 @@ class RrPrediction:
                     if self.tis_measured[a] > 0
                     else math.nan,
                     "points": int(m.sum()),
-                    "in_band": int(ib.sum()),
-                    "median_log10_ratio": float(np.median(lr)) if lr.size else math.nan,
+                    "in_band": int((m & self.in_band[a]).sum()),
+                    "band_ratio": float(self.band_predicted[a] / self.band_measured[a])
+                    if self.band_measured[a] > 0
+                    else math.nan,
                 }
             )
         return pd.DataFrame(rows)
@@ -183,9 +184,9 @@ class RrPrediction:
                 continue
             parts.append(
                 f"at {r['theta_i_deg']:g} deg the predicted TIS on the file's grid is "
-                f"{r['ratio']:.3g} x the measured one, the point ratio's median "
-                f"{10 ** r['median_log10_ratio']:.3g} over the {r['in_band']} of "
-                f"{r['points']} measured points that the map's band sees"
+                f"{r['ratio']:.3g} x the measured one; over the {r['in_band']} of the "
+                f"{r['points']} measured points that scatter from spatial frequencies in the "
+                f"map's band, {r['band_ratio']:.3g} x"
             )
         return "Rayleigh-Rice from the height map's PSD: " + "; ".join(parts) + "."
 
@@ -255,9 +256,16 @@ def predict_rr_brdf(
         in_band=in_band,
         measured=meas,
         predicted=pred,
-        tis_measured=grid_integral(meas[None, None], **geo)["integral"][0, 0],
-        tis_predicted=grid_integral(pred[None, None], **geo)["integral"][0, 0],
+        tis_measured=_tis(meas, geo),
+        tis_predicted=_tis(pred, geo),
+        band_measured=_tis(np.where(in_band, meas, 0.0), geo),
+        band_predicted=_tis(np.where(in_band, pred, 0.0), geo),
     )
+
+
+def _tis(values: NDArray, geo: dict[str, Any]) -> NDArray[np.float64]:
+    """Grid integral of ``(aoi, azimuth, radial)`` values per incidence [1]."""
+    return np.asarray(grid_integral(values[None, None], **geo)["integral"][0, 0], dtype=float)
 
 
 @dataclass(frozen=True)
