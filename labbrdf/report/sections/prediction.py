@@ -20,7 +20,12 @@ with an empty tail beyond the steepest sampled slope and, on a coating's top, on
 noisier counting estimator (the evaluated one needs a GGX top). The measured table is the
 check of GGX itself: where the two predictions differ, the slope distribution matters.
 
-The section draws
+Each measured ``.bsdf`` is first judged by the Rayleigh criterion
+(:mod:`labbrdf.report.smooth_prediction`): smooth at all its angles, it is predicted by
+Rayleigh-Rice from the height map's PSD (with the PSD recovered from the BRDF beside the
+map's) and the tracer is not run; rough, by the tracer; in between, by both.
+
+For the tracer, the section draws
 
 * the specular DOP for unpolarized light, ellipsometer (|cos 2psi|, with its depolarization
   channel) beside the tracer's specular bin with its batch error, per wavelength against
@@ -175,7 +180,11 @@ def prediction_section(ctx: Context, *, slopes: str = "ggx") -> None:
         "a finding about the model (single scattering, the slope distribution, the stack) "
         "or the samples, not a fit residual. Monte Carlo errors are the spread of the "
         f"tracer's 8 independent batches ({rays_of(ctx)} rays per run; a bare substrate's "
-        "single scattering is closed form and has none)."
+        "single scattering is closed form and has none). Which theory predicts each measured "
+        "BRDF is chosen by the Rayleigh criterion of section smoothness at the file's "
+        "wavelength and angles: a smooth sample is predicted by Rayleigh-Rice (first-order "
+        "perturbation theory) from its height map's PSD instead of the tracer, a sample in "
+        "between by both (docs/rayleigh-rice.md)."
     )
     if lacking:
         b.table(
