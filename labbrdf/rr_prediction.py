@@ -305,10 +305,16 @@ class PsdAgreement:
 
     def sentence(self) -> str:
         """How the two PSDs agree, in numbers."""
-        if self.f.size == 0:
+        if not self.f_lo < self.f_hi:
             return (
                 "The height map's band and the spatial frequencies the BRDF sees do not "
                 "overlap: the two PSDs cannot be compared."
+            )
+        if self.f.size == 0:
+            return (
+                "No frequency bin of the height map's PSD lies among the spatial "
+                f"frequencies the BRDF sees ({self.f_lo:.3g} to {self.f_hi:.3g} cycles/m "
+                "within the map's band): the two PSDs cannot be compared."
             )
         lo, med, hi = self.ratio_quantiles()
         return (

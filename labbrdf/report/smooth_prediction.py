@@ -206,8 +206,9 @@ def _table(ctx: Context, sid: str, p: RrPrediction) -> None:
 
 def _inverse(ctx: Context, sid: str, p: RrPrediction, psd: MapPsd) -> None:
     """The ``rayleigh_rice`` model fitted to the .bsdf; its PSD beside the map's."""
-    from .. import adapters, models
+    from .. import adapters
     from ..fitting import fit
+    from ..models.rayleigh_rice import RayleighRice
 
     b = ctx.b
     name = Path(p.path).name
@@ -220,7 +221,7 @@ def _inverse(ctx: Context, sid: str, p: RrPrediction, psd: MapPsd) -> None:
         )
         # points below 1e-6 of the peak carry only the file's rounding
         rows = rows[off & (rows["value"] >= FIT_FLOOR * rows["value"].max())]
-        model = models.get("rayleigh_rice", n=p.n, k=p.k, wavelength_nm=p.wavelength_nm)
+        model = RayleighRice(n=p.n, k=p.k, wavelength_nm=p.wavelength_nm)
         res = fit(model, rows, weighting="relative")
         band = bragg_band(
             rows["theta_i_deg"], rows["theta_r_deg"], rows["phi_r_deg"], p.wavelength_nm

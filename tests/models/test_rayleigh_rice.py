@@ -117,3 +117,23 @@ def test_cli_fit_with_index_options(noisy_bsdf, capsys):
     (row,) = json.loads(capsys.readouterr().out)
     assert row["success"]
     assert abs(row["params"]["C"]["value"] - TRUE["C"]) <= 3 * row["params"]["C"]["stderr"]
+
+
+def test_cli_without_an_index_is_a_usage_error(noisy_bsdf, capsys):
+    assert main(["fit", str(noisy_bsdf), "--model", "rayleigh_rice"]) == 2
+    err = capsys.readouterr().err
+    assert "substrate index" in err and "Traceback" not in err
+
+
+@pytest.mark.shared
+def test_cli_fit_of_a_real_bsdf_with_the_index_of_a_real_ellipsometer_file(real_exports, capsys):
+    """End to end on real files: the Radiant vinyl .bsdf (no wavelength stated: 555 nm is
+    said) with the Ta n, k of a WVASE file. The vinyl is rough, so only that it runs and
+    takes the ellipsometer's index is checked, not the PSD."""
+    bsdf = real_exports / "zemax-bsdf" / "test_13_planesymmetric_brdf_zemax.bsdf"
+    psi = real_exports / "woollam-wvase-ascii" / "w2_10102006.dat"
+    argv = ["fit", str(bsdf), "--model", "rayleigh_rice", "--nk-from", str(psi)]
+    argv += ["--wavelength", "555", "--theta-i-range", "45", "--json"]
+    assert main(argv) == 0
+    (row,) = json.loads(capsys.readouterr().out)
+    assert row["success"] and set(row["params"]) == {"A", "B", "C"}
