@@ -121,3 +121,34 @@ def test_the_psd_recovered_from_the_brdf_is_the_maps(smooth):
     ]
     med = float(text.split("is ")[-1].split(" times")[0])
     assert math.isfinite(med) and 0.7 < med < 1.4
+
+
+def test_a_sample_in_between_gets_both_and_the_page_says_where(prediction_sets, tmp_path):
+    """sigma ~ 110 nm at 600 nm: rough at 30 deg (threshold 87 nm), smooth at 75 deg
+    (threshold 290 nm): both theories, each named with its angles."""
+    from SurfaceTopography import Topography
+
+    from labbrdf.report.smooth_prediction import choose_theory
+
+    z = kc_surface(128, 64e-6, seed=7)
+    z *= 110e-9 / z.std()
+    hm = tmp_path / "between.nc"
+    Topography(z, physical_sizes=(64e-6, 64e-6), unit="m").to_netcdf(str(hm))
+    nk = prediction_sets.TRUE_NK
+    bsdf = model_to_bsdf(
+        models.get("rayleigh_rice", n=nk.real, k=nk.imag),
+        KC,
+        tmp_path / "between.bsdf",
+        theta_i_deg=[30.0, 75.0],
+        radial_deg=[0.0, 5.0, 10.0],
+        azimuth_deg=[0.0, 90.0, 180.0],
+        wavelength_nm=600.0,
+    )
+    b = Builder("t", progress=False)
+    ctx = Context(b)
+    with b.section("ingest", "Ingested files"):
+        ingest_inputs(ctx, [Path(hm), Path(bsdf)])
+    theory = choose_theory(ctx, ctx.height_maps[0], Path(bsdf))
+    assert theory.choice == "both"
+    assert "smooth at 75 deg" in theory.text and "rough at 30 deg" in theory.text
+    assert choose_theory(ctx, ctx.height_maps[0], Path(bsdf), coated=True).choice == "tracer"
