@@ -86,6 +86,11 @@ class RayleighRice(Model):
         The vacuum wavelength [nm]; default: the data's (a ``.bsdf`` file states one only in
         a comment, so give it where the file does not).
     polarization : {"unpolarized", "s", "p"}, default "unpolarized"
+    free_index : bool, default False
+        Fit the substrate index too: parameters ``n_sub`` in [0.01, 20] and ``k_sub`` in
+        [0, 50], started at the options ``n``, ``k``. The index and the PSD's amplitude are
+        strongly correlated (both scale the BRDF): expect wide intervals unless the data
+        span angles where the polarization factors differ.
 
     Parameters: k-correlation ``A`` [um^4] in [1e-12, 1e4] (log), ``B`` [um] in
     [1e-2, 1e4] (log), ``C`` [1] in [0.05, 8]; gaussian and exponential ``sigma`` [um] in
@@ -119,12 +124,13 @@ class RayleighRice(Model):
         psd: str = "k-correlation",
         wavelength_nm: float | None = None,
         polarization: str = "unpolarized",
+        free_index: bool = False,
         **options: Any,
     ) -> None:
         if options:
             raise ModelError(
                 f"model 'rayleigh_rice' got unknown options {sorted(options)}; options are "
-                "['n', 'k', 'psd', 'wavelength_nm', 'polarization']"
+                "['n', 'k', 'psd', 'wavelength_nm', 'polarization', 'free_index']"
             )
         if psd not in PSD_FORMS:
             raise ModelError(
@@ -153,9 +159,12 @@ class RayleighRice(Model):
         self._psd = psd
         self._wl = None if wavelength_nm is None else float(wavelength_nm)
         self._pol = polarization
+        self._free = bool(free_index)
         opts: dict[str, Any] = {"n": float(n), "k": kk, "psd": psd, "polarization": polarization}
         if self._wl is not None:
             opts["wavelength_nm"] = self._wl
+        if self._free:
+            opts["free_index"] = True
         super().__init__(**opts)
 
     def default_params(self) -> Parameters:
@@ -165,7 +174,18 @@ class RayleighRice(Model):
         for name, unit in zip(m.param_names, m.units, strict=True):
             start, lo, hi, log = _RANGES[name]
             p.add(name, start, lo, hi, units=_FIT_UNITS[unit][0], log=log, description=name)
+        if self._free:
+            n0, k0 = self.N.real, self.N.imag
+            p.add("n_sub", n0, 0.01, max(20.0, n0), description="substrate n (start: option n)")
+            p.add("k_sub", k0, 0.0, max(50.0, k0), description="substrate k (start: option k)")
         return p
+
+    def index(self, params: Mapping[str, float] | None = None) -> complex:
+        """The substrate's ``n + ik``: the option's, or the fitted ``n_sub``, ``k_sub``."""
+        if not self._free:
+            return self.N
+        v = self.values(params)
+        return complex(v["n_sub"], v["k_sub"])
 
     def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:
         """True for unpolarized light (module docstring)."""
@@ -198,6 +218,7 @@ class RayleighRice(Model):
     ) -> NDArray:
         lam = np.broadcast_to(self._wavelength_m(wavelength), np.shape(theta_r))
         psd = psd_function(self._psd, p)
+        index = complex(p["n_sub"], p["k_sub"]) if self._free else self.N
         up = (theta_i >= 0) & (theta_i <= math.pi / 2) & (theta_r >= 0) & (theta_r <= math.pi / 2)
         out = np.zeros(np.shape(theta_r))
         for w in np.unique(lam):
@@ -207,7 +228,7 @@ class RayleighRice(Model):
                 theta_r[sel],
                 phi_r[sel],
                 float(w),
-                self.N,
+                index,
                 psd,
                 self._pol,  # type: ignore[arg-type]
             )
@@ -225,4 +246,4 @@ class RayleighRice(Model):
         lam = float(
             self._wavelength_m(None if wavelength_nm is None else np.asarray(wavelength_nm))
         )
-        return mueller_brdf(theta_i, theta_r, phi_r, lam, self.N, self.psd2d(params))
+        return mueller_brdf(theta_i, theta_r, phi_r, lam, self.index(params), self.psd2d(params))

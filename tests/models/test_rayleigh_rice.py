@@ -137,3 +137,17 @@ def test_cli_fit_of_a_real_bsdf_with_the_index_of_a_real_ellipsometer_file(real_
     assert main(argv) == 0
     (row,) = json.loads(capsys.readouterr().out)
     assert row["success"] and set(row["params"]) == {"A", "B", "C"}
+
+
+def test_free_index_adds_the_substrate_parameters(noisy_bsdf):
+    fixed = models.get("rayleigh_rice", **AL, wavelength_nm=WL_NM)
+    free = models.get("rayleigh_rice", **AL, wavelength_nm=WL_NM, free_index=True)
+    assert set(free.params) == {"A", "B", "C", "n_sub", "k_sub"}
+    ti, tr, pr = 0.4, np.array([0.2, 0.9]), np.array([0.5, math.pi])
+    np.testing.assert_array_equal(
+        free.evaluate(ti, tr, pr, params=TRUE), fixed.evaluate(ti, tr, pr, params=TRUE)
+    )
+    other = free.evaluate(ti, tr, pr, params={**TRUE, "n_sub": 1.5, "k_sub": 0.0})
+    assert not np.allclose(other, fixed.evaluate(ti, tr, pr, params=TRUE))
+    res = fit(free, adapters.read(noisy_bsdf), mask_zeros=True, weighting="relative")
+    assert res.success and {"n_sub", "k_sub"} <= set(res.params)
