@@ -14,6 +14,7 @@ from .base import Model, ModelError, Parameter, Parameters
 from .five_param import FiveParam
 from .layered import Layered
 from .microfacet import Microfacet
+from .rayleigh_rice import RayleighRice
 from .smooth3 import Smooth3
 
 __all__ = [
@@ -33,6 +34,7 @@ MODELS: dict[str, type[Model]] = {
     "five_param": FiveParam,
     "microfacet": Microfacet,
     "layered": Layered,
+    "rayleigh_rice": RayleighRice,
 }
 
 

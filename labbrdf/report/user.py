@@ -335,7 +335,7 @@ def _sections(
         ),
         (
             "prediction",
-            "Predict, then measure: the tracer's prediction beside the BRDF",
+            "Predict, then measure: the tracer or Rayleigh-Rice beside the BRDF",
             lambda ctx: prediction_section(ctx, slopes=prediction_slopes),
         ),
     ]

@@ -20,7 +20,12 @@ with an empty tail beyond the steepest sampled slope and, on a coating's top, on
 noisier counting estimator (the evaluated one needs a GGX top). The measured table is the
 check of GGX itself: where the two predictions differ, the slope distribution matters.
 
-The section draws
+Each measured ``.bsdf`` is first judged by the Rayleigh criterion
+(:mod:`labbrdf.report.smooth_prediction`): smooth at all its angles, it is predicted by
+Rayleigh-Rice from the height map's PSD (with the PSD recovered from the BRDF beside the
+map's) and the tracer is not run; rough, by the tracer; in between, by both.
+
+For the tracer, the section draws
 
 * the specular DOP for unpolarized light, ellipsometer (|cos 2psi|, with its depolarization
   channel) beside the tracer's specular bin with its batch error, per wavelength against
@@ -50,6 +55,7 @@ from ...prediction import (
 from .. import figures
 from ..builder import Unavailable, slug
 from ..context import Context
+from ..smooth_prediction import choose_theory, rr_part
 from ..tracing import rays_of, tracer_map
 
 __all__ = ["SLOPES", "prediction_section", "sample_inputs"]
@@ -174,7 +180,11 @@ def prediction_section(ctx: Context, *, slopes: str = "ggx") -> None:
         "a finding about the model (single scattering, the slope distribution, the stack) "
         "or the samples, not a fit residual. Monte Carlo errors are the spread of the "
         f"tracer's 8 independent batches ({rays_of(ctx)} rays per run; a bare substrate's "
-        "single scattering is closed form and has none)."
+        "single scattering is closed form and has none). Which theory predicts each measured "
+        "BRDF is chosen by the Rayleigh criterion of section smoothness at the file's "
+        "wavelength and angles: a smooth sample is predicted by Rayleigh-Rice (first-order "
+        "perturbation theory) from its height map's PSD instead of the tracer, a sample in "
+        "between by both (docs/rayleigh-rice.md)."
     )
     if lacking:
         b.table(
@@ -222,7 +232,14 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
             "|cos 2psi| is the coherent film's, while the tracer's coating is incoherent "
             "(intensities add, which depolarizes), so the two DOPs differ by construction.",
         )
-    else:
+    theories = [choose_theory(ctx, hm, p, coated=film is not None) for p in s["bsdf"]]
+    if film is None and all(t.choice == "rayleigh-rice" for t in theories):
+        b.text(
+            "The sample is smooth (below): its specular reflection is the Fresnel reflection "
+            f"of its n, k, whose DOP is the |cos 2psi| of {psi_path.name} itself, so the "
+            "tracer's specular DOP is not computed."
+        )
+    elif film is None:
         try:
             dop = specular_dop_comparison(
                 frame, fit.alpha, rays=rays_of(ctx), seed=ctx.seed, map=tracer_map(ctx)
@@ -231,22 +248,33 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
             b.note("specular DOP not predicted", str(exc))
         else:
             _dop_part(ctx, sid, dop)
-    for path in s["bsdf"]:
-        try:
-            pred = predict_brdf(
-                path,
-                frame,
-                fit,
-                film=film,
-                ndf=ndf,
-                rays=rays_of(ctx),
-                seed=ctx.seed,
-                map=tracer_map(ctx),
-            )
-        except (PredictionError, ValueError) as exc:
-            b.note(f"{path.name} not predicted", str(exc))
-            continue
-        _brdf_part(ctx, f"{sid}_{slug(path.name)}", pred)
+    for path, theory in zip(s["bsdf"], theories, strict=True):
+        b.text(theory.text)
+        if theory.choice in ("tracer", "both"):
+            _tracer_brdf(ctx, sid, path, frame, fit, film, ndf)
+        if theory.choice in ("rayleigh-rice", "both"):
+            rr_part(ctx, f"{sid}_{slug(path.name)}", hm, path, frame)
+
+
+def _tracer_brdf(
+    ctx: Context, sid: str, path: Path, frame: Any, fit: Any, film: Any, ndf: Any
+) -> None:
+    """The microfacet tracer's prediction of one ``.bsdf`` file and its part of the page."""
+    try:
+        pred = predict_brdf(
+            path,
+            frame,
+            fit,
+            film=film,
+            ndf=ndf,
+            rays=rays_of(ctx),
+            seed=ctx.seed,
+            map=tracer_map(ctx),
+        )
+    except (PredictionError, ValueError) as exc:
+        ctx.b.note(f"{path.name} not predicted", str(exc))
+        return
+    _brdf_part(ctx, f"{sid}_{slug(path.name)}", pred)
 
 
 # --------------------------------------------------------------------------- DOP

@@ -1,0 +1,370 @@
+"""Predict, then measure, for a smooth sample: Rayleigh-Rice from a height map's PSD.
+
+The smooth-surface counterpart of :mod:`labbrdf.prediction` (the microfacet tracer's). A
+sample that is smooth by the Rayleigh criterion (:mod:`labbrdf.smoothness`) scatters as
+first-order perturbation theory says (:mod:`labbrdf.roughness.rayleigh_rice`): its BRDF at
+every point of a measured ``.bsdf`` follows, with **no fitted parameter**, from
+
+* the isotropic 2-D PSD of its height map (:func:`map_psd`: SurfaceTopography's
+  ``power_spectrum_from_area`` of the plane-levelled map, Hann window; the PSD is taken as
+  0 outside the map's band, from ``1 / size`` to the Nyquist frequency ``1 / (2 pixel)``,
+  and the points whose Bragg frequency lies outside it are counted, not guessed);
+* the substrate's n, k from the sample's psi/Delta (:func:`labbrdf.prediction.substrate_nk`).
+
+Prediction and measurement are integrated by the same grid rule
+(:func:`labbrdf.integrate.grid_integral`), so their TIS compare like with like.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from numpy.typing import ArrayLike, NDArray
+
+from .adapters import zemax_bsdf
+from .adapters.topography import HeightMap
+from .bsdf_geometry import scatter_to_angles
+from .integrate import grid_integral
+from .prediction import PredictionError, _checked_table, substrate_nk
+from .roughness.rayleigh_rice import bragg_frequencies, brdf
+
+__all__ = [
+    "MapPsd",
+    "PsdAgreement",
+    "RrPrediction",
+    "bragg_band",
+    "map_psd",
+    "predict_rr_brdf",
+    "psd_agreement",
+]
+
+
+@dataclass(frozen=True)
+class MapPsd:
+    """The isotropic 2-D PSD of a height map.
+
+    Attributes
+    ----------
+    f : ndarray
+        Spatial frequencies [cycles/m], increasing, all within the band.
+    psd : ndarray
+        Azimuthally averaged 2-D PSD [m^4] (``sigma^2 = integral PSD 2 pi f df``).
+    f_min, f_max : float
+        The map's band [cycles/m]: ``1 / size`` to ``1 / (2 pixel)``.
+    source : str
+        The height map's file.
+    """
+
+    f: NDArray[np.float64]
+    psd: NDArray[np.float64]
+    f_min: float
+    f_max: float
+    source: str
+
+    def sigma(self, f_lo: float | None = None, f_hi: float | None = None) -> float:
+        """RMS height [m] of the PSD over ``[f_lo, f_hi]`` (default the band), trapezoid in f."""
+        lo = self.f_min if f_lo is None else max(f_lo, self.f_min)
+        hi = self.f_max if f_hi is None else min(f_hi, self.f_max)
+        if not lo < hi:
+            return 0.0
+        f = np.concatenate([[lo], self.f[(self.f > lo) & (self.f < hi)], [hi]])
+        y = self._interp(f) * 2.0 * math.pi * f
+        return float(math.sqrt(max(np.trapezoid(y, f), 0.0)))
+
+    def _interp(self, f: NDArray) -> NDArray[np.float64]:
+        """Log-log interpolation inside the band (end values held to its edges), 0 outside."""
+        f = np.asarray(f, float)
+        inside = (f >= self.f_min) & (f <= self.f_max)
+        lf = np.log(np.clip(f, self.f[0], self.f[-1]))
+        v = np.exp(np.interp(lf, np.log(self.f), np.log(self.psd)))
+        return np.where(inside, v, 0.0)
+
+    def psd2d(self, fx: NDArray, fy: NDArray) -> NDArray[np.float64]:
+        """``PSD2(fx, fy)`` [m^4] of the isotropic PSD, 0 outside the map's band."""
+        return self._interp(np.hypot(fx, fy))
+
+
+def map_psd(hm: HeightMap) -> MapPsd:
+    """The isotropic PSD of an areal height map (module docstring).
+
+    Raises
+    ------
+    PredictionError
+        A profile, or a map with undefined points (SurfaceTopography's area PSD needs them
+        all), or one with no positive PSD value.
+    """
+    from SurfaceTopography import Topography
+
+    z = np.asarray(hm.heights, float)
+    if z.ndim != 2:
+        raise PredictionError(f"{hm.path}: a profile; the PSD prediction needs an areal map")
+    if not np.isfinite(z).all():
+        raise PredictionError(
+            f"{hm.path}: {int((~np.isfinite(z)).sum())} undefined points; the area PSD needs "
+            "a complete map"
+        )
+    sizes = tuple(n * p for n, p in zip(z.shape, hm.pixel_size, strict=True))
+    topo = Topography(z, physical_sizes=sizes).detrend(detrend_mode="height")
+    q, c = topo.power_spectrum_from_area(window="hann", nb_points_per_decade=10)
+    q, c = np.ma.filled(q, np.nan), np.ma.filled(c, np.nan)
+    ok = np.isfinite(q) & np.isfinite(c) & (c > 0) & (q > 0)
+    if not ok.any():
+        raise PredictionError(f"{hm.path}: no positive PSD value")
+    f = q[ok] / (2.0 * math.pi)
+    return MapPsd(
+        f=f,
+        psd=c[ok],
+        f_min=1.0 / max(sizes),
+        f_max=1.0 / (2.0 * max(hm.pixel_size)),
+        source=str(hm.path),
+    )
+
+
+@dataclass
+class RrPrediction:
+    """The Rayleigh-Rice prediction of a measured ``.bsdf`` (no fitted parameter).
+
+    Arrays are ``(aoi, azimuth, radial)`` on the file's grid; angles [deg]; BRDF [sr^-1].
+    """
+
+    path: str
+    wavelength_nm: float
+    n: float
+    k: float
+    psd: MapPsd
+    theta_i_deg: NDArray[np.float64]
+    theta_r_deg: NDArray[np.float64]
+    phi_r_deg: NDArray[np.float64]
+    above: NDArray[np.bool_]
+    in_band: NDArray[np.bool_]
+    measured: NDArray[np.float64]
+    predicted: NDArray[np.float64]
+    tis_measured: NDArray[np.float64]
+    tis_predicted: NDArray[np.float64]
+    band_measured: NDArray[np.float64]
+    band_predicted: NDArray[np.float64]
+
+    def table(self) -> pd.DataFrame:
+        """Per incidence: both grid TIS, their ratio, how many points the map's band sees."""
+        rows = []
+        for a, ti in enumerate(self.theta_i_deg):
+            m = self.above[a] & (self.measured[a] > 0)
+            rows.append(
+                {
+                    "theta_i_deg": float(ti),
+                    "tis_measured": float(self.tis_measured[a]),
+                    "tis_predicted": float(self.tis_predicted[a]),
+                    "ratio": float(self.tis_predicted[a] / self.tis_measured[a])
+                    if self.tis_measured[a] > 0
+                    else math.nan,
+                    "points": int(m.sum()),
+                    "in_band": int((m & self.in_band[a]).sum()),
+                    "band_ratio": float(self.band_predicted[a] / self.band_measured[a])
+                    if self.band_measured[a] > 0
+                    else math.nan,
+                }
+            )
+        return pd.DataFrame(rows)
+
+    def verdict(self) -> str:
+        """A sentence: how far the prediction is from the measurement, per incidence."""
+        parts = []
+        for r in self.table().to_dict("records"):
+            if r["in_band"] == 0:
+                parts.append(
+                    f"at {r['theta_i_deg']:g} deg no measured point scatters from the map's "
+                    "band: nothing to compare"
+                )
+                continue
+            parts.append(
+                f"at {r['theta_i_deg']:g} deg the predicted TIS on the file's grid is "
+                f"{r['ratio']:.3g} x the measured one; over the {r['in_band']} of the "
+                f"{r['points']} measured points that scatter from spatial frequencies in the "
+                f"map's band, {r['band_ratio']:.3g} x"
+            )
+        return "Rayleigh-Rice from the height map's PSD: " + "; ".join(parts) + "."
+
+
+def predict_rr_brdf(
+    bsdf: str | os.PathLike[str] | zemax_bsdf.BsdfTable,
+    data: pd.DataFrame | None,
+    psd: MapPsd,
+    *,
+    wavelength_nm: float | None = None,
+    substrate_index: complex | None = None,
+) -> RrPrediction:
+    """The Rayleigh-Rice BRDF (unpolarized) at every point of a measured ``.bsdf``.
+
+    Parameters
+    ----------
+    bsdf : path-like or BsdfTable
+        The measured BRDF (one rotation, Monochrome, BRDF).
+    data : pandas.DataFrame or None
+        psi/Delta rows of the same sample (:func:`labbrdf.prediction.substrate_nk`); not
+        used when ``substrate_index`` is given.
+    psd : MapPsd
+        The sample's PSD (:func:`map_psd`).
+    wavelength_nm : float, optional
+        Default: the one the file states.
+    substrate_index : complex, optional
+        ``n + ik`` instead of the psi/Delta's.
+
+    Raises
+    ------
+    PredictionError
+        As :func:`labbrdf.prediction.predict_brdf` (no wavelength, no n, k there, a file
+        with several rotations or channels).
+    """
+    t, path, wl = _checked_table(bsdf, wavelength_nm)
+    if substrate_index is None:
+        if data is None:
+            raise PredictionError(f"{path}: give the psi/Delta rows or the substrate index")
+        nk: dict[str, Any] = substrate_nk(data, [wl])
+        index = complex(float(nk["n"][0]), float(nk["k"][0]))
+    else:
+        index = complex(substrate_index)
+    ti = np.asarray(t.theta_i_deg, float)
+    az, rad = np.asarray(t.azimuth_deg, float), np.asarray(t.radial_deg, float)
+    tr, pr, above = scatter_to_angles(ti[:, None, None], rad[None, None, :], az[None, :, None])
+    tib = np.broadcast_to(ti[:, None, None], tr.shape)
+    trs = np.where(above, tr, 0.0)
+    lam = wl * 1e-9
+    args = (np.radians(tib), np.radians(trs), np.radians(pr))
+    fx, fy = bragg_frequencies(*args, lam)
+    fr = np.hypot(fx, fy)
+    in_band = above & (fr >= psd.f_min) & (fr <= psd.f_max)
+    pred = np.where(above, brdf(*args, lam, index, psd.psd2d), 0.0)
+    meas = np.where(above, t.values[0, 0], 0.0)
+    geo: dict[str, Any] = {"theta_i_deg": ti, "azimuth_deg": az, "radial_deg": rad}
+    geo["symmetry"] = t.symmetry
+    return RrPrediction(
+        path=path,
+        wavelength_nm=float(wl),
+        n=index.real,
+        k=index.imag,
+        psd=psd,
+        theta_i_deg=ti,
+        theta_r_deg=np.where(above, tr, np.nan),
+        phi_r_deg=pr,
+        above=above,
+        in_band=in_band,
+        measured=meas,
+        predicted=pred,
+        tis_measured=_tis(meas, geo),
+        tis_predicted=_tis(pred, geo),
+        band_measured=_tis(np.where(in_band, meas, 0.0), geo),
+        band_predicted=_tis(np.where(in_band, pred, 0.0), geo),
+    )
+
+
+def _tis(values: NDArray, geo: dict[str, Any]) -> NDArray[np.float64]:
+    """Grid integral of ``(aoi, azimuth, radial)`` values per incidence [1]."""
+    return np.asarray(grid_integral(values[None, None], **geo)["integral"][0, 0], dtype=float)
+
+
+@dataclass(frozen=True)
+class PsdAgreement:
+    """A PSD recovered from a BRDF (a ``rayleigh_rice`` fit) beside a height map's PSD.
+
+    Attributes
+    ----------
+    f : ndarray
+        The map's frequencies [cycles/m] inside the common band.
+    psd_map, psd_brdf : ndarray
+        The map's PSD and the fitted model's at ``f`` [m^4].
+    f_lo, f_hi : float
+        The common band [cycles/m]: the map's band intersected with the frequencies the
+        fitted BRDF points see.
+    form : str
+        The fitted PSD form.
+    source : str
+        The height map's file.
+    """
+
+    f: NDArray[np.float64]
+    psd_map: NDArray[np.float64]
+    psd_brdf: NDArray[np.float64]
+    f_lo: float
+    f_hi: float
+    form: str
+    source: str
+
+    def ratio_quantiles(self) -> tuple[float, float, float]:
+        """10 %, 50 % and 90 % quantiles of PSD(BRDF) / PSD(map) over the common band."""
+        if self.f.size == 0:
+            return (math.nan, math.nan, math.nan)
+        r = self.psd_brdf / self.psd_map
+        lo, med, hi = np.quantile(r, [0.1, 0.5, 0.9])
+        return float(lo), float(med), float(hi)
+
+    def sentence(self) -> str:
+        """How the two PSDs agree, in numbers."""
+        if not self.f_lo < self.f_hi:
+            return (
+                "The height map's band and the spatial frequencies the BRDF sees do not "
+                "overlap: the two PSDs cannot be compared."
+            )
+        if self.f.size == 0:
+            return (
+                "No frequency bin of the height map's PSD lies among the spatial "
+                f"frequencies the BRDF sees ({self.f_lo:.3g} to {self.f_hi:.3g} cycles/m "
+                "within the map's band): the two PSDs cannot be compared."
+            )
+        lo, med, hi = self.ratio_quantiles()
+        return (
+            f"Over their common frequencies, {self.f_lo:.3g} to {self.f_hi:.3g} cycles/m "
+            f"({self.f.size} of the map's frequency bins), the PSD recovered from the BRDF "
+            f"({self.form}) is {med:.3g} times the height map's (median; 10 to 90 % of the "
+            f"bins: {lo:.3g} to {hi:.3g})."
+        )
+
+    def plot(self, ax: Any = None) -> Any:
+        """Both PSDs on log-log axes over the common band; returns the matplotlib Figure."""
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(5.5, 3.8)) if ax is None else ax.figure
+        ax = fig.add_subplot(1, 1, 1) if ax is None else ax
+        ax.loglog(self.f, self.psd_map, "o", ms=3, label=f"height map ({Path(self.source).name})")
+        ax.loglog(self.f, self.psd_brdf, "-", label=f"from the BRDF ({self.form} fit)")
+        ax.set_xlabel("spatial frequency f [cycles/m]")
+        ax.set_ylabel("isotropic 2-D PSD [m$^4$]")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        return fig
+
+
+def bragg_band(
+    theta_i_deg: ArrayLike, theta_r_deg: ArrayLike, phi_r_deg: ArrayLike, wavelength_nm: float
+) -> tuple[float, float]:
+    """Smallest and largest |f| [cycles/m] that measured directions see (Bragg)."""
+    fx, fy = bragg_frequencies(
+        np.radians(np.asarray(theta_i_deg, float)),
+        np.radians(np.asarray(theta_r_deg, float)),
+        np.radians(np.asarray(phi_r_deg, float)),
+        wavelength_nm * 1e-9,
+    )
+    fr = np.hypot(fx, fy)
+    fr = fr[fr > 0]
+    if fr.size == 0:
+        raise PredictionError("no measured direction off the specular one")
+    return float(fr.min()), float(fr.max())
+
+
+def psd_agreement(psd2d: Any, form: str, psd: MapPsd, band: tuple[float, float]) -> PsdAgreement:
+    """Compare a fitted PSD (``psd2d(fx, fy)`` [m^4]) with a map's over their common band.
+
+    ``band`` is what the BRDF sees (:func:`bragg_band`); the common band is its
+    intersection with the map's ``[f_min, f_max]``.
+    """
+    lo, hi = max(band[0], psd.f_min), min(band[1], psd.f_max)
+    sel = (psd.f >= lo) & (psd.f <= hi)
+    f = psd.f[sel]
+    fit = np.asarray(psd2d(f, np.zeros_like(f)), dtype=float)
+    return PsdAgreement(f, psd.psd[sel], fit, lo, hi, form, psd.source)
