@@ -63,7 +63,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "fit_film": ("labbrdf.fitting.film", "fit_film"),
     "FilmFit": ("labbrdf.fitting.film", "FilmFit"),
     "read_height_map": ("labbrdf.adapters.topography", "read_height_map"),
-    "roughness_statistics": ("labbrdf.topography", "roughness_statistics"),
+    "roughness_statistics": ("labbrdf.roughness.topography", "roughness_statistics"),
     "trace": ("labbrdf.tracer", "trace"),
     "TraceConfig": ("labbrdf.tracer", "TraceConfig"),
     "TraceResult": ("labbrdf.tracer", "TraceResult"),
@@ -99,21 +99,26 @@ _MODULES = (
     "prediction",
     "report",
     "samples",
+    "roughness",
     "selection",
-    "smoothness",
     "specular_dop",
-    "surface",
-    "topography",
     "tracer",
     "tracer_setup",
 )
+
+#: modules that moved into a subpackage, still offered by their old name
+_MOVED = {
+    "smoothness": "roughness.smoothness",
+    "surface": "roughness.synthetic",
+    "topography": "roughness.topography",
+}
 
 #: plumbing the modules above share (the command line, JSON sanitising, output safety,
 #: provenance, rich displays): importable by path (``import labbrdf.cli``), not offered
 _PLUMBING = ("cli", "jsonsafe", "outputs", "provenance", "richrepr")
 
-#: the public face, derived from the two tables above; ``dir(labbrdf)`` lists it
-__all__ = ["__version__", *_LAZY, *_MODULES]
+#: the public face, derived from the tables above; ``dir(labbrdf)`` lists it
+__all__ = ["__version__", *_LAZY, *_MODULES, *_MOVED]
 
 # What a type checker and an IDE see of the two tables (at run time __getattr__ imports);
 # tests/test_public_api.py checks that it mirrors them entry for entry.
@@ -135,12 +140,10 @@ if TYPE_CHECKING:
         parallel,
         prediction,
         report,
+        roughness,
         samples,
         selection,
-        smoothness,
         specular_dop,
-        surface,
-        topography,
         tracer,
         tracer_setup,
     )
@@ -155,8 +158,10 @@ if TYPE_CHECKING:
     from .models import ModelError
     from .nk import NkError, bulk_index_at, combined_table, model_with_nk, nk_table, read_nk
     from .report import user_report
+    from .roughness import smoothness, topography
+    from .roughness import synthetic as surface
+    from .roughness.topography import roughness_statistics
     from .selection import select
-    from .topography import roughness_statistics
     from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
     from .tracer_setup import trace_config_from_inputs
 
@@ -167,6 +172,8 @@ def __getattr__(name: str) -> Any:
         value = getattr(importlib.import_module(module), attr)
     elif name in _MODULES:
         value = importlib.import_module(f"labbrdf.{name}")
+    elif name in _MOVED:
+        value = importlib.import_module(f"labbrdf.{_MOVED[name]}")
     else:
         raise AttributeError(f"module 'labbrdf' has no attribute {name!r}")
     globals()[name] = value  # later look-ups skip this function

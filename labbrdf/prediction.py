@@ -11,7 +11,7 @@ does that with **no fitted parameter** on a lab's files of one sample:
 * :func:`specular_dop_comparison`: the tracer's DOP in the specular bin at the ellipsometer's
   angles and (a few of its) wavelengths, the substrate's n, k from the psi/Delta file
   (:func:`labbrdf.nk.nk_at`) and its GGX alpha from the height map (the maximum-likelihood
-  fit of :func:`labbrdf.topography.fit_slope_distribution`), with the batch errors of the
+  fit of :func:`labbrdf.roughness.topography.fit_slope_distribution`), with the batch errors of the
   evaluated estimator (:meth:`labbrdf.TraceResult.dop_stderr`);
 * :func:`predict_brdf`: the tracer's S0 (unpolarized incidence) at every point of a measured
   ``.bsdf`` file, with its Monte Carlo error, the grid integral (TIS) of both, and a sentence
@@ -67,8 +67,8 @@ from .films import coating_of_stack
 from .integrate import grid_integral
 from .microfacet import TabulatedNDF
 from .nk import combined_table, nk_at, ordinary_psi_delta
+from .roughness.topography import SlopeFit, fit_slope_distribution, level, slopes
 from .specular_dop import specular_dop
-from .topography import SlopeFit, fit_slope_distribution, level, slopes
 from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
 
 __all__ = [
@@ -140,13 +140,13 @@ def roughness_alpha(
     pixel_size : float or (float, float)
         Grid spacing [m] (not needed for a HeightMap).
     degree : int
-        Levelling polynomial (1 = mean plane), :func:`labbrdf.topography.level`.
+        Levelling polynomial (1 = mean plane), :func:`labbrdf.roughness.topography.level`.
 
     Returns
     -------
     SlopeFit
         ``alpha`` and its uncertainty ``alpha_u`` [1] (the GGX fit of
-        :func:`labbrdf.topography.fit_slope_distribution`, the alpha that
+        :func:`labbrdf.roughness.topography.fit_slope_distribution`, the alpha that
         :meth:`labbrdf.Substrate.from_surface` gives the tracer).
 
     Raises

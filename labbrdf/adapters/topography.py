@@ -3,7 +3,7 @@
 SurfaceTopography (optional extra ``labbrdf[topography]``) reads the instrument formats
 (Zygo MetroPro ``.dat``, Digital Instruments / Nanoscope ``.di``, Bruker ``.opdx``, Gwyddion,
 plain XYZ and matrix ASCII, ...); it is imported only when a file is read. Everything is
-converted to metres here, so :mod:`labbrdf.topography` never sees a unit.
+converted to metres here, so :mod:`labbrdf.roughness.topography` never sees a unit.
 
 Which files are height maps is this module's knowledge too: :data:`HEIGHT_MAP_FORMATS` lists
 the extensions only topography instruments write, the ones shared with optical exports
@@ -127,7 +127,7 @@ class HeightMap:
     points : (ndarray, ndarray) or None
         A non-uniform line scan's measured positions and heights [m], as in the file
         (``heights`` is then their interpolation onto a uniform grid); None otherwise.
-        :func:`labbrdf.topography.on_measured_points` computes sigma and the RMS slope
+        :func:`labbrdf.roughness.topography.on_measured_points` computes sigma and the RMS slope
         on them.
     """
 
@@ -833,14 +833,14 @@ def topography_statistics(
     require_areal: bool = False,
     **read_kw: Any,
 ) -> Any:
-    """Read a file and compute :func:`labbrdf.topography.roughness_statistics`.
+    """Read a file and compute :func:`labbrdf.roughness.topography.roughness_statistics`.
 
     Parameters
     ----------
     path, channel, read_kw
         As :func:`read_height_map`.
     degree, blocks
-        As :func:`labbrdf.topography.roughness_statistics`.
+        As :func:`labbrdf.roughness.topography.roughness_statistics`.
     require_areal : bool
         Raise :class:`AdapterError` for a profile (when an areal map is needed).
 
@@ -848,7 +848,7 @@ def topography_statistics(
     -------
     RoughnessStats
     """
-    from labbrdf.topography import on_measured_points, roughness_statistics
+    from labbrdf.roughness.topography import on_measured_points, roughness_statistics
 
     hm = read_height_map(path, channel, **read_kw)
     if require_areal and hm.is_profile:

@@ -49,7 +49,7 @@ def test_section_present_and_passes(topo_report: dict) -> None:
 @pytest.mark.parametrize("name", ["di-1.di", "opdx-3.opdx"])
 def test_sigma_matches_roughness_statistics(topo_report: dict, name: str) -> None:
     from labbrdf.adapters.topography import read_height_map
-    from labbrdf.topography import roughness_statistics
+    from labbrdf.roughness.topography import roughness_statistics
 
     hm = read_height_map(topo_report["dir"] / name)
     st = roughness_statistics(hm.heights, hm.pixel_size)
@@ -113,7 +113,7 @@ def test_acf_check_fails_with_printed_exponent(monkeypatch: pytest.MonkeyPatch) 
 @pytest.mark.parametrize("seed", range(5))
 def test_acf_tolerance_holds_over_seeds(seed: int) -> None:
     L, N = surf.ACF_LENGTH_UM, surf.ACF_GRID
-    from labbrdf.surface import gaussian_surface
+    from labbrdf.roughness.synthetic import gaussian_surface
 
     for sigma, cx, cy in surf.ACF_CASES:
         tol = surf.ACF_TOL_FACTOR * math.sqrt(cx * cy) / L
