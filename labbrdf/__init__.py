@@ -69,7 +69,7 @@ _LAZY: dict[str, tuple[str, str]] = {
     "TraceResult": ("labbrdf.tracer", "TraceResult"),
     "Substrate": ("labbrdf.tracer", "Substrate"),
     "Coating": ("labbrdf.tracer", "Coating"),
-    "trace_config_from_inputs": ("labbrdf.tracer_setup", "trace_config_from_inputs"),
+    "trace_config_from_inputs": ("labbrdf.sample", "trace_config_from_inputs"),
     "user_report": ("labbrdf.report", "user_report"),
     "LabbrdfError": ("labbrdf.errors", "LabbrdfError"),
     "AdapterError": ("labbrdf.adapters", "AdapterError"),
@@ -100,10 +100,10 @@ _MODULES = (
     "report",
     "samples",
     "roughness",
+    "sample",
     "selection",
     "specular_dop",
     "tracer",
-    "tracer_setup",
 )
 
 #: modules that moved into a subpackage, still offered by their old name
@@ -111,6 +111,7 @@ _MOVED = {
     "smoothness": "roughness.smoothness",
     "surface": "roughness.synthetic",
     "topography": "roughness.topography",
+    "tracer_setup": "sample.run",
 }
 
 #: plumbing the modules above share (the command line, JSON sanitising, output safety,
@@ -141,11 +142,11 @@ if TYPE_CHECKING:
         prediction,
         report,
         roughness,
+        sample,
         samples,
         selection,
         specular_dop,
         tracer,
-        tracer_setup,
     )
     from .adapters import AdapterError, Inputs, formats, read, read_inputs, read_many
     from .adapters.topography import read_height_map
@@ -161,9 +162,10 @@ if TYPE_CHECKING:
     from .roughness import smoothness, topography
     from .roughness import synthetic as surface
     from .roughness.topography import roughness_statistics
+    from .sample import run as tracer_setup
+    from .sample import trace_config_from_inputs
     from .selection import select
     from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
-    from .tracer_setup import trace_config_from_inputs
 
 
 def __getattr__(name: str) -> Any:

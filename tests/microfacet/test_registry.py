@@ -10,7 +10,7 @@ from scipy import integrate
 
 from labbrdf.microfacet import DISTRIBUTIONS, TabulatedNDF, beckmann, get, ggx, names, registry
 from labbrdf.roughness.topography import fit_slope_distribution
-from labbrdf.tracer_setup import trace_config_from_inputs
+from labbrdf.sample import trace_config_from_inputs
 
 
 @pytest.mark.parametrize("name", list(DISTRIBUTIONS))

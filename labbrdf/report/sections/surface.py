@@ -7,8 +7,12 @@ SurfaceTopography, :mod:`labbrdf.adapters.topography`): the levelled map, its
 autocorrelation and slope histogram with the GGX and Beckmann fits; the roughness
 statistics of :func:`labbrdf.roughness.topography.roughness_statistics` with their block-jackknife
 uncertainties; and, for an areal map, tracer S0 and DOP hemisphere maps of a substrate whose
-facets follow the *measured* slope distribution (:meth:`labbrdf.Substrate.from_surface`)
-beside GGX at the fitted alpha.
+facets follow the *measured* slope distribution (:func:`labbrdf.sample.measured_substrate`)
+beside GGX at the fitted alpha. The substrate's index is measured where the report has it,
+as ``labbrdf trace --nk-from`` takes it (:func:`labbrdf.sample.bulk_index` at the traced
+wavelength): the file given with ``labbrdf report --nk-from``, else the first psi/Delta file
+of the map's sample group that gives a bulk index; else the stated default
+:data:`SUBSTRATE_NK`, named as such.
 
 Validation report (:func:`gaussian_acf_section`): surfaces generated with the corrected
 power spectral density of Dong et al. (2022) eq. (2),
@@ -33,6 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...adapters.topography import HeightMap
+from ...nk import NkError
 from ...roughness.synthetic import gaussian_surface
 from ...roughness.topography import (
     autocorrelation,
@@ -40,11 +45,13 @@ from ...roughness.topography import (
     on_measured_points,
     roughness_statistics,
 )
+from ...sample import bulk_index, measured_substrate
 from ...tracer import Substrate, TraceConfig, TraceResult
 from ...tracer.result import SHOW_COUNT
 from .. import figures
 from ..builder import Builder, Unavailable, slug
 from ..context import Context
+from ..inputs import psi_delta_of_group
 from ..tracing import maps, robust_max, run_trace
 
 __all__ = [
@@ -55,10 +62,11 @@ __all__ = [
     "acf_deviation",
     "gaussian_acf_section",
     "printed_psd_surface",
+    "substrate_index",
     "surface_section",
 ]
 
-#: substrate index of the tracer runs: aluminium at 550 nm (n + ik)
+#: substrate index of the tracer runs where none is measured: aluminium at 550 nm (n + ik)
 SUBSTRATE_NK = (0.96, 6.69)
 #: wavelength [nm] and incidence [deg] of the tracer runs
 TRACE_WAVELENGTH_NM = 550.0
@@ -138,13 +146,46 @@ def _fit_rows(st: Any) -> list[dict[str, Any]]:
     ]
 
 
+def substrate_index(
+    ctx: Context, hm: HeightMap, nk_from: tuple[str, complex] | None = None
+) -> tuple[complex, str]:
+    """The index ``n + ik`` [1] of a map's tracer runs at the traced wavelength, and whence.
+
+    ``nk_from`` (the file given with ``report --nk-from`` and its index) first; else the bulk
+    index of the first psi/Delta file of the map's sample group that has one (one with a
+    film fit is a coated sample: its pseudo-index is the stack's); else :data:`SUBSTRATE_NK`,
+    saying why.
+    """
+    if nk_from is not None:
+        return nk_from[1], f"measured: the bulk n, k of {Path(nk_from[0]).name} (--nk-from)"
+    why = []
+    for path, frame in psi_delta_of_group(ctx, hm.path):
+        if path.name in ctx.film_fits:
+            why.append(f"{path.name} has a film fit (a coated sample)")
+            continue
+        try:
+            index = bulk_index(frame, TRACE_WAVELENGTH_NM, where=path.name)
+        except (NkError, ValueError) as exc:
+            why.append(str(exc))
+            continue
+        return index, (
+            f"measured: the bulk n, k of {path.name}, the psi/Delta of the map's sample "
+            "(combined over its angles, as trace --nk-from)"
+        )
+    n, k = SUBSTRATE_NK
+    reason = "; ".join(why) if why else "no psi/Delta file of the map's sample"
+    return complex(n, k), (
+        f"aluminium at {TRACE_WAVELENGTH_NM:g} nm, a stated default, not measured ({reason}; "
+        "give the sample's psi/Delta with --same-sample or report --nk-from FILE)"
+    )
+
+
 def _trace_pair(
-    ctx: Context, hm: HeightMap, alpha: float
+    ctx: Context, hm: HeightMap, alpha: float, index: complex
 ) -> tuple[TraceResult, TraceResult, float]:
     """Tracer runs for the measured slopes and for GGX at ``alpha``; the table's alpha."""
-    n, k = SUBSTRATE_NK
-    px = (hm.pixel_size[0], hm.pixel_size[-1])
-    measured = Substrate.from_surface(hm.heights, px, n=n, k=k)
+    n, k = index.real, index.imag
+    measured = measured_substrate(hm, index)
     cfg = TraceConfig(
         wavelength_nm=TRACE_WAVELENGTH_NM,
         theta_i_deg=TRACE_THETA_I_DEG,
@@ -160,8 +201,12 @@ def _trace_pair(
     return r_meas, r_ggx, ggx_alpha
 
 
-def surface_section(ctx: Context) -> None:
-    """One part per height map: figure, statistics, slope fits, tracer maps (areal maps)."""
+def surface_section(ctx: Context, nk_from: tuple[str, complex] | None = None) -> None:
+    """One part per height map: figure, statistics, slope fits, tracer maps (areal maps).
+
+    ``nk_from``: a file and its bulk index at the traced wavelength, the substrate of every
+    map's tracer runs (:func:`substrate_index`).
+    """
     b = ctx.b
     if not ctx.height_maps:
         raise Unavailable("no height map or profile among the input files")
@@ -181,11 +226,17 @@ def surface_section(ctx: Context) -> None:
         while sid in used:
             sid += "_"
         used.add(sid)
-        _map_part(ctx, hm, sid, albedo_rows)
+        _map_part(ctx, hm, sid, albedo_rows, nk_from)
     _albedo_table(b, albedo_rows)
 
 
-def _map_part(ctx: Context, hm: HeightMap, sid: str, albedo_rows: list[dict[str, Any]]) -> None:
+def _map_part(
+    ctx: Context,
+    hm: HeightMap,
+    sid: str,
+    albedo_rows: list[dict[str, Any]],
+    nk_from: tuple[str, complex] | None = None,
+) -> None:
     """One height map: statistics, figure, tables, notes; tracer maps for an areal map."""
     b = ctx.b
     name = Path(hm.path).name
@@ -223,7 +274,7 @@ def _map_part(ctx: Context, hm: HeightMap, sid: str, albedo_rows: list[dict[str,
             }
         )
         return
-    _tracer_part(ctx, name, sid, hm, st, albedo_rows)
+    _tracer_part(ctx, name, sid, hm, st, albedo_rows, substrate_index(ctx, hm, nk_from))
 
 
 def _statistics_parts(b: Builder, name: str, sid: str, hm: HeightMap, st: Any) -> None:
@@ -312,11 +363,12 @@ def _tracer_part(
     hm: HeightMap,
     st: Any,
     albedo_rows: list[dict[str, Any]],
+    substrate: tuple[complex, str],
 ) -> None:
     """Tracer S0/DOP maps of the measured slopes beside GGX; their albedo rows."""
     b = ctx.b
-    n, k = SUBSTRATE_NK
-    r_meas, r_ggx, ggx_alpha = _trace_pair(ctx, hm, st.slope_fits.ggx.alpha)
+    index, whence = substrate
+    r_meas, r_ggx, ggx_alpha = _trace_pair(ctx, hm, st.slope_fits.ggx.alpha, index)
     pair = [("measured slopes", r_meas), (f"GGX \u03b1 = {ggx_alpha:.3g}", r_ggx)]
     mp = [maps(r) for _, r in pair]
     b.figure(
@@ -325,7 +377,7 @@ def _tracer_part(
         f"Modelled from the measured slopes (Monte Carlo polarization tracer, "
         f"{TRACE_RAYS} rays per case, seed {ctx.seed}, unpolarized input at theta_i = "
         f"{TRACE_THETA_I_DEG:g} deg, phi_i = 0, {TRACE_WAVELENGTH_NM:g} nm). Substrate: "
-        f"aluminium at 550 nm, N = {n:g} + {k:g}i (a stated default, not measured). Left: "
+        f"N = {_index_text(index)}, {whence}. Left: "
         "facets follow the measured slope histogram (tabulated NDF); right: GGX at "
         "the maximum-likelihood alpha of the same slopes. Top S0 = M00 [sr^-1], "
         "bottom DOP [1]; azimuth phi_r (specular half-plane at 180 deg), radius "
@@ -365,20 +417,26 @@ def _tracer_part(
                 "rays": r.rays,
                 "diff": diff if lab.startswith("measured") else None,
                 "diff_u": diff_u if lab.startswith("measured") else None,
+                "substrate": _index_text(index),
                 "reason": "",
             }
         )
 
 
+def _index_text(index: complex) -> str:
+    """``n + ki`` as the captions print it."""
+    return f"{index.real:.4g} + {index.imag:.4g}i"
+
+
 def _albedo_table(b: Builder, albedo_rows: list[dict[str, Any]]) -> None:
     """The tracer albedos of every areal map (and why a profile has none)."""
-    n, k = SUBSTRATE_NK
     b.table(
         "surface_tracer_albedo",
         "Tracer albedo: measured slope distribution vs GGX at the fitted alpha",
         [
             ("file", "file", ""),
             ("case", "facets", ""),
+            ("substrate", "substrate N [1]", ""),
             ("alpha", "GGX alpha [1]", ".4g"),
             ("albedo", "albedo [1]", ".5f"),
             ("albedo_u", "u(albedo) [1]", ".1e"),
@@ -390,7 +448,8 @@ def _albedo_table(b: Builder, albedo_rows: list[dict[str, Any]]) -> None:
         ],
         albedo_rows,
         caption=f"Directional-hemispherical reflectance for unpolarized light at "
-        f"{TRACE_THETA_I_DEG:g} deg, {TRACE_WAVELENGTH_NM:g} nm, substrate N = {n:g} + {k:g}i. "
+        f"{TRACE_THETA_I_DEG:g} deg, {TRACE_WAVELENGTH_NM:g} nm, on the substrate of each map "
+        "(its figure says where the index comes from). "
         "'measured': tabulated NDF of the map's slopes (the alpha shown is the ML GGX alpha "
         "of those slopes, for reference); 'ggx': GGX at that alpha. u = Monte Carlo "
         "standard error.",

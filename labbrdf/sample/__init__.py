@@ -1,0 +1,36 @@
+"""A sample built from its files: substrate index, facets, coating and tracer run.
+
+The one place where a lab's files of one sample (an ellipsometer file, a height map, a film
+fit) become the tracer's :class:`~labbrdf.Substrate`, :class:`~labbrdf.Coating` and
+:class:`~labbrdf.TraceConfig`. ``labbrdf trace``, the report's tracer maps, the prediction
+(:mod:`labbrdf.prediction`) and the layered model build theirs here:
+
+- :mod:`.index`: the bulk ``n + ik`` of psi/Delta at a wavelength (:func:`bulk_index`,
+  :func:`substrate_nk`);
+- :mod:`.slopes`: a height map read for the tracer, its slope table, a substrate with its
+  facets (:func:`slope_table`, :func:`measured_substrate`);
+- :mod:`.coating`: the coating of a one-layer film fit (:func:`coating_from_fit`,
+  :func:`coating_of_stack`, :func:`film_coating`);
+- :mod:`.run`: a whole run from values and files (:func:`trace_config_from_inputs`).
+
+Errors of files that cannot make a sample are :class:`labbrdf.errors.SampleError` (naming
+the file); arguments that do not fit together :class:`labbrdf.errors.SetupError`.
+"""
+
+from __future__ import annotations
+
+from .coating import coating_from_fit, coating_of_stack, film_coating
+from .index import bulk_index, substrate_nk
+from .run import trace_config_from_inputs
+from .slopes import measured_substrate, slope_table
+
+__all__ = [
+    "bulk_index",
+    "coating_from_fit",
+    "coating_of_stack",
+    "film_coating",
+    "measured_substrate",
+    "slope_table",
+    "substrate_nk",
+    "trace_config_from_inputs",
+]
