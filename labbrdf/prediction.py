@@ -62,9 +62,8 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from .adapters import zemax_bsdf
-from .bsdf_geometry import scatter_to_angles, scatter_to_direction
+from .bsdf_geometry import grid_integral, scatter_to_angles, scatter_to_direction
 from .errors import SampleError
-from .integrate import grid_integral
 from .microfacet import TabulatedNDF
 from .nk import ordinary_psi_delta
 from .roughness.topography import SlopeFit, fit_slope_distribution, level, slopes

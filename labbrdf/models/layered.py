@@ -352,27 +352,25 @@ class Layered(Model):
 
     # ------------------------------------------------------------------ tracing
     def _config(self, p: Mapping[str, float], theta_i_deg: float, wl: float) -> Any:
-        from ..sample import trace_config_from_inputs
+        from ..tracer import Coating, Substrate, TraceConfig
 
         n_coat, a_top = float(p["n_coat"]), float(p["alpha_top"])
         for name, v, lo in (("n_coat", n_coat, 0.0), ("alpha_top", a_top, 0.0)):
             if not (math.isfinite(v) and v > lo):
                 raise ModelError(f"layered parameter {name!r} must be > {lo:g}; got {v!r}")
         thick = float(p["thickness_nm"]) if self._coherent else self._thickness
-        base: dict[str, Any]
+        coat = Coating(n=n_coat, k=self._coating_k, thickness_nm=thick, alpha=a_top)
         if self._base == "diffuse":
-            base = {"base_albedo": float(p["albedo"])}
+            sub = Substrate.lambertian(float(p["albedo"]))
         else:
             a_sub = a_top if self._coherent else float(p["alpha_sub"])
-            base = {"substrate_index": complex(*self._nk), "alpha": a_sub}
+            sub = Substrate(n=self._nk[0], k=self._nk[1], alpha=a_sub)
         assert self._grid is not None
-        return trace_config_from_inputs(
-            wl,
-            theta_i_deg,
-            **base,
-            coating_index=complex(n_coat, self._coating_k),
-            thickness_nm=thick,
-            coating_alpha=a_top,
+        return TraceConfig(
+            wavelength_nm=wl,
+            theta_i_deg=theta_i_deg,
+            substrate=sub,
+            coating=coat,
             rays=self._rays,
             seed=self._seed,
             scattering="single",

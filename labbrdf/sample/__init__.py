@@ -2,8 +2,10 @@
 
 The one place where a lab's files of one sample (an ellipsometer file, a height map, a film
 fit) become the tracer's :class:`~labbrdf.Substrate`, :class:`~labbrdf.Coating` and
-:class:`~labbrdf.TraceConfig`. ``labbrdf trace``, the report's tracer maps, the prediction
-(:mod:`labbrdf.prediction`) and the layered model build theirs here:
+:class:`~labbrdf.TraceConfig`. ``labbrdf trace``, the report's tracer maps and the prediction
+(:mod:`labbrdf.prediction`) build theirs here. The layered BRDF model, which reads no file,
+builds its runs from values with the same constructors; it sits below this package, which
+reads files through the optical-constant tables (:mod:`labbrdf.nk`) above the models.
 
 - :mod:`.index`: the bulk ``n + ik`` of psi/Delta at a wavelength (:func:`bulk_index`,
   :func:`substrate_nk`);

@@ -11,9 +11,9 @@
   traced wavelength (:func:`labbrdf.sample.coating_from_fit`), with its top's roughness as an
   alpha (default: the substrate's) or a measured map.
 
-``labbrdf trace`` is this function behind its options, and the layered model builds its
-runs with it. Arguments that do not fit together raise :class:`labbrdf.errors.SetupError`,
-whose message names the keywords (the command line spells them as its options).
+``labbrdf trace`` is this function behind its options. Arguments that do not fit together
+raise :class:`labbrdf.errors.SetupError`, whose message names the keywords (the command line
+spells them as its options).
 """
 
 from __future__ import annotations
