@@ -66,9 +66,8 @@ from .bsdf_geometry import grid_integral, scatter_to_angles, scatter_to_directio
 from .errors import SampleError
 from .microfacet import TabulatedNDF
 from .nk import ordinary_psi_delta
-from .roughness.topography import SlopeFit, fit_slope_distribution, level, slopes
-from .sample import film_coating, slope_table, substrate_nk
-from .sample.slopes import areal
+from .roughness.topography import SlopeFit
+from .sample import film_coating, roughness_alpha, slope_table, substrate_nk
 from .specular_dop import specular_dop
 from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
 
@@ -106,38 +105,6 @@ PredictionError = SampleError
 
 
 # --------------------------------------------------------------------------- inputs
-
-
-def roughness_alpha(
-    heights: Any, pixel_size: float | Sequence[float] | None = None, *, degree: int = 1
-) -> SlopeFit:
-    """GGX roughness of a height map: the maximum-likelihood fit of its slopes.
-
-    Parameters
-    ----------
-    heights : ndarray (M, N) or HeightMap
-        Heights [m] (NaN = missing), or a :class:`labbrdf.adapters.topography.HeightMap`.
-    pixel_size : float or (float, float)
-        Grid spacing [m] (not needed for a HeightMap).
-    degree : int
-        Levelling polynomial (1 = mean plane), :func:`labbrdf.roughness.topography.level`.
-
-    Returns
-    -------
-    SlopeFit
-        ``alpha`` and its uncertainty ``alpha_u`` [1] (the GGX fit of
-        :func:`labbrdf.roughness.topography.fit_slope_distribution`, the alpha that
-        :meth:`labbrdf.Substrate.from_surface` gives the tracer).
-
-    Raises
-    ------
-    PredictionError
-        A profile (a slope distribution of an isotropic surface needs both axes) or a map
-        without a pixel size.
-    """
-    z, px, _ = areal(heights, pixel_size, "the tracer's roughness")
-    sx, sy = slopes(level(z, degree), px)
-    return fit_slope_distribution(sx, sy).ggx
 
 
 def _psi_rows(data: pd.DataFrame) -> pd.DataFrame:

@@ -9,8 +9,9 @@ reads files through the optical-constant tables (:mod:`labbrdf.nk`) above the mo
 
 - :mod:`.index`: the bulk ``n + ik`` of psi/Delta at a wavelength (:func:`bulk_index`,
   :func:`substrate_nk`);
-- :mod:`.slopes`: a height map read for the tracer, its slope table, a substrate with its
-  facets (:func:`slope_table`, :func:`measured_substrate`);
+- :mod:`.slopes`: a height map read for the tracer, its GGX alpha and slope table, a
+  substrate with its facets (:func:`roughness_alpha`, :func:`slope_table`,
+  :func:`measured_substrate`);
 - :mod:`.coating`: the coating of a one-layer film fit (:func:`coating_from_fit`,
   :func:`coating_of_stack`, :func:`film_coating`);
 - :mod:`.run`: a whole run from values and files (:func:`trace_config_from_inputs`).
@@ -24,7 +25,7 @@ from __future__ import annotations
 from .coating import coating_from_fit, coating_of_stack, film_coating
 from .index import bulk_index, substrate_nk
 from .run import trace_config_from_inputs
-from .slopes import measured_substrate, slope_table
+from .slopes import measured_substrate, roughness_alpha, slope_table
 
 __all__ = [
     "bulk_index",
@@ -32,6 +33,7 @@ __all__ = [
     "coating_of_stack",
     "film_coating",
     "measured_substrate",
+    "roughness_alpha",
     "slope_table",
     "substrate_nk",
     "trace_config_from_inputs",

@@ -4,6 +4,8 @@
   on);
 - :func:`pitch` and :func:`areal`: the grid spacing of a map, and a map's heights checked
   areal;
+- :func:`roughness_alpha`: the GGX alpha of an areal map (the maximum-likelihood fit of its
+  slopes);
 - :func:`slope_table`: the measured slope table of an areal map
   (:meth:`labbrdf.Substrate.from_surface`: mean plane removed, 64 slope cells per axis);
 - :func:`measured_substrate`: a substrate of index ``n + ik`` whose facets follow a map's
@@ -24,6 +26,7 @@ from numpy.typing import NDArray
 from ..adapters.topography import HeightMap, read_height_map
 from ..errors import SampleError, SetupError, escaped
 from ..microfacet import DISTRIBUTIONS, TabulatedNDF
+from ..roughness.topography import SlopeFit, fit_slope_distribution, level, slopes
 from ..tracer.config import Substrate
 
 __all__ = [
@@ -32,6 +35,7 @@ __all__ = [
     "height_map",
     "measured_substrate",
     "pitch",
+    "roughness_alpha",
     "slope_table",
 ]
 
@@ -117,6 +121,38 @@ def areal(
         raise SampleError("pixel_size is needed for a plain height array")
     px = np.broadcast_to(np.asarray(pixel_size, float), (2,))
     return z, (float(px[0]), float(px[1])), where
+
+
+def roughness_alpha(
+    heights: Any, pixel_size: float | Sequence[float] | None = None, *, degree: int = 1
+) -> SlopeFit:
+    """GGX roughness of a height map: the maximum-likelihood fit of its slopes.
+
+    Parameters
+    ----------
+    heights : ndarray (M, N) or HeightMap
+        Heights [m] (NaN = missing), or a :class:`labbrdf.adapters.topography.HeightMap`.
+    pixel_size : float or (float, float)
+        Grid spacing [m] (not needed for a HeightMap).
+    degree : int
+        Levelling polynomial (1 = mean plane), :func:`labbrdf.roughness.topography.level`.
+
+    Returns
+    -------
+    SlopeFit
+        ``alpha`` and its uncertainty ``alpha_u`` [1] (the GGX fit of
+        :func:`labbrdf.roughness.topography.fit_slope_distribution`, the alpha that
+        :meth:`labbrdf.Substrate.from_surface` gives the tracer).
+
+    Raises
+    ------
+    labbrdf.errors.SampleError
+        A profile (a slope distribution of an isotropic surface needs both axes) or a map
+        without a pixel size.
+    """
+    z, px, _ = areal(heights, pixel_size, "the tracer's roughness")
+    sx, sy = slopes(level(z, degree), px)
+    return fit_slope_distribution(sx, sy).ggx
 
 
 def slope_table(heights: Any, pixel_size: float | Sequence[float] | None = None) -> TabulatedNDF:
