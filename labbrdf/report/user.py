@@ -200,7 +200,7 @@ def user_report(
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
     nk_file = [] if nk_from is None else [Path(nk_from)]
-    write_report(out, b.results, page, inputs=paths + model_file + nk_file)
+    write_report(out, b.results, page, inputs=[*paths, *model_file, *nk_file])
     b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
     return code
 
