@@ -2,9 +2,9 @@
 
 Prints:
 
-1. :func:`labbrdf.topography.roughness_statistics` of a 1024 x 1024 Gaussian map (median of
-   5 runs), with the default 5 x 5 jackknife tiles and without uncertainties, and the peak
-   of NumPy's allocations (tracemalloc) in multiples of the float64 heights;
+1. :func:`labbrdf.roughness.topography.roughness_statistics` of a 1024 x 1024 Gaussian map
+   (median of 5 runs), with the default 5 x 5 jackknife tiles and without uncertainties, and
+   the peak of NumPy's allocations (tracemalloc) in multiples of the float64 heights;
 2. tracer throughput (rays/s, one process, best of 3) for rough Al (alpha 0.2, 45 deg,
    single and multiple scattering) with GGX and with the GGX table
    (``TabulatedNDF.ggx(0.2)``) and with a table measured from a generated surface, in the
@@ -21,8 +21,8 @@ import time
 import tracemalloc
 
 from labbrdf.microfacet import TabulatedNDF
-from labbrdf.surface import gaussian_surface
-from labbrdf.topography import roughness_statistics
+from labbrdf.roughness.synthetic import gaussian_surface
+from labbrdf.roughness.topography import roughness_statistics
 from labbrdf.tracer import Substrate, TraceConfig, trace
 
 

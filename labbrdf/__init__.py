@@ -64,14 +64,14 @@ _LAZY: dict[str, tuple[str, str]] = {
     "fit_film": ("labbrdf.fitting.film", "fit_film"),
     "FilmFit": ("labbrdf.fitting.film", "FilmFit"),
     "read_height_map": ("labbrdf.adapters.topography", "read_height_map"),
-    "roughness_statistics": ("labbrdf.topography", "roughness_statistics"),
+    "roughness_statistics": ("labbrdf.roughness.topography", "roughness_statistics"),
     "psd": ("labbrdf.roughness.psd_result", "psd"),
     "trace": ("labbrdf.tracer", "trace"),
     "TraceConfig": ("labbrdf.tracer", "TraceConfig"),
     "TraceResult": ("labbrdf.tracer", "TraceResult"),
     "Substrate": ("labbrdf.tracer", "Substrate"),
     "Coating": ("labbrdf.tracer", "Coating"),
-    "trace_config_from_inputs": ("labbrdf.tracer_setup", "trace_config_from_inputs"),
+    "trace_config_from_inputs": ("labbrdf.sample", "trace_config_from_inputs"),
     "user_report": ("labbrdf.report", "user_report"),
     "LabbrdfError": ("labbrdf.errors", "LabbrdfError"),
     "AdapterError": ("labbrdf.adapters", "AdapterError"),
@@ -102,22 +102,27 @@ _MODULES = (
     "report",
     "roughness",
     "rr_prediction",
+    "sample",
     "samples",
     "selection",
-    "smoothness",
     "specular_dop",
-    "surface",
-    "topography",
     "tracer",
-    "tracer_setup",
 )
+
+#: modules that moved into a subpackage, still offered by their old name
+_MOVED = {
+    "smoothness": "roughness.smoothness",
+    "surface": "roughness.synthetic",
+    "topography": "roughness.topography",
+    "tracer_setup": "sample.run",
+}
 
 #: plumbing the modules above share (the command line, JSON sanitising, output safety,
 #: provenance, rich displays): importable by path (``import labbrdf.cli``), not offered
 _PLUMBING = ("cli", "jsonsafe", "outputs", "provenance", "richrepr")
 
-#: the public face, derived from the two tables above; ``dir(labbrdf)`` lists it
-__all__ = ["__version__", *_LAZY, *_MODULES]
+#: the public face, derived from the tables above; ``dir(labbrdf)`` lists it
+__all__ = ["__version__", *_LAZY, *_MODULES, *_MOVED]
 
 # What a type checker and an IDE see of the two tables (at run time __getattr__ imports);
 # tests/test_public_api.py checks that it mirrors them entry for entry.
@@ -141,14 +146,11 @@ if TYPE_CHECKING:
         report,
         roughness,
         rr_prediction,
+        sample,
         samples,
         selection,
-        smoothness,
         specular_dop,
-        surface,
-        topography,
         tracer,
-        tracer_setup,
     )
     from .adapters import AdapterError, Inputs, formats, read, read_inputs, read_many
     from .adapters.topography import read_height_map
@@ -162,10 +164,13 @@ if TYPE_CHECKING:
     from .nk import NkError, bulk_index_at, combined_table, model_with_nk, nk_table, read_nk
     from .report import user_report
     from .roughness.psd_result import psd
+    from .roughness import smoothness, topography
+    from .roughness import synthetic as surface
+    from .roughness.topography import roughness_statistics
+    from .sample import run as tracer_setup
+    from .sample import trace_config_from_inputs
     from .selection import select
-    from .topography import roughness_statistics
     from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
-    from .tracer_setup import trace_config_from_inputs
 
 
 def __getattr__(name: str) -> Any:
@@ -174,6 +179,8 @@ def __getattr__(name: str) -> Any:
         value = getattr(importlib.import_module(module), attr)
     elif name in _MODULES:
         value = importlib.import_module(f"labbrdf.{name}")
+    elif name in _MOVED:
+        value = importlib.import_module(f"labbrdf.{_MOVED[name]}")
     else:
         raise AttributeError(f"module 'labbrdf' has no attribute {name!r}")
     globals()[name] = value  # later look-ups skip this function

@@ -10,9 +10,9 @@ seen by an observer looking back at the sample along the specular direction, so 
 is the +y side when the source is at phi_i = 0. The conversions here are exact (unit
 vectors, no small-angle approximation); ``docs/bsdf.md`` has the derivation. The reader
 (:mod:`labbrdf.adapters.zemax_bsdf`), the writer (:mod:`labbrdf.bsdf_export`) and the grid
-quadrature (:func:`labbrdf.integrate.grid_integral`) share them, and the cells each grid
-node owns (:func:`radial_weights`, :func:`azimuth_weights`): the quadrature's weights, and
-the reader's average over the polar cap.
+quadrature (:func:`grid_integral`, the total integrated scatter of a grid) share them, and
+the cells each grid node owns (:func:`radial_weights`, :func:`azimuth_weights`): the
+quadrature's weights, and the reader's average over the polar cap.
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ __all__ = [
     "SYMMETRIES",
     "angles_to_scatter",
     "azimuth_weights",
+    "grid_integral",
     "radial_weights",
     "scatter_to_angles",
     "scatter_to_direction",
@@ -223,3 +224,119 @@ def azimuth_weights(azimuth_deg: ArrayLike, symmetry: str) -> NDArray[np.float64
     ext = np.concatenate([[a[-1] - 360.0], a, [a[0] + 360.0]])
     mid = 0.5 * (ext[1:] + ext[:-1])
     return np.radians(np.diff(mid))
+
+
+# ----------------------------------------------------------------------------- scatter grid
+def _cos_weights(
+    theta_i_deg: NDArray[np.float64],
+    azimuth_deg: NDArray[np.float64],
+    radial_deg: NDArray[np.float64],
+    symmetry: str,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Solid-angle weights and projected cosines of the grid points.
+
+    Returns ``(w, cos_r)``: weights [sr] and cosines (0 below the horizon), each shaped
+    ``(aoi, azimuth, radial)``.
+    """
+    w = azimuth_weights(azimuth_deg, symmetry)[:, None] * radial_weights(radial_deg)
+    ti = theta_i_deg[:, None, None]
+    d = scatter_to_direction(ti, radial_deg[None, None, :], azimuth_deg[None, :, None])
+    return np.broadcast_to(w, d.shape[1:]), np.clip(d[2], 0.0, None)
+
+
+def _grid_axes(
+    values: ArrayLike,
+    theta_i_deg: ArrayLike,
+    azimuth_deg: ArrayLike,
+    radial_deg: ArrayLike,
+    symmetry: str,
+) -> tuple[NDArray[np.float64], ...]:
+    """The arguments of :func:`grid_integral` as float arrays, checked against each other."""
+    if symmetry not in SYMMETRIES:
+        raise ValueError(f"symmetry {symmetry!r}: expected one of {list(SYMMETRIES)}")
+    v = np.asarray(values, dtype=float)
+    ti, az, rad = (
+        np.atleast_1d(np.asarray(x, float)) for x in (theta_i_deg, azimuth_deg, radial_deg)
+    )
+    for name, a in (("theta_i_deg", ti), ("azimuth_deg", az), ("radial_deg", rad)):
+        if a.ndim != 1 or a.size == 0:
+            raise ValueError(f"{name}: expected a non-empty 1-D list of angles [deg]")
+    if v.ndim != 5 or v.shape[2:] != (ti.size, az.size, rad.size):
+        raise ValueError(
+            "values: expected shape (rotation, channel, "
+            f"{ti.size}, {az.size}, {rad.size}) from the grid, got {v.shape}"
+        )
+    return v, ti, az, rad
+
+
+def grid_integral(
+    values: ArrayLike,
+    theta_i_deg: ArrayLike,
+    azimuth_deg: ArrayLike,
+    radial_deg: ArrayLike,
+    *,
+    symmetry: str = "Asymmetrical",
+    tis: ArrayLike | None = None,
+) -> dict[str, NDArray[np.float64]]:
+    """Hemispherical integral ``int f cos(theta_r) d omega`` of BSDF blocks on a scatter grid.
+
+    Parameters
+    ----------
+    values : array_like
+        ``(rotation, channel, aoi, azimuth, radial)`` BSDF [sr^-1] (0 below the horizon or
+        not: points below it do not count).
+    theta_i_deg, azimuth_deg, radial_deg : array_like
+        The grid [deg]: specular angles, scatter azimuths and radial angles about the
+        specular direction (:func:`labbrdf.bsdf_geometry.scatter_to_direction`).
+    symmetry : {"PlaneSymmetrical", "Asymmetrical", "Asymmetrical4D"}
+        Grid symmetry; a PlaneSymmetrical half (azimuths 0..180) counts twice.
+    tis : array_like, optional
+        ``(rotation, channel, aoi)`` total integrated scatter to compare with (e.g. a
+        file's); NaN when not given.
+
+    Returns
+    -------
+    dict
+        ``integral`` ``(rotation, channel, aoi)`` [1]; ``uncovered_fraction`` ``(aoi,)``: the
+        fraction of the projected solid angle of the hemisphere (pi sr) that the grid does
+        not cover; ``tis`` (NaN when unknown) and ``ratio`` = tis / integral.
+
+    Raises
+    ------
+    ValueError
+        An unknown symmetry, an empty or multi-dimensional angle list, or values whose
+        shape does not fit the grid.
+
+    Notes
+    -----
+    Each grid node owns a cell bounded by the midpoints to its neighbours (the end nodes
+    own half cells; a full azimuth circle wraps; a PlaneSymmetrical half counts twice).
+    The solid angle of a cell about the specular direction is exactly
+    ``(cos r_lo - cos r_hi) (a_hi - a_lo)``, and the projection factor is ``cos theta_r`` at
+    the node, 0 below the horizon (the definition of the hemispherical reflectance, e.g.
+    Nicodemus et al., NBS Monograph 160, 1977). This is a first-order rule, so a file's
+    TIS (integrated by the instrument on its own, finer native sampling) need not agree:
+    on the Radiant imaging-sphere export the TIS is 4-20 % above this integral. Causes:
+    coarse radial steps (10 deg beyond 20 deg) across a curved lobe, the part of the
+    hemisphere beyond the largest radial angle that the grid does not cover
+    (``uncovered_fraction``), the zeros the instrument writes at directions next to the
+    horizon, and the cells that straddle the horizon (cut at the node, not at z = 0).
+    """
+    v, ti, az, rad = _grid_axes(values, theta_i_deg, azimuth_deg, radial_deg, symmetry)
+    if tis is None:
+        tis_a = np.full(v.shape[:3], np.nan)
+    else:
+        tis_a = np.asarray(tis, float)
+        if tis_a.shape != v.shape[:3]:
+            raise ValueError(f"tis: expected shape {v.shape[:3]}, got {tis_a.shape}")
+    w, cz = _cos_weights(ti, az, rad, symmetry)
+    integral = np.einsum("rcazq,azq->rca", v, w * cz)
+    covered = np.sum(w * cz, axis=(1, 2)) / np.pi
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = tis_a / integral
+    return {
+        "integral": integral,
+        "uncovered_fraction": 1.0 - covered,
+        "tis": tis_a,
+        "ratio": ratio,
+    }

@@ -19,7 +19,7 @@ error                                            also a
 
 from __future__ import annotations
 
-__all__ = ["LabbrdfError", "SetupError"]
+__all__ = ["LabbrdfError", "SampleError", "SetupError"]
 
 
 class LabbrdfError(Exception):
@@ -54,6 +54,13 @@ class SetupError(LabbrdfError, ValueError):
     def spelled(self, names: dict[str, str]) -> str:
         """The message with each ``{keyword}`` replaced by ``names[keyword]`` (or itself)."""
         return self.template.format_map(_Spelled(names))
+
+
+class SampleError(LabbrdfError, ValueError):
+    """Files or values that cannot make a sample's substrate, coating or tracer run.
+
+    The message names the file and what is missing.
+    """
 
 
 def escaped(text: object) -> str:

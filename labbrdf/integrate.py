@@ -1,9 +1,11 @@
 """Hemispherical integrals: reflectance, energy and reciprocity checks, grid quadrature.
 
-The models' hemispherical reflectance and its checks, and the quadrature of tabulated BSDF
-values on a scatter grid about the specular direction (:func:`grid_integral`).
+The models' hemispherical reflectance and its checks; the quadrature of tabulated BSDF
+values on a scatter grid about the specular direction (:func:`grid_integral`) lives with the
+grid's geometry in :mod:`labbrdf.bsdf_geometry`, below the file readers, and is offered here
+too.
 
-Physics layer: numpy + scipy only. Angles at the public boundary are in degrees.
+Model layer: numpy + scipy and :mod:`labbrdf.models`. Angles at the public boundary are in degrees.
 
 References
 ----------
@@ -21,7 +23,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import brentq, minimize_scalar
 
-from .bsdf_geometry import SYMMETRIES, azimuth_weights, radial_weights, scatter_to_direction
+from .bsdf_geometry import grid_integral
 from .models.base import Model, Parameters
 from .models.smooth3 import smooth3_hemispherical, smooth3_lobe_integral
 
@@ -387,119 +389,3 @@ def reciprocity_defect(
     return ReciprocityDefect(
         float(d[k]), float(np.max(rel)), float(ti[k]), float(tr[k]), float(pr[k])
     )
-
-
-# ----------------------------------------------------------------------------- scatter grid
-def _cos_weights(
-    theta_i_deg: NDArray[np.float64],
-    azimuth_deg: NDArray[np.float64],
-    radial_deg: NDArray[np.float64],
-    symmetry: str,
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Solid-angle weights and projected cosines of the grid points.
-
-    Returns ``(w, cos_r)``: weights [sr] and cosines (0 below the horizon), each shaped
-    ``(aoi, azimuth, radial)``.
-    """
-    w = azimuth_weights(azimuth_deg, symmetry)[:, None] * radial_weights(radial_deg)
-    ti = theta_i_deg[:, None, None]
-    d = scatter_to_direction(ti, radial_deg[None, None, :], azimuth_deg[None, :, None])
-    return np.broadcast_to(w, d.shape[1:]), np.clip(d[2], 0.0, None)
-
-
-def _grid_axes(
-    values: ArrayLike,
-    theta_i_deg: ArrayLike,
-    azimuth_deg: ArrayLike,
-    radial_deg: ArrayLike,
-    symmetry: str,
-) -> tuple[NDArray[np.float64], ...]:
-    """The arguments of :func:`grid_integral` as float arrays, checked against each other."""
-    if symmetry not in SYMMETRIES:
-        raise ValueError(f"symmetry {symmetry!r}: expected one of {list(SYMMETRIES)}")
-    v = np.asarray(values, dtype=float)
-    ti, az, rad = (
-        np.atleast_1d(np.asarray(x, float)) for x in (theta_i_deg, azimuth_deg, radial_deg)
-    )
-    for name, a in (("theta_i_deg", ti), ("azimuth_deg", az), ("radial_deg", rad)):
-        if a.ndim != 1 or a.size == 0:
-            raise ValueError(f"{name}: expected a non-empty 1-D list of angles [deg]")
-    if v.ndim != 5 or v.shape[2:] != (ti.size, az.size, rad.size):
-        raise ValueError(
-            "values: expected shape (rotation, channel, "
-            f"{ti.size}, {az.size}, {rad.size}) from the grid, got {v.shape}"
-        )
-    return v, ti, az, rad
-
-
-def grid_integral(
-    values: ArrayLike,
-    theta_i_deg: ArrayLike,
-    azimuth_deg: ArrayLike,
-    radial_deg: ArrayLike,
-    *,
-    symmetry: str = "Asymmetrical",
-    tis: ArrayLike | None = None,
-) -> dict[str, NDArray[np.float64]]:
-    """Hemispherical integral ``int f cos(theta_r) d omega`` of BSDF blocks on a scatter grid.
-
-    Parameters
-    ----------
-    values : array_like
-        ``(rotation, channel, aoi, azimuth, radial)`` BSDF [sr^-1] (0 below the horizon or
-        not: points below it do not count).
-    theta_i_deg, azimuth_deg, radial_deg : array_like
-        The grid [deg]: specular angles, scatter azimuths and radial angles about the
-        specular direction (:func:`labbrdf.bsdf_geometry.scatter_to_direction`).
-    symmetry : {"PlaneSymmetrical", "Asymmetrical", "Asymmetrical4D"}
-        Grid symmetry; a PlaneSymmetrical half (azimuths 0..180) counts twice.
-    tis : array_like, optional
-        ``(rotation, channel, aoi)`` total integrated scatter to compare with (e.g. a
-        file's); NaN when not given.
-
-    Returns
-    -------
-    dict
-        ``integral`` ``(rotation, channel, aoi)`` [1]; ``uncovered_fraction`` ``(aoi,)``: the
-        fraction of the projected solid angle of the hemisphere (pi sr) that the grid does
-        not cover; ``tis`` (NaN when unknown) and ``ratio`` = tis / integral.
-
-    Raises
-    ------
-    ValueError
-        An unknown symmetry, an empty or multi-dimensional angle list, or values whose
-        shape does not fit the grid.
-
-    Notes
-    -----
-    Each grid node owns a cell bounded by the midpoints to its neighbours (the end nodes
-    own half cells; a full azimuth circle wraps; a PlaneSymmetrical half counts twice).
-    The solid angle of a cell about the specular direction is exactly
-    ``(cos r_lo - cos r_hi) (a_hi - a_lo)``, and the projection factor is ``cos theta_r`` at
-    the node, 0 below the horizon (the definition of the hemispherical reflectance, e.g.
-    Nicodemus et al., NBS Monograph 160, 1977). This is a first-order rule, so a file's
-    TIS (integrated by the instrument on its own, finer native sampling) need not agree:
-    on the Radiant imaging-sphere export the TIS is 4-20 % above this integral. Causes:
-    coarse radial steps (10 deg beyond 20 deg) across a curved lobe, the part of the
-    hemisphere beyond the largest radial angle that the grid does not cover
-    (``uncovered_fraction``), the zeros the instrument writes at directions next to the
-    horizon, and the cells that straddle the horizon (cut at the node, not at z = 0).
-    """
-    v, ti, az, rad = _grid_axes(values, theta_i_deg, azimuth_deg, radial_deg, symmetry)
-    if tis is None:
-        tis_a = np.full(v.shape[:3], np.nan)
-    else:
-        tis_a = np.asarray(tis, float)
-        if tis_a.shape != v.shape[:3]:
-            raise ValueError(f"tis: expected shape {v.shape[:3]}, got {tis_a.shape}")
-    w, cz = _cos_weights(ti, az, rad, symmetry)
-    integral = np.einsum("rcazq,azq->rca", v, w * cz)
-    covered = np.sum(w * cz, axis=(1, 2)) / np.pi
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = tis_a / integral
-    return {
-        "integral": integral,
-        "uncovered_fraction": 1.0 - covered,
-        "tis": tis_a,
-        "ratio": ratio,
-    }

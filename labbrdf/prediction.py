@@ -11,7 +11,7 @@ does that with **no fitted parameter** on a lab's files of one sample:
 * :func:`specular_dop_comparison`: the tracer's DOP in the specular bin at the ellipsometer's
   angles and (a few of its) wavelengths, the substrate's n, k from the psi/Delta file
   (:func:`labbrdf.nk.nk_at`) and its GGX alpha from the height map (the maximum-likelihood
-  fit of :func:`labbrdf.topography.fit_slope_distribution`), with the batch errors of the
+  fit of :func:`labbrdf.roughness.topography.fit_slope_distribution`), with the batch errors of the
   evaluated estimator (:meth:`labbrdf.TraceResult.dop_stderr`);
 * :func:`predict_brdf`: the tracer's S0 (unpolarized incidence) at every point of a measured
   ``.bsdf`` file, with its Monte Carlo error, the grid integral (TIS) of both, and a sentence
@@ -62,13 +62,13 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from .adapters import zemax_bsdf
-from .bsdf_geometry import scatter_to_angles, scatter_to_direction
-from .films import coating_of_stack
-from .integrate import grid_integral
+from .bsdf_geometry import grid_integral, scatter_to_angles, scatter_to_direction
+from .errors import SampleError
 from .microfacet import TabulatedNDF
-from .nk import combined_table, nk_at, ordinary_psi_delta
+from .nk import ordinary_psi_delta
+from .roughness.topography import SlopeFit
+from .sample import film_coating, roughness_alpha, slope_table, substrate_nk
 from .specular_dop import specular_dop
-from .topography import SlopeFit, fit_slope_distribution, level, slopes
 from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
 
 __all__ = [
@@ -99,65 +99,12 @@ MIN_LOBE_DEG = 3.0
 MapFn = Callable[..., Iterable[Any]]
 
 
-class PredictionError(ValueError):
-    """Inputs that cannot make a prediction (message names the file and what is missing)."""
+#: inputs that cannot make a prediction (the message names the file and what is missing):
+#: the errors of a sample that cannot be built from its files
+PredictionError = SampleError
 
 
 # --------------------------------------------------------------------------- inputs
-
-
-def _areal(
-    heights: Any, pixel_size: float | Sequence[float] | None, what: str
-) -> tuple[NDArray, tuple[float, float], str]:
-    """Heights [m], pitch per axis [m] and a ``"file: "`` prefix of a map or an array.
-
-    Raises PredictionError for a profile (``what`` needs an areal map) or an array without
-    a pixel size.
-    """
-    where = ""
-    if hasattr(heights, "heights") and hasattr(heights, "pixel_size"):
-        where = f"{heights.path}: "
-        pixel_size = heights.pixel_size
-        heights = heights.heights
-    z = np.asarray(heights, dtype=float)
-    if z.ndim != 2:
-        raise PredictionError(f"{where}a line profile; {what} needs an areal height map (2-D)")
-    if pixel_size is None:
-        raise PredictionError("pixel_size is needed for a plain height array")
-    px = np.broadcast_to(np.asarray(pixel_size, float), (2,))
-    return z, (float(px[0]), float(px[1])), where
-
-
-def roughness_alpha(
-    heights: Any, pixel_size: float | Sequence[float] | None = None, *, degree: int = 1
-) -> SlopeFit:
-    """GGX roughness of a height map: the maximum-likelihood fit of its slopes.
-
-    Parameters
-    ----------
-    heights : ndarray (M, N) or HeightMap
-        Heights [m] (NaN = missing), or a :class:`labbrdf.adapters.topography.HeightMap`.
-    pixel_size : float or (float, float)
-        Grid spacing [m] (not needed for a HeightMap).
-    degree : int
-        Levelling polynomial (1 = mean plane), :func:`labbrdf.topography.level`.
-
-    Returns
-    -------
-    SlopeFit
-        ``alpha`` and its uncertainty ``alpha_u`` [1] (the GGX fit of
-        :func:`labbrdf.topography.fit_slope_distribution`, the alpha that
-        :meth:`labbrdf.Substrate.from_surface` gives the tracer).
-
-    Raises
-    ------
-    PredictionError
-        A profile (a slope distribution of an isotropic surface needs both axes) or a map
-        without a pixel size.
-    """
-    z, px, _ = _areal(heights, pixel_size, "the tracer's roughness")
-    sx, sy = slopes(level(z, degree), px)
-    return fit_slope_distribution(sx, sy).ggx
 
 
 def _psi_rows(data: pd.DataFrame) -> pd.DataFrame:
@@ -240,123 +187,6 @@ def ellipsometer_dop(data: pd.DataFrame, *, depolarizer: str = "mixed") -> pd.Da
             "dop_sigma": r.sigma,
         }
     )
-
-
-def substrate_nk(
-    data: pd.DataFrame, wavelength_nm: float | Sequence[float] | NDArray[np.float64]
-) -> dict[str, Any]:
-    """The substrate's n, k at given wavelengths from a psi/Delta dataset (all angles).
-
-    :func:`labbrdf.nk.nk_at` on :func:`labbrdf.nk.combined_table`: the two-phase inversion
-    of every point, combined over the angles of incidence, interpolated in wavelength.
-
-    Raises
-    ------
-    PredictionError
-        No psi/Delta, several files, a wavelength outside the measured range, or angles of
-        incidence that disagree (a stack: its two-phase n, k is no material's).
-    """
-    try:
-        table = combined_table(ordinary_psi_delta(data), on_ill_conditioned="ignore")
-        return nk_at(table, wavelength_nm)
-    except ValueError as exc:
-        src = ", ".join(sorted(set(data["source"].astype(str))))[:200] if len(data) else "-"
-        raise PredictionError(f"{src}: {exc}") from None
-
-
-def slope_table(heights: Any, pixel_size: float | Sequence[float] | None = None) -> TabulatedNDF:
-    """The measured slope table of an areal height map (what ``labbrdf trace --surface`` uses).
-
-    :meth:`labbrdf.Substrate.from_surface` (mean plane removed, 64 slope cells per axis).
-
-    Raises
-    ------
-    PredictionError
-        A profile, or a map without a pixel size (as :func:`roughness_alpha`).
-    """
-    z, px, where = _areal(heights, pixel_size, "a slope table")
-    try:
-        ndf = Substrate.from_surface(z, px).ndf
-    except ValueError as exc:
-        raise PredictionError(f"{where}{exc}") from None
-    assert ndf is not None
-    return ndf
-
-
-def film_coating(
-    fit: Any,
-    wavelength_nm: float,
-    roughness: SlopeFit | float,
-    *,
-    ndf: TabulatedNDF | None = None,
-) -> tuple[Coating, complex]:
-    """The tracer's coating and substrate index from a one-layer film fit of the sample.
-
-    The layer's index at ``wavelength_nm`` and its fitted thickness become the
-    :class:`~labbrdf.Coating` (as ``labbrdf trace --coating-from`` does with a saved fit,
-    :func:`labbrdf.films.coating_of_stack`), the fit's substrate index the substrate's.
-
-    Parameters
-    ----------
-    fit : labbrdf.FilmFit
-        A film fit (:func:`labbrdf.fit_film`) of the sample's psi/Delta, one layer.
-    wavelength_nm : float
-        The wavelength traced [nm], inside the fit's wavelength range.
-    roughness : SlopeFit or float
-        GGX alpha [1] of the height map, given to the coating's top.
-    ndf : TabulatedNDF, optional
-        The height map's measured slope table for the coating's top instead of GGX.
-
-    Returns
-    -------
-    coating : Coating
-    substrate_index : complex
-        The fit's substrate ``n + ik`` at ``wavelength_nm`` [1] (the psi/Delta of a coated
-        sample are the stack's: their two-phase inversion is no substrate's index).
-
-    Raises
-    ------
-    PredictionError
-        A stack of more than one layer (or a roughness layer), a wavelength outside the
-        fitted range, or a layer the tracer cannot hold (0 nm: the incoherent coating
-        needs a thickness).
-
-    Notes
-    -----
-    Conformal coating: the height map is taken as measured on the coating's top, and the
-    substrate below has the same roughness (the tracer's default for ``--coating-from``,
-    the substrate's alpha). The coating is incoherent (intensities, Beer-Lambert in the
-    layer), as :func:`labbrdf.tracer_setup.trace_config_from_inputs` builds it; the film
-    fit itself is coherent, so thin-film interference colours the fit, not the prediction.
-    """
-    d = getattr(fit, "data", None)
-    src = "film fit"
-    if d is not None and "source" in d.columns and len(d):
-        src = "film fit of " + ", ".join(sorted(set(d["source"].astype(str))))[:200]
-    w = np.asarray(d["wavelength_nm"], float) if d is not None else np.array([np.nan])
-    try:
-        layer_n, thickness, sub = coating_of_stack(
-            fit.stack,
-            wavelength_nm,
-            (float(np.nanmin(w)), float(np.nanmax(w))),
-            where=src,
-            hint="the prediction traces one coating; fit a one-layer model",
-        )
-    except ValueError as exc:
-        raise PredictionError(str(exc)) from None
-    alpha = float(roughness.alpha) if isinstance(roughness, SlopeFit) else float(roughness)
-    if not thickness > 0:
-        raise PredictionError(
-            f"{src}: the fitted layer is {thickness:g} nm thick; an incoherent coating needs "
-            "a thickness > 0 (a 0 nm layer is the bare substrate)"
-        )
-    try:
-        coating = Coating(
-            n=layer_n.real, k=layer_n.imag, thickness_nm=thickness, alpha=alpha, ndf=ndf
-        )
-    except ValueError as exc:
-        raise PredictionError(f"{src}: {exc}") from None
-    return coating, sub
 
 
 # --------------------------------------------------------------------------- tracer runs
@@ -457,7 +287,7 @@ def specular_dop_comparison(
     wavelengths_nm : sequence of float, optional
         Wavelengths to trace [nm]; default ``max_wavelengths`` measured ones evenly spread.
     coating : Coating, optional
-        A coating over the substrate (e.g. :func:`labbrdf.films.coating_from_fit`); the
+        A coating over the substrate (e.g. :func:`labbrdf.sample.coating_from_fit`); the
         psi/Delta then still give the substrate.
     rays, seed, step_deg :
         Tracer rays per run, seed and bin width [deg] (the specular bin is the one holding

@@ -1,7 +1,7 @@
 """Predict, then measure, for a smooth sample: Rayleigh-Rice from a height map's PSD.
 
 The smooth-surface counterpart of :mod:`labbrdf.prediction` (the microfacet tracer's). A
-sample that is smooth by the Rayleigh criterion (:mod:`labbrdf.smoothness`) scatters as
+sample that is smooth by the Rayleigh criterion (:mod:`labbrdf.roughness.smoothness`) scatters as
 first-order perturbation theory says (:mod:`labbrdf.roughness.rayleigh_rice`): its BRDF at
 every point of a measured ``.bsdf`` follows, with **no fitted parameter**, from
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from labbrdf import optics
 from labbrdf.bsdf_export import binned_to_bsdf
-from labbrdf.surface import gaussian_surface
+from labbrdf.roughness.synthetic import gaussian_surface
 from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
 
 #: the sample's index (aluminium near 600 nm) and a wrong one (a poorer metal)

@@ -104,6 +104,8 @@ def _type_checking_imports() -> tuple[set[str], set[tuple[str, str]]]:
         for alias in imp.names:
             if imp.module is None:
                 modules.add(alias.name)
+            elif f"{imp.module}.{alias.name}" in labbrdf._MOVED.values():
+                modules.add(alias.asname or alias.name)
             else:
                 names.add((alias.name, f"labbrdf.{imp.module}"))
     return modules, names
@@ -111,11 +113,25 @@ def _type_checking_imports() -> tuple[set[str], set[tuple[str, str]]]:
 
 def test_the_type_checking_imports_mirror_the_tables() -> None:
     modules, names = _type_checking_imports()
-    assert modules == set(labbrdf._MODULES)
+    assert modules == {*labbrdf._MODULES, *labbrdf._MOVED}
     assert names == {(name, module) for name, (module, _) in labbrdf._LAZY.items()}
     assert all(name == attr for name, (_, attr) in labbrdf._LAZY.items())
 
 
 def test_all_and_dir_follow_from_the_tables() -> None:
-    assert labbrdf.__all__ == ["__version__", *labbrdf._LAZY, *labbrdf._MODULES]
+    assert labbrdf.__all__ == [
+        "__version__",
+        *labbrdf._LAZY,
+        *labbrdf._MODULES,
+        *labbrdf._MOVED,
+    ]
     assert dir(labbrdf) == sorted(labbrdf.__all__)
+
+
+def test_moved_modules_keep_their_old_name() -> None:
+    from labbrdf.roughness import smoothness, synthetic, topography
+
+    assert labbrdf.topography is topography
+    assert labbrdf.smoothness is smoothness
+    assert labbrdf.surface is synthetic
+    assert set(labbrdf._MOVED) <= set(dir(labbrdf))

@@ -786,7 +786,7 @@ def grid_integral(obj: BsdfTable | Measurement | Mapping[str, Any]) -> dict[str,
         not cover; ``tis`` (the file's values, NaN when unknown) and ``ratio`` = tis /
         integral.
     """
-    from ..integrate import grid_integral as quadrature  # scipy, only when asked for
+    from ..bsdf_geometry import grid_integral as quadrature
 
     t = _table_of(obj)
     return quadrature(

@@ -16,7 +16,7 @@ One name, one meaning, in every subcommand: ``--wavelength NM`` is one wavelengt
 MIN:MAX`` a range of rows; options are taken by their full names only
 (``allow_abbrev=False``), and older spellings are refused naming the new one. The library
 does the work: the commands parse text into values and call it once (e.g.
-:func:`labbrdf.tracer_setup.trace_config_from_inputs`); a
+:func:`labbrdf.sample.trace_config_from_inputs`); a
 :class:`labbrdf.errors.SetupError` is said with the options' names
 (:data:`._options.OPTION_NAMES`).
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 import os
 from typing import Any
 
@@ -15,21 +14,7 @@ from ._options import (
     _parse_assignments,
     _selected,
 )
-from ._paths import InputPath, OutputPath, _add_overwrite, _layer_files
-
-
-def _film_value(text: str, what: str) -> tuple[float, tuple[float, float] | None]:
-    """``V`` (fixed) or ``LO..HI`` (fitted, started mid-box) of a --layer field."""
-    lo_s, sep, hi_s = text.partition("..")
-    try:
-        if not sep:
-            return float(text), None
-        lo, hi = float(lo_s), float(hi_s)
-    except ValueError:
-        raise UsageError(f"{what}: {text!r} is not a number or LO..HI") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
-        raise UsageError(f"{what}: impossible bounds {text!r} (need LO < HI)")
-    return (lo + hi) / 2, (lo, hi)
+from ._paths import InputPath, OutputPath, _add_overwrite
 
 
 def _film_model(args: argparse.Namespace) -> Any:
@@ -54,38 +39,18 @@ def _film_model(args: argparse.Namespace) -> Any:
         )
     except ValueError as exc:
         raise UsageError(f"--substrate {sub_text}: {exc}") from None
+
+    def material_of(text: str) -> Any:  # a table file is an input (_layer_files checks it)
+        return tabulated_from_file(text) if os.path.exists(text) else films.as_material(text)
+
     layers, free = [], {}
     for j, spec in enumerate(args.layer, 1):
-        fields = spec.split(":")
-        if len(fields) < 3:
-            raise UsageError(
-                f"--layer {spec!r}: expected NAME:MATERIAL:THICKNESS[:PARAM=V|LO..HI ...], "
-                "e.g. oxide:cauchy:0..20:A=1.3..1.7"
-            )
-        name, mat, thick = fields[0] or f"layer{j}", fields[1], fields[2]
-        d, dbox = _film_value(thick, f"--layer {name}: thickness")
-        try:
-            m = tabulated_from_file(mat) if _layer_files(spec) else films.as_material(mat)
-        except ValueError as exc:
-            raise UsageError(f"--layer {name}: {exc}") from None
-        values = {}
-        for item in fields[3:]:
-            key, sep, val = item.partition("=")
-            if not sep or key not in m.params:
-                raise UsageError(
-                    f"--layer {name}: {item!r}: expected PARAM=V or PARAM=LO..HI with PARAM "
-                    f"one of {sorted(m.params) or 'none (a table)'}"
-                )
-            values[key], box = _film_value(val, f"--layer {name}: {key}")
-            if box is not None:
-                free[f"{name}.{key}"] = box
-        try:
-            m = films.materials._with_params(m, values)
-            layers.append(films.Layer(m, d, name))
-        except ValueError as exc:
-            raise UsageError(f"--layer {name}: {exc}") from None
-        if dbox is not None:
-            free[f"{name}.thickness_nm"] = dbox
+        try:  # the grammar and the rule of free parameters: labbrdf.films.layers
+            layer, layer_free = films.layers.parse_layer(spec, j, material_of)
+        except films.FilmError as exc:
+            raise UsageError(f"--layer {exc}") from None
+        layers.append(layer)
+        free.update(layer_free)
     try:
         stack = films.Stack(layers, sub)
     except ValueError as exc:
@@ -213,8 +178,10 @@ def add_parser(sub: Any) -> None:
         action="append",
         default=[],
         metavar="NAME:MATERIAL:THICKNESS[:P=V|LO..HI]",
-        help="a layer, top first (repeat); LO..HI values are fitted, e.g. "
-        "oxide:cauchy:0..20:A=1.3..1.7:B=0.004 (no --model/--layer: one Cauchy layer on Si)",
+        help="a layer, top first (repeat): V is fixed, LO..HI fitted (started mid-box), and a "
+        "material parameter not written is fitted in its default box (Cauchy: A, B, C; its "
+        "absorption k_amp stays 0), the rule of --model TOML; e.g. oxide:cauchy:0..20:A=1.3..1.7:"
+        "B=0.004 (no --model/--layer: one Cauchy layer on Si)",
     )
     s.add_argument(
         "--sigma",

@@ -33,6 +33,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             executor=executor,
             same_sample=[split_same_sample(v, args.files) for v in args.same_sample or ()],
             prediction_slopes=args.prediction_slopes,
+            nk_from=args.nk_from,
         )
     )
 
@@ -84,6 +85,14 @@ def add_parser(sub: Any) -> None:
         default="ggx",
         help="roughness of the section prediction: the GGX alpha of the height map's slopes "
         "(default) or their measured table (as trace --surface)",
+    )
+    s.add_argument(
+        "--nk-from",
+        action=InputPath,
+        default=None,
+        metavar="FILE",
+        help="substrate n, k of the tracer maps from this psi/Delta file (as trace --nk-from; "
+        "default: the psi/Delta file of each height map's sample, else a stated aluminium)",
     )
     s.add_argument("--quiet", action="store_true", help="no progress lines")
     _add_selection(s)

@@ -50,7 +50,7 @@ def cmd_surface(args: argparse.Namespace) -> int:
     """Print (or ``--json``) the roughness statistics of a height map."""
     from ..adapters.topography import length_m
     from ..outputs import check_file_output, check_input_files
-    from ..topography import level, on_measured_points, roughness_statistics
+    from ..roughness.topography import level, on_measured_points, roughness_statistics
 
     check_input_files([args.file])
     if args.png:

@@ -34,7 +34,7 @@ def _complex(text: str, what: str) -> complex:
 def cmd_trace(args: argparse.Namespace) -> int:
     """Trace the sample of the options; print the energy balance, write the outputs."""
     from .. import tracer
-    from ..tracer_setup import trace_config_from_inputs
+    from ..sample import trace_config_from_inputs
 
     executor = _executor(args, progress=not args.json)  # outputs checked by _checked_outputs
     with _option_errors():

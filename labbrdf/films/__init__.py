@@ -1,4 +1,4 @@
-"""Thin films as objects: layers of materials in a stack, model files, fit JSON, coatings.
+"""Thin films as objects: layers of materials in a stack, model files, fit JSON.
 
 Physics at the bottom, objects above it, no workflow: :mod:`~labbrdf.films.matrices` (the
 transfer matrices, the one coherent multilayer) and :mod:`~labbrdf.films.onefilm` (one film
@@ -7,9 +7,9 @@ on a substrate, coherent and incoherent) build on :mod:`labbrdf.optics`;
 :class:`Stack` (:mod:`~labbrdf.films.stack`), which computes psi/Delta, reflectance and
 transmittance from :mod:`labbrdf.nk.dispersion` materials; :mod:`~labbrdf.films.model` adds the
 search box of a fit, :mod:`~labbrdf.films.modelfile` reads it from TOML,
-:mod:`~labbrdf.films.fitjson` checks a fit's JSON, :mod:`~labbrdf.films.coating` turns a
-fitted one-layer stack into the tracer's coating, and :mod:`~labbrdf.films.limits` holds
-the caps all of them check. The film fit, a workflow above these objects, is
+:mod:`~labbrdf.films.fitjson` checks a fit's JSON, and :mod:`~labbrdf.films.limits` holds
+the caps all of them check (a fitted one-layer stack becomes the tracer's coating in
+:mod:`labbrdf.sample.coating`). The film fit, a workflow above these objects, is
 :func:`labbrdf.fitting.film.fit_film` (also ``labbrdf.fit_film``).
 
 Parameter names are ``"<layer>.<parameter>"``: ``"oxide.thickness_nm"``, ``"oxide.A"``,
@@ -22,7 +22,6 @@ Parameter names are ``"<layer>.<parameter>"``: ``"oxide.thickness_nm"``, ``"oxid
 
 from __future__ import annotations
 
-from .coating import coating_from_fit, coating_of_stack
 from .layers import Layer
 from .limits import (
     FILM_QUANTITIES,
@@ -60,8 +59,6 @@ __all__ = [
     "Stack",
     "as_material",
     "check_wavelength_range",
-    "coating_from_fit",
-    "coating_of_stack",
     "load_model",
     "named_inputs",
     "read_fit_json",

@@ -1,13 +1,15 @@
-"""One homogeneous layer of a stack: a material and a thickness."""
+"""One homogeneous layer of a stack, and the one grammar and rule for a layer's values."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from ..nk import dispersion as disp
 from .limits import FilmError
-from .materials import as_material
+from .materials import _with_params, as_material
 
 
 @dataclass(frozen=True)
@@ -47,3 +49,134 @@ class Layer:
             "thickness_nm": self.thickness_nm,
             "material": self.material.to_dict(),
         }
+
+
+# --------------------------------------------------------------------------- a layer's values
+#
+# One grammar and one rule for the values of a layer, shared by the model file (TOML,
+# :func:`labbrdf.films.load_model`) and the command line (``labbrdf film --layer``):
+#
+# - a parameter written as a number is fixed at it (TOML ``A = 1.9``, ``--layer ...:A=1.9``);
+# - a parameter written as a box is fitted in it, started mid-box (TOML ``A = [1.5, 2.2]``,
+#   ``--layer ...:A=1.5..2.2``; TOML also ``{value, min, max, vary}``);
+# - a parameter of a layer's material (a dispersion model, a roughness layer's fraction)
+#   that is not written is fitted in its default box (:func:`default_boxes`), started at the
+#   model's default value, except Cauchy's absorption (:data:`CAUCHY_FIXED`); a table has
+#   none. The substrate's parameters stay at their values unless a box is written.
+
+#: Cauchy parameters kept at their values unless a box is written: k_amp = 0 keeps the
+#: layer transparent, and the Urbach exponent and band edge mean nothing without it
+CAUCHY_FIXED = ("k_amp", "exponent", "band_edge")
+
+
+def default_boxes(material: Any) -> dict[str, tuple[float, float]]:
+    """The default search box of each parameter a layer's material frees when not written.
+
+    Every parameter of a dispersion model (:meth:`labbrdf.nk.dispersion.Dispersion.bounds`)
+    except Cauchy's absorption (:data:`CAUCHY_FIXED`), and a roughness layer's fraction
+    (:meth:`labbrdf.films.Roughness.bounds`); none for a table.
+    """
+    if isinstance(material, disp.Tabulated) or not hasattr(material, "bounds"):
+        return {}
+    skip = CAUCHY_FIXED if isinstance(material, disp.Cauchy) else ()
+    return {k: b for k, b in material.bounds().items() if k not in skip}
+
+
+def free_parameters(
+    layer: Layer, written: Mapping[str, tuple[float, float] | None]
+) -> dict[str, tuple[float, float]]:
+    """The fitted parameters of a layer, ``"<layer>.<name>"`` -> (min, max).
+
+    Parameters
+    ----------
+    layer : Layer
+        The layer, with the values written for it.
+    written : mapping
+        Each parameter written for the layer (``thickness_nm`` included) -> its box, or
+        None where it is written as a number (fixed).
+
+    Returns
+    -------
+    dict
+        The written boxes (in their order), then the default box of every material
+        parameter not written (:func:`default_boxes`).
+    """
+    free = {k: b for k, b in written.items() if b is not None}
+    free.update({k: b for k, b in default_boxes(layer.material).items() if k not in written})
+    return {f"{layer.name}.{k}": b for k, b in free.items()}
+
+
+def parse_value(text: str, where: str) -> tuple[float, tuple[float, float] | None]:
+    """``V`` (fixed) or ``LO..HI`` (fitted, started mid-box), the command line's value.
+
+    Raises
+    ------
+    FilmError
+        Not a number or a box, or impossible bounds (the message starts with ``where``).
+    """
+    lo_s, sep, hi_s = text.partition("..")
+    try:
+        if not sep:
+            return float(text), None
+        lo, hi = float(lo_s), float(hi_s)
+    except ValueError:
+        raise FilmError(f"{where}: {text!r} is not a number or LO..HI") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
+        raise FilmError(f"{where}: impossible bounds {text!r} (need LO < HI)")
+    return (lo + hi) / 2, (lo, hi)
+
+
+def parse_layer(
+    spec: str, j: int, material_of: Callable[[str], Any]
+) -> tuple[Layer, dict[str, tuple[float, float]]]:
+    """A layer and its fitted parameters from ``NAME:MATERIAL:THICKNESS[:PARAM=V|LO..HI ...]``.
+
+    Parameters
+    ----------
+    spec : str
+        The layer, e.g. ``"oxide:cauchy:0..20:A=1.3..1.7"`` (an empty name is ``layer<j>``).
+    j : int
+        Its place from the top, from 1.
+    material_of : callable
+        The material of the MATERIAL field (a name, or a table file read by the caller).
+
+    Returns
+    -------
+    (Layer, dict)
+        The layer (its values, mid-box where a box is given) and its fitted parameters
+        (:func:`free_parameters`: unwritten dispersion parameters free in their default
+        box).
+
+    Raises
+    ------
+    FilmError
+        A malformed field, an unknown parameter, a bad value (the message starts with the
+        layer's name).
+    """
+    fields = spec.split(":")
+    if len(fields) < 3:
+        raise FilmError(
+            f"{spec!r}: expected NAME:MATERIAL:THICKNESS[:PARAM=V|LO..HI ...], "
+            "e.g. oxide:cauchy:0..20:A=1.3..1.7"
+        )
+    name, mat, thick = fields[0] or f"layer{j}", fields[1], fields[2]
+    d, dbox = parse_value(thick, f"{name}: thickness")
+    try:
+        m = material_of(mat)
+    except ValueError as exc:
+        raise FilmError(f"{name}: {exc}") from None
+    values: dict[str, float] = {}
+    written: dict[str, tuple[float, float] | None] = {}
+    for item in fields[3:]:
+        key, sep, val = item.partition("=")
+        if not sep or key not in m.params:
+            raise FilmError(
+                f"{name}: {item!r}: expected PARAM=V or PARAM=LO..HI with PARAM "
+                f"one of {sorted(m.params) or 'none (a table)'}"
+            )
+        values[key], written[key] = parse_value(val, f"{name}: {key}")
+    try:
+        layer = Layer(_with_params(m, values), d, name)
+    except ValueError as exc:
+        raise FilmError(f"{name}: {exc}") from None
+    return layer, free_parameters(layer, {**written, "thickness_nm": dbox})

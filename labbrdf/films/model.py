@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..nk import dispersion as disp
-from .layers import Layer
+from .layers import Layer, free_parameters
 from .stack import Stack
 
 
@@ -46,20 +46,13 @@ class FilmModel:
     def default(cls, stack: Stack, thickness_max_nm: float | None = None) -> FilmModel:
         """The default fit of a stack.
 
-        Vary every layer's thickness and every parametric layer material's parameters
-        (default boxes of :mod:`labbrdf.nk.dispersion`); the substrate and tables stay fixed.
+        Vary every layer's thickness and its material's parameters in their default boxes
+        (:func:`labbrdf.films.layers.default_boxes`, the rule of the model file and
+        ``--layer`` for parameters not written); the substrate and tables stay fixed.
         Thickness box: [0, max(3 d, 20 nm)] unless ``thickness_max_nm`` is given.
         """
         free: dict[str, tuple[float, float]] = {}
         for lay in stack.layers:
             hi = thickness_max_nm or max(3 * lay.thickness_nm, 20.0)
-            free[f"{lay.name}.thickness_nm"] = (0.0, float(hi))
-            if isinstance(lay.material, disp.Tabulated):
-                continue
-            for k, b in lay.material.bounds().items():
-                if isinstance(lay.material, disp.Cauchy) and k in ("exponent", "band_edge"):
-                    continue  # fixed unless asked: k_amp = 0 keeps the layer transparent
-                if isinstance(lay.material, disp.Cauchy) and k == "k_amp":
-                    continue
-                free[f"{lay.name}.{k}"] = b
+            free.update(free_parameters(lay, {"thickness_nm": (0.0, float(hi))}))
         return cls(stack, free)

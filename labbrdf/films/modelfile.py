@@ -18,7 +18,7 @@ from typing import Any
 from ..nk import dispersion as disp
 from ..outputs import InputFileError, read_input_file
 from .fitjson import _fit_doc
-from .layers import Layer
+from .layers import Layer, free_parameters
 from .limits import (
     MAX_LAYERS,
     MAX_MODEL_BYTES,
@@ -253,7 +253,7 @@ def _layer_of(
         raise FilmError(f"{where}, line {lines('layer', j, 'name')}: name must be a string")
     if "thickness_nm" not in tbl:
         raise FilmError(f"{where}, line {lines('layer', j)}: layer {name!r} has no thickness_nm")
-    m, _, mfree = _material_from_table(tbl, where, base, lines, "layer", j)
+    m, values, mfree = _material_from_table(tbl, where, base, lines, "layer", j)
     at = f"{where}, line {lines('layer', j, 'thickness_nm')}: thickness_nm"
     d, dbox = _spec(tbl["thickness_nm"], at)
     if d < 0 or (dbox is not None and dbox[0] < 0):
@@ -263,13 +263,12 @@ def _layer_of(
             f"{at} must be <= {MAX_THICKNESS_NM:g} nm (labbrdf.films.MAX_THICKNESS_NM): "
             "thicker is a substrate, not a film"
         )
-    free = {f"{name}.{k}": b for k, b in mfree.items()}
-    if dbox is not None:
-        free[f"{name}.thickness_nm"] = dbox
     try:
-        return Layer(m, d, name), free
+        layer = Layer(m, d, name)
     except FilmError as exc:
         raise FilmError(f"{where}, line {lines('layer', j)}: {exc}") from None
+    written = {**{k: mfree.get(k) for k in values}, "thickness_nm": dbox}
+    return layer, free_parameters(layer, written)  # the one rule: labbrdf.films.layers
 
 
 def load_model(path: str | os.PathLike[str]) -> FilmModel:
@@ -292,6 +291,8 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
         A = [1.3, 1.7]
         B = 0.0036                     # a number: fixed
         C = {value = 0, min = -0.01, max = 0.01}   # full form (vary = false to fix)
+                                       # not written: fitted in its default box
+                                       # (labbrdf.films.layers.default_boxes)
 
     A ``file`` is relative to the model file's folder, and is an input of the command
     that reads the model (:func:`named_inputs`). The file is at most

@@ -10,7 +10,7 @@ wavelength (:func:`nk_at`, :func:`bulk_index_at`, :func:`model_with_nk`);
 (:func:`compare_reflectance`, :func:`microfacet_hemispherical`); :mod:`~labbrdf.nk.plots`
 draws them (:func:`nk_panels`, :func:`plot_table`); :mod:`~labbrdf.nk.dispersion` holds the
 dispersion models, one module each behind a registry. A fitted film stack's coating is
-:mod:`labbrdf.films.coating`.
+:mod:`labbrdf.sample.coating`.
 
 The names are imported on first use (PEP 562), so the physics below, the dispersion models,
 imports without pandas or the file readers.

@@ -403,7 +403,7 @@ def surface_figure(
         Levelled heights [m] (NaN = missing).
     pixel_size_m : sequence of float
         Grid spacing per axis [m].
-    stats : labbrdf.topography.RoughnessStats
+    stats : labbrdf.roughness.topography.RoughnessStats
         Its correlation lengths and slope fits are drawn.
     title : str
         Figure title.
@@ -424,7 +424,7 @@ def surface_figure(
     ``1 / (2 a (1 + x^2/a^2)^(3/2))`` and Beckmann ``exp(-x^2/a^2) / (a sqrt(pi))``.
     """
     from labbrdf.microfacet import DISTRIBUTIONS
-    from labbrdf.topography import autocorrelation, slopes
+    from labbrdf.roughness.topography import autocorrelation, slopes
 
     z = np.asarray(heights_m, float)
     px = tuple(float(p) for p in pixel_size_m)

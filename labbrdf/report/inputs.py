@@ -26,6 +26,7 @@ __all__ = [
     "ingest_inputs",
     "ingest_read",
     "list_unreadable",
+    "psi_delta_of_group",
 ]
 
 
@@ -302,4 +303,24 @@ def file_frames(ctx: Context) -> list[tuple[str, pd.DataFrame, Mapping[str, Any]
         for src, g in f.groupby("source", sort=False, observed=True):
             g = g.assign(quantity=g["quantity"].astype(str)).reset_index(drop=True)
             out.append((str(src), g, metas.get(str(src), {})))
+    return out
+
+
+def psi_delta_of_group(
+    ctx: Context, path: str | os.PathLike[str]
+) -> list[tuple[Path, pd.DataFrame]]:
+    """The psi/Delta files of the sample group holding ``path``, with their ingested rows.
+
+    In the order the group lists them; ``path`` itself is left out. A file whose name two
+    inputs share is left out too (its rows' ``source`` cannot tell them apart).
+    """
+    key = str(Path(path))
+    holding = [g for g in ctx.samples if any(str(Path(p)) == key for p in g.paths)]
+    out = []
+    for p in (Path(q) for q in (holding[0].paths if len(holding) == 1 else ())):
+        if str(p) == key:
+            continue
+        found = [f for f in ctx.frames if len(f) and set(f["source"].astype(str)) == {p.name}]
+        if len(found) == 1 and (found[0]["quantity"].astype(str) == "psi").any():
+            out.append((p, found[0]))
     return out

@@ -3,7 +3,7 @@
 The numbers the report's sections share about a height map paired with optical files of
 one sample (the section ``smoothness`` tabulates them, ``nk`` divides the measured
 reflectance by the Davies loss, ``fits`` flags fits of a rough sample). Physics:
-:mod:`labbrdf.smoothness`; the band: ``docs/smoothness.md``.
+:mod:`labbrdf.roughness.smoothness`; the band: ``docs/smoothness.md``.
 """
 
 from __future__ import annotations
@@ -16,10 +16,16 @@ from typing import Any
 
 import numpy as np
 
-from .. import smoothness as sm
 from ..adapters.topography import HeightMap
+from ..roughness import smoothness as sm
+from ..roughness.topography import (
+    RoughnessStats,
+    level,
+    on_measured_points,
+    roughness_statistics,
+    s_filter,
+)
 from ..samples import SampleGroup
-from ..topography import RoughnessStats, level, on_measured_points, roughness_statistics, s_filter
 from .context import Context
 
 __all__ = [
@@ -136,7 +142,8 @@ def specular_loss_for(
     The sigma is the same as in the section ``smoothness``'s table
     (:meth:`MapRoughness.sigma_for`: the roughness that scatters at that wavelength and
     angle), g and exp(-g) those of
-    :mod:`labbrdf.smoothness`. None when no height map is of the same sample as ``source``
+    :mod:`labbrdf.roughness.smoothness`. None when no height map is of the same sample as
+    ``source``
     (a file name, as the rows' ``source`` gives it); the first map of the group otherwise.
     """
     maps = [m for _, ms, optical in groups_with_maps(ctx) if source in optical for m in ms]

@@ -21,6 +21,7 @@ from ..films import FilmModel
 from ..fitting import METHOD
 from ..parallel import Executor, as_executor
 from ..provenance import versions
+from ..sample import bulk_index
 from . import html
 from .builder import Builder, Unavailable, write_report
 from .context import Context
@@ -39,7 +40,7 @@ from .sections.psd import psd_section
 from .sections.scans import scans_section
 from .sections.smoothness import smoothness_section
 from .sections.spectra import spectra_section
-from .sections.surface import surface_section
+from .sections.surface import TRACE_WAVELENGTH_NM, surface_section
 
 __all__ = ["user_report"]
 
@@ -88,6 +89,7 @@ def user_report(
     film_model: str | os.PathLike[str] | FilmModel | None = None,
     same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
     prediction_slopes: str = "ggx",
+    nk_from: str | os.PathLike[str] | None = None,
     **kw: Any,
 ) -> int:
     """Build a report for the given files and write it (atomically) to ``out``.
@@ -136,6 +138,11 @@ def user_report(
         The roughness the section ``prediction`` traces: the GGX alpha of the height map's
         slopes (default), or their measured table
         (:mod:`labbrdf.report.sections.prediction` says why GGX is the default).
+    nk_from : path-like, optional
+        An ellipsometer file of the substrate: its bulk n, k at the traced wavelength are
+        the substrate of the section ``surface``'s tracer maps (as ``labbrdf trace
+        --nk-from``). Default: the psi/Delta file of each map's sample group, else a stated
+        default (:func:`labbrdf.report.sections.surface.substrate_index`).
     **kw :
         ``quick`` is accepted for symmetry with :func:`~labbrdf.report.validate` (no effect).
 
@@ -151,7 +158,8 @@ def user_report(
         No paths, an unknown model name or option, a film model file with an error
         (naming the file and the line), a ``same_sample`` mapping that cannot hold
         (:class:`labbrdf.samples.PairingError`), a ``start`` value outside its parameter's
-        bounds, an unknown ``prediction_slopes``, or an
+        bounds, an unknown ``prediction_slopes``, an ``nk_from`` file that gives no bulk
+        index at the traced wavelength (:class:`labbrdf.NkError`), or an
         output folder that is refused
         (:class:`labbrdf.outputs.OutputError`), all before any work.
     """
@@ -162,12 +170,19 @@ def user_report(
         raise ValueError(
             f"prediction_slopes: expected one of {', '.join(SLOPES)}, got {prediction_slopes!r}"
         )
-    paths, model_file, opts = _refused_early(paths, model, options, out, film_model, same_sample)
+    paths, model_file, opts = _refused_early(
+        paths, model, options, out, film_model, same_sample, nk_from
+    )
     _check_start(model, opts, start)
+    substrate = (
+        None if nk_from is None else (str(nk_from), bulk_index(nk_from, TRACE_WAVELENGTH_NM))
+    )
     film, film_how = film_model_of(film_model)
     meta = {"model": model, "options": opts, "method": method, "seed": seed}
     meta.update(files=[str(p) for p in paths], film_model=film_how or None)
     meta.update(prediction_slopes=prediction_slopes)
+    if nk_from is not None:
+        meta.update(nk_from=str(nk_from))
     b = Builder(title or f"labbrdf report: {model} fits", progress=progress, meta=_meta(meta))
     ctx = Context(
         b,
@@ -178,14 +193,15 @@ def user_report(
     )
 
     sections = _sections(
-        model, opts, film, film_how, paths, selection, same_sample, prediction_slopes
+        model, opts, film, film_how, paths, selection, same_sample, prediction_slopes, substrate
     )
     run(ctx, sections)
     if title is None and not _fitted(b.results):
         b.results["title"] = f"labbrdf report: {len(paths)} file(s), nothing fitted"
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
-    write_report(out, b.results, page, inputs=paths + model_file)
+    nk_file = [] if nk_from is None else [Path(nk_from)]
+    write_report(out, b.results, page, inputs=[*paths, *model_file, *nk_file])
     b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
     return code
 
@@ -202,6 +218,7 @@ def _refused_early(
     out: str | os.PathLike[str],
     film_model: str | os.PathLike[str] | FilmModel | None,
     same_sample: Sequence[Sequence[str | os.PathLike[str]]],
+    nk_from: str | os.PathLike[str] | None = None,
 ) -> tuple[list[Path], list[str | os.PathLike[str]], dict[str, Any]]:
     """Refuse bad arguments before any work: the paths, the model file, the options.
 
@@ -217,7 +234,8 @@ def _refused_early(
     model_file: list[str | os.PathLike[str]] = (
         [Path(film_model)] if isinstance(film_model, (str, os.PathLike)) else []
     )
-    check_report_dir(out, inputs=[*files, *model_file])  # refused before the fits, not after
+    nk_file = [] if nk_from is None else [Path(nk_from)]
+    check_report_dir(out, inputs=[*files, *model_file, *nk_file])  # refused before any work
     pair_samples(files, same_sample)  # a mapping that cannot hold
     opts = dict(options or {})
     try:
@@ -297,6 +315,7 @@ def _sections(
     selection: Mapping[str, Any] | None,
     same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
     prediction_slopes: str = "ggx",
+    substrate: tuple[str, complex] | None = None,
 ) -> list[Section]:
     """The user report's sections, in order, bound to its model, film model and files."""
     return [
@@ -326,7 +345,11 @@ def _sections(
             lambda ctx: brdf_section(ctx, model, opts),
         ),
         ("colour", "Sample colour from spectrophotometer reflectance", colour_section),
-        ("surface", "Measured surface topography", surface_section),
+        (
+            "surface",
+            "Measured surface topography",
+            lambda ctx: surface_section(ctx, nk_from=substrate),
+        ),
         ("psd", "Surface power spectral density", psd_section),
         (
             "smoothness",

@@ -1,1 +1,2 @@
-"""Surface roughness beyond microfacets: height-map statistics, power spectra and their models."""
+"""Surface roughness beyond the microfacet distributions: height-map statistics, smoothness,
+synthetic surfaces, power spectra and their models, Rayleigh-Rice scatter."""

@@ -329,7 +329,7 @@ def tis_small_roughness(
     Davies (1954), Bennett & Porteus (1961); Stover eq. 5.17. ``sigma`` [m] must be that of
     the spatial frequencies the collection band sees; the Rayleigh-Rice TIS tends to it when
     those frequencies scatter close to the specular direction (``f lambda << 1``). Equal to
-    ``R_0 g`` of :func:`labbrdf.smoothness.total_integrated_scatter` with
+    ``R_0 g`` of :func:`labbrdf.roughness.smoothness.total_integrated_scatter` with
     ``small_roughness=True``.
     """
     lam = _wavelength(wavelength)

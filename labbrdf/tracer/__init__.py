@@ -11,8 +11,8 @@ Model (Dong 2022 sec. 2.3, done rigorously; the departures, each documented wher
 implemented):
 
 * position-free random walk through laterally infinite layers (:mod:`.walk`); the paper
-  reconstructs an FFT surface (sec. 2.1, :mod:`labbrdf.surface`) but its algorithm samples
-  facet normals from the distribution D, and so do we;
+  reconstructs an FFT surface (sec. 2.1, :mod:`labbrdf.roughness.synthetic`) but its algorithm
+  samples facet normals from the distribution D, and so do we;
 * GGX normals (eq. (14) corrected) sampled as *visible* normals, Smith masking
   (:mod:`labbrdf.microfacet.ggx`); ``scattering="single"`` = one facet event per interface with the
   separable Smith G1 G1 (the model of the SCATMECH/Mitsuba oracles), ``"multiple"`` = the

@@ -108,12 +108,12 @@ class Substrate:
 
         Parameters
         ----------
-        heights : ndarray (M, N) or labbrdf.surface.Surface
+        heights : ndarray (M, N) or labbrdf.roughness.synthetic.Surface
             Heights [m] (NaN = missing) or a generated surface (its spacing is used).
         pixel_size : float or (float, float)
             Grid spacing [m] (not needed for a Surface).
         degree : int
-            Levelling polynomial (1 = mean plane), see :func:`labbrdf.topography.level`.
+            Levelling polynomial (1 = mean plane), see :func:`labbrdf.roughness.topography.level`.
         bins : int
             Slope cells per axis of the table (:meth:`TabulatedNDF.from_slopes`).
         **kw
@@ -124,7 +124,7 @@ class Substrate:
         Substrate
             ``ndf`` = the table; ``alpha`` = the ML GGX alpha of the same slopes.
         """
-        from labbrdf.topography import fit_slope_distribution, level, slopes
+        from labbrdf.roughness.topography import fit_slope_distribution, level, slopes
 
         if hasattr(heights, "z") and hasattr(heights, "spacing"):
             pixel_size = heights.spacing

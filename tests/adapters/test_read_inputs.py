@@ -16,7 +16,7 @@ from labbrdf.adapters import topography
 from labbrdf.adapters._base import AdapterError
 from labbrdf.adapters.topography import HEIGHT_MAP_FORMATS
 from labbrdf.cli import main
-from labbrdf.surface import gaussian_surface
+from labbrdf.roughness.synthetic import gaussian_surface
 
 METROPRO_MAGIC = b"\x88\x1b\x03\x6f"
 

@@ -15,7 +15,7 @@ import pytest
 from labbrdf.adapters._base import AdapterError
 from labbrdf.adapters.topography import check_geometry, length_m, read_height_map
 from labbrdf.cli import main
-from labbrdf.surface import gaussian_surface
+from labbrdf.roughness.synthetic import gaussian_surface
 
 pytest.importorskip("SurfaceTopography")
 
@@ -183,7 +183,7 @@ def test_map_without_roughness_says_so_not_math_domain_error(tmp_path, capsys):
     rc, _, err = run(["surface", str(p)], capsys)
     assert rc == 2 and "flat.bcrf" in err and "no roughness" in err
     assert "math domain" not in err
-    from labbrdf.topography import roughness_statistics
+    from labbrdf.roughness.topography import roughness_statistics
 
     i, j = np.mgrid[0:32, 0:32]
     with pytest.raises(ValueError, match="no roughness"):

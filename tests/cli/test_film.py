@@ -317,7 +317,7 @@ def test_film_prints_the_fits_own_report(film_file, capsys):
     from labbrdf.films import FilmModel
     from labbrdf.fitting.film import fit_film
 
-    argv = ["film", str(film_file), "--layer", "film:cauchy:0..300:A=1.3..1.8:B=0..0.02"]
+    argv = ["film", str(film_file), "--layer", "film:cauchy:0..300:A=1.3..1.8:B=0..0.02:C=0"]
     assert main([*argv, "--ci", "wald"]) == 0
     box = {"film.thickness_nm": (0.0, 300.0), "film.A": (1.3, 1.8), "film.B": (0.0, 0.02)}
     stack = Stack([Layer(Cauchy(A=1.55, B=0.01), 150.0, "film")], "si")

@@ -340,7 +340,7 @@ def test_hemispherical_of_microfacet_from_ellipsometer_nk(real_exports: Path, ca
 def test_trace_coating_roughness_from_its_own_height_map(real_exports: Path, capsys):
     # the coating's top interface takes the ML GGX alpha of its own measured map
     from labbrdf.adapters.topography import read_height_map
-    from labbrdf.topography import fit_slope_distribution, level, slopes
+    from labbrdf.roughness.topography import fit_slope_distribution, level, slopes
 
     di = real_exports / "topography" / "di-1.di"
     argv = ["trace", "--substrate", "1.55+7.71j", "--alpha", "0.1", "--coating", "1.5",

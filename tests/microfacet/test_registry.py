@@ -9,8 +9,8 @@ import pytest
 from scipy import integrate
 
 from labbrdf.microfacet import DISTRIBUTIONS, TabulatedNDF, beckmann, get, ggx, names, registry
-from labbrdf.topography import fit_slope_distribution
-from labbrdf.tracer_setup import trace_config_from_inputs
+from labbrdf.roughness.topography import fit_slope_distribution
+from labbrdf.sample import trace_config_from_inputs
 
 
 @pytest.mark.parametrize("name", list(DISTRIBUTIONS))

@@ -32,6 +32,7 @@ material = "cauchy"
 thickness_nm = [60, 200]
 A = [1.3, 1.7]
 B = [0.0, 0.02]
+C = 0
 """
 
 

@@ -67,13 +67,13 @@ def _rough_ctx(tmp_path: Path, *, paired: bool):
     import numpy as np
     import pandas as pd
 
-    from labbrdf import smoothness as sm
     from labbrdf.adapters.topography import HeightMap
     from labbrdf.dataset import make_frame
     from labbrdf.report.builder import Builder
     from labbrdf.report.context import Context
+    from labbrdf.roughness import smoothness as sm
+    from labbrdf.roughness.synthetic import gaussian_surface
     from labbrdf.samples import pair_samples
-    from labbrdf.surface import gaussian_surface
 
     s = gaussian_surface(128, 20e-6, 20e-9, 2e-6, rng=3)
     hm_path, refl_path = tmp_path / "map.di", tmp_path / "refl.csv"

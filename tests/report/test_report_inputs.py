@@ -15,7 +15,7 @@ from labbrdf.adapters import topography
 from labbrdf.report.builder import Builder
 from labbrdf.report.context import Context
 from labbrdf.report.inputs import ingest_inputs
-from labbrdf.surface import gaussian_surface
+from labbrdf.roughness.synthetic import gaussian_surface
 
 
 def write_bcrf(path: Path, n: int = 32) -> Path:

@@ -15,8 +15,8 @@ from labbrdf.report.builder import Builder
 from labbrdf.report.context import Context
 from labbrdf.report.roughness import rayleigh_flags
 from labbrdf.report.sections.smoothness import smoothness_section
+from labbrdf.roughness.synthetic import gaussian_surface
 from labbrdf.samples import pair_samples
-from labbrdf.surface import gaussian_surface
 
 N, K = 1.5, 3.0  # bulk n, k given to the section as an ellipsometer's combined table
 R_FRESNEL = abs((complex(N, K) - 1) / (complex(N, K) + 1)) ** 2  # normal incidence, by hand

@@ -49,7 +49,7 @@ def test_section_present_and_passes(topo_report: dict) -> None:
 @pytest.mark.parametrize("name", ["di-1.di", "opdx-3.opdx"])
 def test_sigma_matches_roughness_statistics(topo_report: dict, name: str) -> None:
     from labbrdf.adapters.topography import read_height_map
-    from labbrdf.topography import roughness_statistics
+    from labbrdf.roughness.topography import roughness_statistics
 
     hm = read_height_map(topo_report["dir"] / name)
     st = roughness_statistics(hm.heights, hm.pixel_size)
@@ -113,7 +113,7 @@ def test_acf_check_fails_with_printed_exponent(monkeypatch: pytest.MonkeyPatch) 
 @pytest.mark.parametrize("seed", range(5))
 def test_acf_tolerance_holds_over_seeds(seed: int) -> None:
     L, N = surf.ACF_LENGTH_UM, surf.ACF_GRID
-    from labbrdf.surface import gaussian_surface
+    from labbrdf.roughness.synthetic import gaussian_surface
 
     for sigma, cx, cy in surf.ACF_CASES:
         tol = surf.ACF_TOL_FACTOR * math.sqrt(cx * cy) / L
@@ -138,3 +138,90 @@ def test_wvase_dat_stays_optical_beside_a_height_map(
     assert optical == [wvase.name] and maps == [di.name]
     c = _checks(res)
     assert c["ingest.read"]["status"] == "pass" and c["ingest.topography"]["status"] == "pass"
+
+
+# ----------------------------------------------------------------- the tracer's substrate
+
+
+def _group_ctx(hm_path: Path, psi_paths: list[Path]) -> tuple[Context, object]:
+    """A report context holding one height map and psi/Delta files, all one sample."""
+    from labbrdf import read
+    from labbrdf.adapters.topography import read_height_map
+    from labbrdf.parallel import as_executor
+    from labbrdf.samples import pair_samples
+
+    ctx = Context(Builder("t", progress=False), executor=as_executor("serial", progress=False))
+    hm = read_height_map(hm_path)
+    ctx.height_maps.append(hm)
+    ctx.frames.extend(read(p).data for p in psi_paths)
+    given = [[hm_path, *psi_paths]] if psi_paths else []
+    ctx.samples[:] = pair_samples([hm_path, *psi_paths], given)
+    return ctx, hm
+
+
+@pytest.fixture()
+def real_files(real_exports: Path) -> SimpleNamespace:
+    w = real_exports / "woollam-wvase-ascii"
+    ns = SimpleNamespace(
+        di=real_exports / "topography" / "di-1.di",
+        ta=w / "w2_10102006.dat",  # bare tantalum
+        coated=w / "w1_12082006.dat",  # Ta2O5 on Ta: its angles disagree
+    )
+    for p in vars(ns).values():
+        if not p.is_file():
+            pytest.skip(f"{p} absent")
+    return ns
+
+
+def test_the_tracer_maps_take_the_groups_measured_index_as_trace_nk_from(
+    real_files: SimpleNamespace, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from labbrdf import trace
+    from labbrdf.sample import trace_config_from_inputs
+
+    ctx, hm = _group_ctx(real_files.di, [real_files.coated, real_files.ta])
+    index, whence = surf.substrate_index(ctx, hm)
+    # the stack's file is passed over (saying why), the bare one is taken
+    assert "w2_10102006.dat" in whence and whence.startswith("measured")
+    monkeypatch.setattr(surf, "TRACE_RAYS", 4000)
+    r_meas, _, _ = surf._trace_pair(ctx, hm, 0.3, index)
+    cfg = trace_config_from_inputs(
+        surf.TRACE_WAVELENGTH_NM,
+        surf.TRACE_THETA_I_DEG,
+        nk_from=real_files.ta,
+        surface=real_files.di,
+        rays=4000,
+        seed=ctx.seed,
+        theta_step_deg=surf.TRACE_STEP_DEG,
+        phi_step_deg=surf.TRACE_STEP_DEG,
+    )
+    assert complex(cfg.substrate.n, cfg.substrate.k) == index
+    assert r_meas.albedo() == trace(cfg).albedo()
+
+
+def test_the_tracer_maps_fall_back_to_the_stated_default_saying_why(
+    real_files: SimpleNamespace,
+) -> None:
+    ctx, hm = _group_ctx(real_files.di, [real_files.coated])
+    index, whence = surf.substrate_index(ctx, hm)
+    assert index == complex(*surf.SUBSTRATE_NK)
+    assert "not measured" in whence and "w1_12082006.dat" in whence and "--nk-from" in whence
+    alone, hm = _group_ctx(real_files.di, [])
+    assert "no psi/Delta file" in surf.substrate_index(alone, hm)[1]
+    given = surf.substrate_index(ctx, hm, (str(real_files.ta), 1.5 + 2.0j))
+    assert given == (1.5 + 2.0j, "measured: the bulk n, k of w2_10102006.dat (--nk-from)")
+
+
+def test_report_nk_from_a_file_without_an_index_exits_2_before_any_work(
+    real_files: SimpleNamespace, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from labbrdf.cli import main
+
+    out = tmp_path / "rep"
+    code = main(
+        ["report", str(real_files.di), "--nk-from", str(real_files.coated), "-o", str(out)]
+    )
+    err = capsys.readouterr().err
+    last = err.strip().splitlines()[-1]  # after the inversion's own warning
+    assert code == 2 and "w1_12082006.dat" in last and "stack" in last
+    assert "Traceback" not in err and not out.exists()

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from labbrdf.roughness import psd as P
-from labbrdf.topography import level, roughness_statistics
+from labbrdf.roughness.topography import level, roughness_statistics
 
 KC = (2.0e-28, 3.0e-6, 2.4)  # K-correlation A [m^4], B [m], C: sigma ~ 10 nm
 DX = 1.0e-7

@@ -116,7 +116,7 @@ def test_real_maps_through_psd_band_and_k_correlation_fit(real_exports, capsys):
     assert any("no map covers" in w for w in res.warnings)  # AFM and MetroPro bands do not meet
     # sigma over each map's band by Parseval is the map's RMS height within the window's
     # variance bias (the Hann window keeps the expected, not the sample, variance)
-    from labbrdf.topography import roughness_statistics
+    from labbrdf.roughness.topography import roughness_statistics
 
     for s, f in zip(res.spectra, files, strict=True):
         hm = labbrdf.read_height_map(f)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from labbrdf import smoothness
+from labbrdf.roughness import smoothness
 from labbrdf.optics import fresnel
 from labbrdf.roughness import psd_models
 from labbrdf.roughness import rayleigh_rice as rr

@@ -9,7 +9,7 @@ import pytest
 from scipy import special, stats
 
 from labbrdf.microfacet import TabulatedNDF, ggx
-from labbrdf.surface import gaussian_surface
+from labbrdf.roughness.synthetic import gaussian_surface
 from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
 
 

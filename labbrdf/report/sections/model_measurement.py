@@ -60,7 +60,7 @@ FORMULA_RTOL = 1e-9
 #: measured / Fresnel against exp(-g): %R is written with 6 significant digits (5e-6
 #: relative), psi/Delta with 10 (n, k to ~1e-9); 2e-5 leaves a factor 4 on the rounding
 SET_RTOL = 2e-5
-#: coverage factor of the verdicts (labbrdf.smoothness.COVERAGE_FACTOR, restated)
+#: coverage factor of the verdicts (labbrdf.roughness.smoothness.COVERAGE_FACTOR, restated)
 K_VERDICT = 2.0
 
 
@@ -87,7 +87,7 @@ def _rel(a: Any, b: float) -> float:
 def formula_deviations(rows: list[dict[str, Any]]) -> tuple[float, list[str]]:
     """How far a smoothness table is from the formulas: worst deviation, wrong verdicts.
 
-    Written out here, independently of :mod:`labbrdf.smoothness`: ``g = (4 pi sigma cos
+    Written out here, independently of :mod:`labbrdf.roughness.smoothness`: ``g = (4 pi sigma cos
     theta / lambda)^2`` (Davies 1954), ``u(g) = 2 g u(sigma) / sigma``, the Rayleigh
     threshold ``lambda / (8 cos theta)``, the Fraunhofer threshold ``lambda / (32 cos
     theta)``, the specular factor ``exp(-g)``; a verdict is "smooth" when ``sigma + 2u`` is

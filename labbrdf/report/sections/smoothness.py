@@ -8,7 +8,7 @@ Davies specular loss exp(-g), and, where an ellipsometer file of the same sample
 n, k (section ``nk``) or a fitted film stack (section ``film``), the measured specular
 reflectance divided by their prediction;
 for a ``.bsdf`` file of the sample, its measured TIS against ``1 - exp(-g)``. Physics:
-:mod:`labbrdf.smoothness`; derivation and the bandwidth caveat: ``docs/smoothness.md``.
+:mod:`labbrdf.roughness.smoothness`; derivation and the bandwidth caveat: ``docs/smoothness.md``.
 
 sigma is that of the roughness that scatters (spatial periods from
 ``lambda / (1 + sin theta_i)`` up to the map size): the levelled map is S-filtered

@@ -5,10 +5,14 @@ User report (:func:`surface_section`): one part per height map read at ingest
 which :func:`labbrdf.adapters.read_inputs` tells from optical exports and reads through
 SurfaceTopography, :mod:`labbrdf.adapters.topography`): the levelled map, its
 autocorrelation and slope histogram with the GGX and Beckmann fits; the roughness
-statistics of :func:`labbrdf.topography.roughness_statistics` with their block-jackknife
+statistics of :func:`labbrdf.roughness.topography.roughness_statistics` with their block-jackknife
 uncertainties; and, for an areal map, tracer S0 and DOP hemisphere maps of a substrate whose
-facets follow the *measured* slope distribution (:meth:`labbrdf.Substrate.from_surface`)
-beside GGX at the fitted alpha.
+facets follow the *measured* slope distribution (:func:`labbrdf.sample.measured_substrate`)
+beside GGX at the fitted alpha. The substrate's index is measured where the report has it,
+as ``labbrdf trace --nk-from`` takes it (:func:`labbrdf.sample.bulk_index` at the traced
+wavelength): the file given with ``labbrdf report --nk-from``, else the first psi/Delta file
+of the map's sample group that gives a bulk index; else the stated default
+:data:`SUBSTRATE_NK`, named as such.
 
 Validation report (:func:`gaussian_acf_section`): surfaces generated with the corrected
 power spectral density of Dong et al. (2022) eq. (2),
@@ -33,13 +37,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...adapters.topography import HeightMap
-from ...surface import gaussian_surface
-from ...topography import autocorrelation, level, on_measured_points, roughness_statistics
+from ...nk import NkError
+from ...roughness.synthetic import gaussian_surface
+from ...roughness.topography import (
+    autocorrelation,
+    level,
+    on_measured_points,
+    roughness_statistics,
+)
+from ...sample import bulk_index, measured_substrate
 from ...tracer import Substrate, TraceConfig, TraceResult
 from ...tracer.result import SHOW_COUNT
 from .. import figures
 from ..builder import Builder, Unavailable, slug
 from ..context import Context
+from ..inputs import psi_delta_of_group
 from ..tracing import maps, robust_max, run_trace
 
 __all__ = [
@@ -50,10 +62,11 @@ __all__ = [
     "acf_deviation",
     "gaussian_acf_section",
     "printed_psd_surface",
+    "substrate_index",
     "surface_section",
 ]
 
-#: substrate index of the tracer runs: aluminium at 550 nm (n + ik)
+#: substrate index of the tracer runs where none is measured: aluminium at 550 nm (n + ik)
 SUBSTRATE_NK = (0.96, 6.69)
 #: wavelength [nm] and incidence [deg] of the tracer runs
 TRACE_WAVELENGTH_NM = 550.0
@@ -133,13 +146,46 @@ def _fit_rows(st: Any) -> list[dict[str, Any]]:
     ]
 
 
+def substrate_index(
+    ctx: Context, hm: HeightMap, nk_from: tuple[str, complex] | None = None
+) -> tuple[complex, str]:
+    """The index ``n + ik`` [1] of a map's tracer runs at the traced wavelength, and whence.
+
+    ``nk_from`` (the file given with ``report --nk-from`` and its index) first; else the bulk
+    index of the first psi/Delta file of the map's sample group that has one (one with a
+    film fit is a coated sample: its pseudo-index is the stack's); else :data:`SUBSTRATE_NK`,
+    saying why.
+    """
+    if nk_from is not None:
+        return nk_from[1], f"measured: the bulk n, k of {Path(nk_from[0]).name} (--nk-from)"
+    why = []
+    for path, frame in psi_delta_of_group(ctx, hm.path):
+        if path.name in ctx.film_fits:
+            why.append(f"{path.name} has a film fit (a coated sample)")
+            continue
+        try:
+            index = bulk_index(frame, TRACE_WAVELENGTH_NM, where=path.name)
+        except (NkError, ValueError) as exc:
+            why.append(str(exc))
+            continue
+        return index, (
+            f"measured: the bulk n, k of {path.name}, the psi/Delta of the map's sample "
+            "(combined over its angles, as trace --nk-from)"
+        )
+    n, k = SUBSTRATE_NK
+    reason = "; ".join(why) if why else "no psi/Delta file of the map's sample"
+    return complex(n, k), (
+        f"aluminium at {TRACE_WAVELENGTH_NM:g} nm, a stated default, not measured ({reason}; "
+        "give the sample's psi/Delta with --same-sample or report --nk-from FILE)"
+    )
+
+
 def _trace_pair(
-    ctx: Context, hm: HeightMap, alpha: float
+    ctx: Context, hm: HeightMap, alpha: float, index: complex
 ) -> tuple[TraceResult, TraceResult, float]:
     """Tracer runs for the measured slopes and for GGX at ``alpha``; the table's alpha."""
-    n, k = SUBSTRATE_NK
-    px = (hm.pixel_size[0], hm.pixel_size[-1])
-    measured = Substrate.from_surface(hm.heights, px, n=n, k=k)
+    n, k = index.real, index.imag
+    measured = measured_substrate(hm, index)
     cfg = TraceConfig(
         wavelength_nm=TRACE_WAVELENGTH_NM,
         theta_i_deg=TRACE_THETA_I_DEG,
@@ -155,14 +201,18 @@ def _trace_pair(
     return r_meas, r_ggx, ggx_alpha
 
 
-def surface_section(ctx: Context) -> None:
-    """One part per height map: figure, statistics, slope fits, tracer maps (areal maps)."""
+def surface_section(ctx: Context, nk_from: tuple[str, complex] | None = None) -> None:
+    """One part per height map: figure, statistics, slope fits, tracer maps (areal maps).
+
+    ``nk_from``: a file and its bulk index at the traced wavelength, the substrate of every
+    map's tracer runs (:func:`substrate_index`).
+    """
     b = ctx.b
     if not ctx.height_maps:
         raise Unavailable("no height map or profile among the input files")
     b.text(
         "Each height map is levelled (least-squares mean plane removed) and described by "
-        "labbrdf.topography.roughness_statistics: RMS height sigma, RMS slopes, the 1/e "
+        "labbrdf.roughness.topography.roughness_statistics: RMS height sigma, RMS slopes, the 1/e "
         "correlation lengths of the autocorrelation (ACF), alpha = sqrt(2) sigma / c (Dong "
         "et al. 2022; the RMS slope per axis of a surface with a Gaussian ACF), and "
         "maximum-likelihood GGX and Beckmann alphas of the slope distribution. "
@@ -176,11 +226,17 @@ def surface_section(ctx: Context) -> None:
         while sid in used:
             sid += "_"
         used.add(sid)
-        _map_part(ctx, hm, sid, albedo_rows)
+        _map_part(ctx, hm, sid, albedo_rows, nk_from)
     _albedo_table(b, albedo_rows)
 
 
-def _map_part(ctx: Context, hm: HeightMap, sid: str, albedo_rows: list[dict[str, Any]]) -> None:
+def _map_part(
+    ctx: Context,
+    hm: HeightMap,
+    sid: str,
+    albedo_rows: list[dict[str, Any]],
+    nk_from: tuple[str, complex] | None = None,
+) -> None:
     """One height map: statistics, figure, tables, notes; tracer maps for an areal map."""
     b = ctx.b
     name = Path(hm.path).name
@@ -197,7 +253,7 @@ def _map_part(ctx: Context, hm: HeightMap, sid: str, albedo_rows: list[dict[str,
             f"surface.{sid}.statistics",
             f"roughness statistics of {name} computed",
             False,
-            against="labbrdf.topography.roughness_statistics",
+            against="labbrdf.roughness.topography.roughness_statistics",
             reason=str(exc),
         )
         return
@@ -218,7 +274,7 @@ def _map_part(ctx: Context, hm: HeightMap, sid: str, albedo_rows: list[dict[str,
             }
         )
         return
-    _tracer_part(ctx, name, sid, hm, st, albedo_rows)
+    _tracer_part(ctx, name, sid, hm, st, albedo_rows, substrate_index(ctx, hm, nk_from))
 
 
 def _statistics_parts(b: Builder, name: str, sid: str, hm: HeightMap, st: Any) -> None:
@@ -307,11 +363,12 @@ def _tracer_part(
     hm: HeightMap,
     st: Any,
     albedo_rows: list[dict[str, Any]],
+    substrate: tuple[complex, str],
 ) -> None:
     """Tracer S0/DOP maps of the measured slopes beside GGX; their albedo rows."""
     b = ctx.b
-    n, k = SUBSTRATE_NK
-    r_meas, r_ggx, ggx_alpha = _trace_pair(ctx, hm, st.slope_fits.ggx.alpha)
+    index, whence = substrate
+    r_meas, r_ggx, ggx_alpha = _trace_pair(ctx, hm, st.slope_fits.ggx.alpha, index)
     pair = [("measured slopes", r_meas), (f"GGX \u03b1 = {ggx_alpha:.3g}", r_ggx)]
     mp = [maps(r) for _, r in pair]
     b.figure(
@@ -320,7 +377,7 @@ def _tracer_part(
         f"Modelled from the measured slopes (Monte Carlo polarization tracer, "
         f"{TRACE_RAYS} rays per case, seed {ctx.seed}, unpolarized input at theta_i = "
         f"{TRACE_THETA_I_DEG:g} deg, phi_i = 0, {TRACE_WAVELENGTH_NM:g} nm). Substrate: "
-        f"aluminium at 550 nm, N = {n:g} + {k:g}i (a stated default, not measured). Left: "
+        f"N = {_index_text(index)}, {whence}. Left: "
         "facets follow the measured slope histogram (tabulated NDF); right: GGX at "
         "the maximum-likelihood alpha of the same slopes. Top S0 = M00 [sr^-1], "
         "bottom DOP [1]; azimuth phi_r (specular half-plane at 180 deg), radius "
@@ -360,20 +417,26 @@ def _tracer_part(
                 "rays": r.rays,
                 "diff": diff if lab.startswith("measured") else None,
                 "diff_u": diff_u if lab.startswith("measured") else None,
+                "substrate": _index_text(index),
                 "reason": "",
             }
         )
 
 
+def _index_text(index: complex) -> str:
+    """``n + ki`` as the captions print it."""
+    return f"{index.real:.4g} + {index.imag:.4g}i"
+
+
 def _albedo_table(b: Builder, albedo_rows: list[dict[str, Any]]) -> None:
     """The tracer albedos of every areal map (and why a profile has none)."""
-    n, k = SUBSTRATE_NK
     b.table(
         "surface_tracer_albedo",
         "Tracer albedo: measured slope distribution vs GGX at the fitted alpha",
         [
             ("file", "file", ""),
             ("case", "facets", ""),
+            ("substrate", "substrate N [1]", ""),
             ("alpha", "GGX alpha [1]", ".4g"),
             ("albedo", "albedo [1]", ".5f"),
             ("albedo_u", "u(albedo) [1]", ".1e"),
@@ -385,7 +448,8 @@ def _albedo_table(b: Builder, albedo_rows: list[dict[str, Any]]) -> None:
         ],
         albedo_rows,
         caption=f"Directional-hemispherical reflectance for unpolarized light at "
-        f"{TRACE_THETA_I_DEG:g} deg, {TRACE_WAVELENGTH_NM:g} nm, substrate N = {n:g} + {k:g}i. "
+        f"{TRACE_THETA_I_DEG:g} deg, {TRACE_WAVELENGTH_NM:g} nm, on the substrate of each map "
+        "(its figure says where the index comes from). "
         "'measured': tabulated NDF of the map's slopes (the alpha shown is the ML GGX alpha "
         "of those slopes, for reference); 'ggx': GGX at that alpha. u = Monte Carlo "
         "standard error.",
@@ -413,7 +477,7 @@ def printed_psd_surface(
 ) -> NDArray[np.float64]:
     """A surface filtered with the PSD exponent as printed in Dong 2022 eq. (2).
 
-    Same construction as :func:`labbrdf.surface.gaussian_surface` but with
+    Same construction as :func:`labbrdf.roughness.synthetic.gaussian_surface` but with
     ``exp(-(k_x^2 c_x + k_y^2 c_y)/4)`` (the uncorrected exponent); kept here, for the
     check that must fail with it, never used to generate surfaces.
 
@@ -461,7 +525,7 @@ def acf_deviation(
     -------
     (float, float)
         RMS deviation along x and along y of the normalised sample ACF
-        (:func:`labbrdf.topography.autocorrelation`).
+        (:func:`labbrdf.roughness.topography.autocorrelation`).
     """
     r = autocorrelation(z, np.ones(z.shape, dtype=bool))
     i0, j0 = (n // 2 for n in r.shape)
@@ -478,7 +542,7 @@ def gaussian_acf_section(ctx: Context) -> None:
     b = ctx.b
     L, N = ACF_LENGTH_UM, ACF_GRID
     b.text(
-        f"Surfaces generated by labbrdf.surface.gaussian_surface ({N} x {N} points, "
+        f"Surfaces generated by labbrdf.roughness.synthetic.gaussian_surface ({N} x {N} points, "
         f"{L:g} x {L:g} um, seed {ctx.seed}) with the corrected PSD of Dong et al. (2022) eq. "
         "(2), exponent (k_x^2 c_x^2 + k_y^2 c_y^2)/4, must have the Gaussian ACF of eq. (1), "
         "exp(-(x/c_x)^2) along x and exp(-(y/c_y)^2) along y. The same filter with the "
@@ -533,7 +597,8 @@ def gaussian_acf_section(ctx: Context) -> None:
             ("within", "within", ""),
         ],
         rows,
-        caption="'corrected': k_x^2 c_x^2 + k_y^2 c_y^2 (labbrdf.surface.gaussian_psd); "
+        caption="'corrected': k_x^2 c_x^2 + k_y^2 c_y^2 "
+        "(labbrdf.roughness.synthetic.gaussian_psd); "
         "'printed': k_x^2 c_x + k_y^2 c_y as printed in the paper (control).",
     )
     b.check(

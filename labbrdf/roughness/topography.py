@@ -54,8 +54,8 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import fft as sfft
 from scipy import ndimage, optimize, special
 
-from .jsonsafe import jsonable
-from .microfacet import DISTRIBUTIONS
+from ..jsonsafe import jsonable
+from ..microfacet import DISTRIBUTIONS
 
 __all__ = [
     "C_MIN_PIXELS",

@@ -1,4 +1,4 @@
-"""Roughness statistics (labbrdf.topography) and the topography file reader."""
+"""Roughness statistics (labbrdf.roughness.topography) and the topography file reader."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import pytest
 from scipy import stats
 
 from labbrdf.adapters._base import AdapterError
-from labbrdf.surface import gaussian_surface
-from labbrdf.topography import (
+from labbrdf.roughness.synthetic import gaussian_surface
+from labbrdf.roughness.topography import (
     KS_WARN,
     autocorrelation,
     fit_slope_distribution,
@@ -303,7 +303,7 @@ def test_s_filter_transmits_half_at_the_cutoff_as_iso_16610_61():
     """ISO 16610-61 Gaussian: transmission exp(-pi (a lambda_s / lambda)^2), a = sqrt(ln2/pi):
     0.5 at lambda = lambda_s and 2^(-1/4) = 0.841 at 2 lambda_s (interior of the map, away
     from the border, where the truncated normal kernel is exact to 1e-4)."""
-    from labbrdf.topography import s_filter
+    from labbrdf.roughness.topography import s_filter
 
     n, d, lam_s = 512, 1e-7, 3.2e-6
     x = np.arange(n) * d
@@ -320,7 +320,7 @@ def test_short_cutoff_removes_pixel_noise_and_states_the_bandwidth():
     """AFM-like: a smooth surface (c = 40 px) plus white pixel noise. Without a bandwidth
     the slopes are the noise's; with lambda_s = 8 px they are those of the filtered surface
     plus the little noise left in the band."""
-    from labbrdf.topography import s_filter
+    from labbrdf.roughness.topography import s_filter
 
     d = 1e-9
     s = gaussian_surface(256, 256 * d, 2e-9, 40 * d, rng=5)
@@ -360,7 +360,7 @@ def _dropout_map():
 
 
 def test_dropout_rims_are_flagged_and_eroding_the_mask_recovers_the_surface():
-    from labbrdf.topography import C_MIN_PIXELS, erode_mask
+    from labbrdf.roughness.topography import C_MIN_PIXELS, erode_mask
 
     z, d, s = _dropout_map()
     st = roughness_statistics(z, d, blocks=0)
@@ -389,7 +389,7 @@ def test_gaussian_map_gets_no_dropout_or_pixel_notes():
 
 
 def test_progress_reports_every_pass_and_chunking_leaves_results_unchanged(monkeypatch):
-    import labbrdf.topography as T
+    import labbrdf.roughness.topography as T
 
     z = gaussian_surface(96, 96e-6, 1e-7, 5e-6, rng=3).z
     calls = []
@@ -443,7 +443,7 @@ def test_pair_counts_of_a_grid_minus_a_tile_equal_the_fft_counts(shape, hole):
     those the FFT of the indicator gives, so rho is the same to round-off."""
     from scipy import fft as sfft
 
-    from labbrdf.topography import _correlate_window, _rect_pair_counts
+    from labbrdf.roughness.topography import _correlate_window, _rect_pair_counts
 
     v = np.ones(shape, bool)
     v[hole] = False

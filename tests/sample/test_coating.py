@@ -1,4 +1,4 @@
-"""The tracer's coating from a film fit: films.coating_from_fit and trace --coating-from."""
+"""The tracer's coating from a film fit: sample.coating_from_fit and trace --coating-from."""
 
 from __future__ import annotations
 
@@ -11,9 +11,9 @@ import pytest
 
 from labbrdf import films
 from labbrdf.cli import main
-from labbrdf.films import coating_from_fit
 from labbrdf.fitting.film import fit_film
 from labbrdf.nk.dispersion import Cauchy
+from labbrdf.sample import coating_from_fit
 
 CAUCHY = {"A": 1.52, "B": 0.006, "C": 0.0}
 D_NM = 250.0

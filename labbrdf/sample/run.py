@@ -1,20 +1,19 @@
 """A tracer run from what a user has: index values or files, roughness values or height maps.
 
-The objects layer over :mod:`labbrdf.tracer` (which reads no file):
 :func:`trace_config_from_inputs` assembles the :class:`~labbrdf.Substrate` and the
 :class:`~labbrdf.Coating` of a :class:`~labbrdf.TraceConfig` from
 
 - the substrate index: a value, or the bulk n, k of an ellipsometer file at the traced
-  wavelength (:func:`labbrdf.nk.read_nk`, :func:`labbrdf.nk.bulk_index_at`);
+  wavelength (:func:`labbrdf.sample.bulk_index`);
 - the substrate roughness: a GGX or Beckmann alpha, or the slope table of a measured
-  areal height map (:meth:`labbrdf.Substrate.from_surface`);
+  areal height map (:func:`labbrdf.sample.measured_substrate`);
 - an optional coating: index and thickness values, or the one layer of a film fit at the
-  traced wavelength (:func:`labbrdf.films.coating_from_fit`), with its top's roughness as an
+  traced wavelength (:func:`labbrdf.sample.coating_from_fit`), with its top's roughness as an
   alpha (default: the substrate's) or a measured map.
 
 ``labbrdf trace`` is this function behind its options. Arguments that do not fit together
-raise :class:`labbrdf.errors.SetupError`, whose message names the keywords (the command
-line spells them as its options).
+raise :class:`labbrdf.errors.SetupError`, whose message names the keywords (the command line
+spells them as its options).
 """
 
 from __future__ import annotations
@@ -24,12 +23,13 @@ import warnings
 from collections.abc import Callable
 from typing import Any, Literal
 
-from .adapters.topography import HeightMap, read_height_map
-from .errors import SetupError, escaped
-from .films import coating_from_fit
-from .microfacet import DISTRIBUTIONS, TabulatedNDF
-from .nk import NkError, bulk_index_at, read_nk
-from .tracer.config import Coating, Substrate, TraceConfig
+from ..adapters.topography import HeightMap
+from ..errors import SetupError, escaped
+from ..nk import NkError
+from ..tracer.config import Coating, Substrate, TraceConfig
+from .coating import coating_from_fit
+from .index import bulk_index
+from .slopes import analytic_table, height_map, measured_substrate, pitch
 
 __all__ = ["trace_config_from_inputs"]
 
@@ -38,50 +38,6 @@ PathLike = str | os.PathLike[str]
 
 def _warn(message: str) -> None:
     warnings.warn(message, UserWarning, stacklevel=3)
-
-
-def _height_map(
-    source: PathLike | HeightMap,
-    keyword: str,
-    channel: int | str | None,
-    unit: str | None,
-    pixel_size: float | tuple[float, ...] | None,
-    warn: Callable[[str], None],
-) -> HeightMap:
-    """``source`` read as a height map (its geometry doubts passed to ``warn``)."""
-    if isinstance(source, HeightMap):
-        return source
-    try:
-        hm = read_height_map(source, channel, unit=unit, pixel_size=pixel_size)
-    except MemoryError:
-        raise SetupError(
-            f"{{{keyword}}} {escaped(source)}: out of memory while reading the height map"
-        ) from None
-    for w in hm.warnings:
-        warn(f"{source}: {w}")
-    return hm
-
-
-def _pitch(hm: HeightMap) -> float | tuple[float, float]:
-    """The grid spacing of an areal map [m] (a profile's one pitch as it is)."""
-    px = tuple(float(v) for v in hm.pixel_size)
-    return (px[0], px[1]) if len(px) == 2 else px[0]
-
-
-def _analytic_table(distribution: str, alpha: float) -> TabulatedNDF | None:
-    """The slope table of an analytic distribution.
-
-    None for a distribution the tracer samples in closed form (GGX).
-    """
-    if distribution not in DISTRIBUTIONS:
-        expected = " or ".join(repr(name) for name in DISTRIBUTIONS)
-        raise SetupError(f"{{distribution}} {escaped(repr(distribution))}: expected {expected}")
-    dist = DISTRIBUTIONS[distribution]
-    if dist.TRACED_IN_CLOSED_FORM:
-        return None
-    if not alpha > 0:
-        raise SetupError(f"{{distribution}} {dist.NAME} needs a roughness alpha > 0")
-    return TabulatedNDF.of(dist, alpha)
 
 
 def _substrate(
@@ -97,21 +53,16 @@ def _substrate(
         raise SetupError("give the substrate index with {substrate_index} N+Kj or {nk_from} FILE")
     if nk_from is not None:
         try:
-            n, k = bulk_index_at(read_nk(nk_from), wavelength_nm, source=nk_from)
+            index = bulk_index(nk_from, wavelength_nm)
         except NkError as exc:
             raise SetupError(f"{{nk_from}} {escaped(exc)}") from None
-        index = complex(n, k)
     assert index is not None
     if surface is not None:
-        hm = read(surface, "surface")
-        try:
-            return Substrate.from_surface(hm.heights, _pitch(hm), n=index.real, k=index.imag)
-        except ValueError as exc:
-            raise SetupError(f"{{surface}} {escaped(hm.path)}: {escaped(exc)}") from None
+        return measured_substrate(read(surface, "surface"), index)
     if alpha is None:
         raise SetupError("give the substrate roughness with {alpha} A or {surface} FILE")
     return Substrate(
-        n=index.real, k=index.imag, alpha=alpha, ndf=_analytic_table(distribution, alpha)
+        n=index.real, k=index.imag, alpha=alpha, ndf=analytic_table(distribution, alpha)
     )
 
 
@@ -171,13 +122,13 @@ def _coating(
                 "an areal height map"
             )
         try:
-            top = Substrate.from_surface(hm.heights, _pitch(hm))
+            top = Substrate.from_surface(hm.heights, pitch(hm))
         except ValueError as exc:
             raise SetupError(f"{{coating_surface}} {escaped(hm.path)}: {escaped(exc)}") from None
         coat_alpha, coat_ndf = float(top.alpha), top.ndf
     else:
         coat_alpha = alpha if alpha is not None else substrate.alpha
-        coat_ndf = _analytic_table(distribution, coat_alpha)
+        coat_ndf = analytic_table(distribution, coat_alpha)
     return Coating(
         n=index.real, k=index.imag, thickness_nm=thickness_nm, alpha=coat_alpha, ndf=coat_ndf
     )
@@ -220,7 +171,7 @@ def trace_config_from_inputs(
         Substrate index ``n + ik`` [1] ...
     nk_from : path-like, optional
         ... or an ellipsometer file: its bulk n, k at ``wavelength_nm``
-        (:func:`labbrdf.nk.bulk_index_at`). Exactly one of the two.
+        (:func:`labbrdf.sample.bulk_index`). Exactly one of the two.
     alpha : float, optional
         Substrate roughness [1] (GGX or Beckmann alpha, see ``distribution``) ...
     surface : path-like or HeightMap, optional
@@ -230,7 +181,7 @@ def trace_config_from_inputs(
         Coating index [1], with ``thickness_nm`` ...
     coating_from : path-like, optional
         ... or a one-layer film fit's JSON: the layer's index at ``wavelength_nm`` and
-        its thickness (:func:`labbrdf.films.coating_from_fit`). At most one of the two; none:
+        its thickness (:func:`labbrdf.sample.coating_from_fit`). At most one of the two; none:
         no coating.
     thickness_nm : float, optional
         Coating thickness [nm] (with ``coating_index``).
@@ -265,7 +216,7 @@ def trace_config_from_inputs(
     """
 
     def read(source: PathLike | HeightMap, keyword: str) -> HeightMap:
-        return _height_map(source, keyword, channel, unit, pixel_size, warn)
+        return height_map(source, keyword, channel, unit, pixel_size, warn)
 
     if base_albedo is not None:
         metal: dict[str, object] = {

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from labbrdf import smoothness as sm
-from labbrdf.surface import gaussian_surface
-from labbrdf.topography import roughness_statistics
+from labbrdf.roughness import smoothness as sm
+from labbrdf.roughness.synthetic import gaussian_surface
+from labbrdf.roughness.topography import roughness_statistics
 
 # (sigma [nm], wavelength [nm], theta_i [deg]) -> g computed with plain math below
 CASES = [(10.0, 500.0, 0.0), (10.0, 500.0, 60.0), (2.0, 633.0, 45.0), (50.0, 1000.0, 30.0)]

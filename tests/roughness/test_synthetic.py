@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from labbrdf.surface import (
+from labbrdf.roughness.synthetic import (
     correlation_length,
     gaussian_psd,
     gaussian_surface,

@@ -1,4 +1,4 @@
-"""A tracer run from values and files: labbrdf.tracer_setup.trace_config_from_inputs.
+"""A tracer run from values and files: labbrdf.sample.trace_config_from_inputs.
 
 The assembled config must equal the one written out by hand from the same values (the
 command line and Python build the same run); every argument that does not fit raises a
@@ -12,13 +12,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from labbrdf import tracer_setup
 from labbrdf.adapters.topography import HeightMap
 from labbrdf.errors import SetupError
 from labbrdf.microfacet import TabulatedNDF
 from labbrdf.nk import bulk_index_at, read_nk
+from labbrdf.sample import slopes, trace_config_from_inputs
 from labbrdf.tracer import Coating, Substrate, TraceConfig
-from labbrdf.tracer_setup import trace_config_from_inputs
 
 TA = "woollam-wvase-ascii/w2_10102006.dat"
 
@@ -146,7 +145,7 @@ def test_height_map_files_are_read_with_their_warnings(monkeypatch) -> None:
         calls.append((str(path), channel, unit, pixel_size))
         return hm_warned
 
-    monkeypatch.setattr(tracer_setup, "read_height_map", fake_read)
+    monkeypatch.setattr(slopes, "read_height_map", fake_read)
     said: list[str] = []
     cfg = trace_config_from_inputs(
         633.0, 45.0, substrate_index=2j, surface="m.di", channel="Height", unit="nm",
@@ -163,7 +162,7 @@ def test_a_map_too_big_for_memory_is_a_setup_error(monkeypatch) -> None:
     def no_memory(*args, **kw):
         raise MemoryError
 
-    monkeypatch.setattr(tracer_setup, "read_height_map", no_memory)
+    monkeypatch.setattr(slopes, "read_height_map", no_memory)
     with pytest.raises(SetupError, match=r"^surface huge.di: out of memory"):
         trace_config_from_inputs(633.0, 45.0, substrate_index=2j, surface="huge.di")
 
