@@ -283,7 +283,18 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("files", ("adapters",)),
     ("models", ("models", "integrate")),
     ("measured constants and samples", ("nk", "sample")),
-    ("workflows", ("fitting", "prediction", "bsdf_export")),
+    (
+        "workflows",
+        (
+            "fitting",
+            "prediction",
+            "rr_prediction",
+            "bsdf_export",
+            # a PSD fitted with the fitting core's intervals; spectra of files as read
+            "roughness.psd_fit",
+            "roughness.psd_result",
+        ),
+    ),
     ("report", ("report",)),
     ("command line", ("cli",)),
 )
