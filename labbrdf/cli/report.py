@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import os
 from typing import Any
 
 from ._executor import _add_scheduler, _executor, _executor_errors
-from ._options import _add_selection, _selection, _split_params
+from ._options import UsageError, _add_selection, _selection, _split_params
 from ._paths import InputPath, OutputPath, _add_overwrite
 
 
@@ -17,6 +18,16 @@ def cmd_report(args: argparse.Namespace) -> int:
     from ..report.sections.film import default_film_model
     from ..samples import split_same_sample
 
+    film_files = None
+    if args.film_files is not None:
+        film_files = split_same_sample(args.film_files, args.files)
+        inputs = {os.path.realpath(p) for p in args.files}
+        stray = [str(f) for f in film_files if os.path.realpath(f) not in inputs]
+        if stray:
+            raise UsageError(
+                f"--film-files: {', '.join(stray)} is not among the input files (give the "
+                "files of the coated sample as they are given as DATA)"
+            )
     executor = _executor(args, progress=not args.quiet)
     options, start = _split_params(args.model, args.param)
     selection = _selection(args)
@@ -33,6 +44,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             executor=executor,
             same_sample=[split_same_sample(v, args.files) for v in args.same_sample or ()],
             prediction_slopes=args.prediction_slopes,
+            film_files=film_files,
         )
     )
 
@@ -69,6 +81,13 @@ def add_parser(sub: Any) -> None:
         "--film-default",
         action="store_true",
         help="... or the stated default: one transparent Cauchy layer on c-Si, thickness free",
+    )
+    s.add_argument(
+        "--film-files",
+        default=None,
+        metavar="A[,B...]",
+        help="the psi/Delta files the film model is of (default: the files of the sample "
+        "group holding them; never the file the model reads as its substrate)",
     )
     s.add_argument(
         "--same-sample",

@@ -87,6 +87,7 @@ def user_report(
     film_model: str | os.PathLike[str] | FilmModel | None = None,
     same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
     prediction_slopes: str = "ggx",
+    film_files: Sequence[str | os.PathLike[str]] | None = None,
     **kw: Any,
 ) -> int:
     """Build a report for the given files and write it (atomically) to ``out``.
@@ -127,6 +128,8 @@ def user_report(
         Cauchy layer on c-Si with the thickness free,
         :func:`labbrdf.report.sections.film.default_film_model`) fitted to every psi/Delta
         file whose angles of incidence disagree (section ``film``). None: no film fit.
+    film_files : sequence of path-like, optional
+        The files the film model is of (default: :func:`.sections.film._applies_to`).
     same_sample : sequence of sequences of path-like
         Files that are one sample, one sequence per sample (each file among ``paths``),
         in addition to the sample names the files state (:func:`labbrdf.samples.pair_samples`);
@@ -150,8 +153,7 @@ def user_report(
         No paths, an unknown model name or option, a film model file with an error
         (naming the file and the line), a ``same_sample`` mapping that cannot hold
         (:class:`labbrdf.samples.PairingError`), a ``start`` value outside its parameter's
-        bounds, an unknown ``prediction_slopes``, or an
-        output folder that is refused
+        bounds, an unknown ``prediction_slopes``, or an output folder that is refused
         (:class:`labbrdf.outputs.OutputError`), all before any work.
     """
     unknown = set(kw) - {"quick"}
@@ -176,9 +178,8 @@ def user_report(
         fit_options={"params": dict(start)} if start else {},
     )
 
-    sections = _sections(
-        model, opts, film, film_how, paths, selection, same_sample, prediction_slopes
-    )
+    film_of = (film, film_how, film_files)
+    sections = _sections(model, opts, film_of, paths, selection, same_sample, prediction_slopes)
     run(ctx, sections)
     if title is None and not _fitted(b.results):
         b.results["title"] = f"labbrdf report: {len(paths)} file(s), nothing fitted"
@@ -290,14 +291,18 @@ def _among(
 def _sections(
     model: str,
     opts: dict[str, Any],
-    film: Any,
-    film_how: str,
+    film_of: tuple[Any, str, Sequence[str | os.PathLike[str]] | None],
     paths: Sequence[str | os.PathLike[str]],
     selection: Mapping[str, Any] | None,
     same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
     prediction_slopes: str = "ggx",
 ) -> list[Section]:
-    """The user report's sections, in order, bound to its model, film model and files."""
+    """The user report's sections, in order, bound to its model, film model and files.
+
+    ``film_of``: the film model, how it was given, and the files it is of (or None).
+    """
+    film, film_how, film_files = film_of
+    names = None if film_files is None else [Path(f).name for f in film_files]
     return [
         ("ingest", "Ingested files", lambda ctx: _ingest(ctx, paths, selection, same_sample)),
         ("measured", "Measured data, file by file", measured_section),
@@ -305,7 +310,7 @@ def _sections(
         (
             "film",
             "Film stacks fitted to angle-dependent psi/Delta",
-            lambda ctx: film_section(ctx, film, how=film_how),
+            lambda ctx: film_section(ctx, film, how=film_how, film_files=names),
         ),
         (
             "fits",
