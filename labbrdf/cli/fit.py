@@ -170,7 +170,7 @@ def _residual_groups(args: argparse.Namespace, data: Any, by: list[str]) -> None
 def cmd_fit(args: argparse.Namespace) -> int:
     """Fit ``--model`` to each group of the files; exit 3 if a group fails."""
     from .. import adapters
-    from ..fitting import auto_weighting, fit_many, fit_many_nk, fit_records
+    from ..fitting import fit_many, fit_many_nk, fit_records
 
     model, options, settings = _fit_settings(args)
     by = [c.strip() for c in args.by.split(",") if c.strip()]
@@ -187,9 +187,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
         "mask_zeros": not args.keep_zeros,
         "relative_floor": args.relative_floor,
     }
-    weighting = args.weighting if args.weighting != "auto" else auto_weighting(data)
-    if weighting is not None:
-        kw["weighting"] = weighting
+    kw["weighting"] = args.weighting
     if args.nk_from:
         with _option_errors():
             table, results = fit_many_nk(
@@ -299,7 +297,8 @@ def add_parser(sub: Any) -> None:
         "--weighting",
         choices=["auto", "sigma", "relative", "uniform"],
         default="auto",
-        help="auto: 1/sigma^2 where every point has sigma, else relative",
+        help="auto (the default everywhere: labbrdf.fit, the report): 1/sigma^2 where every "
+        "point has sigma, else relative",
     )
     s.add_argument(
         "--relative-floor",

@@ -97,7 +97,9 @@ def _row(row: dict[str, Any], s: dict[str, Any], param_names: list[str]) -> dict
         row["replicates"] = len(s["replicates"])
     for col in ("rmse", "rmse_pct", "chisqr", "redchi", "aic", "bic", "ndata", "nfev"):
         row[col] = s.get(col)
+    row["weighting"] = str(s.get("weighting") or "").split(":")[0]
     row["success"] = bool(s.get("success", False))
+    row["status"] = s.get("status") or ("ok" if row["success"] else "failed")
     row["message"] = s.get("message", "")
     row["elapsed_s"] = s.get("elapsed_s")
     return row
@@ -243,7 +245,9 @@ def fit_many(
         One row per group: the group keys; per parameter ``<name>``, ``<name>_stderr``,
         ``<name>_ci95_lo``, ``<name>_ci95_hi``, ``<name>_flags`` (``;``-joined); then
         ``rmse``, ``rmse_pct``, ``chisqr``, ``redchi``, ``aic``, ``bic``, ``ndata``,
-        ``nfev``, ``success``, ``message``, ``elapsed_s``. A group that cannot be fitted
+        ``nfev``, ``weighting`` (its kind), ``success``, ``status`` (``ok``, ``at bound:
+        NAMES`` or ``failed``: :attr:`FitResult.status`), ``message``, ``elapsed_s``. A
+        group that cannot be fitted
         (too few points, ...) gets ``success=False`` and the reason in ``message``.
     """
     if progress is None and not isinstance(executor, parallel.Executor):

@@ -448,9 +448,9 @@ def fit(
     nan_policy: str = "raise",
     guess: bool = True,
     ci: str = "wald",
-    weighting: str | None = None,
+    weighting: str | None = "auto",
     relative_floor: float = RELATIVE_FLOOR,
-    mask_zeros: bool = False,
+    mask_zeros: bool = True,
     replicates: int | None = None,
 ) -> FitResult:
     """Fit a reflectance/BRDF model: an nlopt global stage inside the bounds, then a local one.
@@ -488,7 +488,9 @@ def fit(
     quantity, unit : str, optional
         Which rows to fit when the data mix quantities or units.
     use_sigma : bool, optional
-        Weight by ``1/sigma^2``. None: when every point has a finite sigma > 0.
+        With ``weighting=None``: weight by ``1/sigma^2`` (True), uniformly (False), or
+        by ``1/sigma^2`` when every point has a finite sigma > 0 (None). With
+        ``weighting="auto"``, False means: do not use the sigmas (relative weights).
     nan_policy : {"raise", "omit"}
         Points with NaN/inf values or angles raise, or are dropped and counted in
         ``FitResult.ndropped``.
@@ -498,14 +500,18 @@ def fit(
     ci : {"wald", "profile"}
         95% intervals from the covariance (value +- t stderr) or from the profile of
         chi-square (docs/models.md 5.3). Not combined with ``energy_constraint``.
-    weighting : {None, "sigma", "relative", "uniform"}
-        None: as ``use_sigma`` says. ``"relative"``: sigma_i = max(|y_i|, floor), floor =
-        ``relative_floor x max|y|``, covariance rescaled by ``redchi`` (docs/models.md 5.4).
+    weighting : {"auto", "sigma", "relative", "uniform", None}
+        ``"auto"`` (the default, as the CLI's ``fit`` and the report): ``1/sigma^2`` when
+        every point has a finite sigma > 0, else ``"relative"``. ``"relative"``: sigma_i =
+        max(|y_i|, floor), floor = ``relative_floor x max|y|``, covariance rescaled by
+        ``redchi`` (docs/models.md 5.4: why this is the default for data without sigmas).
+        None: as ``use_sigma`` says (uniform without sigmas).
     relative_floor : float
         The floor of ``weighting="relative"`` as a fraction of the largest value.
     mask_zeros : bool
-        Exclude points whose value is exactly 0 (instrument-masked directions), counted in
-        ``FitResult.nmasked`` and named in ``warnings``.
+        Exclude points whose value is exactly 0 (instrument-masked directions, not a
+        measurement of 0), counted in ``FitResult.nmasked`` and named in ``warnings``.
+        Default True, as the CLI's ``fit`` (``--keep-zeros`` turns it off) and the report.
     replicates : int, optional
         R > 1: a stochastic model fitted with R seeds, combined (:func:`fit_replicates`);
         None: the model's ``default_replicates`` (1 for a deterministic model).
@@ -714,6 +720,8 @@ def _finish(
         pb.nmasked > 0
     )
     warn += [ONE_SEED_WARNING] * bool(model.stochastic)
+    domain = model.outside_domain(fd.theta_i_deg, fd.phi_r_deg) or ""
+    warn += [f"outside the model's domain: {domain}"] * bool(domain)
     if ci == "profile" and finite:
         delta = float(special.stdtrit(nfree, 0.975)) ** 2 * (1.0 if use_sigma else redchi)
         warn += _profile_intervals(model, fd, out, pb.weights, prof, varying, chisqr, delta, seed)
@@ -758,6 +766,7 @@ def _finish(
         stages=stage_info,
         energy=energy_info,
         warnings=warn,
+        outside_domain=domain,
         ci_method=ci,
         cond=cond,
         nlopt_version=".".join(
@@ -1040,6 +1049,9 @@ def _weighting(
     fd: FitData, use_sigma: bool | None, weighting: str | None, floor: float
 ) -> tuple[NDArray, bool, str]:
     """Weights, whether sigma is used, and a one-line description of the weighting."""
+    if weighting == "auto":  # sigma on some rows only, or sigma <= 0: refused by _weights
+        has = np.isfinite(np.asarray(fd.sigma, float))
+        weighting = None if has.any() and use_sigma is not False else "relative"
     if weighting is None or weighting == "sigma":
         w, used = _weights(fd, True if weighting == "sigma" else use_sigma)
         return w, used, "1/sigma^2 (the data's sigma)" if used else "uniform"
@@ -1054,7 +1066,9 @@ def _weighting(
             raise FitError("weighting='relative' needs a value > 0")
         s = np.maximum(y, floor * ymax)
         return 1.0 / s**2, False, f"relative: sigma = max(|y|, {floor:g} x max|y|)"
-    raise FitError(f"weighting must be None, 'sigma', 'relative' or 'uniform', got {weighting!r}")
+    raise FitError(
+        f"weighting must be 'auto', 'sigma', 'relative', 'uniform' or None, got {weighting!r}"
+    )
 
 
 def _check_design(model: Model, fd: FitData, varying: list[str]) -> None:

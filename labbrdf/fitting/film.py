@@ -719,7 +719,8 @@ def fit_film(
         "film",
         "mixed",
     )
-    res = fit(model, fd, method=method, seed=seed, ci=ci, maxeval=maxeval, guess=False)
+    res = fit(model, fd, method=method, seed=seed, ci=ci, maxeval=maxeval, guess=False,
+              weighting="sigma", mask_zeros=False)  # fmt: skip
     best = fm.stack.with_values({k: res.params[k].value for k in fm.free})
     return FilmFit(
         result=res,
