@@ -106,3 +106,19 @@ def test_examples_run(page: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatc
                 pytest.fail(f"{page.name} block {i + 1} ({mark or 'fixtures'}): {exc!r}")
     finally:
         plt.close("all")
+
+
+def test_the_tutorials_ingest_table_is_what_ingest_prints(capsys, monkeypatch) -> None:
+    """The tutorial's shown output of `labbrdf ingest` is the command's, column for column."""
+    from labbrdf.cli import main
+
+    text = (ROOT / "docs" / "tutorial.md").read_text("utf-8")
+    shown = re.search(r"```text\n(file .*?)```", text, re.S)
+    assert shown is not None
+    monkeypatch.chdir(FIXTURES)
+    files = ["specular/osr_specular.csv", "ellipsometry/al_bare_wvase.dat",
+             "spectrophotometer/osr_sphere_cary.csv"]  # fmt: skip
+    assert main(["ingest", *files]) == 0
+    printed = [ln.rstrip() for ln in capsys.readouterr().out.splitlines() if ln.strip()]
+    assert printed == [ln.rstrip() for ln in shown.group(1).splitlines() if ln.strip()]
+    assert "one JSON array with an object per file" in text

@@ -7,7 +7,13 @@ import os
 from typing import Any
 
 from ._executor import _add_scheduler, _executor, _executor_errors
-from ._options import UsageError, _add_selection, _selection, _split_params
+from ._options import (
+    UsageError,
+    _add_selection,
+    _selection,
+    _split_params,
+    _wavelength_value,
+)
 from ._paths import InputPath, OutputPath, _add_overwrite
 
 
@@ -45,6 +51,7 @@ def cmd_report(args: argparse.Namespace) -> int:
             same_sample=[split_same_sample(v, args.files) for v in args.same_sample or ()],
             prediction_slopes=args.prediction_slopes,
             film_files=film_files,
+            wavelength_nm=args.wavelength,
         )
     )
 
@@ -104,7 +111,15 @@ def add_parser(sub: Any) -> None:
         help="roughness of the section prediction: the GGX alpha of the height map's slopes "
         "(default) or their measured table (as trace --surface)",
     )
+    s.add_argument(
+        "--wavelength",
+        type=_wavelength_value,
+        default=None,
+        metavar="NM",
+        help="[nm] the wavelength of the files that state none (a .bsdf has no field for "
+        "it; 555 nm is then a label, and the prediction and smoothness sections need it)",
+    )
     s.add_argument("--quiet", action="store_true", help="no progress lines")
-    _add_selection(s)
+    _add_selection(s, wavelength_taken=True)
     _add_scheduler(s)
     s.set_defaults(func=cmd_report)

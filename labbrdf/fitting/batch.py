@@ -245,10 +245,8 @@ def fit_many(
         One row per group: the group keys; per parameter ``<name>``, ``<name>_stderr``,
         ``<name>_ci95_lo``, ``<name>_ci95_hi``, ``<name>_flags`` (``;``-joined); then
         ``rmse``, ``rmse_pct``, ``chisqr``, ``redchi``, ``aic``, ``bic``, ``ndata``,
-        ``nfev``, ``weighting`` (its kind), ``success``, ``status`` (``ok``, ``at bound:
-        NAMES`` or ``failed``: :attr:`FitResult.status`), ``message``, ``elapsed_s``. A
-        group that cannot be fitted
-        (too few points, ...) gets ``success=False`` and the reason in ``message``.
+        ``nfev``, ``weighting``, ``success``, ``status`` (:attr:`FitResult.status`),
+        ``message``, ``elapsed_s``; a group not fitted: ``success=False``, why in ``message``.
     """
     if progress is None and not isinstance(executor, parallel.Executor):
         progress = True  # a scheduler name or no executor: a bar, as ``labbrdf fit`` shows
@@ -448,7 +446,8 @@ def fit_records(
     Returns
     -------
     list of dict
-        Per row: ``group`` (``{column: value}`` of ``by``), ``params`` (per parameter
+        Per row: ``model`` and ``options`` (what was fitted: ``labbrdf export --from-fit``
+        rebuilds it), ``group`` (``{column: value}`` of ``by``), ``params`` (per parameter
         ``value``, ``stderr``, ``ci95``, ``at_bound``), ``rmse``, ``redchi``,
         ``weighting``, ``nmasked``, ``flags`` (per flagged parameter), ``nfev``,
         ``replicates`` and ``seed_spread`` (seed replicates, else None), ``success``,
@@ -467,6 +466,8 @@ def fit_records(
             j += 1
             out.append(
                 {
+                    "model": s["model"],
+                    "options": s["options"],
                     "group": results[j - 1][0],
                     "params": {
                         name: {

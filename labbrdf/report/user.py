@@ -88,6 +88,7 @@ def user_report(
     same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
     prediction_slopes: str = "ggx",
     film_files: Sequence[str | os.PathLike[str]] | None = None,
+    wavelength_nm: float | None = None,
     **kw: Any,
 ) -> int:
     """Build a report for the given files and write it (atomically) to ``out``.
@@ -124,12 +125,10 @@ def user_report(
         ``theta_i``, ``quantity``, ``sample``); applied to every file after reading.
     film_model : path-like or FilmModel, optional
         A film model (a TOML file, :func:`labbrdf.films.load_model`, or a
-        :class:`~labbrdf.films.FilmModel`, e.g. the stated default of one transparent
-        Cauchy layer on c-Si with the thickness free,
-        :func:`labbrdf.report.sections.film.default_film_model`) fitted to every psi/Delta
-        file whose angles of incidence disagree (section ``film``). None: no film fit.
-    film_files : sequence of path-like, optional
-        The files the film model is of (default: :func:`.sections.film._applies_to`).
+        :class:`~labbrdf.films.FilmModel`, e.g. :func:`.sections.film.default_film_model`)
+        fitted to the psi/Delta files whose angles disagree (section ``film``).
+    film_files, wavelength_nm : optional
+        The film model's files (section ``film``); the [nm] of files that state none.
     same_sample : sequence of sequences of path-like
         Files that are one sample, one sequence per sample (each file among ``paths``),
         in addition to the sample names the files state (:func:`labbrdf.samples.pair_samples`);
@@ -139,7 +138,7 @@ def user_report(
         slopes (default), or their measured table
         (:mod:`labbrdf.report.sections.prediction` says why GGX is the default).
     **kw :
-        ``quick`` is accepted for symmetry with :func:`~labbrdf.report.validate` (no effect).
+        ``quick``: accepted as :func:`~labbrdf.report.validate` takes it (no effect).
 
     Returns
     -------
@@ -153,8 +152,7 @@ def user_report(
         No paths, an unknown model name or option, a film model file with an error
         (naming the file and the line), a ``same_sample`` mapping that cannot hold
         (:class:`labbrdf.samples.PairingError`), a ``start`` value outside its parameter's
-        bounds, an unknown ``prediction_slopes``, or an output folder that is refused
-        (:class:`labbrdf.outputs.OutputError`), all before any work.
+        bounds, an unknown ``prediction_slopes``, or a refused output folder, before any work.
     """
     unknown = set(kw) - {"quick"}
     if unknown:
@@ -176,6 +174,7 @@ def user_report(
         method=method,
         seed=seed,
         fit_options={"params": dict(start)} if start else {},
+        wavelength_nm=wavelength_nm,
     )
 
     film_of = (film, film_how, film_files)
@@ -254,6 +253,8 @@ def _ingest(
         "with SurfaceTopography."
     )
     read = ingest_inputs(ctx, paths)
+    if ctx.wavelength_nm is not None:
+        _given_wavelength(ctx, ctx.wavelength_nm)
     sample_groups(ctx, read, _among(same_sample, read))
     if selection:
         from ..selection import SelectionError, select
@@ -270,6 +271,29 @@ def _ingest(
             + f"; {sum(len(f) for f in kept)} of {sum(len(f) for f in ctx.frames)} rows kept."
         )
         ctx.frames[:] = [f for f in kept if len(f)]
+
+
+def _given_wavelength(ctx: Context, wl: float) -> None:
+    """The rows of every file that states no wavelength get ``wl`` [nm]; the page says so."""
+    given, stated = [], []
+    for rec in ctx.files:
+        meta = rec.get("meta") or {}
+        if meta.get("wavelength_stated") is not False:
+            stated.append(str(rec["file"]))
+            continue
+        given.append(str(rec["file"]))
+        for j, f in enumerate(ctx.frames):
+            mine = (f["source"].astype(str) == rec["file"]).to_numpy()
+            if mine.any():
+                ctx.frames[j] = f.assign(wavelength_nm=f["wavelength_nm"].where(~mine, wl))
+        rec["meta"] = {**meta, "wavelength_nm": wl, "wavelength_stated": True,
+                       "wavelength_given": True}  # fmt: skip
+    ctx.b.text(
+        f"Wavelength given with --wavelength: {wl:g} nm, for the files that state none ("
+        + (", ".join(given) or "none of the files")
+        + ")"
+        + (f"; the others keep their own ({', '.join(stated)})." if stated else ".")
+    )
 
 
 def _among(

@@ -233,11 +233,14 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
             _dop_part(ctx, sid, dop)
     for path in s["bsdf"]:
         try:
+            given = [r["meta"]["wavelength_nm"] for r in ctx.files if r.get("meta", {}).get(
+                "wavelength_given") and Path(str(r["path"])).name == path.name]  # fmt: skip
             pred = predict_brdf(
                 path,
                 frame,
                 fit,
                 film=film,
+                wavelength_nm=given[0] if given else None,
                 ndf=ndf,
                 rays=rays_of(ctx),
                 seed=ctx.seed,
