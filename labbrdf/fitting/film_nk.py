@@ -84,7 +84,7 @@ def nk_with_sigma(fit: FilmFit, wavelength_nm: ArrayLike) -> dict[str, dict[str,
         g = np.stack(grads[lay], axis=-1) if names else np.zeros((wl.size, 0), complex)
         for part, gv in (("n", g.real), ("k", g.imag)):
             zero = ~np.any(gv != 0, axis=-1)
-            if usable:
+            if usable and cov is not None:
                 var = np.einsum("ij,jk,ik->i", gv, cov, gv)
                 se = np.sqrt(np.where(var >= 0, var, np.nan))
             else:
