@@ -138,7 +138,7 @@ def add_parser(sub: Any) -> None:
         type=_wavelength_value,
         default=None,
         metavar="NM",
-        help="[nm] for --nk-from, the group of --from-fit, recorded in the file",
+        help="[nm] for --nk-from, the group of --from-fit; recorded in the output",
     )
     s.add_argument("--theta-i", type=_angle_value, nargs="+", default=None, metavar="DEG")
     s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")

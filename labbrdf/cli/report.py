@@ -93,8 +93,8 @@ def add_parser(sub: Any) -> None:
         "--film-files",
         default=None,
         metavar="A[,B...]",
-        help="the psi/Delta files the film model is of (default: the files of the sample "
-        "group holding them; never the file the model reads as its substrate)",
+        help="the psi/Delta DATA inputs the film model is of (default: those of the sample "
+        "group holding them; never the model's own substrate table)",
     )
     s.add_argument(
         "--same-sample",
