@@ -207,6 +207,9 @@ def brdf_section(ctx: Context, model: str, options: Mapping[str, Any]) -> None:
             if weighting == "relative"
             else "."
         )
+        + " The joint fit is the fit of section fits (the same weighting, masked points, "
+        "method and seed as there and as labbrdf fit and labbrdf.fit); each per-angle fit "
+        "sees one angle of incidence only, so its values differ from the joint ones by design."
     )
     for f in ctx.files:
         meta = f.get("meta") or {}

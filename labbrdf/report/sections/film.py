@@ -412,6 +412,8 @@ def _fit_shown(
         f"{s['mse']:.4g}; {s['message']}."
         + (" Notes: " + "; ".join(s["notes"]) + "." if s["notes"] else "")
     )
+    if s.get("verdict"):
+        b.note("parameters not meaningful", s["verdict"])
     b.table(
         f"film_{tag}_params",
         f"{src}: fitted parameters",
