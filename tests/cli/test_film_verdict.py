@@ -133,3 +133,23 @@ def test_w1_on_the_default_silicon_says_the_answer_is_not_meaningful(real_export
     assert "substrate: si (reference table, Green 2008)" in out
     assert "n, k at 550 nm" in out
     assert "VERDICT: MSE" in out and "the parameters above are not meaningful" in out
+
+
+def test_the_report_shows_the_verdict_of_a_wrong_model(film_file):
+    from types import SimpleNamespace
+
+    from labbrdf import read
+    from labbrdf.report.builder import Builder
+    from labbrdf.report.context import Context
+    from labbrdf.report.sections.film import _fit_shown
+
+    box = {"film.thickness_nm": (0.0, 300.0), "film.A": (1.3, 1.8), "film.B": (0.0, 0.02)}
+    stack = Stack([Layer(Cauchy(A=1.55, B=0.01), 150.0, "film")], "sio2")
+    fit = fit_film(FilmModel(stack, box), read(film_file), ci="wald")
+    assert fit.mse > MSE_WRONG_MODEL
+    ctx = Context(Builder("t", progress=False))
+    with ctx.b.section("film", "Film stacks"):
+        _fit_shown(ctx, "0", "film.parquet", SimpleNamespace(text="stack"), fit)
+    text = str(ctx.b.results)
+    assert "parameters not meaningful" in text
+    assert f"MSE {fit.mse:.4g} > 20: the model does not describe this sample" in text
