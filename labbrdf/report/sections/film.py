@@ -4,7 +4,9 @@ Where the angles of incidence of a psi/Delta file disagree (:func:`labbrdf.nk.an
 ``stack`` or ``partly``), its two-phase pseudo-constants are those of a stack and give
 neither a material's n, k nor a reflectance (section ``nk``). Given a film model (a TOML
 file, :func:`labbrdf.films.load_model`, or the stated default :func:`default_film_model`),
-this section fits it to the file's psi/Delta at every angle (:func:`labbrdf.fit_film`)
+this section fits it to the file's psi/Delta at every angle (:func:`labbrdf.fit_film`),
+for the files of the model's sample only (:func:`_applies_to`: never a file the model reads
+as its substrate's table, a bare wafer; ``--film-files`` where the sample groups do not say)
 and shows the model, the parameters with their intervals, psi and Delta against wavelength
 per angle with the fit and the residuals, each layer's n, k with its uncertainty band, and
 the reflectance comparison redone with the fitted stack: the measured reflectance of the
