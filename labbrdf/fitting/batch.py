@@ -310,8 +310,8 @@ def auto_weighting(data: Measurement | pd.DataFrame) -> str | None:
     Returns
     -------
     None or "relative"
-        None (``1/sigma^2``, :func:`fit`'s default) when every row has a finite sigma
-        > 0; else ``"relative"`` (sigma_i = max(|y_i|, floor x max|y|)): rows without
+        None (``1/sigma^2``, as :func:`fit`'s ``weighting="auto"``) when every row has a
+        finite sigma > 0; else ``"relative"`` (sigma_i = max(|y_i|, floor x max|y|)): rows without
         sigma (a ``.bsdf`` has none) are fitted with relative weights, not uniform ones.
     """
     df = data.data if isinstance(data, Measurement) else data
