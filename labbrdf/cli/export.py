@@ -18,16 +18,18 @@ def cmd_export(args: argparse.Namespace) -> int:
 
     if args.format != "zemax-bsdf":
         raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
-    if (args.model is None) == (args.trace is None):
-        raise UsageError("export a model (--model NAME --param ...) or a trace (--trace RUN.npz)")
+    if sum(x is not None for x in (args.model, args.trace, args.from_fit)) != 1:
+        raise UsageError(
+            "export a model (--model NAME --param ...), a fit (--from-fit FIT.json) or a "
+            "trace (--trace RUN.npz)"
+        )
     if args.trace is not None:
         return _export_trace(args)
     if args.theta_i is None:
-        raise UsageError("--model needs --theta-i DEG [DEG ...]")
-    model, values = _model_from_args(args)
-    unknown = [k for k in values if k not in model.params]
-    if unknown:
-        raise UsageError(f"--param {unknown}: {args.model} parameters are {list(model.params)}")
+        raise UsageError(
+            f"{'--model' if args.model else '--from-fit'} needs --theta-i DEG [DEG ...]"
+        )
+    model, values, wl, comments = _from_fit(args) if args.from_fit else _from_model(args)
     out = Path(args.output)  # checked with the inputs by _checked_outputs
     model_to_bsdf(
         model,
@@ -36,10 +38,39 @@ def cmd_export(args: argparse.Namespace) -> int:
         theta_i_deg=np.asarray(args.theta_i, float),
         radial_deg=_grid(args.radial, "--radial"),
         azimuth_deg=_grid(args.azimuth, "--azimuth"),
+        wavelength_nm=wl,
+        comments=comments,
         overwrite=args.overwrite,
     )
-    print(f"wrote {out}")
+    print(f"wrote {out}" + (f" (wavelength {wl:g} nm)" if wl else " (no wavelength: none given)"))
     return 0
+
+
+def _from_model(args: argparse.Namespace) -> tuple[Any, dict[str, float], float | None, tuple]:
+    """``--model NAME --param ...``: the model, its values, ``--wavelength`` [nm]."""
+    model, values = _model_from_args(args)
+    unknown = [k for k in values if k not in model.params]
+    if unknown:
+        raise UsageError(f"--param {unknown}: {args.model} parameters are {list(model.params)}")
+    return model, values, args.wavelength, ()
+
+
+def _from_fit(args: argparse.Namespace) -> tuple[Any, dict[str, float], float | None, tuple]:
+    """``--from-fit FIT.json``: the fitted model, its values and its group's wavelength [nm]."""
+    from .. import models
+    from ._fit_record import fit_record
+
+    if args.param or args.nk_from:
+        raise UsageError("--from-fit takes the model and its values from the fit; drop --param")
+    rec = fit_record(args.from_fit, args.wavelength)
+    try:
+        model = models.get(rec["model"], **rec["options"])
+        for k, v in rec["values"].items():
+            model.check_value(k, v)
+    except ValueError as exc:
+        raise UsageError(f"--from-fit {args.from_fit}: {exc}") from None
+    note = f"labbrdf fit of {rec['model']} from {Path(args.from_fit).name}"
+    return model, rec["values"], rec["wavelength_nm"], (note,)
 
 
 def _export_trace(args: argparse.Namespace) -> int:
@@ -92,6 +123,14 @@ def add_parser(sub: Any) -> None:
     s.add_argument(
         "--trace", action=InputPath, default=None, metavar="RUN.npz", help="... or a trace's S0"
     )
+    s.add_argument(
+        "--from-fit",
+        action=InputPath,
+        default=None,
+        metavar="FIT.json",
+        help="... or the model and values of a fit (what `labbrdf fit --json` prints; with "
+        "several groups choose one with --wavelength); its wavelength is recorded",
+    )
     s.add_argument("--param", action="append", metavar="NAME=VALUE")
     s.add_argument("--nk-from", action=InputPath, default=None, metavar="FILE")
     s.add_argument(
@@ -99,7 +138,7 @@ def add_parser(sub: Any) -> None:
         type=_wavelength_value,
         default=None,
         metavar="NM",
-        help="[nm] for --nk-from",
+        help="[nm] for --nk-from, the group of --from-fit; recorded in the output",
     )
     s.add_argument("--theta-i", type=_angle_value, nargs="+", default=None, metavar="DEG")
     s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")

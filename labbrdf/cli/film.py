@@ -58,6 +58,22 @@ def _film_model(args: argparse.Namespace) -> Any:
     return films.FilmModel(stack, free, None, "--layer")
 
 
+def _at_wavelengths(text: str | None) -> list[float]:
+    """The wavelengths [nm] of ``--at 550[,633...]``: positive finite numbers."""
+    if text is None:
+        return []
+    out = []
+    for item in text.split(","):
+        try:
+            w = float(item)
+        except ValueError:
+            w = math.nan
+        if not (math.isfinite(w) and w > 0):
+            raise UsageError(f"--at {text}: expected wavelengths [nm] > 0, e.g. --at 550,633")
+        out.append(w)
+    return out
+
+
 def _one_sample(args: argparse.Namespace, parts: list[Any], data: Any) -> bool:
     """Whether the files of a film fit are one sample: refused (exit 2) when they are not.
 
@@ -103,10 +119,13 @@ def cmd_film(args: argparse.Namespace) -> int:
     """Fit the film model of the options to the files; print the layers and the fit."""
     from .. import adapters
     from ..dataset import concat
+    from ..films import FilmError
     from ..fitting.film import fit_film
+    from ..fitting.film_display import film_fit_report
     from ..outputs import atomic_output, csv_safe_frame
 
     fm = _film_model(args)
+    at_nm = _at_wavelengths(args.at)
     sigma = _parse_assignments(args.sigma, "--sigma")
     wl_range = None
     if args.wavelength_range is not None:  # the rows, and the range that replaces the file's
@@ -131,15 +150,19 @@ def cmd_film(args: argparse.Namespace) -> int:
         ci=args.ci,
         one_sample=_one_sample(args, parts, data),
     )
+    try:
+        summary = res.summary(at_nm)
+    except FilmError as exc:
+        raise UsageError(f"--at {args.at}: {exc}") from None
     if args.output:
         with atomic_output(args.output) as tmp:
             csv_safe_frame(res.nk_table()).to_csv(tmp, index=False)
     if args.fit_json:
-        res.save_json(args.fit_json)
+        res.save_json(args.fit_json, at_nm)
     if args.json:
-        _emit_json(res.summary())
+        _emit_json(summary)
     else:
-        print(res.fit_report())
+        print(film_fit_report(summary))
     return 0
 
 
@@ -203,6 +226,13 @@ def add_parser(sub: Any) -> None:
         default="profile",
         help="95%% intervals from the profile of chi2 (default) or the covariance",
     )
+    s.add_argument(
+        "--at",
+        default=None,
+        metavar="NM[,NM...]",
+        help="print every layer's and the substrate's n, k with standard errors at these "
+        "wavelengths [nm] (also in --json and --fit-json)",
+    )
     s.add_argument("--method", default=METHOD, help="nlopt stages")
     s.add_argument("--seed", type=_fit_seed, default=0, help="the optimiser's seed")
     s.add_argument(
@@ -212,7 +242,7 @@ def add_parser(sub: Any) -> None:
         suffixes=(".csv",),
         default=None,
         metavar="NK.csv",
-        help="write each layer's n, k on the fitted wavelengths",
+        help="write each layer's n, k and their standard errors on the fitted wavelengths",
     )
     s.add_argument(
         "--fit-json",

@@ -170,7 +170,7 @@ def _residual_groups(args: argparse.Namespace, data: Any, by: list[str]) -> None
 def cmd_fit(args: argparse.Namespace) -> int:
     """Fit ``--model`` to each group of the files; exit 3 if a group fails."""
     from .. import adapters
-    from ..fitting import auto_weighting, fit_many, fit_many_nk, fit_records
+    from ..fitting import fit_many, fit_many_nk, fit_records
 
     model, options, settings = _fit_settings(args)
     by = [c.strip() for c in args.by.split(",") if c.strip()]
@@ -187,9 +187,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
         "mask_zeros": not args.keep_zeros,
         "relative_floor": args.relative_floor,
     }
-    weighting = args.weighting if args.weighting != "auto" else auto_weighting(data)
-    if weighting is not None:
-        kw["weighting"] = weighting
+    kw["weighting"] = args.weighting
     if args.nk_from:
         with _option_errors():
             table, results = fit_many_nk(
@@ -211,7 +209,7 @@ def cmd_fit(args: argparse.Namespace) -> int:
         _residual_maps(args, data, results)
     failed = [r for r in table.to_dict("records") if not r["success"]]
     if args.json:
-        _emit_json(fit_records(table, results, by))
+        _emit_json(_with_stated(fit_records(table, results, by), data))
     else:
         import pandas as pd
 
@@ -221,6 +219,35 @@ def cmd_fit(args: argparse.Namespace) -> int:
         group = ", ".join(f"{b}={r[b]}" for b in by)
         print(f"labbrdf fit: group {group} FAILED: {r['message']}", file=sys.stderr)
     return 3 if failed else 0
+
+
+def _with_stated(records: list[dict[str, Any]], data: Any) -> list[dict[str, Any]]:
+    """Each record with ``wavelength_stated``: False where a file of its group states none.
+
+    A ``.bsdf`` states no wavelength; its 555 nm is a label (``export --from-fit`` then
+    records the wavelength given with ``--wavelength``, not the label).
+    """
+    import numpy as np
+
+    parts = data.meta.get("parts")
+    if parts:
+        unstated = {
+            str(p.get("source"))
+            for p in parts
+            if (p.get("meta") or {}).get("wavelength_stated") is False
+        }
+    elif data.meta.get("wavelength_stated") is False:  # one file: every row is its
+        unstated = set(data.data["source"].astype(str))
+    else:
+        unstated = set()
+    rows = data.data
+    for rec in records:
+        keep = np.ones(len(rows), bool)
+        for col, v in (rec.get("group") or {}).items():
+            keep &= (rows[col] == v).to_numpy()
+        sources = set(rows.loc[keep, "source"].astype(str))
+        rec["wavelength_stated"] = not (sources & unstated)
+    return records
 
 
 def _residual_maps(args: argparse.Namespace, data: Any, results: list) -> None:
@@ -299,7 +326,8 @@ def add_parser(sub: Any) -> None:
         "--weighting",
         choices=["auto", "sigma", "relative", "uniform"],
         default="auto",
-        help="auto: 1/sigma^2 where every point has sigma, else relative",
+        help="auto (the default everywhere: labbrdf.fit, the report): 1/sigma^2 where every "
+        "point has sigma, else relative",
     )
     s.add_argument(
         "--relative-floor",

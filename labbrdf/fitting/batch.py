@@ -97,7 +97,9 @@ def _row(row: dict[str, Any], s: dict[str, Any], param_names: list[str]) -> dict
         row["replicates"] = len(s["replicates"])
     for col in ("rmse", "rmse_pct", "chisqr", "redchi", "aic", "bic", "ndata", "nfev"):
         row[col] = s.get(col)
+    row["weighting"] = str(s.get("weighting") or "").split(":")[0]
     row["success"] = bool(s.get("success", False))
+    row["status"] = s.get("status") or ("ok" if row["success"] else "failed")
     row["message"] = s.get("message", "")
     row["elapsed_s"] = s.get("elapsed_s")
     return row
@@ -243,8 +245,8 @@ def fit_many(
         One row per group: the group keys; per parameter ``<name>``, ``<name>_stderr``,
         ``<name>_ci95_lo``, ``<name>_ci95_hi``, ``<name>_flags`` (``;``-joined); then
         ``rmse``, ``rmse_pct``, ``chisqr``, ``redchi``, ``aic``, ``bic``, ``ndata``,
-        ``nfev``, ``success``, ``message``, ``elapsed_s``. A group that cannot be fitted
-        (too few points, ...) gets ``success=False`` and the reason in ``message``.
+        ``nfev``, ``weighting``, ``success``, ``status`` (:attr:`FitResult.status`),
+        ``message``, ``elapsed_s``; a group not fitted: ``success=False``, why in ``message``.
     """
     if progress is None and not isinstance(executor, parallel.Executor):
         progress = True  # a scheduler name or no executor: a bar, as ``labbrdf fit`` shows
@@ -308,8 +310,8 @@ def auto_weighting(data: Measurement | pd.DataFrame) -> str | None:
     Returns
     -------
     None or "relative"
-        None (``1/sigma^2``, :func:`fit`'s default) when every row has a finite sigma
-        > 0; else ``"relative"`` (sigma_i = max(|y_i|, floor x max|y|)): rows without
+        None (``1/sigma^2``, as :func:`fit`'s ``weighting="auto"``) when every row has a
+        finite sigma > 0; else ``"relative"`` (sigma_i = max(|y_i|, floor x max|y|)): rows without
         sigma (a ``.bsdf`` has none) are fitted with relative weights, not uniform ones.
     """
     df = data.data if isinstance(data, Measurement) else data
@@ -444,7 +446,8 @@ def fit_records(
     Returns
     -------
     list of dict
-        Per row: ``group`` (``{column: value}`` of ``by``), ``params`` (per parameter
+        Per row: ``model`` and ``options`` (what was fitted: ``labbrdf export --from-fit``
+        rebuilds it), ``group`` (``{column: value}`` of ``by``), ``params`` (per parameter
         ``value``, ``stderr``, ``ci95``, ``at_bound``), ``rmse``, ``redchi``,
         ``weighting``, ``nmasked``, ``flags`` (per flagged parameter), ``nfev``,
         ``replicates`` and ``seed_spread`` (seed replicates, else None), ``success``,
@@ -463,6 +466,8 @@ def fit_records(
             j += 1
             out.append(
                 {
+                    "model": s["model"],
+                    "options": s["options"],
                     "group": results[j - 1][0],
                     "params": {
                         name: {

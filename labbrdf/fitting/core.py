@@ -24,6 +24,7 @@ from .objective import Objective
 from .replicates import ONE_SEED_WARNING, run_replicates
 from .result import FitResult
 from .uncertainty import AT_BOUND_FRAC, jacobian, noise_meat, uncertainties
+from .weighting import _weighting
 
 __all__ = [
     "ALGORITHMS",
@@ -448,9 +449,9 @@ def fit(
     nan_policy: str = "raise",
     guess: bool = True,
     ci: str = "wald",
-    weighting: str | None = None,
+    weighting: str | None = "auto",
     relative_floor: float = RELATIVE_FLOOR,
-    mask_zeros: bool = False,
+    mask_zeros: bool = True,
     replicates: int | None = None,
 ) -> FitResult:
     """Fit a reflectance/BRDF model: an nlopt global stage inside the bounds, then a local one.
@@ -488,7 +489,7 @@ def fit(
     quantity, unit : str, optional
         Which rows to fit when the data mix quantities or units.
     use_sigma : bool, optional
-        Weight by ``1/sigma^2``. None: when every point has a finite sigma > 0.
+        False: ignore the sigmas. With ``weighting=None``, True/None: ``1/sigma^2``.
     nan_policy : {"raise", "omit"}
         Points with NaN/inf values or angles raise, or are dropped and counted in
         ``FitResult.ndropped``.
@@ -498,14 +499,15 @@ def fit(
     ci : {"wald", "profile"}
         95% intervals from the covariance (value +- t stderr) or from the profile of
         chi-square (docs/models.md 5.3). Not combined with ``energy_constraint``.
-    weighting : {None, "sigma", "relative", "uniform"}
-        None: as ``use_sigma`` says. ``"relative"``: sigma_i = max(|y_i|, floor), floor =
-        ``relative_floor x max|y|``, covariance rescaled by ``redchi`` (docs/models.md 5.4).
+    weighting : {"auto", "sigma", "relative", "uniform", None}
+        ``"auto"`` (default, as the CLI and the report): ``1/sigma^2`` with sigmas, else
+        ``"relative"``: sigma_i = max(|y_i|, ``relative_floor x max|y|``), covariance
+        rescaled by ``redchi``; None: ``use_sigma`` decides (docs/models.md 5.4: why).
     relative_floor : float
         The floor of ``weighting="relative"`` as a fraction of the largest value.
     mask_zeros : bool
         Exclude points whose value is exactly 0 (instrument-masked directions), counted in
-        ``FitResult.nmasked`` and named in ``warnings``.
+        ``FitResult.nmasked`` and named in ``warnings`` (default, as the CLI and report).
     replicates : int, optional
         R > 1: a stochastic model fitted with R seeds, combined (:func:`fit_replicates`);
         None: the model's ``default_replicates`` (1 for a deterministic model).
@@ -714,6 +716,8 @@ def _finish(
         pb.nmasked > 0
     )
     warn += [ONE_SEED_WARNING] * bool(model.stochastic)
+    domain = model.outside_domain(fd.theta_i_deg, fd.phi_r_deg) or ""  # warned, not refused
+    warn += [f"outside the model's domain: {domain}"] * bool(domain)
     if ci == "profile" and finite:
         delta = float(special.stdtrit(nfree, 0.975)) ** 2 * (1.0 if use_sigma else redchi)
         warn += _profile_intervals(model, fd, out, pb.weights, prof, varying, chisqr, delta, seed)
@@ -758,6 +762,7 @@ def _finish(
         stages=stage_info,
         energy=energy_info,
         warnings=warn,
+        outside_domain=domain,
         ci_method=ci,
         cond=cond,
         nlopt_version=".".join(
@@ -1016,45 +1021,6 @@ def _apply_guess(model: Model, fd: FitData, p: Parameters, given: set[str]) -> b
             q.value = float(v)
             used = True
     return used
-
-
-def _weights(fd: FitData, use_sigma: bool | None) -> tuple[NDArray, bool]:
-    """Weights 1/sigma^2 (or ones) and whether sigma is used."""
-    sig = np.asarray(fd.sigma, float)
-    has = np.isfinite(sig)
-    if use_sigma is None:
-        if has.any() and not has.all():
-            raise FitError(
-                f"data: sigma is given for {int(has.sum())} of {sig.size} points; "
-                "give it for all or pass use_sigma=False to ignore it"
-            )
-        use_sigma = bool(has.all())
-    if not use_sigma:
-        return np.ones_like(sig), False
-    if not has.all() or np.any(sig <= 0):
-        raise FitError("data: use_sigma needs a finite sigma > 0 on every point")
-    return 1.0 / sig**2, True
-
-
-def _weighting(
-    fd: FitData, use_sigma: bool | None, weighting: str | None, floor: float
-) -> tuple[NDArray, bool, str]:
-    """Weights, whether sigma is used, and a one-line description of the weighting."""
-    if weighting is None or weighting == "sigma":
-        w, used = _weights(fd, True if weighting == "sigma" else use_sigma)
-        return w, used, "1/sigma^2 (the data's sigma)" if used else "uniform"
-    if weighting == "uniform":
-        return np.ones(len(fd)), False, "uniform"
-    if weighting == "relative":
-        if not (math.isfinite(floor) and 0 < floor < 1):
-            raise FitError(f"relative_floor must be in (0, 1), got {floor!r}")
-        y = np.abs(np.asarray(fd.value, float))
-        ymax = float(y.max())
-        if not ymax > 0:
-            raise FitError("weighting='relative' needs a value > 0")
-        s = np.maximum(y, floor * ymax)
-        return 1.0 / s**2, False, f"relative: sigma = max(|y|, {floor:g} x max|y|)"
-    raise FitError(f"weighting must be None, 'sigma', 'relative' or 'uniform', got {weighting!r}")
 
 
 def _check_design(model: Model, fd: FitData, varying: list[str]) -> None:

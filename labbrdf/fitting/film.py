@@ -275,50 +275,28 @@ class FilmFit:
         return woollam_mse(self.result.chisqr, self.result.ndata, self.result.nvarys)
 
     def _nk_at(self, wl: float) -> dict[str, dict[str, Any]]:
-        """n, k of each layer at ``wl`` with stderr and 95 % intervals from the covariance."""
-        res = self.result
-        names = list(res.var_names)
-        cov = None if res.covar is None else np.asarray(res.covar, float)
-        base = self.stack.nk(wl)
-        out: dict[str, dict[str, Any]] = {}
-        vals = {k: res.params[k].value for k in names}
-        grads: dict[str, list[complex]] = {k: [] for k in base}
-        for k in names:
-            q = res.params[k]
-            h = 1e-6 * max(abs(q.value), 1e-3)
-            lo_ok = q.value - h >= q.min
-            up = dict(vals)
-            dn = dict(vals)
-            up[k] = q.value + h if q.value + h <= q.max else q.value
-            dn[k] = q.value - h if lo_ok else q.value
-            step = up[k] - dn[k]
-            try:
-                a = self.model.stack.with_values(up).nk(wl)
-                b = self.model.stack.with_values(dn).nk(wl)
-            except ValueError:
-                a = b = base
-                step = 1.0
-            for lay in base:
-                grads[lay].append(complex((a[lay] - b[lay]) / step) if step else 0j)
-        for lay, nk in base.items():
-            entry: dict[str, Any] = {"n": float(nk.real), "k": float(nk.imag)}
-            g = np.asarray(grads[lay]) if names else np.zeros(0, complex)
-            for part, gv in (("n", g.real), ("k", g.imag)):
-                if cov is not None and cov.shape == (len(names), len(names)) and np.any(gv):
-                    var = float(gv @ cov @ gv)
-                    se = math.sqrt(var) if var >= 0 and math.isfinite(var) else None
-                elif names:
-                    se = 0.0 if not np.any(gv) else None
-                else:
-                    se = 0.0
-                entry[f"{part}_stderr"] = se
-                if se is not None:
-                    t = float(special.stdtrit(max(res.nfree, 1), 0.975))
-                    entry[f"{part}_ci95"] = [entry[part] - t * se, entry[part] + t * se]
-                else:
-                    entry[f"{part}_ci95"] = None
-            out[lay] = entry
-        return out
+        """n, k of each medium at ``wl`` with stderr and 95 % intervals (:mod:`.film_nk`)."""
+        from .film_nk import nk_entry
+
+        return nk_entry(self, wl)
+
+    @property
+    def substrate_name(self) -> str:
+        """The substrate in words: its table's or file's name, or its model."""
+        from .film_verdict import material_label
+
+        return material_label(self.stack.substrate)
+
+    @property
+    def verdict(self) -> str | None:
+        """Words saying that the model is wrong (MSE above ``MSE_WRONG_MODEL``), or None.
+
+        :mod:`labbrdf.fitting.film_verdict`: the parameters are then not meaningful, and
+        the words say what to try (another substrate, the bare-substrate file, more layers).
+        """
+        from .film_verdict import wrong_model_verdict
+
+        return wrong_model_verdict(self.mse, self.substrate_name)
 
     @property
     def misfit_scale(self) -> float | None:
@@ -377,24 +355,34 @@ class FilmFit:
                 out[nm] = {"n": int(m.sum()), "chi2": float(np.sum(r[m] ** 2))}
         return out
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self, at_nm: Sequence[float] | None = None) -> dict[str, Any]:
         """JSON-safe summary of the fit.
 
         Layers (thickness, material parameters, n and k at 633 nm with
-        stderr and 95 % intervals), chi2, nu, chi2/nu, MSE, flags, correlations, notes.
+        stderr and 95 % intervals), chi2, nu, chi2/nu, MSE, the verdict (None, or words
+        saying that the model is wrong: :attr:`verdict`), flags, correlations, notes.
+
+        Parameters
+        ----------
+        at_nm : sequence of float, optional
+            Wavelengths [nm] at which ``nk_at`` gives every medium's n, k with stderr and
+            95 % intervals (as ``nk_at_633nm``).
+
+        Raises
+        ------
+        FilmError
+            A wavelength of ``at_nm`` outside a table of the stack.
         """
         res = self.result
         nk = self._nk_at(NK_REPORT_NM) if self._covers(NK_REPORT_NM) else {}
         scale = self.misfit_scale
         tq = float(special.stdtrit(max(res.nfree, 1), 0.975))
-        if scale is not None:
-            for entry in nk.values():
-                for part in ("n", "k"):
-                    se = entry.get(f"{part}_stderr")
-                    if se is not None:
-                        v = entry[part]
-                        entry[f"{part}_stderr_scaled"] = se * scale
-                        entry[f"{part}_ci95_scaled"] = [v - tq * se * scale, v + tq * se * scale]
+        at_nm = [float(w) for w in (at_nm or ())]
+        for w in at_nm:
+            if not self._covers(w):
+                raise FilmError(
+                    f"n, k at {w:g} nm: outside the wavelengths the stack's tables cover"
+                )
 
         def param(k: str) -> dict[str, Any]:
             q = res.params[k]
@@ -438,6 +426,7 @@ class FilmFit:
                 "stack": self.stack.to_dict(),
                 "layers": layers,
                 "substrate": {
+                    "name": self.substrate_name,
                     "material": self.stack.substrate.to_dict(),
                     "parameters": {k.split(".", 1)[1]: param(k) for k in sub_keys},
                     f"nk_at_{NK_REPORT_NM:g}nm": nk.get("substrate"),
@@ -466,6 +455,8 @@ class FilmFit:
                 },
                 "notes": self.notes(),
                 "warnings": list(res.warnings),
+                "verdict": self.verdict,
+                "nk_at": [{"wavelength_nm": w, "media": self._nk_at(w)} for w in at_nm],
             }
         )
 
@@ -476,13 +467,19 @@ class FilmFit:
             return False
         return True
 
-    def save_json(self, path: str | os.PathLike[str]) -> Path:
-        """Write :meth:`summary` as JSON, atomically (a new file or a complete replacement)."""
+    def save_json(
+        self, path: str | os.PathLike[str], at_nm: Sequence[float] | None = None
+    ) -> Path:
+        """Write :meth:`summary` (``at_nm`` as there) as JSON, atomically.
+
+        A new file or a complete replacement.
+        """
         from ..outputs import atomic_output
 
         p = Path(path)
+        text = json.dumps(self.summary(at_nm), indent=2, allow_nan=False) + "\n"
         with atomic_output(p) as tmp:
-            Path(tmp).write_text(json.dumps(self.summary(), indent=2, allow_nan=False) + "\n")
+            Path(tmp).write_text(text)
         return p
 
     def compare_reflectance(self, reflectance: Any) -> pd.DataFrame:
@@ -579,28 +576,32 @@ class FilmFit:
         return out
 
     def nk_table(self, wavelength_nm: ArrayLike | None = None) -> pd.DataFrame:
-        """n, k of every layer and the substrate on the fitted wavelengths (or given ones)."""
+        """n, k of every layer and the substrate, with their standard errors.
+
+        On the fitted wavelengths (or the given ones [nm]); the columns of
+        :func:`labbrdf.fitting.film_nk.nk_at_table` (``<name>_n``, ``<name>_n_stderr``, ...,
+        and ``*_stderr_scaled`` where chi-square rejects the model).
+        """
+        from .film_nk import nk_at_table
+
         wl = (
             np.unique(self.data["wavelength_nm"].to_numpy(float))
             if wavelength_nm is None
             else np.asarray(wavelength_nm, float)
         )
-        nk = self.stack.nk(wl)
-        cols: dict[str, Any] = {"wavelength_nm": wl}
-        for name, v in nk.items():
-            cols[f"{name}_n"] = v.real
-            cols[f"{name}_k"] = v.imag
-        return pd.DataFrame(cols)
+        return nk_at_table(self, wl)
 
-    def fit_report(self) -> str:
+    def fit_report(self, at_nm: Sequence[float] | None = None) -> str:
         """Text report: each layer's parameters and n, k, the substrate, the fit, notes.
 
         What ``labbrdf film`` prints (:func:`labbrdf.fitting.film_display.film_fit_report`
-        of :meth:`summary`).
+        of :meth:`summary`); ``at_nm``: wavelengths [nm] at which to print every medium's
+        n, k with stderr (``labbrdf film --at``). Ends with the verdict where the MSE says
+        that the model is wrong.
         """
         from .film_display import film_fit_report
 
-        return film_fit_report(self.summary())
+        return film_fit_report(self.summary(at_nm))
 
     def __str__(self) -> str:
         return self.fit_report()
@@ -718,7 +719,8 @@ def fit_film(
         "film",
         "mixed",
     )
-    res = fit(model, fd, method=method, seed=seed, ci=ci, maxeval=maxeval, guess=False)
+    res = fit(model, fd, method=method, seed=seed, ci=ci, maxeval=maxeval, guess=False,
+              weighting="sigma", mask_zeros=False)  # fmt: skip
     best = fm.stack.with_values({k: res.params[k].value for k in fm.free})
     return FilmFit(
         result=res,

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .._plotting import COLOURS, draw_panel
+from .film_verdict import material_label
 
 if TYPE_CHECKING:
     from .film import FilmFit
@@ -59,12 +60,21 @@ def _param_text(p: Mapping[str, Any]) -> str:
     return out
 
 
-def _nk_line(wl: str, nk: Mapping[str, Any]) -> str:
+def _nk_text(nk: Mapping[str, Any]) -> str:
+    """``n +- se, k +- se`` of one medium (and the scaled stderr where given)."""
     n_se = nk.get("n_stderr")
     k_se = nk.get("k_stderr")
     n_txt = f"{nk['n']:.5f}" + (f" +- {n_se:.2g}" if n_se is not None else "")
     k_txt = f"{nk['k']:.5f}" + (f" +- {k_se:.2g}" if k_se is not None else "")
-    return f"  n, k at {wl} nm: {n_txt}, {k_txt}"
+    out = f"{n_txt}, {k_txt}"
+    n_sc, k_sc = nk.get("n_stderr_scaled"), nk.get("k_stderr_scaled")
+    if n_sc is not None:
+        out += f"  (scaled: +- {n_sc:.2g}" + (f", +- {k_sc:.2g})" if k_sc is not None else ")")
+    return out
+
+
+def _nk_line(wl: str, nk: Mapping[str, Any]) -> str:
+    return f"  n, k at {wl} nm: {_nk_text(nk)}"
 
 
 def _fit_line(summary: Mapping[str, Any]) -> str:
@@ -100,13 +110,29 @@ def film_fit_report(summary: Mapping[str, Any]) -> str:
         wl, nk = _nk_entry(lay)
         if nk:
             lines.append(_nk_line(wl, nk))
-    lines.append(f"substrate ({summary['substrate']['material'].get('model', '?')})")
+    sub = summary["substrate"]
+    lines.append(f"substrate: {sub.get('name') or material_label(sub['material'])}")
+    for p_name, p in sub.get("parameters", {}).items():
+        lines.append(f"  {p_name:<14s} {_param_text(p)}")
+    lines.extend(_at_lines(summary.get("nk_at") or []))
     lines.append(_fit_line(summary))
     if not summary["success"]:
         lines.append(f"fit did not converge: {summary['message']}")
     lines.extend(f"note: {n}" for n in summary["notes"])
     lines.extend(f"warning: {w}" for w in summary["warnings"])
+    if summary.get("verdict"):
+        lines.append(f"VERDICT: {summary['verdict']}")
     return "\n".join(lines)
+
+
+def _at_lines(entries: list[Mapping[str, Any]]) -> list[str]:
+    """n, k of every medium at each asked wavelength, with stderr (scaled where given)."""
+    lines = []
+    for e in entries:
+        lines.append(f"n, k at {e['wavelength_nm']:g} nm (+- standard error):")
+        for name, nk in e["media"].items():
+            lines.append(f"  {name:<14s} {_nk_text(nk)}")
+    return lines
 
 
 def film_fit_html(summary: Mapping[str, Any]) -> str:
@@ -139,16 +165,19 @@ def film_fit_html(summary: Mapping[str, Any]) -> str:
     ]
     parts = [*(("layer " + lay["name"], lay) for lay in summary["layers"])]
     parts.append(("substrate", summary["substrate"]))
+    facts.insert(0, ("substrate", summary["substrate"].get("name", "?")))
     rows = [
         (where, k, _param_text(p))
         for where, part in parts
         for k, p in part.get("parameters", {}).items()
     ]
     notes = [*summary["notes"], *summary["warnings"]]
+    if summary.get("verdict"):
+        notes.insert(0, "VERDICT: " + summary["verdict"])
     extra = "<ul>" + "".join(f"<li>{html.escape(n)}</li>" for n in notes) + "</ul>"
     layers = ", ".join(lay["name"] for lay in summary["layers"]) or "no layer"
     return card(
-        f"Film fit: {layers} on the substrate",
+        f"Film fit: {layers} on {summary['substrate'].get('name', 'the substrate')}",
         facts,
         (("part", "parameter", "value +- stderr  [95 % interval]  flags"), rows),
         extra if notes else "",

@@ -90,6 +90,9 @@ class FitResult:
         The weighting used, in words (``uniform``, ``1/sigma^2 ...``, ``relative: ...``).
     nmasked : int
         Points with value 0 excluded as instrument-masked (``mask_zeros``).
+    outside_domain : str
+        Why the points lie outside the model's domain (a specular-plane model fitted to
+        out-of-plane points: :meth:`labbrdf.models.Model.outside_domain`); "" when inside.
     success : bool
         The last stage converged and every parameter and chisqr is finite.
     message : str
@@ -163,6 +166,7 @@ class FitResult:
     unit: str = "sr-1"
     ndropped: int = 0
     weighting: str = "uniform"
+    outside_domain: str = ""
     nmasked: int = 0
     stages: list[dict[str, Any]] = field(default_factory=list)
     energy: dict[str, Any] | None = None
@@ -301,6 +305,37 @@ class FitResult:
             )
         return series
 
+    @property
+    def at_bound(self) -> list[str]:
+        """The varying parameters that ended at a bound of their box (flag ``at_bound``)."""
+        return [k for k in self.var_names if "at_bound" in self.flags.get(k, [])]
+
+    @property
+    def status(self) -> str:
+        """``ok``, or why a fit is not a plain success.
+
+        ``failed``; ``outside the model's domain`` (the points lie where the model does not
+        apply: :meth:`labbrdf.models.Model.outside_domain`); ``at bound: NAMES``
+        (converged, but the optimum may lie outside the box).
+        """
+        if not self.success:
+            return "failed"
+        if self.outside_domain:
+            return "outside the model's domain"
+        return f"at bound: {', '.join(self.at_bound)}" if self.at_bound else "ok"
+
+    def _success_text(self) -> str:
+        """``success`` as a person should read it: with the domain and the bounds."""
+        if self.success and self.outside_domain:
+            return f"True, but outside the model's domain (see Warnings) ({self.message})"
+        if self.success and self.at_bound:
+            return (
+                f"True, but {', '.join(self.at_bound)} at a bound of its box: the best fit "
+                f"may lie outside it; widen the bound, fix the parameter or change the model "
+                f"({self.message})"
+            )
+        return f"{self.success} ({self.message})"
+
     def summary(self) -> dict[str, Any]:
         """Plain-Python, JSON-safe dict (NaN/inf as None) for reports and the CLI."""
         params = {}
@@ -342,6 +377,9 @@ class FitResult:
             "unit": self.unit,
             "weighted": self.weighted,
             "success": self.success,
+            "status": self.status,
+            "at_bound": self.at_bound,
+            "outside_domain": self.outside_domain or None,
             "message": self.message,
             "elapsed_s": self.elapsed_s,
             "ndropped": self.ndropped,
@@ -384,14 +422,19 @@ class FitResult:
             + (f" ({self.ndropped} dropped: NaN/inf)" if self.ndropped else ""),
             f"    # variables        = {self.nvarys}",
             f"    chi-square         = {self.chisqr:.6g}"
-            + ("" if self.weighted else " (unweighted: no sigma in the data)"),
+            + (
+                ""
+                if self.weighted
+                else f" (no sigma in the data: {self.weighting.split(':')[0]} weights)"
+            ),
             f"    reduced chi-square = {self.redchi:.6g}",
             f"    Akaike info crit   = {self.aic:.6g}",
             f"    Bayesian info crit = {self.bic:.6g}",
             f"    RMSE               = {self.rmse:.4g} [{unit}]",
             "    RMSE (paper, %)    = "
             + ("n/a" if self.rmse_pct is None else f"{self.rmse_pct:.4g}"),
-            f"    success            = {self.success} ({self.message})",
+            f"    weighting          = {self.weighting}",
+            f"    success            = {self._success_text()}",
             f"    elapsed            = {self.elapsed_s * 1e3:.1f} ms",
             "[[Variables]]",
         ]
@@ -413,7 +456,6 @@ class FitResult:
         notes = [f"{k}: {r}" for k, rs in self.flag_reasons.items() for r in rs]
         notes += self.warnings
         if self.replicates:
-            notes.append(f"weighting: {self.weighting}")
             for k, sb in (self.seed_spread or {}).items():
                 vals = ", ".join(f"{r[k]:.6g}" for r in self.replicates)
                 notes.append(f"{k}: seed replicates {vals} (s_between {sb:.3g})")
@@ -440,7 +482,8 @@ class FitResult:
             ("reduced chi-square", f"{self.redchi:.6g}"),
             ("RMSE", f"{self.rmse:.4g} {self.unit}"),
             ("RMSE (paper, %)", "n/a" if self.rmse_pct is None else f"{self.rmse_pct:.4g}"),
-            ("success", f"{self.success} ({self.message})"),
+            ("weighting", self.weighting),
+            ("success", self._success_text()),
             ("elapsed", f"{self.elapsed_s * 1e3:.1f} ms"),
         ]
         h = [f"<h4>Fit of {e(self.model)} {e(str(self.options or ''))}</h4>", "<table><tbody>"]

@@ -29,6 +29,11 @@ def lambert(theta_i: NDArray, theta_r: NDArray) -> NDArray:
     return np.where(up, 1.0 / np.pi, 0.0)
 
 
+#: a detector azimuth within this of the specular half-plane (180 deg) is in the plane of
+#: incidence [deg]: goniometers set the azimuth to well under a degree
+PLANE_TOL_DEG = 1.0
+
+
 class ModelError(LabbrdfError, ValueError):
     """Unknown model, option or parameter name, or an invalid parameter value."""
 
@@ -212,10 +217,44 @@ class Model(ABC):
     stochastic: bool = False
     #: seed replicates of a fit when none are asked for (``fit(replicates=None)``)
     default_replicates: int = 1
+    #: the geometry the model describes: ``"hemisphere"`` (any detector direction) or
+    #: ``"specular_plane"`` (the plane of incidence on the specular side, detector azimuth
+    #: phi_r = 180 deg: an in-plane model that ignores the azimuth). :meth:`outside_domain`
+    #: tells a fit whose points lie outside it
+    domain: str = "hemisphere"
 
     def __init__(self, **options: Any) -> None:
         self.options: dict[str, Any] = dict(options)
         self.params: Parameters = self.default_params()
+
+    def outside_domain(self, theta_i_deg: ArrayLike, phi_r_deg: ArrayLike) -> str | None:
+        """Why the points lie outside the model's :attr:`domain`, or None when they do not.
+
+        Parameters
+        ----------
+        theta_i_deg, phi_r_deg : array_like
+            Incidence angle and outward detector azimuth (source at 0) of every point [deg].
+
+        Returns
+        -------
+        str or None
+            For a ``"specular_plane"`` model: how many points lie more than
+            :data:`PLANE_TOL_DEG` out of the specular half-plane and what to do instead.
+        """
+        if self.domain != "specular_plane":
+            return None
+        phi = np.broadcast_to(np.asarray(phi_r_deg, float), np.shape(theta_i_deg))
+        off = np.abs((phi - 180.0 + 180.0) % 360.0 - 180.0) > PLANE_TOL_DEG
+        off &= np.asarray(theta_i_deg, float) > 0  # at normal incidence any azimuth is in-plane
+        if not off.any():
+            return None
+        return (
+            f"{int(off.sum())} of {off.size} points lie out of the plane of incidence "
+            f"(detector azimuth more than {PLANE_TOL_DEG:g} deg from 180 deg): {self.name} is "
+            "a specular-plane model that ignores the azimuth, so its value there is the "
+            "in-plane curve, not a prediction; fit the in-plane points only (select "
+            "phi_r_deg = 180) or a hemispherical model (microfacet, five_param)"
+        )
 
     def reseeded(self, seed: int) -> Model:
         """The same model with the Monte Carlo seed ``seed`` (stochastic models only).

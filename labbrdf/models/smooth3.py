@@ -170,6 +170,9 @@ class Smooth3(Model):
     # on theta_r == theta_i only k1 exp(-k2^2/k3^2) is identifiable (docs/models.md 1.1)
     specular_line_shape = ("k2", "k3")
     reciprocity_note = "smooth3 is reciprocal only for k2 = 0."
+    # the paper's model is of the plane of incidence (a specular scan): fits to points out
+    # of that plane are told so (Model.outside_domain)
+    domain = "specular_plane"
 
     def __init__(self, **options: Any) -> None:
         if options:

@@ -109,6 +109,8 @@ class Context:
     nk_combined: dict[str, pd.DataFrame] = field(default_factory=dict)
     #: user report: the film stack fitted per psi/Delta file (section ``film``), by file name
     film_fits: dict[str, Any] = field(default_factory=dict)
+    #: user report: the wavelength [nm] the user gave for files that state none (a .bsdf)
+    wavelength_nm: float | None = None
     #: user report: each height map's sigma and band, by path (section ``smoothness``)
     map_roughness: dict[str, Any] = field(default_factory=dict)
 

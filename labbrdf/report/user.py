@@ -90,6 +90,8 @@ def user_report(
     same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
     prediction_slopes: str = "ggx",
     nk_from: str | os.PathLike[str] | None = None,
+    film_files: Sequence[str | os.PathLike[str]] | None = None,
+    wavelength_nm: float | None = None,
     **kw: Any,
 ) -> int:
     """Build a report for the given files and write it (atomically) to ``out``.
@@ -126,10 +128,10 @@ def user_report(
         ``theta_i``, ``quantity``, ``sample``); applied to every file after reading.
     film_model : path-like or FilmModel, optional
         A film model (a TOML file, :func:`labbrdf.films.load_model`, or a
-        :class:`~labbrdf.films.FilmModel`, e.g. the stated default of one transparent
-        Cauchy layer on c-Si with the thickness free,
-        :func:`labbrdf.report.sections.film.default_film_model`) fitted to every psi/Delta
-        file whose angles of incidence disagree (section ``film``). None: no film fit.
+        :class:`~labbrdf.films.FilmModel`, e.g. :func:`.sections.film.default_film_model`)
+        fitted to the psi/Delta files whose angles disagree (section ``film``).
+    film_files, wavelength_nm : optional
+        The film model's files (section ``film``); the [nm] of files that state none.
     same_sample : sequence of sequences of path-like
         Files that are one sample, one sequence per sample (each file among ``paths``),
         in addition to the sample names the files state (:func:`labbrdf.samples.pair_samples`);
@@ -144,7 +146,7 @@ def user_report(
         --nk-from``). Default: the psi/Delta file of each map's sample group, else a stated
         default (:func:`labbrdf.report.sections.surface.substrate_index`).
     **kw :
-        ``quick`` is accepted for symmetry with :func:`~labbrdf.report.validate` (no effect).
+        ``quick``: accepted as :func:`~labbrdf.report.validate` takes it (no effect).
 
     Returns
     -------
@@ -190,10 +192,12 @@ def user_report(
         method=method,
         seed=seed,
         fit_options={"params": dict(start)} if start else {},
+        wavelength_nm=wavelength_nm,
     )
 
+    film_of = (film, film_how, film_files)
     sections = _sections(
-        model, opts, film, film_how, paths, selection, same_sample, prediction_slopes, substrate
+        model, opts, film_of, paths, selection, same_sample, prediction_slopes, substrate
     )
     run(ctx, sections)
     if title is None and not _fitted(b.results):
@@ -272,6 +276,8 @@ def _ingest(
         "with SurfaceTopography."
     )
     read = ingest_inputs(ctx, paths)
+    if ctx.wavelength_nm is not None:
+        _given_wavelength(ctx, ctx.wavelength_nm)
     sample_groups(ctx, read, _among(same_sample, read))
     if selection:
         from ..selection import SelectionError, select
@@ -288,6 +294,29 @@ def _ingest(
             + f"; {sum(len(f) for f in kept)} of {sum(len(f) for f in ctx.frames)} rows kept."
         )
         ctx.frames[:] = [f for f in kept if len(f)]
+
+
+def _given_wavelength(ctx: Context, wl: float) -> None:
+    """The rows of every file that states no wavelength get ``wl`` [nm]; the page says so."""
+    given, stated = [], []
+    for rec in ctx.files:
+        meta = rec.get("meta") or {}
+        if meta.get("wavelength_stated") is not False:
+            stated.append(str(rec["file"]))
+            continue
+        given.append(str(rec["file"]))
+        for j, f in enumerate(ctx.frames):
+            mine = (f["source"].astype(str) == rec["file"]).to_numpy()
+            if mine.any():
+                ctx.frames[j] = f.assign(wavelength_nm=f["wavelength_nm"].where(~mine, wl))
+        rec["meta"] = {**meta, "wavelength_nm": wl, "wavelength_stated": True,
+                       "wavelength_given": True}  # fmt: skip
+    ctx.b.text(
+        f"Wavelength given with --wavelength: {wl:g} nm, for the files that state none ("
+        + (", ".join(given) or "none of the files")
+        + ")"
+        + (f"; the others keep their own ({', '.join(stated)})." if stated else ".")
+    )
 
 
 def _among(
@@ -309,15 +338,19 @@ def _among(
 def _sections(
     model: str,
     opts: dict[str, Any],
-    film: Any,
-    film_how: str,
+    film_of: tuple[Any, str, Sequence[str | os.PathLike[str]] | None],
     paths: Sequence[str | os.PathLike[str]],
     selection: Mapping[str, Any] | None,
     same_sample: Sequence[Sequence[str | os.PathLike[str]]] = (),
     prediction_slopes: str = "ggx",
     substrate: tuple[str, complex] | None = None,
 ) -> list[Section]:
-    """The user report's sections, in order, bound to its model, film model and files."""
+    """The user report's sections, in order, bound to its model, film model and files.
+
+    ``film_of``: the film model, how it was given, and the files it is of (or None).
+    """
+    film, film_how, film_files = film_of
+    names = None if film_files is None else [Path(f).name for f in film_files]
     return [
         ("ingest", "Ingested files", lambda ctx: _ingest(ctx, paths, selection, same_sample)),
         ("measured", "Measured data, file by file", measured_section),
@@ -325,7 +358,7 @@ def _sections(
         (
             "film",
             "Film stacks fitted to angle-dependent psi/Delta",
-            lambda ctx: film_section(ctx, film, how=film_how),
+            lambda ctx: film_section(ctx, film, how=film_how, film_files=names),
         ),
         (
             "fits",

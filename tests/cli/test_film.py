@@ -78,9 +78,13 @@ def test_film_with_a_model_file_writes_json_nk_csv_and_fit_json(film_file, tmp_p
     assert list(table.columns) == [
         "wavelength_nm",
         "film_n",
+        "film_n_stderr",
         "film_k",
+        "film_k_stderr",
         "substrate_n",
+        "substrate_n_stderr",
         "substrate_k",
+        "substrate_k_stderr",
     ]
     assert len(table) == 40
     assert Stack.from_fit_json(fj).layers[0].thickness_nm == pytest.approx(105.0, abs=0.5)

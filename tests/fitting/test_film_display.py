@@ -53,14 +53,14 @@ def test_fit_report_is_the_text_of_the_summary_and_str(fit):
     assert float(thickness[1]) == pytest.approx(fit.summary()["layers"][0]["parameters"][
         "thickness_nm"]["value"], rel=1e-5)  # fmt: skip
     assert any(x.startswith("  n, k at 633 nm: ") for x in lines)
-    assert "substrate (" in text
+    assert "substrate: " in text
     s = fit.summary()
     assert f"fit: {s['ndata']} values, 300-1000 nm, 3 free; chi2/nu = {s['redchi']:.4g}" in text
 
 
 def test_repr_html_shows_every_parameter_escaped(fit):
     h = fit._repr_html_()
-    assert h.startswith("<div><strong>Film fit: film on the substrate</strong>")
+    assert h.startswith("<div><strong>Film fit: film on si (reference table, Green 2008)</strong>")
     for name in ("thickness_nm", "A", "B", "C"):
         assert f">{name}</td>" in h
     assert "MSE (Woollam)" in h and "+-" in h

@@ -39,14 +39,11 @@ def brdf_rows(ctx: Context) -> pd.DataFrame:
 def brdf_fit_options(ctx: Context, rows: pd.DataFrame) -> dict[str, Any]:
     """The :func:`labbrdf.fitting.fit` keywords the CLI would use for these rows.
 
-    Zeros are masked (instrument floor, not a measurement of 0); without a sigma on every
-    row the residuals are weighted relative to the data (``weighting="relative"``),
-    otherwise the file's sigma is used.
+    :func:`labbrdf.fitting.fit`'s defaults, which are the CLI's: zeros masked (instrument
+    floor, not a measurement of 0), the file's sigma where every row has one, else weights
+    relative to the data (``weighting="auto"``).
     """
-    kw: dict[str, Any] = {"mask_zeros": True, **ctx.fit_options}
-    if not rows["sigma"].notna().all():
-        kw.setdefault("weighting", "relative")
-    return kw
+    return {"mask_zeros": True, "weighting": "auto", **ctx.fit_options}
 
 
 def _label(ti: float | None) -> str:
@@ -197,7 +194,9 @@ def brdf_section(ctx: Context, model: str, options: Mapping[str, Any]) -> None:
     b = ctx.b
     rows = brdf_rows(ctx)
     kw = brdf_fit_options(ctx, rows)
-    weighting = kw.get("weighting", "sigma")
+    weighting = kw.get("weighting", "auto")
+    if weighting == "auto":
+        weighting = "sigma" if rows["sigma"].notna().all() else "relative"
     b.text(
         f"{len(rows)} BRDF rows [sr\u207b\u00b9] in {rows['sample'].nunique()} sample(s). "
         f"{model} is fitted to each angle of incidence on its own and to all angles jointly "
@@ -208,6 +207,9 @@ def brdf_section(ctx: Context, model: str, options: Mapping[str, Any]) -> None:
             if weighting == "relative"
             else "."
         )
+        + " The joint fit is the fit of section fits (the same weighting, masked points, "
+        "method and seed as there and as labbrdf fit and labbrdf.fit); each per-angle fit "
+        "sees one angle of incidence only, so its values differ from the joint ones by design."
     )
     for f in ctx.files:
         meta = f.get("meta") or {}
@@ -262,7 +264,7 @@ def _fits_table(
         ("weighting", "weighting", ""),
         ("nmasked", "masked", "d"),
         ("nfev", "nfev", "d"),
-        ("success", "success", ""),
+        ("status", "status", ""),
     ]
     out = []
     for ti, r in fits:
@@ -283,6 +285,7 @@ def _fits_table(
         row["nmasked"] = r.summary.get("nmasked")
         row["nfev"] = r.summary.get("nfev")
         row["success"] = bool(r.summary.get("success"))
+        row["status"] = r.summary.get("status") or ("ok" if row["success"] else "failed")
         out.append(row)
     opts = ", ".join(f"{k}={v}" for k, v in options.items()) or "defaults"
     b.table(

@@ -4,7 +4,9 @@ Where the angles of incidence of a psi/Delta file disagree (:func:`labbrdf.nk.an
 ``stack`` or ``partly``), its two-phase pseudo-constants are those of a stack and give
 neither a material's n, k nor a reflectance (section ``nk``). Given a film model (a TOML
 file, :func:`labbrdf.films.load_model`, or the stated default :func:`default_film_model`),
-this section fits it to the file's psi/Delta at every angle (:func:`labbrdf.fit_film`)
+this section fits it to the file's psi/Delta at every angle (:func:`labbrdf.fit_film`),
+for the files of the model's sample only (:func:`_applies_to`: never a file the model reads
+as its substrate's table, a bare wafer; ``--film-files`` where the sample groups do not say)
 and shows the model, the parameters with their intervals, psi and Delta against wavelength
 per angle with the fit and the residuals, each layer's n, k with its uncertainty band, and
 the reflectance comparison redone with the fitted stack: the measured reflectance of the
@@ -21,6 +23,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -34,7 +37,7 @@ from ..agreement import P_AGREE, chi_square
 from ..builder import Unavailable, slug
 from ..context import Context
 from ..inputs import file_frames
-from ..pairing import how_to_pair, same_sample
+from ..pairing import how_to_pair, same_sample, sample_groups_of
 
 __all__ = ["default_film_model", "film_model_of", "film_section"]
 
@@ -314,6 +317,72 @@ def _flagged(
     return flagged
 
 
+def _table_files(model: films.FilmModel) -> list[Path]:
+    """The files a film model reads as tables (its substrate's, its layers')."""
+    media = [model.stack.substrate, *(lay.material for lay in model.stack.layers)]
+    out = []
+    for m in media:
+        f = m.to_dict().get("file") if hasattr(m, "to_dict") else None
+        if f:
+            out.append(Path(str(f)))
+    return out
+
+
+def _is_table(ctx: Context, src: str, tables: list[Path]) -> bool:
+    """Whether the input file named ``src`` is one of the model's table files.
+
+    By the resolved path where the report's groups know the input's path, else by name.
+    """
+    inputs = [p for g in ctx.samples for p in g.paths if Path(p).name == src]
+    for t in tables:
+        if t.name != src:
+            continue
+        if not inputs or any(os.path.samefile(p, t) for p in inputs if p.exists() and t.exists()):
+            return True
+    return False
+
+
+def _applies_to(
+    ctx: Context,
+    model: films.FilmModel,
+    flagged: list[tuple[str, pd.DataFrame, nkmod.AngleVerdict]],
+    film_files: list[str] | None,
+) -> list[tuple[str, pd.DataFrame, nkmod.AngleVerdict]]:
+    """The flagged files the film model is of, saying why any other is left out.
+
+    Never a file the model reads as a table (its substrate's file is a bare substrate, not
+    a coated sample). Of the rest: the files given in ``film_files`` where given; else the
+    files of the samples whose groups hold more than one file (the sample names the files
+    state or ``--same-sample``) where there are such; else every flagged file.
+    """
+    tables = _table_files(model)
+    out, left = [], []
+    for src, g, v in flagged:
+        if _is_table(ctx, src, tables):
+            left.append(f"{src} (the model reads it as a table: a bare substrate, not a film)")
+        else:
+            out.append((src, g, v))
+    if film_files is not None:
+        keep = {Path(f).name for f in film_files}
+        left += [f"{s} (not among --film-files)" for s, _g, _v in out if s not in keep]
+        out = [x for x in out if x[0] in keep]
+    else:
+        grouped = {Path(p).name for g in sample_groups_of(ctx) if g.paired for p in g.paths}
+        if any(s in grouped for s, _g, _v in out):
+            left += [
+                f"{s} (of no sample group holding other files; name it with --film-files)"
+                for s, _g, _v in out
+                if s not in grouped
+            ]
+            out = [x for x in out if x[0] in grouped]
+    if left:
+        ctx.b.note(
+            "film model not applied",
+            "the film model is of its sample's files only; not fitted to: " + "; ".join(left),
+        )
+    return out
+
+
 def _model_text(ctx: Context, model: films.FilmModel, how: str) -> None:
     """The film model in words: its layers, what is fitted, the fit window."""
     free = ", ".join(f"{k} in [{lo:g}, {hi:g}]" for k, (lo, hi) in model.free.items())
@@ -345,6 +414,8 @@ def _fit_shown(
         f"{s['mse']:.4g}; {s['message']}."
         + (" Notes: " + "; ".join(s["notes"]) + "." if s["notes"] else "")
     )
+    if s.get("verdict"):
+        b.note("parameters not meaningful", s["verdict"])
     b.table(
         f"film_{tag}_params",
         f"{src}: fitted parameters",
@@ -441,8 +512,14 @@ def _fit_file(
         )
 
 
-def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") -> None:
-    """Fit ``model`` to every angle-dependent psi/Delta file and redo its reflectance check.
+def film_section(
+    ctx: Context,
+    model: films.FilmModel | None,
+    *,
+    how: str = "",
+    film_files: list[str] | None = None,
+) -> None:
+    """Fit ``model`` to the angle-dependent psi/Delta files of its sample; redo their R check.
 
     Parameters
     ----------
@@ -451,6 +528,9 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
         The film model; None: the section is not available (says how to give one).
     how : str
         How the model was given (shown with it), e.g. the model file's path.
+    film_files : list of str, optional
+        The files the model is of (file names or paths); default: see :func:`_applies_to`
+        (never a file the model reads as its substrate's table).
     """
     b = ctx.b
     frames = file_frames(ctx)
@@ -469,6 +549,12 @@ def film_section(ctx: Context, model: films.FilmModel | None, *, how: str = "") 
             f"{names}: pseudo-constants of a stack, and no film model given: give one with "
             "--film-model FILE.toml, or --film-default for one transparent Cauchy layer on "
             "crystalline silicon (thickness free)"
+        )
+    flagged = _applies_to(ctx, model, flagged, film_files)
+    if not flagged:
+        raise Unavailable(
+            "the film model applies to no psi/Delta file of the report: its substrate's file "
+            "is a bare substrate, and --film-files names the files of the coated sample"
         )
     _model_text(ctx, model, how)
     refl = [(s, g) for s, g, _m in frames if (g["quantity"] == "reflectance").any()]

@@ -84,8 +84,9 @@ def _columns(
     cols += [
         ("rmse_abs", "RMSE [data units]", ".3g"),
         ("redchi", "\u03c7\u00b2/\u03bd", ".4g"),
+        ("weighting", "weighting", ""),
         ("nfev", "nfev", "d"),
-        ("success", "success", ""),
+        ("status", "status", ""),
     ]
     return cols
 
@@ -115,8 +116,10 @@ def _row(ctx: Context, r: FitRecord, varying: Sequence[str], has_pub: bool) -> d
     row["rmse_pub"] = pub.get("rmse")
     row["rmse_abs"] = rmse_abs(r.summary)
     row["redchi"] = num(r.summary.get("redchi"))
+    row["weighting"] = str(r.summary.get("weighting") or "").split(":")[0]
     row["nfev"] = r.summary.get("nfev")
     row["success"] = bool(r.summary.get("success"))
+    row["status"] = r.summary.get("status") or ("ok" if row["success"] else "failed")
     return row
 
 

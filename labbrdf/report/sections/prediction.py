@@ -260,12 +260,18 @@ def _tracer_brdf(
     ctx: Context, sid: str, path: Path, frame: Any, fit: Any, film: Any, ndf: Any
 ) -> None:
     """The microfacet tracer's prediction of one ``.bsdf`` file and its part of the page."""
+    given = [
+        r["meta"]["wavelength_nm"]
+        for r in ctx.files
+        if r.get("meta", {}).get("wavelength_given") and Path(str(r["path"])).name == path.name
+    ]
     try:
         pred = predict_brdf(
             path,
             frame,
             fit,
             film=film,
+            wavelength_nm=given[0] if given else None,
             ndf=ndf,
             rays=rays_of(ctx),
             seed=ctx.seed,

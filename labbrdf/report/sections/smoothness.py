@@ -199,8 +199,18 @@ def _tis_rows(
     rows = []
     for rec in ctx.files:
         name = Path(str(rec.get("path", ""))).name
-        tis = (rec.get("meta") or {}).get("tis")
+        meta = rec.get("meta") or {}
+        tis = meta.get("tis")
         if name not in names or not isinstance(tis, list):
+            continue
+        if meta.get("wavelength_stated") is False:  # a placeholder is no wavelength
+            ctx.b.note(
+                "TIS not compared",
+                f"{name} states no wavelength ({float(meta.get('wavelength_nm', 0)):g} nm is "
+                "the format's placeholder), so its TIS is not compared with the height map's: "
+                "the Rayleigh factor depends on the wavelength; give it with labbrdf report "
+                "--wavelength NM (Python: user_report(..., wavelength_nm=NM))",
+            )
             continue
         wls = data.loc[data["source"] == name, "wavelength_nm"].dropna().unique()
         if len(wls) != 1:
