@@ -10,7 +10,7 @@ from collections.abc import Iterator, Sequence
 from typing import Any
 
 from ._options import UsageError
-from ._parser import build_parser
+from ._parser import build_parser, chosen_command
 from ._paths import _checked_outputs
 
 
@@ -39,13 +39,18 @@ def _labbrdf_warnings(command: str) -> Iterator[None]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit code."""
+    """Run the command line; returns the exit code.
+
+    Only the chosen command's module is imported (:func:`._parser.build_parser`).
+    """
+    words = sys.argv[1:] if argv is None else list(argv)
+    command = chosen_command(words)
     try:
-        parser = build_parser()
+        parser = build_parser(commands=() if command is None else (command,))
     except KeyboardInterrupt:
         print("labbrdf: interrupted", file=sys.stderr)
         return 130
-    args = parser.parse_args(argv)
+    args = parser.parse_args(words)
     try:
         with _checked_outputs(args), _labbrdf_warnings(args.command):
             return int(args.func(args))

@@ -8,7 +8,6 @@ import time
 from pathlib import Path
 from typing import Any
 
-from ..microfacet import DISTRIBUTIONS
 from ._options import UsageError, _add_geometry, _channel, _emit_json, _pixel_size, _warn
 from ._paths import InputPath, OutputPath, _add_overwrite
 
@@ -49,6 +48,7 @@ def _progress_printer(label: str, after_s: float = 2.0) -> Any:
 def cmd_surface(args: argparse.Namespace) -> int:
     """Print (or ``--json``) the roughness statistics of a height map."""
     from ..adapters.topography import length_m
+    from ..microfacet import DISTRIBUTIONS
     from ..outputs import check_file_output, check_input_files
     from ..topography import level, on_measured_points, roughness_statistics
 

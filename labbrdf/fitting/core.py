@@ -20,6 +20,7 @@ from ..dataset import Measurement
 from ..models import Model, ModelError, Parameters
 from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
+from .defaults import MAX_SEED, METHOD
 from .objective import Objective
 from .replicates import ONE_SEED_WARNING, run_replicates
 from .result import FitResult
@@ -40,10 +41,6 @@ __all__ = [
     "parse_method",
     "setup_params",
 ]
-
-#: the default optimiser of every fit (film, batch, report, CLI): the global controlled
-#: random search CRS2 with local mutation, then BOBYQA from its best point
-METHOD = "GN_CRS2_LM+LN_BOBYQA"
 
 #: every nlopt algorithm, by name (``GN_CRS2_LM`` ...), read from the nlopt module itself
 ALGORITHMS: dict[str, int] = {
@@ -149,11 +146,6 @@ def _energy_rho(
     except ImportError as exc:  # pragma: no cover - integrate ships with labbrdf
         raise FitError("energy_constraint=True needs labbrdf.integrate") from exc
     return lambda vals, th: np.asarray(hemispherical_reflectance(model, vals, th), float)
-
-
-#: the largest seed of a fit: nlopt's ``srand`` takes an unsigned long, 32 bits on some
-#: platforms, so seeds are integers in [0, MAX_SEED] everywhere
-MAX_SEED = 2**32 - 1
 
 
 def check_seed(seed: Any) -> int:
