@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import json
 import sys
 
@@ -402,13 +403,20 @@ def test_progress_reports_every_pass_and_chunking_leaves_results_unchanged(monke
         assert b.uncertainty[k] == pytest.approx(a.uncertainty[k], rel=1e-6)
 
 
-def test_cli_progress_goes_to_stderr_only_after_the_delay(capsys):
-    from labbrdf.cli.surface import _progress_printer
+def test_cli_passes_show_on_the_progress_line_only():
+    from labbrdf import progress
+    from labbrdf.cli.surface import _report_pass
 
-    _progress_printer("labbrdf surface: f.dat", after_s=3600)(2, 26)
-    assert capsys.readouterr().err == ""
-    _progress_printer("labbrdf surface: f.dat", after_s=0.0)(2, 26)
-    assert "labbrdf surface: f.dat: pass 2/26" in capsys.readouterr().err
+    tty = _Terminal()
+    with progress.shown("labbrdf surface", stream=tty):
+        _report_pass(2, 26)
+        assert "labbrdf surface: leave-one-block-out passes 2/26" in tty.getvalue()
+    assert "\n" not in tty.getvalue()  # one line, redrawn, erased at the end
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
 
 
 def test_height_map_is_drawn_x_horizontal_y_down_as_gwyddion():

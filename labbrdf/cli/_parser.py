@@ -36,6 +36,10 @@ COMMANDS: dict[str, str] = {
 }
 
 
+#: every command's ``--quiet`` (a command may define its own, saying more)
+QUIET_HELP = "no progress line (there is none when stderr is not a terminal)"
+
+
 class _Parser(argparse.ArgumentParser):
     """A parser that takes options by their full names only.
 
@@ -91,6 +95,8 @@ def build_parser(commands: Collection[str] | None = None) -> argparse.ArgumentPa
             command_module(name).add_parser(sub)
         else:
             sub.add_parser(name, help=help_line)
-    for sp in sub.choices.values():  # what _checked_outputs checks, per command
-        sp.set_defaults(path_actions=tuple(path_actions(sp)))
+    for sp in sub.choices.values():
+        if not any(a.dest == "quiet" for a in sp._actions):
+            sp.add_argument("--quiet", action="store_true", help=QUIET_HELP)
+        sp.set_defaults(path_actions=tuple(path_actions(sp)))  # what _checked_outputs checks
     return p

@@ -9,6 +9,7 @@ import warnings
 from collections.abc import Iterator, Sequence
 from typing import Any
 
+from .. import progress
 from ._options import UsageError
 from ._parser import build_parser, chosen_command
 from ._paths import _checked_outputs
@@ -28,6 +29,7 @@ def _labbrdf_warnings(command: str) -> Iterator[None]:
         original = warnings.showwarning
 
         def show(message: Any, category: Any, *rest: Any, **kw: Any) -> None:
+            progress.clear()  # the warning starts on a clean line
             if category.__module__.partition(".")[0] == "labbrdf":
                 print(f"labbrdf {command}: warning: {message}", file=sys.stderr)
             else:
@@ -52,7 +54,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     args = parser.parse_args(words)
     try:
-        with _checked_outputs(args), _labbrdf_warnings(args.command):
+        with (
+            _checked_outputs(args),
+            _labbrdf_warnings(args.command),
+            progress.shown(f"labbrdf {args.command}", enabled=not args.quiet),
+        ):
             return int(args.func(args))
     except UsageError as exc:
         print(f"labbrdf {args.command}: {exc}", file=sys.stderr)

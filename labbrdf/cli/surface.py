@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import sys
-import time
 from pathlib import Path
 from typing import Any
 
+from .. import progress
 from ._options import UsageError, _add_geometry, _channel, _emit_json, _pixel_size, _warn
 from ._paths import InputPath, OutputPath, _add_overwrite
 
@@ -33,16 +32,9 @@ def _height_map(path: str, channel: str | None, args: argparse.Namespace) -> Any
     return hm
 
 
-def _progress_printer(label: str, after_s: float = 2.0) -> Any:
-    """``progress(done, total)`` reporting on stderr after ``after_s`` s (a TTY: at once)."""
-    t0 = time.monotonic()
-
-    def progress(done: int, total: int) -> None:
-        if total > 1 and (sys.stderr.isatty() or time.monotonic() - t0 > after_s):
-            el = time.monotonic() - t0
-            print(f"{label}: pass {done}/{total} ({el:.0f} s)", file=sys.stderr, flush=True)
-
-    return progress
+def _report_pass(done: int, total: int) -> None:
+    """The statistics' passes on the command's progress line."""
+    progress.report(phase="leave-one-block-out passes", done=done, total=total)
 
 
 def cmd_surface(args: argparse.Namespace) -> int:
@@ -72,7 +64,7 @@ def cmd_surface(args: argparse.Namespace) -> int:
             blocks=args.blocks,
             short_cutoff=cutoff,
             erode=args.erode_mask,
-            progress=_progress_printer(f"labbrdf surface: {args.file}"),
+            progress=_report_pass,
         )
         st = on_measured_points(st, hm.points, args.degree)
         if args.png:

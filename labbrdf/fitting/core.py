@@ -15,7 +15,7 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special
 
-from .. import parallel
+from .. import parallel, progress
 from ..dataset import Measurement
 from ..models import Model, ModelError, Parameters
 from ..models import get as get_model
@@ -250,6 +250,7 @@ def _run_stage(
 
         opt.add_inequality_constraint(constraint, 1e-10)
     nlopt.srand(seed)
+    progress.report(stage=name, budget=budget)
     nfev0 = obj.nfev
     x0 = np.clip(x, lo, hi)
     try:
@@ -305,6 +306,7 @@ def _polish(obj: Objective, x: NDArray, nfree: int, weighted: bool) -> tuple[NDA
     or the chi-square change (relative :data:`_POLISH_TOL`), i.e. at a first-order stationary
     point. The best point seen is kept, so the polish never raises chi-square.
     """
+    progress.report(stage="polish")
     nfev0 = obj.nfev
     lo, hi = obj.bounds()
     x0 = np.clip(np.asarray(x, float), lo, hi)
@@ -876,7 +878,8 @@ def _profile_intervals(
     """
     warn = []
     with np.errstate(all="ignore"):
-        for k in varying:
+        for i, k in enumerate(varying):
+            progress.report(phase=f"profile interval of {k}", done=i, total=len(varying))
             try:
                 out[k].ci95 = _profile_interval(
                     model, fd, out, weights, prof, k, chisqr, delta, int(seed)
