@@ -1,0 +1,1 @@
+"""Surface roughness beyond the microfacet distributions: height maps, form, smoothness."""
