@@ -494,3 +494,30 @@ def test_non_uniform_profile_statistics_are_those_of_the_measured_points(tmp_pat
     d = json.loads(capsys.readouterr().out)
     ref = SurfaceTopography.NonuniformLineScan(xs, zs, unit="um").detrend(detrend_mode="height")
     assert d["slope_rms_x"] == pytest.approx(ref.rms_slope_from_profile(), rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("degree", "holes", "ndim"), [(1, False, 2), (0, True, 2), (2, True, 2), (1, False, 1)]
+)
+def test_jackknife_levelling_by_partial_sums_equals_levelling_each_replicate(
+    monkeypatch, degree, holes, ndim
+):
+    """Each replicate's levelling from the whole map's sums less its tile's, against the
+    direct levelling of the replicate (the implementation before): the same arithmetic but
+    for the order of summation, so the values agree to rounding (a few 1e-12 measured); the
+    uncertainties are differences of replicates, 1e-2 of the values, hence rel=1e-6."""
+    import labbrdf.topography as T
+
+    z = gaussian_surface(96, 96e-6, 1e-7, 5e-6, rng=4).z
+    z = z + np.linspace(0.0, 3e-7, 96)[:, None]  # a tilt the replicates level differently
+    if holes:
+        z[10:20, 40:47] = np.nan
+    if ndim == 1:
+        z = z[5]
+    a = roughness_statistics(z, 1e-6, degree=degree, blocks=3)
+    direct = lambda self, z, valid, exps: T._level(z, valid, degree)  # noqa: E731
+    monkeypatch.setattr(T._NormalSums, "levelled", direct)
+    b = roughness_statistics(z, 1e-6, degree=degree, blocks=3)
+    assert a.uncertainty.keys() == b.uncertainty.keys() and len(a.uncertainty) > 20
+    for k, v in b.uncertainty.items():
+        assert a.uncertainty[k] == pytest.approx(v, rel=1e-6, nan_ok=True), k
