@@ -91,6 +91,7 @@ class ProgressLine:
         self.fields: dict[str, Any] = {}
         self._t_phase = self._t_stage = clock()
         self._evals_at_stage = 0
+        self._done_at_phase = 0
         self._drawn = 0  # width of what is on the terminal now
         self._t_drawn = -math.inf
 
@@ -99,6 +100,7 @@ class ProgressLine:
         now = self.clock()
         if "phase" in fields and fields["phase"] != self.fields.get("phase"):
             self._t_phase = now
+            self._done_at_phase = int(fields.get("done") or 0)  # the rate counts from here
             for k in ("done", "total"):
                 self.fields.pop(k, None)
         if "stage" in fields:
@@ -116,8 +118,9 @@ class ProgressLine:
         """The estimated time left, or None (nothing to estimate from yet)."""
         f = self.fields
         done, total = f.get("done"), f.get("total")
-        if done and total and done < total:
-            return "~" + _duration((now - self._t_phase) / done * (total - done))
+        if done and total and self._done_at_phase < done < total:
+            rate = (now - self._t_phase) / (done - self._done_at_phase)
+            return "~" + _duration(rate * (total - done))
         spent = int(f.get("evaluations", 0)) - self._evals_at_stage
         budget = f.get("budget")
         if budget and 0 < spent < budget:

@@ -49,6 +49,11 @@ def test_phase_fraction_gives_the_time_left_and_a_new_stage_restarts_its_count()
     clock.t = 21.0
     line.update(evaluations=505)  # 5 of 10 in 1 s (the 500 before belong to earlier stages)
     assert "<= 1 s left" in line.text()
+    line.update(phase="passes", done=1, total=26)  # reported first after one pass
+    assert "~" not in line.text()  # no rate yet: the pass before the phase was not seen
+    clock.t = 23.0
+    line.update(done=2)
+    assert "passes 2/26" in line.text() and "~48 s left" in line.text()  # 24 x 2 s
 
 
 def test_redraws_are_throttled_and_the_line_is_erased_at_the_end():
