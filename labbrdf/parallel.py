@@ -352,6 +352,8 @@ class Progress:
         outer = progress.active()
         self._own = outer is None
         self._line = outer or progress.ProgressLine("labbrdf", stream=stream, enabled=enabled)
+        if self.enabled and self._line.enabled:  # what runs, before the first task ends
+            self._line.update(phase=self.desc, done=0, total=self.total)
 
     def update(self, n: int = 1) -> None:
         """Count ``n`` more finished tasks and show the progress (when enabled)."""

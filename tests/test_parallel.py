@@ -159,7 +159,7 @@ def test_progress_counts_every_task_once_on_one_line_of_a_terminal():
         bar.update()
     assert bar.done == 4
     text = buf.getvalue()
-    assert text.startswith("\rlabbrdf: fits 1/4") and "\n" not in text
+    assert text.startswith("\rlabbrdf: fits 0/4") and "\n" not in text  # drawn at once
     assert text.endswith("\r") and text.rsplit("\r", 2)[-2].strip() == ""  # erased at the end
 
 
