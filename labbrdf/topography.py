@@ -56,6 +56,7 @@ from scipy import ndimage, optimize, special
 
 from .jsonsafe import jsonable
 from .microfacet import DISTRIBUTIONS
+from .roughness.levelling_sums import NormalSums
 
 __all__ = [
     "C_MIN_PIXELS",
@@ -378,19 +379,6 @@ def _fit_acf(r: NDArray, step: float, c0: float) -> dict[str, float]:
     return out
 
 
-def _ks_normal(x: NDArray) -> float:
-    """KS distance of standardised samples to N(0, 1) [1]."""
-    if x.size < 2:
-        return float("nan")
-    s = x.std()
-    if s == 0:
-        return float("nan")
-    xs = x - x.mean()
-    xs /= s
-    xs.sort()
-    return _ks_sorted(xs, special.ndtr)
-
-
 def _ks_sorted(xs: NDArray, cdf: Any) -> float:
     """Two-sided KS distance sup|F_n - F| of sorted samples to the CDF ``cdf``.
 
@@ -421,7 +409,7 @@ def _shape_stats(x: NDArray) -> tuple[float, float, float]:
     m3 = float(np.dot(d2, d)) / x.size
     m4 = float(np.dot(d2, d2)) / x.size
     del d2
-    d /= s  # the standardised sample of _ks_normal, formed once (the same arithmetic)
+    d /= s  # standardised: the KS distance to N(0, 1)
     d.sort()
     return m3 / m2**1.5, m4 / m2**2, _ks_sorted(d, special.ndtr)
 
@@ -711,11 +699,7 @@ def _core(
     hole: tuple[slice, ...] | None = None,
     levelled: NDArray | None = None,
 ) -> dict[str, Any]:
-    """All statistics of one (replicate) valid set; scalars only, plus the slope fits.
-
-    ``levelled``: ``_level(z, valid, degree)`` when the caller has it (a replicate's, from
-    partial sums).
-    """
+    """All statistics of one valid set (``levelled``: its levelled z, if known); scalars, fits."""
     if np.count_nonzero(valid) < 8:
         raise ValueError("fewer than 8 valid points")
     lz = _level(z, valid, degree) if levelled is None else levelled
@@ -919,80 +903,6 @@ def _eroded(valid: NDArray, erode: int) -> tuple[NDArray, int]:
     return valid, n_eroded
 
 
-@dataclass(frozen=True)
-class _NormalSums:
-    """The sums a polynomial levelling needs over a set of points, which add and subtract.
-
-    ``n`` points, ``sz = sum z``, ``ata = sum a a^T``, ``sa = sum a``, ``saz = sum a z`` with
-    ``a`` the monomials of :func:`_block_design` (coordinates scaled to [-1, 1) over the
-    whole grid). A jackknife replicate's are the whole map's less its tile's (partial sums),
-    so the replicate is levelled without a pass over the map to form them.
-    """
-
-    n: float
-    sz: float
-    ata: NDArray
-    sa: NDArray
-    saz: NDArray
-
-    @classmethod
-    def of(
-        cls, z: NDArray, valid: NDArray, exps: list[tuple[int, ...]], regions: Any
-    ) -> _NormalSums:
-        """The sums over the valid points of ``regions`` (disjoint tuples of slices)."""
-        k = len(exps)
-        n, sz, ata, sa, saz = 0.0, 0.0, np.zeros((k, k)), np.zeros(k), np.zeros(k)
-        for reg in regions:
-            reg = tuple(reg) + (slice(None),) * (z.ndim - len(tuple(reg)))
-            v = valid[reg]
-            a = _region_design(z.shape, reg, exps, v)
-            zz = z[reg][v]
-            n += zz.size
-            sz += float(np.sum(zz))
-            ata += a.T @ a
-            sa += a.sum(axis=0)
-            saz += a.T @ zz
-        return cls(n, sz, ata, sa, saz)
-
-    def __sub__(self, o: _NormalSums) -> _NormalSums:
-        return _NormalSums(
-            self.n - o.n, self.sz - o.sz, self.ata - o.ata, self.sa - o.sa, self.saz - o.saz
-        )
-
-    def levelled(self, z: NDArray, valid: NDArray, exps: list[tuple[int, ...]]) -> NDArray:
-        """``_level(z, valid, degree)`` from these sums (those of ``valid``'s points)."""
-        if self.n <= len(exps):
-            raise ValueError(f"{int(self.n)} valid points cannot fix the levelling polynomial")
-        zmean = self.sz / self.n
-        coef = np.linalg.lstsq(self.ata, self.saz - zmean * self.sa, rcond=None)[0]
-        axes = [2.0 * np.arange(m) / m - 1.0 for m in z.shape]
-        poly = np.zeros(z.shape)
-        for c, e in zip(coef, exps, strict=True):
-            term = axes[0] ** e[0]
-            for ax, p in zip(axes[1:], e[1:], strict=True):
-                term = np.multiply.outer(term, ax**p)
-            poly += c * term
-        out = np.full(z.shape, np.nan)
-        np.subtract(z - zmean, poly, out=out, where=valid)
-        return out
-
-
-def _region_design(
-    shape: tuple[int, ...], reg: tuple[slice, ...], exps: list[tuple[int, ...]], v: NDArray
-) -> NDArray:
-    """:func:`_block_design` at the valid points ``v`` of the region ``reg`` of the grid."""
-    coords = [2.0 * np.arange(*sl.indices(m)) / m - 1.0 for sl, m in zip(reg, shape, strict=True)]
-    grids = np.meshgrid(*coords, indexing="ij") if len(coords) > 1 else coords
-    pts = [g[v] for g in grids]
-    cols = []
-    for e in exps:
-        col = pts[0] ** e[0]
-        for p, q in zip(pts[1:], e[1:], strict=True):
-            col = col * p**q
-        cols.append(col)
-    return np.column_stack(cols)
-
-
 def _jackknife(
     z: NDArray,
     valid: NDArray,
@@ -1017,12 +927,11 @@ def _jackknife(
     no_dropouts = bool(valid.all())
     reps: dict[str, list[float]] = {k: [] for k in scal}
     exps = _exponents(z.ndim, int(degree))
-    whole = _NormalSums.of(z, valid, exps, ((slice(a, b),) for a, b in _row_blocks(z.shape)))
+    whole = NormalSums.of(z, valid, exps, ((slice(a, b),) for a, b in _row_blocks(z.shape)))
     for i, t in enumerate(tiles):
         sub = valid.copy()
         sub[t] = False
-        # the replicate's levelling from the whole map's sums less the tile's
-        lz = (whole - _NormalSums.of(z, valid, exps, [t])).levelled(z, sub, exps)
+        lz = (whole - NormalSums.of(z, valid, exps, [t])).levelled(z, sub, exps)
         rep = _core(z, sub, px, degree, hole=t if no_dropouts else None, levelled=lz)
         del sub, lz
         for k in scal:
