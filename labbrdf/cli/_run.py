@@ -23,7 +23,7 @@ def _labbrdf_warnings(command: str) -> Iterator[None]:
     cache file that was rebuilt, an ill-conditioned inversion: every warning class defined
     in labbrdf. Other libraries' warnings keep Python's format.
     """
-    from ..adapters import AdapterWarning
+    from ..errors import AdapterWarning  # not the readers: nothing heavy at start-up
 
     with warnings.catch_warnings():
         original = warnings.showwarning

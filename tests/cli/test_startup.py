@@ -31,6 +31,10 @@ out = {{"--version": heavy(), "numpy after --version": "numpy" in sys.modules}}
 for name in COMMANDS:
     build_parser(commands=(name,))
     out[name] = heavy()
+from labbrdf.cli._run import _labbrdf_warnings
+from labbrdf import progress
+with _labbrdf_warnings("x"), progress.shown("x"):  # what wraps every command
+    out["around a command"] = heavy()
 print(json.dumps(out))
 """
 
@@ -51,6 +55,11 @@ def test_version_imports_no_heavy_library_nor_numpy(imported):
 @pytest.mark.parametrize("command", list(COMMANDS))
 def test_each_command_parser_imports_no_scipy_pandas_matplotlib(imported, command):
     assert imported[command] == []
+
+
+def test_what_wraps_every_command_imports_no_heavy_library(imported):
+    # the warnings shown as one line and the progress line: no reader, no pandas
+    assert imported["around a command"] == []
 
 
 def test_help_lists_each_command_with_its_module_own_help_line():
