@@ -42,7 +42,6 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import stats
 
 from . import optics
 from .optics import _angle, _finite, _physical_root, _real_index
@@ -474,6 +473,8 @@ class CombinedNK:
 
 def _scatter_test(theta: FloatArray, y: FloatArray) -> float:
     """Two-sided p-value of the least-squares slope of ``y`` against ``theta``."""
+    from scipy import stats  # here, not at the top: scipy.stats costs ~1 s to import
+
     res = stats.linregress(theta, y)
     if res.stderr == 0:
         return 0.0 if res.slope != 0 else 1.0
@@ -540,6 +541,8 @@ def combine_angles(
         )  # fmt: skip
     x = np.stack([n, k], axis=-1)
     if c is not None and np.all(np.isfinite(c)):
+        from scipy import stats  # here, not at the top: scipy.stats costs ~1 s to import
+
         w_i = np.linalg.pinv(c, hermitian=True)
         w = w_i.sum(axis=0)
         cov_mean = np.linalg.pinv(w, hermitian=True)

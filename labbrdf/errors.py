@@ -19,7 +19,17 @@ error                                            also a
 
 from __future__ import annotations
 
-__all__ = ["LabbrdfError", "SampleError", "SetupError"]
+__all__ = ["AdapterWarning", "LabbrdfError", "SampleError", "SetupError"]
+
+
+class AdapterWarning(UserWarning):
+    """A file was read, but something in it may be wrong (the message names file and line).
+
+    Readers issue it with :func:`warnings.warn` and keep the text in ``meta["warnings"]``
+    where they can; the command line prints it as ``labbrdf <command>: warning: ...``.
+    Defined here, with nothing to import, so that the command line can show it without
+    importing the readers; :mod:`labbrdf.adapters` offers it.
+    """
 
 
 class LabbrdfError(Exception):

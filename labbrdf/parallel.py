@@ -79,7 +79,6 @@ import functools
 import os
 import sys
 import threading
-import time
 import uuid
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator
@@ -94,6 +93,7 @@ from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, replace
 from typing import Any, TypeVar
 
+from . import progress
 from .errors import LabbrdfError
 
 __all__ = [
@@ -338,43 +338,31 @@ def _workers(workers: int | None, scheduler: str | None = None) -> int:
 
 
 class Progress:
-    """A plain progress bar on stderr that counts finished tasks (from any worker).
+    """Counts finished tasks (from any worker) on the one progress line of :mod:`labbrdf.progress`.
 
-    On a terminal it redraws one line; elsewhere (CI logs) it prints a line at each
-    10% step. ``enabled=False`` makes it silent.
+    The line of the running command when one is shown, else its own: redrawn in place on a
+    terminal, silent elsewhere (pipes, CI logs). ``enabled=False`` makes it silent.
     """
 
     def __init__(self, total: int, desc: str = "", enabled: bool = True, stream: Any = None):
         self.total = int(total)
         self.desc = desc or "tasks"
         self.enabled = bool(enabled) and self.total > 0
-        self.stream = stream if stream is not None else sys.stderr
         self.done = 0
-        self._t0 = time.perf_counter()
-        self._tty = bool(getattr(self.stream, "isatty", lambda: False)())
-        self._last_decile = -1
+        outer = progress.active()
+        self._own = outer is None
+        self._line = outer or progress.ProgressLine("labbrdf", stream=stream, enabled=enabled)
+        if self.enabled and self._line.enabled:  # what runs, before the first task ends
+            self._line.update(phase=self.desc, done=0, total=self.total)
 
     def update(self, n: int = 1) -> None:
         """Count ``n`` more finished tasks and show the progress (when enabled)."""
         self.done += n
-        if not self.enabled:
+        if not (self.enabled and self._line.enabled):
             return
-        frac = self.done / self.total
-        elapsed = time.perf_counter() - self._t0
-        if self._tty:
-            width = 30
-            bar = "#" * int(frac * width)
-            self.stream.write(
-                f"\r{self.desc}: [{bar:<{width}}] {self.done}/{self.total} {elapsed:6.1f} s"
-            )
-            if self.done >= self.total:
-                self.stream.write("\n")
-        else:
-            decile = int(frac * 10)
-            if decile > self._last_decile or self.done >= self.total:
-                self._last_decile = decile
-                self.stream.write(f"{self.desc}: {self.done}/{self.total} ({elapsed:.1f} s)\n")
-        self.stream.flush()
+        self._line.update(phase=self.desc, done=self.done, total=self.total)
+        if self._own and self.done >= self.total:
+            self._line.clear()
 
 
 #: the reusable LocalCluster: {"key": (workers, retries, tls files, dashboard), "client": ...}

@@ -148,20 +148,25 @@ def test_executor_refuses_bad_options_at_construction():
         parallel.as_executor(3)  # type: ignore[arg-type]
 
 
-def test_progress_counts_every_task_once():
-    buf = io.StringIO()
+def test_progress_counts_every_task_once_on_one_line_of_a_terminal():
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    buf = Terminal()
     bar = Progress(4, "fits", stream=buf)
     for _ in range(4):
         bar.update()
-    lines = buf.getvalue().splitlines()
-    assert lines[-1].startswith("fits: 4/4")
     assert bar.done == 4
+    text = buf.getvalue()
+    assert text.startswith("\rlabbrdf: fits 0/4") and "\n" not in text  # drawn at once
+    assert text.endswith("\r") and text.rsplit("\r", 2)[-2].strip() == ""  # erased at the end
 
 
-def test_progress_across_workers_reaches_total(capsys):
-    parallel.run(math.sqrt, range(7), scheduler="processes", workers=2, progress=True, desc="w")
-    err = capsys.readouterr().err.splitlines()
-    assert err[-1].startswith("w: 7/7")
+def test_progress_across_workers_is_silent_when_stderr_is_not_a_terminal(capsys):
+    out = parallel.run(math.sqrt, range(7), scheduler="processes", workers=2, progress=True)
+    assert out == [math.sqrt(x) for x in range(7)]
+    assert capsys.readouterr().err == ""
 
 
 @pytest.fixture(scope="module")
@@ -347,9 +352,14 @@ def _close_local_cluster() -> Any:
 
 
 def _progress_counts(err: str, desc: str) -> list[tuple[int, int]]:
-    return [
-        (int(a), int(b)) for a, b in re.findall(rf"^{re.escape(desc)}: (\d+)/(\d+)", err, re.M)
-    ]
+    """The counts drawn on a terminal's progress line (every update: no throttling)."""
+    pattern = rf"^labbrdf: {re.escape(desc)} (\d+)/(\d+)"
+    return [(int(a), int(b)) for a, b in re.findall(pattern, err.replace("\r", "\n"), re.M)]
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
 
 
 # ----------------------------------------------------------------------------------------
@@ -400,8 +410,13 @@ def test_tcp_scheduler_address_gives_serial_numbers(
 
 @pytest.mark.slow
 def test_worker_killed_mid_trace_is_retried_and_result_equals_serial(
-    dask_ok, serial_trace, tmp_path, capsys
+    dask_ok, serial_trace, tmp_path, monkeypatch
 ):
+    from labbrdf import progress
+
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    monkeypatch.setattr(progress, "MIN_INTERVAL", 0.0)  # draw every count
     marker = tmp_path / "deaths"
     killer = KillOnce("labbrdf.tracer.walk", "_unit", trace_block, 5, marker)
 
@@ -414,7 +429,7 @@ def test_worker_killed_mid_trace_is_retried_and_result_equals_serial(
     res = trace(TRACE, map=faulty_map)
     assert deaths(marker) == 1  # a worker really died, mid-run (block 5 of 8)
     assert_same_trace(serial_trace, res)
-    counts = _progress_counts(capsys.readouterr().err, "trace")
+    counts = _progress_counts(terminal.getvalue(), "trace")
     done = [c for c, _ in counts]
     assert done == sorted(done) and counts[-1] == (8, 8)  # truthful: never past 8/8
 

@@ -30,6 +30,7 @@ import numpy as np
 import pandas as pd
 
 from ..dataset import DatasetError, Measurement
+from ..errors import AdapterWarning
 from ._base import DECIMAL, NONFINITE, AdapterError
 
 __all__ = [
@@ -93,14 +94,6 @@ class Block:
 
 
 _EOL = re.compile(r"\r\n|\n|\r")
-
-
-class AdapterWarning(UserWarning):
-    """A file was read, but something in it may be wrong (the message names file and line).
-
-    Readers issue it with :func:`warnings.warn` and keep the text in ``meta["warnings"]``
-    where they can; the command line prints it as ``labbrdf <command>: warning: ...``.
-    """
 
 
 def warn(path: str | os.PathLike[str], message: str, line: int | None = None) -> str:

@@ -16,14 +16,14 @@ import sys
 from collections.abc import Iterator, Sequence
 from typing import Any
 
-from ..jsonsafe import jsonable
-
 
 class UsageError(Exception):
     """A command-line input error: printed, exit code 2."""
 
 
 def _emit_json(obj: Any) -> None:
+    from ..jsonsafe import jsonable
+
     print(json.dumps(jsonable(obj), indent=2, allow_nan=False))
 
 
@@ -99,7 +99,7 @@ def _range(text: str) -> str:
 
 def _fit_seed(text: str) -> int:
     """The argparse type of a fit's ``--seed``: an integer in [0, MAX_SEED]."""
-    from ..fitting.core import MAX_SEED
+    from ..fitting.defaults import MAX_SEED
 
     try:
         x = int(text)

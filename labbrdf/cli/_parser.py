@@ -1,30 +1,44 @@
-"""The ``labbrdf`` argument parser: one subparser per command, from the command's module."""
+"""The ``labbrdf`` argument parser: one subparser per command, from the command's module.
+
+Start-up is kept short: :data:`COMMANDS` names each command's module and its one-line help
+without importing it, so that ``labbrdf --help`` and ``labbrdf --version`` import no
+command (nor numpy), and ``labbrdf CMD ...`` imports the module of ``CMD`` only
+(:func:`build_parser` with ``commands``); the other commands are then stubs that carry
+their help line.
+"""
 
 from __future__ import annotations
 
 import argparse
+import importlib
+from collections.abc import Collection, Sequence
+from types import ModuleType
 from typing import Any
 
-from . import (
-    cache,
-    export,
-    film,
-    fit,
-    formats,
-    hemispherical,
-    ingest,
-    nk,
-    psd,
-    report,
-    surface,
-    trace,
-    validate,
-)
 from ._paths import path_actions
 
-#: the commands in the order ``labbrdf --help`` lists them
-COMMANDS = (ingest, formats, fit, nk, film, surface, psd, export, hemispherical, trace,
-            validate, report, cache)  # fmt: skip
+#: command -> its one-line help, in the order ``labbrdf --help`` lists them; the command
+#: is the module ``labbrdf.cli.<name>`` (``add_parser`` and ``cmd_<name>``), imported only
+#: when the command is chosen (tests check that each line is the module's own)
+COMMANDS: dict[str, str] = {
+    "ingest": "read instrument exports into one dataset",
+    "formats": "list the supported export formats",
+    "fit": "fit a model per group (sample, wavelength)",
+    "nk": "optical constants n, k from ellipsometer psi/Delta",
+    "film": "fit a thin-film stack (thicknesses, n, k) to psi/Delta, R and T of one sample",
+    "surface": "roughness statistics of a height map or profile",
+    "psd": "power spectral density of height maps (composite over maps, model fit)",
+    "export": "write a model BRDF in an exchange format",
+    "hemispherical": "directional-hemispherical reflectance of a model",
+    "trace": "Monte Carlo polarization ray tracing (pBRDF)",
+    "validate": "run the whole validation and write the HTML report",
+    "report": "HTML report for your own files",
+    "cache": "show or clear the tracer's operator cache",
+}
+
+
+#: every command's ``--quiet`` (a command may define its own, saying more)
+QUIET_HELP = "no progress line (there is none when stderr is not a terminal)"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -39,8 +53,35 @@ class _Parser(argparse.ArgumentParser):
         super().__init__(*args, **kw)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The parser of the ``labbrdf`` command, every subcommand with its options."""
+def command_module(name: str) -> ModuleType:
+    """The module of the command ``name`` (imported on this call, not before)."""
+    return importlib.import_module(f"{__package__}.{name}")
+
+
+def chosen_command(argv: Sequence[str]) -> str | None:
+    """The command named on a command line, or None (none, or not a command).
+
+    The top-level parser has no option that takes a value, so the command is the first
+    word that is not an option.
+    """
+    for word in argv:
+        if word == "--":
+            return None
+        if not word.startswith("-"):
+            return word if word in COMMANDS else None
+    return None
+
+
+def build_parser(commands: Collection[str] | None = None) -> argparse.ArgumentParser:
+    """The parser of the ``labbrdf`` command.
+
+    Parameters
+    ----------
+    commands : collection of str, optional
+        Build these commands' options only (their modules are the only ones imported);
+        the other commands are listed with their help line. Default: every command in
+        full (what the documentation shows).
+    """
     from .. import __version__
 
     p = _Parser(
@@ -50,8 +91,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--version", action="version", version=f"labbrdf {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for command in COMMANDS:
-        command.add_parser(sub)
-    for sp in sub.choices.values():  # what _checked_outputs checks, per command
-        sp.set_defaults(path_actions=tuple(path_actions(sp)))
+    for name, help_line in COMMANDS.items():
+        if commands is None or name in commands:
+            command_module(name).add_parser(sub)
+        else:
+            sub.add_parser(name, help=help_line)
+    for sp in sub.choices.values():
+        if not any(a.dest == "quiet" for a in sp._actions):
+            sp.add_argument("--quiet", action="store_true", help=QUIET_HELP)
+        sp.set_defaults(path_actions=tuple(path_actions(sp)))  # what _checked_outputs checks
     return p

@@ -9,8 +9,9 @@ import warnings
 from collections.abc import Iterator, Sequence
 from typing import Any
 
+from .. import progress
 from ._options import UsageError
-from ._parser import build_parser
+from ._parser import build_parser, chosen_command
 from ._paths import _checked_outputs
 
 
@@ -22,12 +23,13 @@ def _labbrdf_warnings(command: str) -> Iterator[None]:
     cache file that was rebuilt, an ill-conditioned inversion: every warning class defined
     in labbrdf. Other libraries' warnings keep Python's format.
     """
-    from ..adapters import AdapterWarning
+    from ..errors import AdapterWarning  # not the readers: nothing heavy at start-up
 
     with warnings.catch_warnings():
         original = warnings.showwarning
 
         def show(message: Any, category: Any, *rest: Any, **kw: Any) -> None:
+            progress.clear()  # the warning starts on a clean line
             if category.__module__.partition(".")[0] == "labbrdf":
                 print(f"labbrdf {command}: warning: {message}", file=sys.stderr)
             else:
@@ -39,15 +41,24 @@ def _labbrdf_warnings(command: str) -> Iterator[None]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the command line; returns the exit code."""
+    """Run the command line; returns the exit code.
+
+    Only the chosen command's module is imported (:func:`._parser.build_parser`).
+    """
+    words = sys.argv[1:] if argv is None else list(argv)
+    command = chosen_command(words)
     try:
-        parser = build_parser()
+        parser = build_parser(commands=() if command is None else (command,))
     except KeyboardInterrupt:
         print("labbrdf: interrupted", file=sys.stderr)
         return 130
-    args = parser.parse_args(argv)
+    args = parser.parse_args(words)
     try:
-        with _checked_outputs(args), _labbrdf_warnings(args.command):
+        with (
+            _checked_outputs(args),
+            _labbrdf_warnings(args.command),
+            progress.shown(f"labbrdf {args.command}", enabled=not args.quiet),
+        ):
             return int(args.func(args))
     except UsageError as exc:
         print(f"labbrdf {args.command}: {exc}", file=sys.stderr)

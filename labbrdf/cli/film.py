@@ -168,7 +168,7 @@ def cmd_film(args: argparse.Namespace) -> int:
 
 def add_parser(sub: Any) -> None:
     """The ``film`` subcommand's options."""
-    from ..fitting.core import METHOD
+    from ..fitting.defaults import METHOD
 
     s = sub.add_parser(
         "film",

@@ -279,7 +279,7 @@ def _residual_maps(args: argparse.Namespace, data: Any, results: list) -> None:
 
 def add_parser(sub: Any) -> None:
     """The ``fit`` subcommand's options."""
-    from ..fitting.core import METHOD
+    from ..fitting.defaults import METHOD
 
     s = sub.add_parser("fit", help="fit a model per group (sample, wavelength)")
     s.add_argument("files", nargs="+", action=InputPath, metavar="FILE_OR_DATASET")

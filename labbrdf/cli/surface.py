@@ -3,13 +3,21 @@
 from __future__ import annotations
 
 import argparse
-import sys
-import time
+import math
 from pathlib import Path
 from typing import Any
 
-from ..microfacet import DISTRIBUTIONS
-from ._options import UsageError, _add_geometry, _channel, _emit_json, _pixel_size, _warn
+from .. import progress
+from ._options import (
+    UsageError,
+    _add_geometry,
+    _angle_value,
+    _channel,
+    _emit_json,
+    _pixel_size,
+    _warn,
+    _wavelength_value,
+)
 from ._paths import InputPath, OutputPath, _add_overwrite
 
 
@@ -34,51 +42,59 @@ def _height_map(path: str, channel: str | None, args: argparse.Namespace) -> Any
     return hm
 
 
-def _progress_printer(label: str, after_s: float = 2.0) -> Any:
-    """``progress(done, total)`` reporting on stderr after ``after_s`` s (a TTY: at once)."""
-    t0 = time.monotonic()
-
-    def progress(done: int, total: int) -> None:
-        if total > 1 and (sys.stderr.isatty() or time.monotonic() - t0 > after_s):
-            el = time.monotonic() - t0
-            print(f"{label}: pass {done}/{total} ({el:.0f} s)", file=sys.stderr, flush=True)
-
-    return progress
+def _report_pass(done: int, total: int) -> None:
+    """The statistics' passes on the command's progress line."""
+    progress.report(phase="leave-one-block-out passes", done=done, total=total)
 
 
-def cmd_surface(args: argparse.Namespace) -> int:
-    """Print (or ``--json``) the roughness statistics of a height map."""
+def _levelling(args: argparse.Namespace) -> int:
+    """The levelling degree of ``--form NAME`` or ``--degree N`` (default 1, the plane)."""
+    from ..roughness.form import FORMS
+
+    if args.form is None:
+        return 1 if args.degree is None else args.degree
+    if args.degree is not None:
+        raise UsageError("--form and --degree both set the levelling: give one")
+    if args.form not in FORMS:
+        raise UsageError(f"--form {args.form!r}: expected one of {', '.join(FORMS)}")
+    return FORMS[args.form]
+
+
+def _cutoff(args: argparse.Namespace) -> float | None:
+    """``--short-cutoff`` in metres; the other option values checked before any reading."""
     from ..adapters.topography import length_m
-    from ..outputs import check_file_output, check_input_files
-    from ..roughness.topography import level, on_measured_points, roughness_statistics
 
-    check_input_files([args.file])
-    if args.png:
-        check_file_output(args.png, inputs=[args.file], suffixes=(".png",), option="--png")
-    cutoff = None
-    if args.short_cutoff is not None:
-        try:
-            cutoff = length_m(args.short_cutoff, args.unit)
-        except ValueError as exc:
-            raise UsageError(f"--short-cutoff: {exc}") from None
+    if args.theta_i is not None and args.wavelength is None:
+        raise UsageError("--theta-i needs --wavelength NM (the Rayleigh verdict)")
     if args.erode_mask < 0:
         raise UsageError(f"--erode-mask {args.erode_mask}: expected pixels >= 0")
-    hm = _height_map(args.file, args.channel, args)
+    if args.short_cutoff is None:
+        return None
+    try:
+        return float(length_m(args.short_cutoff, args.unit))
+    except ValueError as exc:
+        raise UsageError(f"--short-cutoff: {exc}") from None
+
+
+def _statistics(args: argparse.Namespace, hm: Any, degree: int, cutoff: float | None) -> Any:
+    """The roughness statistics (and ``--png``), errors said with the file's name."""
+    from ..roughness.topography import level, on_measured_points, roughness_statistics
+
     try:
         st = roughness_statistics(
             hm.heights,
             hm.pixel_size,
-            degree=args.degree,
+            degree=degree,
             blocks=args.blocks,
             short_cutoff=cutoff,
             erode=args.erode_mask,
-            progress=_progress_printer(f"labbrdf surface: {args.file}"),
+            progress=_report_pass,
         )
-        st = on_measured_points(st, hm.points, args.degree)
+        st = on_measured_points(st, hm.points, degree)
         if args.png:
             from ..report.figures import save_png, surface_figure
 
-            z = level(hm.heights, args.degree)
+            z = level(hm.heights, degree)
             title = f"{Path(args.file).name} ({hm.channel})"
             save_png(surface_figure(z, hm.pixel_size, st, title=title), args.png)
     except MemoryError:
@@ -90,13 +106,81 @@ def cmd_surface(args: argparse.Namespace) -> int:
         ) from None
     except ValueError as exc:
         raise UsageError(f"{args.file}: {exc}") from None
+    return st
+
+
+def _rayleigh(args: argparse.Namespace, hm: Any, st: Any, degree: int) -> dict[str, Any]:
+    """The Rayleigh verdict at ``--wavelength`` and ``--theta-i``, as the report judges it.
+
+    The sigma is that of the roughness which scatters at that geometry
+    (:func:`labbrdf.report.roughness.judge`: the map S-filtered at the shortest scattering
+    period when the map resolves it), with the map's jackknife uncertainty.
+    """
+    from ..report.roughness import MapRoughness, judge
+    from ..roughness.topography import level
+
+    short = 2.0 * min(hm.pixel_size) * 1e9
+    if math.isfinite(st.short_cutoff):
+        short = max(short, st.short_cutoff * 1e9)
+    size = max(hm.physical_sizes) * 1e9
+    m = MapRoughness(hm, st, level(hm.heights, degree), short, size, {})
+    return judge(m, args.wavelength, args.theta_i or 0.0)
+
+
+def _rayleigh_lines(r: dict[str, Any]) -> list[str]:
+    """The verdict in two lines."""
+    head = (
+        f"Rayleigh at {r['wavelength_nm']:g} nm, theta_i {r['theta_i']:g} deg: "
+        f"periods >= {r['shortest_nm']:.4g} nm scatter (map's band: {r['coverage']})"
+    )
+    if "g" not in r:
+        return [head, f"verdict: {r['rayleigh']}"]
+    u = r.get("u_sigma_nm")
+    sig = f"{r['sigma_nm']:.4g}" + (f" +- {u:.2g}" if u is not None else "")
+    ug = r.get("u_g")
+    g = f"{r['g']:.3g}" + (f" +- {ug:.2g}" if ug is not None else "")
+    return [
+        head,
+        f"sigma {sig} nm, g {g}, exp(-g) {r['loss']:.4g}: {r['rayleigh']} by Rayleigh "
+        f"(sigma < {r['thr_rayleigh']:.4g} nm), {r['fraunhofer']} by Fraunhofer "
+        f"(sigma < {r['thr_fraunhofer']:.4g} nm); verdicts at sigma +- 2u",
+    ]
+
+
+def cmd_surface(args: argparse.Namespace) -> int:
+    """Print (or ``--json``) the roughness statistics of a height map."""
+    from ..outputs import check_file_output, check_input_files
+    from ..roughness.form import check_form
+
+    check_input_files([args.file])
+    if args.png:
+        check_file_output(args.png, inputs=[args.file], suffixes=(".png",), option="--png")
+    degree, cutoff = _levelling(args), _cutoff(args)
+    hm = _height_map(args.file, args.channel, args)
+    st = _statistics(args, hm, degree, cutoff)
     d = st.to_dict()
     d["file"] = str(args.file)
     d["channel"] = hm.channel
     d["geometry_warnings"] = list(hm.warnings)
+    form = check_form(hm.heights, hm.pixel_size, degree)
+    d["form"] = form.to_dict() if form is not None else None
+    if args.wavelength is not None:
+        d["rayleigh"] = _rayleigh(args, hm, st, degree)
     if args.json:
         _emit_json(d)
         return 0
+    _print(d, hm.channel, args.file)
+    if form is not None and form.dominated:
+        print(f"warning: {form.message()}")
+    for line in _rayleigh_lines(d["rayleigh"]) if "rayleigh" in d else ():
+        print(line)
+    return 0
+
+
+def _print(d: dict[str, Any], channel: str, file: str) -> None:
+    """The statistics as a table, then the slope fits, warnings and notes."""
+    from ..microfacet import DISTRIBUTIONS
+
     u = d.get("uncertainty") or {}
 
     def row(label: str, key: str, scale: float, unit: str) -> None:
@@ -108,7 +192,7 @@ def cmd_surface(args: argparse.Namespace) -> int:
         err = f" +- {e * scale:.3g}" if e is not None else ""
         print(f"{label:<38} {v * scale:.4g}{err} {unit}")
 
-    print(f"{args.file} ({d['kind']}, channel {hm.channel}, {d['levelling']})")
+    print(f"{file} ({d['kind']}, channel {channel}, {d['levelling']})")
     print(f"bandwidth: {d['bandwidth']}")
     row("sigma (RMS height)", "sigma", 1e9, "nm")
     row("RMS slope", "slope_rms", 1.0, "")
@@ -127,7 +211,6 @@ def cmd_surface(args: argparse.Namespace) -> int:
     for note in d.get("notes") or ():
         if note != fits.get("warning"):
             print(f"note: {note}")
-    return 0
 
 
 def add_parser(sub: Any) -> None:
@@ -135,7 +218,19 @@ def add_parser(sub: Any) -> None:
     s = sub.add_parser("surface", help="roughness statistics of a height map or profile")
     s.add_argument("file", action=InputPath, metavar="FILE")
     s.add_argument("--channel", default=None, help="channel name or index (default: height)")
-    s.add_argument("--degree", type=int, default=1, help="levelling polynomial (1 = plane)")
+    s.add_argument(
+        "--form",
+        default=None,
+        metavar="NAME",
+        help="form removed before the statistics: mean, plane (default) or quadric (a "
+        "cylinder's or a lens's curvature; a map dominated by form is flagged)",
+    )
+    s.add_argument(
+        "--degree",
+        type=int,
+        default=None,
+        help="levelling polynomial of any total degree (1 = plane; or --form)",
+    )
     s.add_argument("--blocks", type=int, default=None, help="tiles per axis for uncertainties")
     s.add_argument(
         "--png",
@@ -160,5 +255,20 @@ def add_parser(sub: Any) -> None:
         help="drop the points within N pixels of a dropout (their rims often carry spikes)",
     )
     _add_geometry(s)
+    s.add_argument(
+        "--wavelength",
+        type=_wavelength_value,
+        default=None,
+        metavar="NM",
+        help="[nm] also say whether the surface is smooth by the Rayleigh criterion at this "
+        "wavelength (sigma of the roughness that scatters, with its uncertainty)",
+    )
+    s.add_argument(
+        "--theta-i",
+        type=_angle_value,
+        default=None,
+        metavar="DEG",
+        help="[deg] angle of incidence of the Rayleigh verdict (default 0)",
+    )
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_surface)

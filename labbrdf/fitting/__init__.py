@@ -33,13 +33,44 @@ among them in its own ``__all__``. They may change without notice.
 
 from __future__ import annotations
 
-from .batch import auto_weighting, fit_many, fit_many_nk, fit_records
-from .core import ALGORITHMS, CONSTRAINED, METHOD, fit, fit_replicates, parse_method
-from .data import FITTABLE_QUANTITIES, FitData, FitError
-from .objective import Objective
-from .replicates import combine_replicates
-from .result import FitResult
-from .uncertainty import AT_BOUND_FRAC, COND_MAX, CORREL_MAX, REL_STDERR_MAX, REL_STDERR_POOR
+import importlib
+from typing import TYPE_CHECKING, Any
+
+#: name -> the module of this package that defines it, imported on first use: the command
+#: line reads ``fitting.defaults`` without paying for nlopt, scipy and pandas
+_LAZY: dict[str, str] = {
+    "auto_weighting": "batch",
+    "fit_many": "batch",
+    "fit_many_nk": "batch",
+    "fit_records": "batch",
+    "ALGORITHMS": "core",
+    "CONSTRAINED": "core",
+    "fit": "core",
+    "fit_replicates": "core",
+    "parse_method": "core",
+    "METHOD": "defaults",
+    "FITTABLE_QUANTITIES": "data",
+    "FitData": "data",
+    "FitError": "data",
+    "Objective": "objective",
+    "combine_replicates": "replicates",
+    "FitResult": "result",
+    "AT_BOUND_FRAC": "uncertainty",
+    "COND_MAX": "uncertainty",
+    "CORREL_MAX": "uncertainty",
+    "REL_STDERR_MAX": "uncertainty",
+    "REL_STDERR_POOR": "uncertainty",
+}
+
+if TYPE_CHECKING:
+    from .batch import auto_weighting, fit_many, fit_many_nk, fit_records
+    from .core import ALGORITHMS, CONSTRAINED, fit, fit_replicates, parse_method
+    from .data import FITTABLE_QUANTITIES, FitData, FitError
+    from .defaults import METHOD
+    from .objective import Objective
+    from .replicates import combine_replicates
+    from .result import FitResult
+    from .uncertainty import AT_BOUND_FRAC, COND_MAX, CORREL_MAX, REL_STDERR_MAX, REL_STDERR_POOR
 
 __all__ = [
     "ALGORITHMS",
@@ -64,3 +95,23 @@ __all__ = [
     "fit_records",
     "parse_method",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
+    elif name.startswith("__"):
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    else:
+        try:  # a module of the package, as after ``import labbrdf.fitting.<name>``
+            value = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}") from None
+    globals()[name] = value  # later look-ups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})

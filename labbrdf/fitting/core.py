@@ -15,11 +15,12 @@ import pandas as pd
 from numpy.typing import ArrayLike, NDArray
 from scipy import optimize, special
 
-from .. import parallel
+from .. import parallel, progress
 from ..dataset import Measurement
 from ..models import Model, ModelError, Parameters
 from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
+from .defaults import MAX_SEED, METHOD
 from .objective import Objective
 from .replicates import ONE_SEED_WARNING, run_replicates
 from .result import FitResult
@@ -41,10 +42,6 @@ __all__ = [
     "parse_method",
     "setup_params",
 ]
-
-#: the default optimiser of every fit (film, batch, report, CLI): the global controlled
-#: random search CRS2 with local mutation, then BOBYQA from its best point
-METHOD = "GN_CRS2_LM+LN_BOBYQA"
 
 #: every nlopt algorithm, by name (``GN_CRS2_LM`` ...), read from the nlopt module itself
 ALGORITHMS: dict[str, int] = {
@@ -152,11 +149,6 @@ def _energy_rho(
     return lambda vals, th: np.asarray(hemispherical_reflectance(model, vals, th), float)
 
 
-#: the largest seed of a fit: nlopt's ``srand`` takes an unsigned long, 32 bits on some
-#: platforms, so seeds are integers in [0, MAX_SEED] everywhere
-MAX_SEED = 2**32 - 1
-
-
 def check_seed(seed: Any) -> int:
     """``seed`` as an int, if it is an integer in ``[0, MAX_SEED]``; else :class:`FitError`."""
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
@@ -259,6 +251,7 @@ def _run_stage(
 
         opt.add_inequality_constraint(constraint, 1e-10)
     nlopt.srand(seed)
+    progress.report(stage=name, budget=budget)
     nfev0 = obj.nfev
     x0 = np.clip(x, lo, hi)
     try:
@@ -314,6 +307,7 @@ def _polish(obj: Objective, x: NDArray, nfree: int, weighted: bool) -> tuple[NDA
     or the chi-square change (relative :data:`_POLISH_TOL`), i.e. at a first-order stationary
     point. The best point seen is kept, so the polish never raises chi-square.
     """
+    progress.report(stage="polish")
     nfev0 = obj.nfev
     lo, hi = obj.bounds()
     x0 = np.clip(np.asarray(x, float), lo, hi)
@@ -889,7 +883,8 @@ def _profile_intervals(
     """
     warn = []
     with np.errstate(all="ignore"):
-        for k in varying:
+        for i, k in enumerate(varying):
+            progress.report(phase=f"profile interval of {k}", done=i, total=len(varying))
             try:
                 out[k].ci95 = _profile_interval(
                     model, fd, out, weights, prof, k, chisqr, delta, int(seed)

@@ -12,6 +12,7 @@ from collections.abc import Callable, Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .. import progress
 from ..models import Model, Parameters
 from .data import FitData, FitError
 
@@ -295,6 +296,7 @@ class Objective:
 
     def _f(self, x: NDArray) -> float:
         self.nfev += 1
+        progress.report(evaluations=self.nfev, best=self.best_f)
         _, chi2 = self.solve(self.from_vector(x))
         if not math.isfinite(chi2):
             return _PENALTY
@@ -309,6 +311,7 @@ class Objective:
         m)`` each, so their chi-square is the penalty value the nlopt stages see.
         """
         self.nfev += 1
+        progress.report(evaluations=self.nfev, best=self.best_f)
         _, r = self.residuals(self.from_vector(x))
         if not np.all(np.isfinite(r)):
             return np.full(r.size, math.sqrt(_PENALTY / max(r.size, 1)))

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import progress
 from ..jsonsafe import jsonable
 
 __all__ = [
@@ -170,6 +171,7 @@ class Builder:
         """One progress line on stderr (when enabled)."""
         if self.progress:
             dt = time.perf_counter() - self._t0
+            progress.clear()  # a fit's updating line, if one is drawn
             sys.stderr.write(f"[labbrdf report {dt:6.1f} s] {msg}\n")
             sys.stderr.flush()
 

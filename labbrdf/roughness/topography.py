@@ -56,6 +56,7 @@ from scipy import ndimage, optimize, special
 
 from ..jsonsafe import jsonable
 from ..microfacet import DISTRIBUTIONS
+from .levelling_sums import NormalSums
 
 __all__ = [
     "C_MIN_PIXELS",
@@ -378,19 +379,6 @@ def _fit_acf(r: NDArray, step: float, c0: float) -> dict[str, float]:
     return out
 
 
-def _ks_normal(x: NDArray) -> float:
-    """KS distance of standardised samples to N(0, 1) [1]."""
-    if x.size < 2:
-        return float("nan")
-    s = x.std()
-    if s == 0:
-        return float("nan")
-    xs = x - x.mean()
-    xs /= s
-    xs.sort()
-    return _ks_sorted(xs, special.ndtr)
-
-
 def _ks_sorted(xs: NDArray, cdf: Any) -> float:
     """Two-sided KS distance sup|F_n - F| of sorted samples to the CDF ``cdf``.
 
@@ -412,15 +400,18 @@ def _shape_stats(x: NDArray) -> tuple[float, float, float]:
     The moment estimators of :func:`scipy.stats.skew` and :func:`scipy.stats.kurtosis`
     (biased, ``m3 / m2^1.5`` and ``m4 / m2^2``), formed with two temporaries.
     """
-    if x.size < 3 or x.std() == 0:
+    s = x.std() if x.size >= 3 else 0.0
+    if s == 0:
         return float("nan"), float("nan"), float("nan")
     d = x - x.mean()
     d2 = d * d
     m2 = float(np.mean(d2))
     m3 = float(np.dot(d2, d)) / x.size
     m4 = float(np.dot(d2, d2)) / x.size
-    del d, d2
-    return m3 / m2**1.5, m4 / m2**2, _ks_normal(x)
+    del d2
+    d /= s  # standardised: the KS distance to N(0, 1)
+    d.sort()
+    return m3 / m2**1.5, m4 / m2**2, _ks_sorted(d, special.ndtr)
 
 
 # ------------------------------------------------------------------ slope-space fits
@@ -706,11 +697,12 @@ def _core(
     degree: int,
     with_slopes: bool = False,
     hole: tuple[slice, ...] | None = None,
+    levelled: NDArray | None = None,
 ) -> dict[str, Any]:
-    """All statistics of one (replicate) valid set; scalars only, plus the slope fits."""
+    """All statistics of one valid set (``levelled``: its levelled z, if known); scalars, fits."""
     if np.count_nonzero(valid) < 8:
         raise ValueError("fewer than 8 valid points")
-    lz = _level(z, valid, degree)
+    lz = _level(z, valid, degree) if levelled is None else levelled
     h = lz[valid]
     out: dict[str, Any] = {}
     out["sigma"] = float(np.sqrt(np.mean(h * h)))
@@ -934,11 +926,14 @@ def _jackknife(
     ]
     no_dropouts = bool(valid.all())
     reps: dict[str, list[float]] = {k: [] for k in scal}
+    exps = _exponents(z.ndim, int(degree))
+    whole = NormalSums.of(z, valid, exps, ((slice(a, b),) for a, b in _row_blocks(z.shape)))
     for i, t in enumerate(tiles):
         sub = valid.copy()
         sub[t] = False
-        rep = _core(z, sub, px, degree, hole=t if no_dropouts else None)
-        del sub
+        lz = (whole - NormalSums.of(z, valid, exps, [t])).levelled(z, sub, exps)
+        rep = _core(z, sub, px, degree, hole=t if no_dropouts else None, levelled=lz)
+        del sub, lz
         for k in scal:
             reps[k].append(rep[k])
         if progress is not None:

@@ -339,7 +339,7 @@ def test_labbrdf_warnings_print_as_one_line_and_others_keep_their_format(monkeyp
 def test_ctrl_c_while_the_parser_is_built_exits_130_without_traceback(monkeypatch, capsys):
     import labbrdf.cli._run as cli_run
 
-    def interrupted():
+    def interrupted(*args, **kw):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(cli_run, "build_parser", interrupted)

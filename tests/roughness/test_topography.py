@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import json
 import sys
 
@@ -402,13 +403,20 @@ def test_progress_reports_every_pass_and_chunking_leaves_results_unchanged(monke
         assert b.uncertainty[k] == pytest.approx(a.uncertainty[k], rel=1e-6)
 
 
-def test_cli_progress_goes_to_stderr_only_after_the_delay(capsys):
-    from labbrdf.cli.surface import _progress_printer
+def test_cli_passes_show_on_the_progress_line_only():
+    from labbrdf import progress
+    from labbrdf.cli.surface import _report_pass
 
-    _progress_printer("labbrdf surface: f.dat", after_s=3600)(2, 26)
-    assert capsys.readouterr().err == ""
-    _progress_printer("labbrdf surface: f.dat", after_s=0.0)(2, 26)
-    assert "labbrdf surface: f.dat: pass 2/26" in capsys.readouterr().err
+    tty = _Terminal()
+    with progress.shown("labbrdf surface", stream=tty):
+        _report_pass(2, 26)
+        assert "labbrdf surface: leave-one-block-out passes 2/26" in tty.getvalue()
+    assert "\n" not in tty.getvalue()  # one line, redrawn, erased at the end
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
 
 
 def test_height_map_is_drawn_x_horizontal_y_down_as_gwyddion():
@@ -486,3 +494,30 @@ def test_non_uniform_profile_statistics_are_those_of_the_measured_points(tmp_pat
     d = json.loads(capsys.readouterr().out)
     ref = SurfaceTopography.NonuniformLineScan(xs, zs, unit="um").detrend(detrend_mode="height")
     assert d["slope_rms_x"] == pytest.approx(ref.rms_slope_from_profile(), rel=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("degree", "holes", "ndim"), [(1, False, 2), (0, True, 2), (2, True, 2), (1, False, 1)]
+)
+def test_jackknife_levelling_by_partial_sums_equals_levelling_each_replicate(
+    monkeypatch, degree, holes, ndim
+):
+    """Each replicate's levelling from the whole map's sums less its tile's, against the
+    direct levelling of the replicate (the implementation before): the same arithmetic but
+    for the order of summation, so the values agree to rounding (a few 1e-12 measured); the
+    uncertainties are differences of replicates, 1e-2 of the values, hence rel=1e-6."""
+    import labbrdf.roughness.topography as T
+
+    z = gaussian_surface(96, 96e-6, 1e-7, 5e-6, rng=4).z
+    z = z + np.linspace(0.0, 3e-7, 96)[:, None]  # a tilt the replicates level differently
+    if holes:
+        z[10:20, 40:47] = np.nan
+    if ndim == 1:
+        z = z[5]
+    a = roughness_statistics(z, 1e-6, degree=degree, blocks=3)
+    direct = lambda self, z, valid, exps: T._level(z, valid, degree)  # noqa: E731
+    monkeypatch.setattr(T.NormalSums, "levelled", direct)
+    b = roughness_statistics(z, 1e-6, degree=degree, blocks=3)
+    assert a.uncertainty.keys() == b.uncertainty.keys() and len(a.uncertainty) > 20
+    for k, v in b.uncertainty.items():
+        assert a.uncertainty[k] == pytest.approx(v, rel=1e-6, nan_ok=True), k
