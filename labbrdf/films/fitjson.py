@@ -71,6 +71,7 @@ def _fit_json_schema() -> dict[str, Any]:
             "name": {"type": "string", "max_length": 200},
             "thickness_nm": {"type": "number", "min": 0.0, "max": MAX_THICKNESS_NM},
             "material": material,
+            "coherent": {"type": "boolean"},
         },
         "additional": False,
     }
@@ -88,6 +89,11 @@ def _fit_json_schema() -> dict[str, Any]:
                     "ambient": material,
                     "substrate": material,
                     "layers": {"type": "array", "items": layer, "max_items": MAX_LAYERS},
+                    "substrate_thickness_nm": {
+                        "type": "number",
+                        "min": 0.0,
+                        "max": MAX_THICKNESS_NM,
+                    },
                 },
                 "additional": False,
             },

@@ -48,12 +48,14 @@ class FilmModel:
 
         Vary every layer's thickness and every parametric layer material's parameters
         (default boxes of :mod:`labbrdf.nk.dispersion`); the substrate and tables stay fixed.
-        Thickness box: [0, max(3 d, 20 nm)] unless ``thickness_max_nm`` is given.
+        Thickness box: [0, max(3 d, 20 nm)] unless ``thickness_max_nm`` is given. The
+        thickness of an incoherent layer stays fixed (it enters only through absorption).
         """
         free: dict[str, tuple[float, float]] = {}
         for lay in stack.layers:
             hi = thickness_max_nm or max(3 * lay.thickness_nm, 20.0)
-            free[f"{lay.name}.thickness_nm"] = (0.0, float(hi))
+            if lay.coherent:
+                free[f"{lay.name}.thickness_nm"] = (0.0, float(hi))
             if isinstance(lay.material, disp.Tabulated):
                 continue
             for k, b in lay.material.bounds().items():

@@ -30,7 +30,16 @@ from .materials import Material, Roughness, _table_file, _with_params, as_materi
 from .model import FilmModel
 from .stack import Stack
 
-_LAYER_KEYS = {"name", "material", "model", "file", "reference", "thickness_nm", "fraction"}
+_LAYER_KEYS = {
+    "name",
+    "material",
+    "model",
+    "file",
+    "reference",
+    "thickness_nm",
+    "fraction",
+    "coherent",
+}
 
 
 _TOP_KEYS = ("ambient", "wavelength_nm", "substrate", "layer")
@@ -266,10 +275,38 @@ def _layer_of(
     free = {f"{name}.{k}": b for k, b in mfree.items()}
     if dbox is not None:
         free[f"{name}.thickness_nm"] = dbox
+    coherent = tbl.get("coherent", True)
+    if not isinstance(coherent, bool):
+        raise FilmError(
+            f"{where}, line {lines('layer', j, 'coherent')}: coherent must be true or false, "
+            f"got {coherent!r}"
+        )
     try:
-        return Layer(m, d, name), free
+        return Layer(m, d, name, coherent), free
     except FilmError as exc:
         raise FilmError(f"{where}, line {lines('layer', j)}: {exc}") from None
+
+
+def _substrate_thickness(
+    tbl: Mapping[str, Any], where: str, lines: _KeyLines
+) -> tuple[float | None, tuple[float, float] | None]:
+    """A [substrate]'s ``thickness_nm`` (a finite, incoherent substrate) and its box."""
+    for key in ("coherent", "name", "fraction"):
+        if key in tbl:
+            raise FilmError(
+                f"{where}, line {lines('substrate', None, key)}: {key!r} is a layer key; a "
+                "substrate is semi-infinite, or incoherent with its thickness_nm"
+            )
+    if "thickness_nm" not in tbl:
+        return None, None
+    at = f"{where}, line {lines('substrate', None, 'thickness_nm')}: thickness_nm"
+    d, box = _spec(tbl["thickness_nm"], at)
+    if min(d, box[0] if box else d) <= 0 or max(d, box[1] if box else d) > MAX_THICKNESS_NM:
+        raise FilmError(
+            f"{at}: expected a thickness in (0, {MAX_THICKNESS_NM:g}] nm "
+            "(labbrdf.films.MAX_THICKNESS_NM)"
+        )
+    return d, box
 
 
 def load_model(path: str | os.PathLike[str]) -> FilmModel:
@@ -283,6 +320,8 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
         [substrate]
         material = "si"                # si, sio2 (shipped tables), a model name, or
                                        # file = "ta.dat" (n,k table or ellipsometer file)
+        thickness_nm = 1e6             # optional: a finite substrate, incoherent, with
+                                       # the ambient behind it (backside reflection)
 
         [[layer]]                      # top first; repeat for more layers
         name = "oxide"
@@ -292,6 +331,7 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
         A = [1.3, 1.7]
         B = 0.0036                     # a number: fixed
         C = {value = 0, min = -0.01, max = 0.01}   # full form (vary = false to fix)
+        coherent = true                # false: a thick layer, added in intensity
 
     A ``file`` is relative to the model file's folder, and is an input of the command
     that reads the model (:func:`named_inputs`). The file is at most
@@ -314,8 +354,11 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
     )
     if isinstance(sub, Roughness):
         raise FilmError(f"{where}, line {lines('substrate')}: roughness is a layer")
+    sub_d, sub_box = _substrate_thickness(doc["substrate"], where, lines)
     layers = []
     free: dict[str, tuple[float, float]] = {f"substrate.{k}": b for k, b in sub_free.items()}
+    if sub_box is not None:
+        free["substrate.thickness_nm"] = sub_box
     seen: set[str] = set()
     for j, tbl in enumerate(doc.get("layer", [])):
         layer, layer_free = _layer_of(tbl, j, where, p.parent, lines)
@@ -328,7 +371,7 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
         layers.append(layer)
         free.update(layer_free)
     try:
-        st = Stack(layers, sub, ambient)
+        st = Stack(layers, sub, ambient, sub_d)
     except FilmError as exc:
         raise FilmError(f"{where}: {exc}") from None
     return FilmModel(st, free, wl_range, where)

@@ -15,18 +15,21 @@ Parameter names are ``"<layer>.<parameter>"``: ``"oxide.thickness_nm"``, ``"oxid
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..nk import dispersion as disp
+from . import incoherent as inc
 from . import matrices as stk
 from .fitjson import _check_indices, _fit_doc, _tabulated
 from .layers import Layer
-from .limits import MAX_LAYERS, FilmError, check_wavelength_range
+from .limits import MAX_LAYERS, MAX_THICKNESS_NM, FilmError, check_wavelength_range
 from .materials import Roughness, _with_params, as_material
 
 __all__ = ["Stack", "read_fit_json"]
@@ -43,9 +46,26 @@ class Stack:
         Semi-infinite substrate (see :func:`as_material`).
     ambient : material
         Semi-infinite, lossless ambient; default 1 (vacuum/air).
+    substrate_thickness_nm : float, optional
+        A substrate of this thickness [nm] with the ambient behind it: an incoherent slab
+        whose backside reflection adds in intensity (:mod:`labbrdf.films.incoherent`), as
+        for a film on a glass slide. Default: semi-infinite (no backside reflection: a
+        wafer, or a roughened or index-matched back).
+
+    Notes
+    -----
+    A stack with an incoherent layer or a finite substrate has no amplitudes; its psi and
+    Delta are those of the incoherent sum of the reflected light (:meth:`psi_delta`), which
+    is partly depolarized (:meth:`depolarization`, :meth:`mueller`).
     """
 
-    def __init__(self, layers: Sequence[Layer], substrate: Any, ambient: Any = 1.0) -> None:
+    def __init__(
+        self,
+        layers: Sequence[Layer],
+        substrate: Any,
+        ambient: Any = 1.0,
+        substrate_thickness_nm: float | None = None,
+    ) -> None:
         layers = list(layers)
         if len(layers) > MAX_LAYERS:
             raise FilmError(
@@ -56,7 +76,7 @@ class Stack:
         for j, lay in enumerate(layers, 1):
             if not isinstance(lay, Layer):
                 raise FilmError(f"layers[{j - 1}]: expected a Layer, got {type(lay).__name__}")
-            named.append(lay if lay.name else Layer(lay.material, lay.thickness_nm, f"layer{j}"))
+            named.append(lay if lay.name else replace(lay, name=f"layer{j}"))
         names = [lay.name for lay in named]
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
@@ -69,6 +89,12 @@ class Stack:
             raise FilmError("roughness is a layer, not a substrate or ambient")
         self.substrate: disp.Dispersion = sub
         self.ambient: disp.Dispersion = amb
+        self.substrate_thickness_nm = _substrate_thickness(substrate_thickness_nm)
+
+    @property
+    def coherent(self) -> bool:
+        """True when every layer is coherent and the substrate semi-infinite."""
+        return self.substrate_thickness_nm is None and all(x.coherent for x in self.layers)
 
     # ---- optics
     def _ambient_nk(self, lam: NDArray) -> NDArray:
@@ -107,26 +133,74 @@ class Stack:
         lam = np.asarray(wavelength_nm, float)
         return self.indices(lam), self._thicknesses(), lam, np.asarray(theta_deg, float)
 
+    def intensity_sums(self, wavelength_nm: ArrayLike, theta_deg: ArrayLike) -> inc.IntensitySums:
+        """R_s, R_p, the s-p cross term X and T_s, T_p (:func:`~.incoherent.intensity_sums`).
+
+        Any stack, coherent or not; inputs broadcast. With a finite substrate the medium
+        behind it is the ambient and T is the light that leaves the backside.
+        """
+        lam = np.asarray(wavelength_nm, float)
+        n = self.indices(lam)
+        d = self._thicknesses()
+        flags = [lay.coherent for lay in self.layers]
+        if self.substrate_thickness_nm is not None:
+            n, d, flags = [*n, n[0]], [*d, self.substrate_thickness_nm], [*flags, False]
+        return inc.intensity_sums(n, d, flags, lam, np.asarray(theta_deg, float))
+
     def psi_delta(
         self, wavelength_nm: ArrayLike, theta_deg: ArrayLike
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """psi, Delta [deg] (Nebraska convention, Delta in [0, 360)); inputs broadcast."""
-        return stk.ellipsometry(*self._grid(wavelength_nm, theta_deg))
+        """psi, Delta [deg] (Nebraska convention, Delta in [0, 360)); inputs broadcast.
+
+        With incoherent layers: psi from ``R_p / R_s`` and Delta the phase of the cross
+        term (:func:`labbrdf.films.incoherent.ellipsometry`).
+        """
+        if self.coherent:
+            return stk.ellipsometry(*self._grid(wavelength_nm, theta_deg))
+        psi, delta, _ = inc.ellipsometry(self.intensity_sums(wavelength_nm, theta_deg))
+        return psi, delta
+
+    def depolarization(
+        self, wavelength_nm: ArrayLike, theta_deg: ArrayLike
+    ) -> NDArray[np.float64]:
+        """``1 - sqrt(N^2 + C^2 + S^2)`` of the reflected light [1] (0 for a coherent stack)."""
+        return inc.ellipsometry(self.intensity_sums(wavelength_nm, theta_deg))[2]
+
+    def mueller(self, wavelength_nm: ArrayLike, theta_deg: ArrayLike) -> NDArray[np.float64]:
+        """Mueller matrix of the specular reflection, shape ``(..., 4, 4)`` [1]."""
+        return inc.mueller(self.intensity_sums(wavelength_nm, theta_deg))
 
     def reflectance(
         self, wavelength_nm: ArrayLike, theta_deg: ArrayLike
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """R_s, R_p [1]; inputs broadcast."""
-        return stk.reflectance(*self._grid(wavelength_nm, theta_deg))
+        if self.coherent:
+            return stk.reflectance(*self._grid(wavelength_nm, theta_deg))
+        sums = self.intensity_sums(wavelength_nm, theta_deg)
+        return sums.Rs, sums.Rp
 
     def transmittance(
         self, wavelength_nm: ArrayLike, theta_deg: ArrayLike
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """T_s, T_p into the substrate [1]; inputs broadcast."""
-        return stk.transmittance(*self._grid(wavelength_nm, theta_deg))
+        """T_s, T_p into the substrate (out of its back if it is finite) [1]; inputs broadcast."""
+        if self.coherent:
+            return stk.transmittance(*self._grid(wavelength_nm, theta_deg))
+        sums = self.intensity_sums(wavelength_nm, theta_deg)
+        return sums.Ts, sums.Tp
 
     def amplitudes(self, wavelength_nm: ArrayLike, theta_deg: ArrayLike):
-        """r_s, r_p, t_s, t_p (:func:`labbrdf.films.matrices.amplitudes`); inputs broadcast."""
+        """r_s, r_p, t_s, t_p (:func:`labbrdf.films.matrices.amplitudes`); inputs broadcast.
+
+        Raises
+        ------
+        FilmError
+            The stack has an incoherent layer or a finite substrate (no amplitudes).
+        """
+        if not self.coherent:
+            raise FilmError(
+                "a stack with an incoherent layer or a finite substrate has no amplitudes; "
+                "use intensity_sums, reflectance or psi_delta"
+            )
         return stk.amplitudes(*self._grid(wavelength_nm, theta_deg))
 
     def nk(self, wavelength_nm: ArrayLike) -> dict[str, NDArray[np.complex128]]:
@@ -143,6 +217,8 @@ class Stack:
         for lay in self.layers:
             out.update({f"{lay.name}.{k}": v for k, v in lay.params.items()})
         out.update({f"substrate.{k}": v for k, v in self.substrate.params.items()})
+        if self.substrate_thickness_nm is not None:
+            out["substrate.thickness_nm"] = self.substrate_thickness_nm
         return out
 
     def units(self) -> dict[str, str]:
@@ -152,6 +228,8 @@ class Stack:
             out[f"{lay.name}.thickness_nm"] = "nm"
             out.update({f"{lay.name}.{k}": u for k, u in lay.material.units().items()})
         out.update({f"substrate.{k}": u for k, u in self.substrate.units().items()})
+        if self.substrate_thickness_nm is not None:
+            out["substrate.thickness_nm"] = "nm"
         return out
 
     def with_values(self, values: Mapping[str, float]) -> Stack:
@@ -167,28 +245,38 @@ class Stack:
         for lay in self.layers:
             p = dict(per.get(lay.name, {}))
             d = p.pop("thickness_nm", lay.thickness_nm)
-            layers.append(Layer(_with_params(lay.material, p), d, lay.name))
-        sub = _with_params(self.substrate, per.get("substrate", {}))
-        return Stack(layers, sub, self.ambient)
+            layers.append(replace(lay, material=_with_params(lay.material, p), thickness_nm=d))
+        p = dict(per.get("substrate", {}))
+        d_sub = p.pop("thickness_nm", self.substrate_thickness_nm)
+        return Stack(layers, _with_params(self.substrate, p), self.ambient, d_sub)
 
     # ---- serialisation
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe form (inverse: :meth:`from_dict`)."""
-        return {
+        out = {
             "ambient": self.ambient.to_dict(),
             "layers": [lay.to_dict() for lay in self.layers],
             "substrate": self.substrate.to_dict(),
         }
+        if self.substrate_thickness_nm is not None:
+            out["substrate_thickness_nm"] = self.substrate_thickness_nm
+        return out
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Stack:
         """A stack from :meth:`to_dict`'s form."""
         try:
             layers = [
-                Layer(as_material(x["material"]), float(x["thickness_nm"]), str(x.get("name", "")))
+                Layer(
+                    as_material(x["material"]),
+                    float(x["thickness_nm"]),
+                    str(x.get("name", "")),
+                    bool(x.get("coherent", True)),
+                )
                 for x in d.get("layers", [])
             ]
-            return cls(layers, as_material(d["substrate"]), as_material(d.get("ambient", 1.0)))
+            sub, amb = as_material(d["substrate"]), as_material(d.get("ambient", 1.0))
+            return cls(layers, sub, amb, d.get("substrate_thickness_nm"))
         except KeyError as exc:
             raise FilmError(f"stack: missing key {exc}") from None
 
@@ -199,9 +287,29 @@ class Stack:
 
     def __repr__(self) -> str:
         inner = ", ".join(
-            f"{lay.name}: {lay.material.name} {lay.thickness_nm:.4g} nm" for lay in self.layers
+            f"{lay.name}: {lay.material.name} {lay.thickness_nm:.4g} nm"
+            + ("" if lay.coherent else " incoherent")
+            for lay in self.layers
         )
-        return f"Stack([{inner}], substrate={self.substrate.name})"
+        d = self.substrate_thickness_nm
+        thick = "" if d is None else f", substrate_thickness_nm={d:.6g}"
+        return f"Stack([{inner}], substrate={self.substrate.name}{thick})"
+
+
+def _substrate_thickness(d: Any) -> float | None:
+    """None (semi-infinite) or a finite thickness in (0, MAX_THICKNESS_NM] [nm]."""
+    if d is None:
+        return None
+    try:
+        v = float(d)
+    except (TypeError, ValueError):
+        raise FilmError(f"substrate_thickness_nm: expected a number, got {d!r}") from None
+    if not (math.isfinite(v) and 0.0 < v <= MAX_THICKNESS_NM):
+        raise FilmError(
+            f"substrate_thickness_nm: expected a thickness in (0, {MAX_THICKNESS_NM:g}] nm "
+            f"(labbrdf.films.MAX_THICKNESS_NM), got {d!r}"
+        )
+    return v
 
 
 def read_fit_json(path: str | os.PathLike[str]) -> tuple[Stack, tuple[float, float]]:
