@@ -35,7 +35,7 @@ def _fit_json_schema() -> dict[str, Any]:
     number = {"type": "number"}
     column = {"type": "array", "items": {"type": "number", "min": 0.0}, "min_items": 2}
     column["max_items"] = MAX_TABLE_POINTS
-    model = {"type": "string", "enum": sorted({*disp.MODELS, "roughness"})}
+    model = {"type": "string", "enum": sorted({*disp.MODELS, "roughness", "ema"})}
     table = {
         "type": "object",
         "properties": {
@@ -56,7 +56,19 @@ def _fit_json_schema() -> dict[str, Any]:
     }
     params = {"type": "object", "properties": {"model": model}, "additional": number}
     by_model: dict[str, Any] = dict.fromkeys(disp.MODELS, params)
-    by_model.update(tabulated=table, roughness=rough)
+    fraction = {"type": "number", "min": 0.0, "max": 1.0}
+    ema = {
+        "type": "object",
+        "required": ["components"],
+        "properties": {
+            "model": model,
+            "components": {"type": "array", "min_items": 2, "max_items": 3},
+            "fraction": fraction,
+            "fraction3": fraction,
+        },
+        "additional": False,
+    }
+    by_model.update(tabulated=table, roughness=rough, ema=ema)
     material = {
         "type": "object",
         "required": ["model"],
@@ -130,6 +142,9 @@ def _check_tables(stack_doc: Mapping[str, Any], where: str) -> None:
 def _tabulated(stack: Any) -> list[tuple[str, disp.Tabulated]]:
     mats = [("ambient", stack.ambient), ("substrate", stack.substrate)]
     mats += [(lay.name, lay.material) for lay in stack.layers]
+    for lay in stack.layers:  # the constituents of a mixture
+        comps = getattr(lay.material, "components", ())
+        mats += [(f"{lay.name} constituent {j + 1}", c) for j, c in enumerate(comps)]
     return [(name, m) for name, m in mats if isinstance(m, disp.Tabulated)]
 
 

@@ -39,6 +39,7 @@ _LAYER_KEYS = {
     "thickness_nm",
     "fraction",
     "coherent",
+    "components",
 }
 
 
@@ -145,12 +146,36 @@ def _material_of(tbl: Mapping[str, Any], base: Path, at: Any) -> Material:
     val = tbl[kind]
     if not isinstance(val, str):
         raise FilmError(f"{at(kind)}: {kind} must be a string")
+    if "components" in tbl and val.strip().lower() != "ema":
+        raise FilmError(f'{at("components")}: components belong to material = "ema"')
     try:
         if kind == "file":
             return _table_file(_named_file(val, base))
+        if val.strip().lower() == "ema":
+            return _ema_of(tbl.get("components"), base)
         return as_material(val)
     except (FilmError, disp.DispersionError) as exc:
-        raise FilmError(f"{at(kind)}: {exc}") from None
+        raise FilmError(
+            f"{at(kind if 'components' not in tbl else 'components')}: {exc}"
+        ) from None
+
+
+def _ema_of(components: Any, base: Path) -> Material:
+    """``material = "ema"``, ``components = [...]``: names, @LAYER, void, {model...}, {file}."""
+    if not isinstance(components, list):
+        raise FilmError('material = "ema" needs components = [2 or 3 constituents]')
+    comps: list[Any] = []
+    for c in components:
+        if isinstance(c, dict) and set(c) == {"file"} and isinstance(c["file"], str):
+            comps.append(_table_file(_named_file(c["file"], base)))
+        elif isinstance(c, (str, dict)):
+            comps.append(c)
+        else:
+            raise FilmError(
+                f"constituent {c!r}: expected a name, 'void', '@LAYER', "
+                "{model = ..., ...} or {file = ...}"
+            )
+    return as_material({"model": "ema", "components": comps})
 
 
 def _material_from_table(
@@ -326,7 +351,9 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
         [[layer]]                      # top first; repeat for more layers
         name = "oxide"
         material = "cauchy"            # constant, cauchy, sellmeier, tauc_lorentz, drude,
-                                       # lorentz, roughness, si, sio2; or file = "..."
+                                       # lorentz, roughness, si, sio2; or file = "...";
+                                       # "ema(@oxide, void)" (a Bruggeman mixture), or
+                                       # "ema" with components = ["@oxide", "void", ...]
         thickness_nm = [0, 10]         # [min, max]: fitted, started mid-box
         A = [1.3, 1.7]
         B = 0.0036                     # a number: fixed
@@ -382,6 +409,9 @@ def _model_files(doc: Mapping[str, Any], base: Path) -> list[Path]:
     tables = [doc.get("substrate")]
     layers = doc.get("layer")
     tables += layers if isinstance(layers, list) else []
+    for t in list(tables):
+        comps = t.get("components") if isinstance(t, dict) else None
+        tables += comps if isinstance(comps, list) else []
     return [
         _named_file(t["file"], base)
         for t in tables
@@ -418,5 +448,8 @@ def named_inputs(path: str | os.PathLike[str], kind: str) -> list[Path]:
         _, doc = _fit_doc(path)
         st = doc["stack"]
         mats = [st.get("ambient"), st["substrate"], *(x["material"] for x in st.get("layers", []))]
+        for m in list(mats):
+            comps = m.get("components") if isinstance(m, dict) else None
+            mats += comps if isinstance(comps, list) else []
         return [Path(m["file"]) for m in mats if isinstance(m, dict) and "file" in m]
     raise ValueError(f"kind: expected 'model' or 'fit', got {kind!r}")

@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..nk import dispersion as disp
 from . import incoherent as inc
 from . import matrices as stk
+from .ema import Ema
 from .fitjson import _check_indices, _fit_doc, _tabulated
 from .layers import Layer
 from .limits import MAX_LAYERS, MAX_THICKNESS_NM, FilmError, check_wavelength_range
@@ -85,8 +86,10 @@ class Stack:
             raise FilmError("'substrate' and 'ambient' are reserved names")
         self.layers: tuple[Layer, ...] = tuple(named)
         sub, amb = as_material(substrate), as_material(ambient)
-        if isinstance(sub, Roughness) or isinstance(amb, Roughness):
-            raise FilmError("roughness is a layer, not a substrate or ambient")
+        for m in (sub, amb):
+            if isinstance(m, (Roughness, Ema)):
+                raise FilmError(f"{m.name} is a layer, not a substrate or ambient")
+        _check_references(self.layers)
         self.substrate: disp.Dispersion = sub
         self.ambient: disp.Dispersion = amb
         self.substrate_thickness_nm = _substrate_thickness(substrate_thickness_nm)
@@ -108,7 +111,9 @@ class Stack:
 
         A :class:`Roughness` layer is the Bruggeman mixture
         (:func:`labbrdf.films.matrices.bruggeman`) of the medium directly below it and the
-        ambient.
+        ambient; an :class:`~labbrdf.films.ema.Ema` layer that of its constituents
+        (:func:`labbrdf.films.ema.bruggeman_mix`), ``@NAME`` ones taken from the
+        material of the layer ``NAME``.
         """
         lam = np.asarray(wavelength_nm, float)
         n_amb = self._ambient_nk(lam)
@@ -119,12 +124,28 @@ class Stack:
             if isinstance(m, Roughness):
                 n = np.sqrt(stk.bruggeman(below * below, n_amb * n_amb + 0j, m.fraction))
                 n = np.where(n.imag < 0, -n, n)
+            elif isinstance(m, Ema):
+                eps = [self._constituent(c, lam, n_amb) ** 2 for c in m.components]
+                n = np.sqrt(m.mix(eps))
+                n = np.where(n.imag < 0, -n, n)
             else:
                 n = np.asarray(m.nk(lam))
             out.append(n)
             below = n
         out.append(n_amb)
         return out[::-1]
+
+    def _constituent(self, c: Any, lam: NDArray, n_amb: NDArray) -> NDArray:
+        """The index of an EMA constituent: a material, or ``@NAME`` of the stack."""
+        if not isinstance(c, str):
+            return np.asarray(c.nk(lam), complex)
+        ref = c[1:]
+        if ref == "ambient":
+            return np.asarray(n_amb, complex)
+        if ref == "substrate":
+            return np.asarray(self.substrate.nk(lam), complex)
+        (lay,) = (x for x in self.layers if x.name == ref)
+        return np.asarray(lay.material.nk(lam), complex)
 
     def _thicknesses(self) -> list[float]:
         return [lay.thickness_nm for lay in self.layers]
@@ -294,6 +315,28 @@ class Stack:
         d = self.substrate_thickness_nm
         thick = "" if d is None else f", substrate_thickness_nm={d:.6g}"
         return f"Stack([{inner}], substrate={self.substrate.name}{thick})"
+
+
+def _check_references(layers: Sequence[Layer]) -> None:
+    """Every ``@NAME`` of an EMA names another layer of plain material, or the media."""
+    kinds = {lay.name: lay.material for lay in layers}
+    for lay in layers:
+        if not isinstance(lay.material, Ema):
+            continue
+        for ref in lay.material.references:
+            if ref in ("substrate", "ambient"):
+                continue
+            if ref not in kinds or ref == lay.name:
+                others = sorted(set(kinds) - {lay.name})
+                raise FilmError(
+                    f"layer {lay.name!r}: ema constituent '@{ref}' names no other layer; "
+                    f"expected one of {others + ['substrate', 'ambient']}"
+                )
+            if isinstance(kinds[ref], (Roughness, Ema)):
+                raise FilmError(
+                    f"layer {lay.name!r}: ema constituent '@{ref}' is itself a mixture; "
+                    "expected a layer of one material"
+                )
 
 
 def _substrate_thickness(d: Any) -> float | None:
