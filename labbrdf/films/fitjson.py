@@ -19,6 +19,7 @@ import numpy as np
 from ..jsonsafe import SchemaError, check_schema
 from ..nk import dispersion as disp
 from ..outputs import InputFileError, read_input_file
+from .graded import MAX_SUBLAYERS
 from .limits import (
     MAX_FIT_JSON_BYTES,
     MAX_INDEX,
@@ -35,7 +36,7 @@ def _fit_json_schema() -> dict[str, Any]:
     number = {"type": "number"}
     column = {"type": "array", "items": {"type": "number", "min": 0.0}, "min_items": 2}
     column["max_items"] = MAX_TABLE_POINTS
-    model = {"type": "string", "enum": sorted({*disp.MODELS, "roughness", "ema"})}
+    model = {"type": "string", "enum": sorted({*disp.MODELS, "roughness", "ema", "graded"})}
     table = {
         "type": "object",
         "properties": {
@@ -68,7 +69,21 @@ def _fit_json_schema() -> dict[str, Any]:
         },
         "additional": False,
     }
-    by_model.update(tabulated=table, roughness=rough, ema=ema)
+    graded = {
+        "type": "object",
+        "required": ["base", "parameter", "top", "bottom"],
+        "properties": {
+            "model": model,
+            "base": {"type": "object"},
+            "parameter": {"type": "string", "max_length": 100},
+            "top": number,
+            "bottom": number,
+            "shape": number,
+            "sublayers": {"type": "integer", "min": 1, "max": MAX_SUBLAYERS},
+        },
+        "additional": False,
+    }
+    by_model.update(tabulated=table, roughness=rough, ema=ema, graded=graded)
     material = {
         "type": "object",
         "required": ["model"],

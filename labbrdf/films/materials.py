@@ -16,6 +16,7 @@ from typing import Any
 
 from ..nk import dispersion as disp
 from .ema import VOID, Ema
+from .graded import Graded
 from .limits import FilmError
 
 
@@ -53,7 +54,7 @@ class Roughness:
         return {"model": "roughness", "fraction": float(self.fraction)}
 
 
-Material = disp.Dispersion | Roughness | Ema
+Material = disp.Dispersion | Roughness | Ema | Graded
 
 _EMA_NAME = re.compile(r"^ema\((.*)\)$")
 
@@ -88,7 +89,7 @@ def as_material(m: Any) -> Material:
     Numbers are constant indices; names are reference tables (``"si"``, ``"sio2"``) or
     registry names (default parameters).
     """
-    if isinstance(m, (disp.Dispersion, Roughness, Ema)):
+    if isinstance(m, (disp.Dispersion, Roughness, Ema, Graded)):
         return m
     if isinstance(m, (int, float, complex)) and not isinstance(m, bool):
         c = complex(m)
@@ -115,10 +116,32 @@ def as_material(m: Any) -> Material:
             return Roughness(float(m.get("fraction", 0.5)))
         if model == "ema":
             return _ema(m)
+        if model == "graded":
+            return _graded(m)
         if model == "tabulated" and "file" in m:
             return _table_file(str(m["file"]))
         return disp.from_dict(m)
     raise FilmError(f"material: expected a dispersion model, a number or a name, got {m!r}")
+
+
+def _graded(m: Mapping[str, Any]) -> Graded:
+    bad = sorted(set(m) - {"model", "base", "parameter", "top", "bottom", "shape", "sublayers"})
+    if bad or not {"base", "parameter", "top", "bottom"} <= set(m):
+        raise FilmError(
+            f"graded: expected base, parameter, top, bottom (shape, sublayers); got {sorted(m)}"
+        )
+    base = as_material(m["base"])
+    try:
+        return Graded(
+            base,
+            str(m["parameter"]),
+            float(m["top"]),
+            float(m["bottom"]),
+            float(m.get("shape", 1.0)),
+            m.get("sublayers", 20),
+        )
+    except (TypeError, ValueError) as exc:
+        raise FilmError(f"graded: {exc}") from None
 
 
 def _table_file(path: str | os.PathLike[str]) -> disp.Tabulated:
@@ -133,6 +156,6 @@ def _with_params(m: Material, values: Mapping[str, float]) -> Material:
         return m
     if isinstance(m, Roughness):
         return Roughness(float(values.get("fraction", m.fraction)))
-    if isinstance(m, Ema):
+    if isinstance(m, (Ema, Graded)):
         return m.with_params(values)
     return type(m).from_params({**m.params, **values})

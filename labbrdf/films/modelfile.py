@@ -18,6 +18,7 @@ from typing import Any
 from ..nk import dispersion as disp
 from ..outputs import InputFileError, read_input_file
 from .fitjson import _fit_doc
+from .graded import Graded
 from .layers import Layer
 from .limits import (
     MAX_LAYERS,
@@ -40,6 +41,8 @@ _LAYER_KEYS = {
     "fraction",
     "coherent",
     "components",
+    "graded",
+    "sublayers",
 }
 
 
@@ -160,6 +163,26 @@ def _material_of(tbl: Mapping[str, Any], base: Path, at: Any) -> Material:
         ) from None
 
 
+def _graded_of(m: Material, tbl: Mapping[str, Any], at: Any) -> Material:
+    """``graded = "PARAM"`` (and ``sublayers = N``): the material graded in that parameter."""
+    key = "graded" if "graded" in tbl else "sublayers"
+    p = tbl.get("graded")
+    if not isinstance(p, str):
+        raise FilmError(f'{at(key)}: graded = "PARAM" names the parameter that varies')
+    n = tbl.get("sublayers", 20)
+    if isinstance(n, bool) or not isinstance(n, int):
+        raise FilmError(f"{at('sublayers')}: sublayers must be an integer, got {n!r}")
+    if isinstance(m, (Roughness, Graded)) or not hasattr(m, "params") or p not in m.params:
+        raise FilmError(
+            f"{at('graded')}: {p!r} is not a parameter of {m.name}; parameters: "
+            f"{sorted(getattr(m, 'params', {}))}"
+        )
+    try:
+        return Graded(m, p, m.params[p], m.params[p], 1.0, n)
+    except FilmError as exc:
+        raise FilmError(f"{at(key)}: {exc}") from None
+
+
 def _ema_of(components: Any, base: Path) -> Material:
     """``material = "ema"``, ``components = [...]``: names, @LAYER, void, {model...}, {file}."""
     if not isinstance(components, list):
@@ -187,6 +210,8 @@ def _material_from_table(
         return f"{where}, line {lines(table, index, key)}"
 
     m = _material_of(tbl, base, at)
+    if "graded" in tbl or "sublayers" in tbl:
+        m = _graded_of(m, tbl, at)
     values: dict[str, float] = {}
     free: dict[str, tuple[float, float]] = {}
     known = set(m.params)
@@ -359,6 +384,8 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
         B = 0.0036                     # a number: fixed
         C = {value = 0, min = -0.01, max = 0.01}   # full form (vary = false to fix)
         coherent = true                # false: a thick layer, added in intensity
+        # graded = "A"                 # A varies from A_top to A_bottom (set those, and
+        # sublayers = 20               # shape = 1: linear) in 20 slices
 
     A ``file`` is relative to the model file's folder, and is an input of the command
     that reads the model (:func:`named_inputs`). The file is at most

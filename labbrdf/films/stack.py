@@ -29,6 +29,7 @@ from . import incoherent as inc
 from . import matrices as stk
 from .ema import Ema
 from .fitjson import _check_indices, _fit_doc, _tabulated
+from .graded import Graded
 from .layers import Layer
 from .limits import MAX_LAYERS, MAX_THICKNESS_NM, FilmError, check_wavelength_range
 from .materials import Roughness, _with_params, as_material
@@ -87,7 +88,7 @@ class Stack:
         self.layers: tuple[Layer, ...] = tuple(named)
         sub, amb = as_material(substrate), as_material(ambient)
         for m in (sub, amb):
-            if isinstance(m, (Roughness, Ema)):
+            if isinstance(m, (Roughness, Ema, Graded)):
                 raise FilmError(f"{m.name} is a layer, not a substrate or ambient")
         _check_references(self.layers)
         self.substrate: disp.Dispersion = sub
@@ -114,26 +115,46 @@ class Stack:
         ambient; an :class:`~labbrdf.films.ema.Ema` layer that of its constituents
         (:func:`labbrdf.films.ema.bruggeman_mix`), ``@NAME`` ones taken from the
         material of the layer ``NAME``.
+        A :class:`~labbrdf.films.graded.Graded` layer gives its index at mid-depth here; the
+        optics use its slices.
         """
         lam = np.asarray(wavelength_nm, float)
         n_amb = self._ambient_nk(lam)
         below = np.asarray(self.substrate.nk(lam))
         out = [below]
         for lay in reversed(self.layers):
-            m = lay.material
-            if isinstance(m, Roughness):
-                n = np.sqrt(stk.bruggeman(below * below, n_amb * n_amb + 0j, m.fraction))
-                n = np.where(n.imag < 0, -n, n)
-            elif isinstance(m, Ema):
-                eps = [self._constituent(c, lam, n_amb) ** 2 for c in m.components]
-                n = np.sqrt(m.mix(eps))
-                n = np.where(n.imag < 0, -n, n)
-            else:
-                n = np.asarray(m.nk(lam))
-            out.append(n)
-            below = n
+            m = lay.material.at(0.5) if isinstance(lay.material, Graded) else lay.material
+            below = self._layer_index(m, lam, below, n_amb)
+            out.append(below)
         out.append(n_amb)
         return out[::-1]
+
+    def _layer_index(self, m: Any, lam: NDArray, below: NDArray, n_amb: NDArray) -> NDArray:
+        """The index of one homogeneous layer material (a mixture from its constituents)."""
+        if isinstance(m, Roughness):
+            n = np.sqrt(stk.bruggeman(below * below, n_amb * n_amb + 0j, m.fraction))
+        elif isinstance(m, Ema):
+            eps = [self._constituent(c, lam, n_amb) ** 2 for c in m.components]
+            n = np.sqrt(m.mix(eps))
+        else:
+            return np.asarray(m.nk(lam))
+        return np.asarray(np.where(n.imag < 0, -n, n))
+
+    def _optical(self, lam: NDArray) -> tuple[list[NDArray], list[float], list[bool]]:
+        """Indices, thicknesses and coherence flags as computed (graded layers in slices)."""
+        n_amb = self._ambient_nk(lam)
+        below = np.asarray(self.substrate.nk(lam))
+        n_out, d_out, c_out = [below], [], []
+        for lay in reversed(self.layers):
+            m = lay.material
+            parts = m.slices()[::-1] if isinstance(m, Graded) else [m]
+            for part in parts:
+                below = self._layer_index(part, lam, below, n_amb)
+                n_out.append(below)
+                d_out.append(lay.thickness_nm / len(parts))
+                c_out.append(lay.coherent)
+        n_out.append(n_amb)
+        return n_out[::-1], d_out[::-1], c_out[::-1]
 
     def _constituent(self, c: Any, lam: NDArray, n_amb: NDArray) -> NDArray:
         """The index of an EMA constituent: a material, or ``@NAME`` of the stack."""
@@ -152,7 +173,8 @@ class Stack:
 
     def _grid(self, wavelength_nm: ArrayLike, theta_deg: ArrayLike):
         lam = np.asarray(wavelength_nm, float)
-        return self.indices(lam), self._thicknesses(), lam, np.asarray(theta_deg, float)
+        n, d, _ = self._optical(lam)
+        return n, d, lam, np.asarray(theta_deg, float)
 
     def intensity_sums(self, wavelength_nm: ArrayLike, theta_deg: ArrayLike) -> inc.IntensitySums:
         """R_s, R_p, the s-p cross term X and T_s, T_p (:func:`~.incoherent.intensity_sums`).
@@ -161,9 +183,7 @@ class Stack:
         behind it is the ambient and T is the light that leaves the backside.
         """
         lam = np.asarray(wavelength_nm, float)
-        n = self.indices(lam)
-        d = self._thicknesses()
-        flags = [lay.coherent for lay in self.layers]
+        n, d, flags = self._optical(lam)
         if self.substrate_thickness_nm is not None:
             n, d, flags = [*n, n[0]], [*d, self.substrate_thickness_nm], [*flags, False]
         return inc.intensity_sums(n, d, flags, lam, np.asarray(theta_deg, float))
@@ -321,9 +341,10 @@ def _check_references(layers: Sequence[Layer]) -> None:
     """Every ``@NAME`` of an EMA names another layer of plain material, or the media."""
     kinds = {lay.name: lay.material for lay in layers}
     for lay in layers:
-        if not isinstance(lay.material, Ema):
+        m = lay.material.base if isinstance(lay.material, Graded) else lay.material
+        if not isinstance(m, Ema):
             continue
-        for ref in lay.material.references:
+        for ref in m.references:
             if ref in ("substrate", "ambient"):
                 continue
             if ref not in kinds or ref == lay.name:
@@ -332,10 +353,10 @@ def _check_references(layers: Sequence[Layer]) -> None:
                     f"layer {lay.name!r}: ema constituent '@{ref}' names no other layer; "
                     f"expected one of {others + ['substrate', 'ambient']}"
                 )
-            if isinstance(kinds[ref], (Roughness, Ema)):
+            if isinstance(kinds[ref], (Roughness, Ema, Graded)):
                 raise FilmError(
-                    f"layer {lay.name!r}: ema constituent '@{ref}' is itself a mixture; "
-                    "expected a layer of one material"
+                    f"layer {lay.name!r}: ema constituent '@{ref}' is itself a mixture or "
+                    "graded; expected a layer of one material"
                 )
 
 
