@@ -116,6 +116,7 @@ def _fit_json_schema() -> dict[str, Any]:
                     "ambient": material,
                     "substrate": material,
                     "layers": {"type": "array", "items": layer, "max_items": MAX_LAYERS},
+                    "thickness_spread": {"type": "number", "min": 0.0, "max": 0.1},
                     "substrate_thickness_nm": {
                         "type": "number",
                         "min": 0.0,

@@ -29,6 +29,7 @@ from .limits import (
 )
 from .materials import Material, Roughness, _table_file, _with_params, as_material
 from .model import FilmModel
+from .nonuniform import MAX_SPREAD
 from .stack import Stack
 
 _LAYER_KEYS = {
@@ -46,7 +47,7 @@ _LAYER_KEYS = {
 }
 
 
-_TOP_KEYS = ("ambient", "wavelength_nm", "substrate", "layer")
+_TOP_KEYS = ("ambient", "wavelength_nm", "thickness_spread", "substrate", "layer")
 
 
 class _KeyLines:
@@ -266,7 +267,7 @@ def _check_top(doc: Mapping[str, Any], where: str, text: str, lines: _KeyLines) 
         line = next((i for i, raw in enumerate(text.splitlines(), 1) if re.match(pattern, raw)), 1)
         raise FilmError(
             f"{where}, line {line}: unknown key or table {key!r}; expected ambient, "
-            "wavelength_nm, [substrate], [[layer]]"
+            "wavelength_nm, thickness_spread, [substrate], [[layer]]"
         )
     layers = doc.get("layer", [])
     if not isinstance(layers, list) or not all(isinstance(t, dict) for t in layers):
@@ -366,6 +367,7 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
 
         ambient = 1.0                  # optional, a number (lossless)
         wavelength_nm = [250, 1000]    # optional fit window [nm]
+        thickness_spread = [0, 0.05]   # optional: relative 1-sigma thickness spread
 
         [substrate]
         material = "si"                # si, sio2 (shipped tables), a model name, or
@@ -416,16 +418,25 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
     seen: set[str] = set()
     for j, tbl in enumerate(doc.get("layer", [])):
         layer, layer_free = _layer_of(tbl, j, where, p.parent, lines)
-        if layer.name and (layer.name in seen or layer.name in ("substrate", "ambient")):
+        if layer.name and (layer.name in seen or layer.name in ("substrate", "ambient", "stack")):
             raise FilmError(
                 f"{where}, line {lines('layer', j, 'name')}: layer name {layer.name!r} is "
-                "repeated or reserved ('substrate', 'ambient'); expected a unique name"
+                "repeated or reserved ('substrate', 'ambient', 'stack'); expected a unique name"
             )
         seen.add(layer.name)
         layers.append(layer)
         free.update(layer_free)
+    spread = None
+    if "thickness_spread" in doc:
+        at = f"{where}, line {lines('', 0, 'thickness_spread')}: thickness_spread"
+        spread, box = _spec(doc["thickness_spread"], at)
+        if box is not None:
+            free["stack.thickness_spread"] = box
+        lo, hi = box or (spread, spread)
+        if not 0.0 <= lo <= hi <= MAX_SPREAD:
+            raise FilmError(f"{at}: expected a relative spread in [0, {MAX_SPREAD:g}]")
     try:
-        st = Stack(layers, sub, ambient, sub_d)
+        st = Stack(layers, sub, ambient, sub_d, spread)
     except FilmError as exc:
         raise FilmError(f"{where}: {exc}") from None
     return FilmModel(st, free, wl_range, where)

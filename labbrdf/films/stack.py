@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..nk import dispersion as disp
 from . import incoherent as inc
 from . import matrices as stk
+from . import nonuniform
 from .ema import Ema
 from .fitjson import _check_indices, _fit_doc, _tabulated
 from .graded import Graded
@@ -53,6 +54,10 @@ class Stack:
         whose backside reflection adds in intensity (:mod:`labbrdf.films.incoherent`), as
         for a film on a glass slide. Default: semi-infinite (no backside reflection: a
         wafer, or a roughened or index-matched back).
+    thickness_spread : float, optional
+        Relative 1-sigma spread of every coherent layer's thickness over the measured spot,
+        in [0, 0.1] [1] (:func:`labbrdf.films.nonuniform.spread_sums`): the parameter
+        ``stack.thickness_spread``. Default: none (not a parameter).
 
     Notes
     -----
@@ -67,6 +72,7 @@ class Stack:
         substrate: Any,
         ambient: Any = 1.0,
         substrate_thickness_nm: float | None = None,
+        thickness_spread: float | None = None,
     ) -> None:
         layers = list(layers)
         if len(layers) > MAX_LAYERS:
@@ -83,8 +89,8 @@ class Stack:
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
             raise FilmError(f"layer names must be unique; repeated: {dup}")
-        if set(names) & {"substrate", "ambient"}:
-            raise FilmError("'substrate' and 'ambient' are reserved names")
+        if set(names) & {"substrate", "ambient", "stack"}:
+            raise FilmError("'substrate', 'ambient' and 'stack' are reserved names")
         self.layers: tuple[Layer, ...] = tuple(named)
         sub, amb = as_material(substrate), as_material(ambient)
         for m in (sub, amb):
@@ -94,11 +100,15 @@ class Stack:
         self.substrate: disp.Dispersion = sub
         self.ambient: disp.Dispersion = amb
         self.substrate_thickness_nm = _substrate_thickness(substrate_thickness_nm)
+        self.thickness_spread = _spread(thickness_spread)
 
     @property
     def coherent(self) -> bool:
-        """True when every layer is coherent and the substrate semi-infinite."""
-        return self.substrate_thickness_nm is None and all(x.coherent for x in self.layers)
+        """True when every layer is coherent, the substrate semi-infinite and no spread."""
+        flat = not self.thickness_spread
+        return (
+            flat and self.substrate_thickness_nm is None and all(x.coherent for x in self.layers)
+        )
 
     # ---- optics
     def _ambient_nk(self, lam: NDArray) -> NDArray:
@@ -186,7 +196,10 @@ class Stack:
         n, d, flags = self._optical(lam)
         if self.substrate_thickness_nm is not None:
             n, d, flags = [*n, n[0]], [*d, self.substrate_thickness_nm], [*flags, False]
-        return inc.intensity_sums(n, d, flags, lam, np.asarray(theta_deg, float))
+        th = np.asarray(theta_deg, float)
+        if self.thickness_spread:
+            return nonuniform.spread_sums(n, d, flags, lam, th, self.thickness_spread)
+        return inc.intensity_sums(n, d, flags, lam, th)
 
     def psi_delta(
         self, wavelength_nm: ArrayLike, theta_deg: ArrayLike
@@ -239,7 +252,8 @@ class Stack:
         """
         if not self.coherent:
             raise FilmError(
-                "a stack with an incoherent layer or a finite substrate has no amplitudes; "
+                "a stack with an incoherent layer, a finite substrate or a thickness spread "
+                "has no amplitudes; "
                 "use intensity_sums, reflectance or psi_delta"
             )
         return stk.amplitudes(*self._grid(wavelength_nm, theta_deg))
@@ -260,6 +274,8 @@ class Stack:
         out.update({f"substrate.{k}": v for k, v in self.substrate.params.items()})
         if self.substrate_thickness_nm is not None:
             out["substrate.thickness_nm"] = self.substrate_thickness_nm
+        if self.thickness_spread is not None:
+            out["stack.thickness_spread"] = self.thickness_spread
         return out
 
     def units(self) -> dict[str, str]:
@@ -271,6 +287,8 @@ class Stack:
         out.update({f"substrate.{k}": u for k, u in self.substrate.units().items()})
         if self.substrate_thickness_nm is not None:
             out["substrate.thickness_nm"] = "nm"
+        if self.thickness_spread is not None:
+            out["stack.thickness_spread"] = "1"
         return out
 
     def with_values(self, values: Mapping[str, float]) -> Stack:
@@ -289,7 +307,8 @@ class Stack:
             layers.append(replace(lay, material=_with_params(lay.material, p), thickness_nm=d))
         p = dict(per.get("substrate", {}))
         d_sub = p.pop("thickness_nm", self.substrate_thickness_nm)
-        return Stack(layers, _with_params(self.substrate, p), self.ambient, d_sub)
+        spread = per.get("stack", {}).get("thickness_spread", self.thickness_spread)
+        return Stack(layers, _with_params(self.substrate, p), self.ambient, d_sub, spread)
 
     # ---- serialisation
     def to_dict(self) -> dict[str, Any]:
@@ -301,6 +320,8 @@ class Stack:
         }
         if self.substrate_thickness_nm is not None:
             out["substrate_thickness_nm"] = self.substrate_thickness_nm
+        if self.thickness_spread is not None:
+            out["thickness_spread"] = self.thickness_spread
         return out
 
     @classmethod
@@ -317,7 +338,8 @@ class Stack:
                 for x in d.get("layers", [])
             ]
             sub, amb = as_material(d["substrate"]), as_material(d.get("ambient", 1.0))
-            return cls(layers, sub, amb, d.get("substrate_thickness_nm"))
+            d_sub, spread = d.get("substrate_thickness_nm"), d.get("thickness_spread")
+            return cls(layers, sub, amb, d_sub, spread)
         except KeyError as exc:
             raise FilmError(f"stack: missing key {exc}") from None
 
@@ -334,6 +356,8 @@ class Stack:
         )
         d = self.substrate_thickness_nm
         thick = "" if d is None else f", substrate_thickness_nm={d:.6g}"
+        if self.thickness_spread is not None:
+            thick += f", thickness_spread={self.thickness_spread:.4g}"
         return f"Stack([{inner}], substrate={self.substrate.name}{thick})"
 
 
@@ -358,6 +382,22 @@ def _check_references(layers: Sequence[Layer]) -> None:
                     f"layer {lay.name!r}: ema constituent '@{ref}' is itself a mixture or "
                     "graded; expected a layer of one material"
                 )
+
+
+def _spread(s: Any) -> float | None:
+    """None (no parameter) or a relative thickness spread in [0, MAX_SPREAD]."""
+    if s is None:
+        return None
+    try:
+        v = float(s)
+    except (TypeError, ValueError):
+        raise FilmError(f"thickness_spread: expected a number, got {s!r}") from None
+    if not 0.0 <= v <= nonuniform.MAX_SPREAD:
+        raise FilmError(
+            f"thickness_spread: expected a relative spread in [0, {nonuniform.MAX_SPREAD}], "
+            f"got {s!r}"
+        )
+    return v
 
 
 def _substrate_thickness(d: Any) -> float | None:
