@@ -96,6 +96,7 @@ class Stack:
         for m in (sub, amb):
             if isinstance(m, (Roughness, Ema, Graded)):
                 raise FilmError(f"{m.name} is a layer, not a substrate or ambient")
+        assert isinstance(sub, disp.Dispersion) and isinstance(amb, disp.Dispersion)
         _check_references(self.layers)
         self.substrate: disp.Dispersion = sub
         self.ambient: disp.Dispersion = amb
@@ -313,7 +314,7 @@ class Stack:
     # ---- serialisation
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe form (inverse: :meth:`from_dict`)."""
-        out = {
+        out: dict[str, Any] = {
             "ambient": self.ambient.to_dict(),
             "layers": [lay.to_dict() for lay in self.layers],
             "substrate": self.substrate.to_dict(),
