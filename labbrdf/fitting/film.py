@@ -428,7 +428,8 @@ class FilmFit:
                     f"nk_at_{NK_REPORT_NM:g}nm": nk.get(lay.name),
                 }
             )
-        sub_keys = [f"substrate.{k}" for k in self.stack.substrate.params]
+        sub_keys = [k for k in self.stack.values() if k.startswith("substrate.")]
+        stack_keys = [k for k in self.stack.values() if k.startswith("stack.")]
         return jsonable(
             {
                 "kind": "labbrdf film fit",
@@ -440,6 +441,7 @@ class FilmFit:
                     "parameters": {k.split(".", 1)[1]: param(k) for k in sub_keys},
                     f"nk_at_{NK_REPORT_NM:g}nm": nk.get("substrate"),
                 },
+                "stack_parameters": {k.split(".", 1)[1]: param(k) for k in stack_keys},
                 "wavelength_range_nm": [
                     float(self.data["wavelength_nm"].min()),
                     float(self.data["wavelength_nm"].max()),

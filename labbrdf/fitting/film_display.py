@@ -101,6 +101,11 @@ def film_fit_report(summary: Mapping[str, Any]) -> str:
         if nk:
             lines.append(_nk_line(wl, nk))
     lines.append(f"substrate ({summary['substrate']['material'].get('model', '?')})")
+    for k, p in summary["substrate"]["parameters"].items():
+        if k == "thickness_nm":  # a finite substrate (backside reflection)
+            lines.append(f"  {k:<14s} {_param_text(p)}")
+    for k, p in summary.get("stack_parameters", {}).items():  # e.g. thickness_spread
+        lines.append(f"stack {k:<14s} {_param_text(p)}")
     lines.append(_fit_line(summary))
     if not summary["success"]:
         lines.append(f"fit did not converge: {summary['message']}")
@@ -139,6 +144,7 @@ def film_fit_html(summary: Mapping[str, Any]) -> str:
     ]
     parts = [*(("layer " + lay["name"], lay) for lay in summary["layers"])]
     parts.append(("substrate", summary["substrate"]))
+    parts.append(("stack", {"parameters": summary.get("stack_parameters", {})}))
     rows = [
         (where, k, _param_text(p))
         for where, part in parts

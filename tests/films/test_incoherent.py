@@ -236,5 +236,6 @@ def test_film_on_glass_is_fitted_from_spectrophotometer_r_and_t(tmp_path):
     assert s["redchi"] < 1.5
     back = Stack.from_fit_json(fit.save_json(tmp_path / "fit.json"))
     assert back.substrate_thickness_nm == 1e6
+    assert "1e+06 (fixed)" in fit.fit_report().split("substrate (")[1]  # the glass shown
     semi = Stack(truth.layers, "sio2")
     assert fit_film(FilmModel(semi, box), data, seed=1).summary()["redchi"] > 50

@@ -128,3 +128,5 @@ def test_a_thickness_spread_is_fitted_from_psi_and_delta():
     fit = fit_film(FilmModel(truth, box), pd.concat(rows, ignore_index=True), seed=4)
     p = fit.result.params["stack.thickness_spread"]
     assert abs(p.value - 0.03) < 1.96 * p.stderr and p.stderr < 0.001
+    assert "stack thickness_spread" in fit.fit_report()
+    assert fit.summary()["stack_parameters"]["thickness_spread"]["value"] == p.value
