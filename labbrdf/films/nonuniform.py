@@ -42,7 +42,7 @@ def _nodes(spread, indices, thicknesses_nm, coherent, wavelength_nm, points):
             for n, d, c in zip(indices[1:-1], thicknesses_nm, coherent, strict=True)
             if c
         )  # 1-sigma spread of the round-trip phase through the coherent layers [rad]
-        h = 0.75 / (1.0 + 2.0 * phase)
+        h = 1.0 / (1.0 + 1.1 * phase)
         points = int(min(2 * np.ceil(_REACH / h) + 1, MAX_POINTS))
     x = np.linspace(-_REACH, _REACH, points)
     w = np.exp(-0.5 * x * x)
@@ -70,7 +70,7 @@ def spread_sums(
     points : int, optional
         Quadrature nodes, odd, in [3, :data:`MAX_POINTS`]. Default: from the 1-sigma spread
         ``phi`` of the round-trip phase (``4 pi n d s / lambda`` summed over the coherent
-        layers, at the shortest wavelength): node spacing ``0.75 / (1 + 2 phi)`` sigma.
+        layers, at the shortest wavelength): node spacing ``1 / (1 + 1.1 phi)`` sigma.
 
     Returns
     -------
