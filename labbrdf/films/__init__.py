@@ -12,8 +12,14 @@ the caps all of them check (a fitted one-layer stack becomes the tracer's coatin
 :mod:`labbrdf.sample.coating`). The film fit, a workflow above these objects, is
 :func:`labbrdf.fitting.film.fit_film` (also ``labbrdf.fit_film``).
 
+Thick layers and a finite substrate add in intensity (:mod:`~labbrdf.films.incoherent`,
+``Layer(..., coherent=False)``, ``Stack(..., substrate_thickness_nm=...)``); interface layers
+are Bruggeman mixtures of two or three materials (:class:`Ema`), a graded layer varies a
+parameter through its thickness (:class:`Graded`), and a thickness spread over the spot
+depolarizes (:mod:`~labbrdf.films.nonuniform`, ``Stack(..., thickness_spread=...)``).
+
 Parameter names are ``"<layer>.<parameter>"``: ``"oxide.thickness_nm"``, ``"oxide.A"``,
-``"substrate.omega_p"``, ``"rough.fraction"``.
+``"substrate.omega_p"``, ``"rough.fraction"``, ``"stack.thickness_spread"``.
 
 >>> from labbrdf.films import Layer, Stack
 >>> s = Stack([Layer("sio2", 2.0, name="oxide")], substrate="si")
@@ -22,6 +28,8 @@ Parameter names are ``"<layer>.<parameter>"``: ``"oxide.thickness_nm"``, ``"oxid
 
 from __future__ import annotations
 
+from .ema import Ema
+from .graded import Graded
 from .layers import Layer
 from .limits import (
     FILM_QUANTITIES,
@@ -51,8 +59,10 @@ __all__ = [
     "MAX_THICKNESS_NM",
     "NK_REPORT_NM",
     "WAVELENGTH_LIMITS_NM",
+    "Ema",
     "FilmError",
     "FilmModel",
+    "Graded",
     "Layer",
     "Material",
     "Roughness",

@@ -19,6 +19,7 @@ import numpy as np
 from ..jsonsafe import SchemaError, check_schema
 from ..nk import dispersion as disp
 from ..outputs import InputFileError, read_input_file
+from .graded import MAX_SUBLAYERS
 from .limits import (
     MAX_FIT_JSON_BYTES,
     MAX_INDEX,
@@ -35,7 +36,7 @@ def _fit_json_schema() -> dict[str, Any]:
     number = {"type": "number"}
     column = {"type": "array", "items": {"type": "number", "min": 0.0}, "min_items": 2}
     column["max_items"] = MAX_TABLE_POINTS
-    model = {"type": "string", "enum": sorted({*disp.MODELS, "roughness"})}
+    model = {"type": "string", "enum": sorted({*disp.MODELS, "roughness", "ema", "graded"})}
     table = {
         "type": "object",
         "properties": {
@@ -56,7 +57,33 @@ def _fit_json_schema() -> dict[str, Any]:
     }
     params = {"type": "object", "properties": {"model": model}, "additional": number}
     by_model: dict[str, Any] = dict.fromkeys(disp.MODELS, params)
-    by_model.update(tabulated=table, roughness=rough)
+    fraction = {"type": "number", "min": 0.0, "max": 1.0}
+    ema = {
+        "type": "object",
+        "required": ["components"],
+        "properties": {
+            "model": model,
+            "components": {"type": "array", "min_items": 2, "max_items": 3},
+            "fraction": fraction,
+            "fraction3": fraction,
+        },
+        "additional": False,
+    }
+    graded = {
+        "type": "object",
+        "required": ["base", "parameter", "top", "bottom"],
+        "properties": {
+            "model": model,
+            "base": {"type": "object"},
+            "parameter": {"type": "string", "max_length": 100},
+            "top": number,
+            "bottom": number,
+            "shape": number,
+            "sublayers": {"type": "integer", "min": 1, "max": MAX_SUBLAYERS},
+        },
+        "additional": False,
+    }
+    by_model.update(tabulated=table, roughness=rough, ema=ema, graded=graded)
     material = {
         "type": "object",
         "required": ["model"],
@@ -71,6 +98,7 @@ def _fit_json_schema() -> dict[str, Any]:
             "name": {"type": "string", "max_length": 200},
             "thickness_nm": {"type": "number", "min": 0.0, "max": MAX_THICKNESS_NM},
             "material": material,
+            "coherent": {"type": "boolean"},
         },
         "additional": False,
     }
@@ -88,6 +116,12 @@ def _fit_json_schema() -> dict[str, Any]:
                     "ambient": material,
                     "substrate": material,
                     "layers": {"type": "array", "items": layer, "max_items": MAX_LAYERS},
+                    "thickness_spread": {"type": "number", "min": 0.0, "max": 0.1},
+                    "substrate_thickness_nm": {
+                        "type": "number",
+                        "min": 0.0,
+                        "max": MAX_THICKNESS_NM,
+                    },
                 },
                 "additional": False,
             },
@@ -124,6 +158,9 @@ def _check_tables(stack_doc: Mapping[str, Any], where: str) -> None:
 def _tabulated(stack: Any) -> list[tuple[str, disp.Tabulated]]:
     mats = [("ambient", stack.ambient), ("substrate", stack.substrate)]
     mats += [(lay.name, lay.material) for lay in stack.layers]
+    for lay in stack.layers:  # the constituents of a mixture
+        comps = getattr(lay.material, "components", ())
+        mats += [(f"{lay.name} constituent {j + 1}", c) for j, c in enumerate(comps)]
     return [(name, m) for name, m in mats if isinstance(m, disp.Tabulated)]
 
 

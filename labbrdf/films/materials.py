@@ -1,18 +1,22 @@
-"""A layer's material: a dispersion model, a reference or file table, a number, or roughness.
+"""A layer's material: a dispersion model, a reference or file table, a number, or a mixture.
 
 :func:`as_material` turns what a user writes (a :class:`~labbrdf.nk.dispersion.Dispersion`,
 a number, a name, a dict) into one; :class:`Roughness` is the Bruggeman effective medium of
-the material below and the ambient.
+the material below and the ambient, :class:`~labbrdf.films.ema.Ema` that of two or three
+named constituents (``"ema(@film, void)"``).
 """
 
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 from ..nk import dispersion as disp
+from .ema import VOID, Ema
+from .graded import Graded
 from .limits import FilmError
 
 
@@ -50,7 +54,33 @@ class Roughness:
         return {"model": "roughness", "fraction": float(self.fraction)}
 
 
-Material = disp.Dispersion | Roughness
+Material = disp.Dispersion | Roughness | Ema | Graded
+
+_EMA_NAME = re.compile(r"^ema\((.*)\)$")
+
+
+def _constituent(c: Any) -> disp.Dispersion | str:
+    """An EMA constituent: ``void`` and ``@NAME`` stay strings, the rest a dispersion."""
+    if isinstance(c, str) and (c.strip().lower() == VOID or c.strip().startswith("@")):
+        return c.strip()
+    m = as_material(c)
+    if not isinstance(m, disp.Dispersion):
+        raise FilmError(f"ema: constituent {c!r} is {m.name}; expected a material")
+    return m
+
+
+def _ema(m: Mapping[str, Any]) -> Ema:
+    comps = m.get("components")
+    if not isinstance(comps, (list, tuple)):
+        raise FilmError("ema: expected components = [2 or 3 constituents]")
+    bad = sorted(set(m) - {"model", "components", "fraction", "fraction3"})
+    if bad:
+        raise FilmError(f"ema: unknown key(s) {bad}; expected components, fraction, fraction3")
+    fr = {k: m[k] for k in ("fraction", "fraction3") if k in m}
+    for k, v in fr.items():
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise FilmError(f"ema: {k} must be a number, got {v!r}")
+    return Ema(tuple(_constituent(c) for c in comps), **{k: float(v) for k, v in fr.items()})
 
 
 def as_material(m: Any) -> Material:
@@ -59,7 +89,7 @@ def as_material(m: Any) -> Material:
     Numbers are constant indices; names are reference tables (``"si"``, ``"sio2"``) or
     registry names (default parameters).
     """
-    if isinstance(m, (disp.Dispersion, Roughness)):
+    if isinstance(m, (disp.Dispersion, Roughness, Ema, Graded)):
         return m
     if isinstance(m, (int, float, complex)) and not isinstance(m, bool):
         c = complex(m)
@@ -70,21 +100,48 @@ def as_material(m: Any) -> Material:
             return disp.Tabulated.reference(key)
         if key == "roughness":
             return Roughness()
+        ema = _EMA_NAME.match(key)
+        if ema:
+            return _ema({"components": [c.strip() for c in ema.group(1).split(",")]})
         if key in disp.MODELS and key != "tabulated":
             return disp.MODELS[key]()
         raise FilmError(
             f"unknown material {m!r}: expected a reference table {sorted(disp.REFERENCE_TABLES)}, "
-            f"a dispersion model {sorted(k for k in disp.MODELS if k != 'tabulated')} or "
-            "'roughness'"
+            f"a dispersion model {sorted(k for k in disp.MODELS if k != 'tabulated')}, "
+            "'roughness' or 'ema(A, B[, C])' (constituents: materials, void, @LAYER)"
         )
     if isinstance(m, Mapping):
         model = str(m.get("model", "")).lower()
         if model == "roughness":
             return Roughness(float(m.get("fraction", 0.5)))
+        if model == "ema":
+            return _ema(m)
+        if model == "graded":
+            return _graded(m)
         if model == "tabulated" and "file" in m:
             return _table_file(str(m["file"]))
         return disp.from_dict(m)
     raise FilmError(f"material: expected a dispersion model, a number or a name, got {m!r}")
+
+
+def _graded(m: Mapping[str, Any]) -> Graded:
+    bad = sorted(set(m) - {"model", "base", "parameter", "top", "bottom", "shape", "sublayers"})
+    if bad or not {"base", "parameter", "top", "bottom"} <= set(m):
+        raise FilmError(
+            f"graded: expected base, parameter, top, bottom (shape, sublayers); got {sorted(m)}"
+        )
+    base = as_material(m["base"])
+    try:
+        return Graded(
+            base,
+            str(m["parameter"]),
+            float(m["top"]),
+            float(m["bottom"]),
+            float(m.get("shape", 1.0)),
+            m.get("sublayers", 20),
+        )
+    except (TypeError, ValueError) as exc:
+        raise FilmError(f"graded: {exc}") from None
 
 
 def _table_file(path: str | os.PathLike[str]) -> disp.Tabulated:
@@ -99,4 +156,6 @@ def _with_params(m: Material, values: Mapping[str, float]) -> Material:
         return m
     if isinstance(m, Roughness):
         return Roughness(float(values.get("fraction", m.fraction)))
+    if isinstance(m, (Ema, Graded)):
+        return m.with_params(values)
     return type(m).from_params({**m.params, **values})

@@ -83,11 +83,27 @@ def _stack(
 ) -> tuple[ComplexArray, ComplexArray, ComplexArray, ComplexArray, ComplexArray, ComplexArray]:
     """rs, rp, ts, tp and the normal wave-vector components of ambient and substrate."""
     n, d, lam, th = _validated(indices, thicknesses_nm, wavelength_nm, theta_deg)
-    cos_i = np.cos(np.radians(th))
+    kz = _normal_components(n, th)
+    rs, rp, ts, tp = _recursion(n, kz, d, lam)
+    return rs, rp, ts, tp, kz[0], kz[-1]
+
+
+def _normal_components(n: list[ComplexArray], theta_deg: FloatArray) -> list[ComplexArray]:
+    """``kz_j = N_j cos(theta_j)`` of every medium, from the angle in the first one."""
+    cos_i = np.cos(np.radians(theta_deg))
     n0 = n[0]
     kz0 = n0 * cos_i
     # the tangential component kx = n0 sin(theta) is conserved: kz_j^2 = n_j^2 - kx^2
-    kz = [kz0] + [_physical_root((nj * nj - n0 * n0) + kz0 * kz0) for nj in n[1:]]
+    return [kz0] + [_physical_root((nj * nj - n0 * n0) + kz0 * kz0) for nj in n[1:]]
+
+
+def _recursion(
+    n: Sequence[ComplexArray],
+    kz: Sequence[ComplexArray],
+    d: Sequence[FloatArray],
+    lam: FloatArray,
+) -> tuple[ComplexArray, ComplexArray, ComplexArray, ComplexArray]:
+    """rs, rp, ts, tp of media ``n`` (normal components ``kz``, layer thicknesses ``d``)."""
     # start from the bottom interface and add one layer at a time (Azzam & Bashara [2]
     # section 4.6): the scattering-matrix form of the characteristic-matrix product of
     # Born & Wolf [1] 1.6.5, identical algebraically, and free of the overflow of
@@ -105,7 +121,7 @@ def _stack(
         tp = a_tp * tp * ph1 / den_p
         rs = (a_rs + rs * ph2) / den_s
         rp = (a_rp + rp * ph2) / den_p
-    return rs, rp, ts, tp, kz[0], kz[last]
+    return rs, rp, ts, tp
 
 
 def amplitudes(
@@ -244,17 +260,25 @@ def transmittance(
     """
     if np.any(np.asarray(indices[0]).imag != 0):
         raise ValueError("indices[0] (ambient): transmittance needs a lossless (real) ambient")
-    rs, rp, ts, tp, kz0, kzs = _stack(indices, thicknesses_nm, wavelength_nm, theta_deg)
-    n0 = np.asarray(indices[0], complex)
-    ns = np.asarray(indices[-1], complex)
-    cos0 = kz0 / n0
-    coss = kzs / ns
+    _, _, ts, tp, kz0, kzs = _stack(indices, thicknesses_nm, wavelength_nm, theta_deg)
+    f_s, f_p = _power_factors(indices[0], indices[-1], kz0, kzs)
+    return np.asarray(np.abs(ts) ** 2 * f_s), np.asarray(np.abs(tp) ** 2 * f_p)
+
+
+def _power_factors(
+    n_in: ArrayLike, n_out: ArrayLike, kz_in: ComplexArray, kz_out: ComplexArray
+) -> tuple[FloatArray, FloatArray]:
+    """``T / |t|^2`` for s and p (Byrnes [3]_); 0 where nothing enters (grazing)."""
+    n0 = np.asarray(n_in, complex)
+    ns = np.asarray(n_out, complex)
+    cos0 = kz_in / n0
+    coss = kz_out / ns
     with np.errstate(divide="ignore", invalid="ignore"):
         den_s = np.real(n0 * cos0)
         den_p = np.real(n0 * np.conj(cos0))
-        t_s = np.where(den_s > 0, np.abs(ts) ** 2 * np.real(ns * coss) / den_s, 0.0)
-        t_p = np.where(den_p > 0, np.abs(tp) ** 2 * np.real(ns * np.conj(coss)) / den_p, 0.0)
-    return np.asarray(t_s), np.asarray(t_p)
+        f_s = np.where(den_s > 0, np.real(ns * coss) / den_s, 0.0)
+        f_p = np.where(den_p > 0, np.real(ns * np.conj(coss)) / den_p, 0.0)
+    return np.asarray(f_s), np.asarray(f_p)
 
 
 def bruggeman(eps_a: ArrayLike, eps_b: ArrayLike, fraction: ArrayLike) -> ComplexArray:

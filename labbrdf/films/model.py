@@ -50,9 +50,11 @@ class FilmModel:
         (:func:`labbrdf.films.layers.default_boxes`, the rule of the model file and
         ``--layer`` for parameters not written); the substrate and tables stay fixed.
         Thickness box: [0, max(3 d, 20 nm)] unless ``thickness_max_nm`` is given.
+        The thickness of an incoherent layer stays fixed (it enters only through absorption).
         """
         free: dict[str, tuple[float, float]] = {}
         for lay in stack.layers:
             hi = thickness_max_nm or max(3 * lay.thickness_nm, 20.0)
-            free.update(free_parameters(lay, {"thickness_nm": (0.0, float(hi))}))
+            box = (0.0, float(hi)) if lay.coherent else None
+            free.update(free_parameters(lay, {"thickness_nm": box}))
         return cls(stack, free)

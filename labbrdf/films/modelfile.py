@@ -18,6 +18,7 @@ from typing import Any
 from ..nk import dispersion as disp
 from ..outputs import InputFileError, read_input_file
 from .fitjson import _fit_doc
+from .graded import Graded
 from .layers import Layer, free_parameters
 from .limits import (
     MAX_LAYERS,
@@ -28,12 +29,25 @@ from .limits import (
 )
 from .materials import Material, Roughness, _table_file, _with_params, as_material
 from .model import FilmModel
+from .nonuniform import MAX_SPREAD
 from .stack import Stack
 
-_LAYER_KEYS = {"name", "material", "model", "file", "reference", "thickness_nm", "fraction"}
+_LAYER_KEYS = {
+    "name",
+    "material",
+    "model",
+    "file",
+    "reference",
+    "thickness_nm",
+    "fraction",
+    "coherent",
+    "components",
+    "graded",
+    "sublayers",
+}
 
 
-_TOP_KEYS = ("ambient", "wavelength_nm", "substrate", "layer")
+_TOP_KEYS = ("ambient", "wavelength_nm", "thickness_spread", "substrate", "layer")
 
 
 class _KeyLines:
@@ -136,12 +150,56 @@ def _material_of(tbl: Mapping[str, Any], base: Path, at: Any) -> Material:
     val = tbl[kind]
     if not isinstance(val, str):
         raise FilmError(f"{at(kind)}: {kind} must be a string")
+    if "components" in tbl and val.strip().lower() != "ema":
+        raise FilmError(f'{at("components")}: components belong to material = "ema"')
     try:
         if kind == "file":
             return _table_file(_named_file(val, base))
+        if val.strip().lower() == "ema":
+            return _ema_of(tbl.get("components"), base)
         return as_material(val)
     except (FilmError, disp.DispersionError) as exc:
-        raise FilmError(f"{at(kind)}: {exc}") from None
+        raise FilmError(
+            f"{at(kind if 'components' not in tbl else 'components')}: {exc}"
+        ) from None
+
+
+def _graded_of(m: Material, tbl: Mapping[str, Any], at: Any) -> Material:
+    """``graded = "PARAM"`` (and ``sublayers = N``): the material graded in that parameter."""
+    key = "graded" if "graded" in tbl else "sublayers"
+    p = tbl.get("graded")
+    if not isinstance(p, str):
+        raise FilmError(f'{at(key)}: graded = "PARAM" names the parameter that varies')
+    n = tbl.get("sublayers", 20)
+    if isinstance(n, bool) or not isinstance(n, int):
+        raise FilmError(f"{at('sublayers')}: sublayers must be an integer, got {n!r}")
+    if isinstance(m, (Roughness, Graded)) or not hasattr(m, "params") or p not in m.params:
+        raise FilmError(
+            f"{at('graded')}: {p!r} is not a parameter of {m.name}; parameters: "
+            f"{sorted(getattr(m, 'params', {}))}"
+        )
+    try:
+        return Graded(m, p, m.params[p], m.params[p], 1.0, n)
+    except FilmError as exc:
+        raise FilmError(f"{at(key)}: {exc}") from None
+
+
+def _ema_of(components: Any, base: Path) -> Material:
+    """``material = "ema"``, ``components = [...]``: names, @LAYER, void, {model...}, {file}."""
+    if not isinstance(components, list):
+        raise FilmError('material = "ema" needs components = [2 or 3 constituents]')
+    comps: list[Any] = []
+    for c in components:
+        if isinstance(c, dict) and set(c) == {"file"} and isinstance(c["file"], str):
+            comps.append(_table_file(_named_file(c["file"], base)))
+        elif isinstance(c, (str, dict)):
+            comps.append(c)
+        else:
+            raise FilmError(
+                f"constituent {c!r}: expected a name, 'void', '@LAYER', "
+                "{model = ..., ...} or {file = ...}"
+            )
+    return as_material({"model": "ema", "components": comps})
 
 
 def _material_from_table(
@@ -153,6 +211,8 @@ def _material_from_table(
         return f"{where}, line {lines(table, index, key)}"
 
     m = _material_of(tbl, base, at)
+    if "graded" in tbl or "sublayers" in tbl:
+        m = _graded_of(m, tbl, at)
     values: dict[str, float] = {}
     free: dict[str, tuple[float, float]] = {}
     known = set(m.params)
@@ -207,7 +267,7 @@ def _check_top(doc: Mapping[str, Any], where: str, text: str, lines: _KeyLines) 
         line = next((i for i, raw in enumerate(text.splitlines(), 1) if re.match(pattern, raw)), 1)
         raise FilmError(
             f"{where}, line {line}: unknown key or table {key!r}; expected ambient, "
-            "wavelength_nm, [substrate], [[layer]]"
+            "wavelength_nm, thickness_spread, [substrate], [[layer]]"
         )
     layers = doc.get("layer", [])
     if not isinstance(layers, list) or not all(isinstance(t, dict) for t in layers):
@@ -263,12 +323,40 @@ def _layer_of(
             f"{at} must be <= {MAX_THICKNESS_NM:g} nm (labbrdf.films.MAX_THICKNESS_NM): "
             "thicker is a substrate, not a film"
         )
+    coherent = tbl.get("coherent", True)
+    if not isinstance(coherent, bool):
+        raise FilmError(
+            f"{where}, line {lines('layer', j, 'coherent')}: coherent must be true or false, "
+            f"got {coherent!r}"
+        )
     try:
-        layer = Layer(m, d, name)
+        layer = Layer(m, d, name, coherent)
     except FilmError as exc:
         raise FilmError(f"{where}, line {lines('layer', j)}: {exc}") from None
     written = {**{k: mfree.get(k) for k in values}, "thickness_nm": dbox}
     return layer, free_parameters(layer, written)  # the one rule: labbrdf.films.layers
+
+
+def _substrate_thickness(
+    tbl: Mapping[str, Any], where: str, lines: _KeyLines
+) -> tuple[float | None, tuple[float, float] | None]:
+    """A [substrate]'s ``thickness_nm`` (a finite, incoherent substrate) and its box."""
+    for key in ("coherent", "name", "fraction"):
+        if key in tbl:
+            raise FilmError(
+                f"{where}, line {lines('substrate', None, key)}: {key!r} is a layer key; a "
+                "substrate is semi-infinite, or incoherent with its thickness_nm"
+            )
+    if "thickness_nm" not in tbl:
+        return None, None
+    at = f"{where}, line {lines('substrate', None, 'thickness_nm')}: thickness_nm"
+    d, box = _spec(tbl["thickness_nm"], at)
+    if min(d, box[0] if box else d) <= 0 or max(d, box[1] if box else d) > MAX_THICKNESS_NM:
+        raise FilmError(
+            f"{at}: expected a thickness in (0, {MAX_THICKNESS_NM:g}] nm "
+            "(labbrdf.films.MAX_THICKNESS_NM)"
+        )
+    return d, box
 
 
 def load_model(path: str | os.PathLike[str]) -> FilmModel:
@@ -278,21 +366,29 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
 
         ambient = 1.0                  # optional, a number (lossless)
         wavelength_nm = [250, 1000]    # optional fit window [nm]
+        thickness_spread = [0, 0.05]   # optional: relative 1-sigma thickness spread
 
         [substrate]
         material = "si"                # si, sio2 (shipped tables), a model name, or
                                        # file = "ta.dat" (n,k table or ellipsometer file)
+        thickness_nm = 1e6             # optional: a finite substrate, incoherent, with
+                                       # the ambient behind it (backside reflection)
 
         [[layer]]                      # top first; repeat for more layers
         name = "oxide"
         material = "cauchy"            # constant, cauchy, sellmeier, tauc_lorentz, drude,
-                                       # lorentz, roughness, si, sio2; or file = "..."
+                                       # lorentz, roughness, si, sio2; or file = "...";
+                                       # "ema(@oxide, void)" (a Bruggeman mixture), or
+                                       # "ema" with components = ["@oxide", "void", ...]
         thickness_nm = [0, 10]         # [min, max]: fitted, started mid-box
         A = [1.3, 1.7]
         B = 0.0036                     # a number: fixed
         C = {value = 0, min = -0.01, max = 0.01}   # full form (vary = false to fix)
                                        # not written: fitted in its default box
                                        # (labbrdf.films.layers.default_boxes)
+        coherent = true                # false: a thick layer, added in intensity
+        # graded = "A"                 # A varies from A_top to A_bottom (set those, and
+        # sublayers = 20               # shape = 1: linear) in 20 slices
 
     A ``file`` is relative to the model file's folder, and is an input of the command
     that reads the model (:func:`named_inputs`). The file is at most
@@ -315,21 +411,33 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
     )
     if isinstance(sub, Roughness):
         raise FilmError(f"{where}, line {lines('substrate')}: roughness is a layer")
+    sub_d, sub_box = _substrate_thickness(doc["substrate"], where, lines)
     layers = []
     free: dict[str, tuple[float, float]] = {f"substrate.{k}": b for k, b in sub_free.items()}
+    if sub_box is not None:
+        free["substrate.thickness_nm"] = sub_box
     seen: set[str] = set()
     for j, tbl in enumerate(doc.get("layer", [])):
         layer, layer_free = _layer_of(tbl, j, where, p.parent, lines)
-        if layer.name and (layer.name in seen or layer.name in ("substrate", "ambient")):
+        if layer.name and (layer.name in seen or layer.name in ("substrate", "ambient", "stack")):
             raise FilmError(
                 f"{where}, line {lines('layer', j, 'name')}: layer name {layer.name!r} is "
-                "repeated or reserved ('substrate', 'ambient'); expected a unique name"
+                "repeated or reserved ('substrate', 'ambient', 'stack'); expected a unique name"
             )
         seen.add(layer.name)
         layers.append(layer)
         free.update(layer_free)
+    spread = None
+    if "thickness_spread" in doc:
+        at = f"{where}, line {lines('', 0, 'thickness_spread')}: thickness_spread"
+        spread, box = _spec(doc["thickness_spread"], at)
+        if box is not None:
+            free["stack.thickness_spread"] = box
+        lo, hi = box or (spread, spread)
+        if not 0.0 <= lo <= hi <= MAX_SPREAD:
+            raise FilmError(f"{at}: expected a relative spread in [0, {MAX_SPREAD:g}]")
     try:
-        st = Stack(layers, sub, ambient)
+        st = Stack(layers, sub, ambient, sub_d, spread)
     except FilmError as exc:
         raise FilmError(f"{where}: {exc}") from None
     return FilmModel(st, free, wl_range, where)
@@ -340,6 +448,9 @@ def _model_files(doc: Mapping[str, Any], base: Path) -> list[Path]:
     tables = [doc.get("substrate")]
     layers = doc.get("layer")
     tables += layers if isinstance(layers, list) else []
+    for t in list(tables):
+        comps = t.get("components") if isinstance(t, dict) else None
+        tables += comps if isinstance(comps, list) else []
     return [
         _named_file(t["file"], base)
         for t in tables
@@ -376,5 +487,8 @@ def named_inputs(path: str | os.PathLike[str], kind: str) -> list[Path]:
         _, doc = _fit_doc(path)
         st = doc["stack"]
         mats = [st.get("ambient"), st["substrate"], *(x["material"] for x in st.get("layers", []))]
+        for m in list(mats):
+            comps = m.get("components") if isinstance(m, dict) else None
+            mats += comps if isinstance(comps, list) else []
         return [Path(m["file"]) for m in mats if isinstance(m, dict) and "file" in m]
     raise ValueError(f"kind: expected 'model' or 'fit', got {kind!r}")

@@ -15,18 +15,24 @@ Parameter names are ``"<layer>.<parameter>"``: ``"oxide.thickness_nm"``, ``"oxid
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..nk import dispersion as disp
+from . import incoherent as inc
 from . import matrices as stk
+from . import nonuniform
+from .ema import Ema
 from .fitjson import _check_indices, _fit_doc, _tabulated
+from .graded import Graded
 from .layers import Layer
-from .limits import MAX_LAYERS, FilmError, check_wavelength_range
+from .limits import MAX_LAYERS, MAX_THICKNESS_NM, FilmError, check_wavelength_range
 from .materials import Roughness, _with_params, as_material
 
 __all__ = ["Stack", "read_fit_json"]
@@ -43,9 +49,31 @@ class Stack:
         Semi-infinite substrate (see :func:`as_material`).
     ambient : material
         Semi-infinite, lossless ambient; default 1 (vacuum/air).
+    substrate_thickness_nm : float, optional
+        A substrate of this thickness [nm] with the ambient behind it: an incoherent slab
+        whose backside reflection adds in intensity (:mod:`labbrdf.films.incoherent`), as
+        for a film on a glass slide. Default: semi-infinite (no backside reflection: a
+        wafer, or a roughened or index-matched back).
+    thickness_spread : float, optional
+        Relative 1-sigma spread of every coherent layer's thickness over the measured spot,
+        in [0, 0.1] [1] (:func:`labbrdf.films.nonuniform.spread_sums`): the parameter
+        ``stack.thickness_spread``. Default: none (not a parameter).
+
+    Notes
+    -----
+    A stack with an incoherent layer or a finite substrate has no amplitudes; its psi and
+    Delta are those of the incoherent sum of the reflected light (:meth:`psi_delta`), which
+    is partly depolarized (:meth:`depolarization`, :meth:`mueller`).
     """
 
-    def __init__(self, layers: Sequence[Layer], substrate: Any, ambient: Any = 1.0) -> None:
+    def __init__(
+        self,
+        layers: Sequence[Layer],
+        substrate: Any,
+        ambient: Any = 1.0,
+        substrate_thickness_nm: float | None = None,
+        thickness_spread: float | None = None,
+    ) -> None:
         layers = list(layers)
         if len(layers) > MAX_LAYERS:
             raise FilmError(
@@ -56,19 +84,32 @@ class Stack:
         for j, lay in enumerate(layers, 1):
             if not isinstance(lay, Layer):
                 raise FilmError(f"layers[{j - 1}]: expected a Layer, got {type(lay).__name__}")
-            named.append(lay if lay.name else Layer(lay.material, lay.thickness_nm, f"layer{j}"))
+            named.append(lay if lay.name else replace(lay, name=f"layer{j}"))
         names = [lay.name for lay in named]
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
             raise FilmError(f"layer names must be unique; repeated: {dup}")
-        if set(names) & {"substrate", "ambient"}:
-            raise FilmError("'substrate' and 'ambient' are reserved names")
+        if set(names) & {"substrate", "ambient", "stack"}:
+            raise FilmError("'substrate', 'ambient' and 'stack' are reserved names")
         self.layers: tuple[Layer, ...] = tuple(named)
         sub, amb = as_material(substrate), as_material(ambient)
-        if isinstance(sub, Roughness) or isinstance(amb, Roughness):
-            raise FilmError("roughness is a layer, not a substrate or ambient")
+        for m in (sub, amb):
+            if isinstance(m, (Roughness, Ema, Graded)):
+                raise FilmError(f"{m.name} is a layer, not a substrate or ambient")
+        assert isinstance(sub, disp.Dispersion) and isinstance(amb, disp.Dispersion)
+        _check_references(self.layers)
         self.substrate: disp.Dispersion = sub
         self.ambient: disp.Dispersion = amb
+        self.substrate_thickness_nm = _substrate_thickness(substrate_thickness_nm)
+        self.thickness_spread = _spread(thickness_spread)
+
+    @property
+    def coherent(self) -> bool:
+        """True when every layer is coherent, the substrate semi-infinite and no spread."""
+        flat = not self.thickness_spread
+        return (
+            flat and self.substrate_thickness_nm is None and all(x.coherent for x in self.layers)
+        )
 
     # ---- optics
     def _ambient_nk(self, lam: NDArray) -> NDArray:
@@ -82,51 +123,140 @@ class Stack:
 
         A :class:`Roughness` layer is the Bruggeman mixture
         (:func:`labbrdf.films.matrices.bruggeman`) of the medium directly below it and the
-        ambient.
+        ambient; an :class:`~labbrdf.films.ema.Ema` layer that of its constituents
+        (:func:`labbrdf.films.ema.bruggeman_mix`), ``@NAME`` ones taken from the
+        material of the layer ``NAME``.
+        A :class:`~labbrdf.films.graded.Graded` layer gives its index at mid-depth here; the
+        optics use its slices.
         """
         lam = np.asarray(wavelength_nm, float)
         n_amb = self._ambient_nk(lam)
         below = np.asarray(self.substrate.nk(lam))
         out = [below]
         for lay in reversed(self.layers):
-            m = lay.material
-            if isinstance(m, Roughness):
-                n = np.sqrt(stk.bruggeman(below * below, n_amb * n_amb + 0j, m.fraction))
-                n = np.where(n.imag < 0, -n, n)
-            else:
-                n = np.asarray(m.nk(lam))
-            out.append(n)
-            below = n
+            m = lay.material.at(0.5) if isinstance(lay.material, Graded) else lay.material
+            below = self._layer_index(m, lam, below, n_amb)
+            out.append(below)
         out.append(n_amb)
         return out[::-1]
+
+    def _layer_index(self, m: Any, lam: NDArray, below: NDArray, n_amb: NDArray) -> NDArray:
+        """The index of one homogeneous layer material (a mixture from its constituents)."""
+        if isinstance(m, Roughness):
+            n = np.sqrt(stk.bruggeman(below * below, n_amb * n_amb + 0j, m.fraction))
+        elif isinstance(m, Ema):
+            eps = [self._constituent(c, lam, n_amb) ** 2 for c in m.components]
+            n = np.sqrt(m.mix(eps))
+        else:
+            return np.asarray(m.nk(lam))
+        return np.asarray(np.where(n.imag < 0, -n, n))
+
+    def _optical(self, lam: NDArray) -> tuple[list[NDArray], list[float], list[bool]]:
+        """Indices, thicknesses and coherence flags as computed (graded layers in slices)."""
+        n_amb = self._ambient_nk(lam)
+        below = np.asarray(self.substrate.nk(lam))
+        n_out, d_out, c_out = [below], [], []
+        for lay in reversed(self.layers):
+            m = lay.material
+            parts = m.slices()[::-1] if isinstance(m, Graded) else [m]
+            for part in parts:
+                below = self._layer_index(part, lam, below, n_amb)
+                n_out.append(below)
+                d_out.append(lay.thickness_nm / len(parts))
+                c_out.append(lay.coherent)
+        n_out.append(n_amb)
+        return n_out[::-1], d_out[::-1], c_out[::-1]
+
+    def _constituent(self, c: Any, lam: NDArray, n_amb: NDArray) -> NDArray:
+        """The index of an EMA constituent: a material, or ``@NAME`` of the stack."""
+        if not isinstance(c, str):
+            return np.asarray(c.nk(lam), complex)
+        ref = c[1:]
+        if ref == "ambient":
+            return np.asarray(n_amb, complex)
+        if ref == "substrate":
+            return np.asarray(self.substrate.nk(lam), complex)
+        (lay,) = (x for x in self.layers if x.name == ref)
+        return np.asarray(lay.material.nk(lam), complex)
 
     def _thicknesses(self) -> list[float]:
         return [lay.thickness_nm for lay in self.layers]
 
     def _grid(self, wavelength_nm: ArrayLike, theta_deg: ArrayLike):
         lam = np.asarray(wavelength_nm, float)
-        return self.indices(lam), self._thicknesses(), lam, np.asarray(theta_deg, float)
+        n, d, _ = self._optical(lam)
+        return n, d, lam, np.asarray(theta_deg, float)
+
+    def intensity_sums(self, wavelength_nm: ArrayLike, theta_deg: ArrayLike) -> inc.IntensitySums:
+        """R_s, R_p, the s-p cross term X and T_s, T_p (:func:`~.incoherent.intensity_sums`).
+
+        Any stack, coherent or not; inputs broadcast. With a finite substrate the medium
+        behind it is the ambient and T is the light that leaves the backside.
+        """
+        lam = np.asarray(wavelength_nm, float)
+        n, d, flags = self._optical(lam)
+        if self.substrate_thickness_nm is not None:
+            n, d, flags = [*n, n[0]], [*d, self.substrate_thickness_nm], [*flags, False]
+        th = np.asarray(theta_deg, float)
+        if self.thickness_spread:
+            return nonuniform.spread_sums(n, d, flags, lam, th, self.thickness_spread)
+        return inc.intensity_sums(n, d, flags, lam, th)
 
     def psi_delta(
         self, wavelength_nm: ArrayLike, theta_deg: ArrayLike
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """psi, Delta [deg] (Nebraska convention, Delta in [0, 360)); inputs broadcast."""
-        return stk.ellipsometry(*self._grid(wavelength_nm, theta_deg))
+        """psi, Delta [deg] (Nebraska convention, Delta in [0, 360)); inputs broadcast.
+
+        With incoherent layers: psi from ``R_p / R_s`` and Delta the phase of the cross
+        term (:func:`labbrdf.films.incoherent.ellipsometry`).
+        """
+        if self.coherent:
+            return stk.ellipsometry(*self._grid(wavelength_nm, theta_deg))
+        psi, delta, _ = inc.ellipsometry(self.intensity_sums(wavelength_nm, theta_deg))
+        return psi, delta
+
+    def depolarization(
+        self, wavelength_nm: ArrayLike, theta_deg: ArrayLike
+    ) -> NDArray[np.float64]:
+        """``1 - sqrt(N^2 + C^2 + S^2)`` of the reflected light [1] (0 for a coherent stack)."""
+        return inc.ellipsometry(self.intensity_sums(wavelength_nm, theta_deg))[2]
+
+    def mueller(self, wavelength_nm: ArrayLike, theta_deg: ArrayLike) -> NDArray[np.float64]:
+        """Mueller matrix of the specular reflection, shape ``(..., 4, 4)`` [1]."""
+        return inc.mueller(self.intensity_sums(wavelength_nm, theta_deg))
 
     def reflectance(
         self, wavelength_nm: ArrayLike, theta_deg: ArrayLike
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """R_s, R_p [1]; inputs broadcast."""
-        return stk.reflectance(*self._grid(wavelength_nm, theta_deg))
+        if self.coherent:
+            return stk.reflectance(*self._grid(wavelength_nm, theta_deg))
+        sums = self.intensity_sums(wavelength_nm, theta_deg)
+        return sums.Rs, sums.Rp
 
     def transmittance(
         self, wavelength_nm: ArrayLike, theta_deg: ArrayLike
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """T_s, T_p into the substrate [1]; inputs broadcast."""
-        return stk.transmittance(*self._grid(wavelength_nm, theta_deg))
+        """T_s, T_p into the substrate (out of its back if it is finite) [1]; inputs broadcast."""
+        if self.coherent:
+            return stk.transmittance(*self._grid(wavelength_nm, theta_deg))
+        sums = self.intensity_sums(wavelength_nm, theta_deg)
+        return sums.Ts, sums.Tp
 
     def amplitudes(self, wavelength_nm: ArrayLike, theta_deg: ArrayLike):
-        """r_s, r_p, t_s, t_p (:func:`labbrdf.films.matrices.amplitudes`); inputs broadcast."""
+        """r_s, r_p, t_s, t_p (:func:`labbrdf.films.matrices.amplitudes`); inputs broadcast.
+
+        Raises
+        ------
+        FilmError
+            The stack has an incoherent layer or a finite substrate (no amplitudes).
+        """
+        if not self.coherent:
+            raise FilmError(
+                "a stack with an incoherent layer, a finite substrate or a thickness spread "
+                "has no amplitudes; "
+                "use intensity_sums, reflectance or psi_delta"
+            )
         return stk.amplitudes(*self._grid(wavelength_nm, theta_deg))
 
     def nk(self, wavelength_nm: ArrayLike) -> dict[str, NDArray[np.complex128]]:
@@ -143,6 +273,10 @@ class Stack:
         for lay in self.layers:
             out.update({f"{lay.name}.{k}": v for k, v in lay.params.items()})
         out.update({f"substrate.{k}": v for k, v in self.substrate.params.items()})
+        if self.substrate_thickness_nm is not None:
+            out["substrate.thickness_nm"] = self.substrate_thickness_nm
+        if self.thickness_spread is not None:
+            out["stack.thickness_spread"] = self.thickness_spread
         return out
 
     def units(self) -> dict[str, str]:
@@ -152,6 +286,10 @@ class Stack:
             out[f"{lay.name}.thickness_nm"] = "nm"
             out.update({f"{lay.name}.{k}": u for k, u in lay.material.units().items()})
         out.update({f"substrate.{k}": u for k, u in self.substrate.units().items()})
+        if self.substrate_thickness_nm is not None:
+            out["substrate.thickness_nm"] = "nm"
+        if self.thickness_spread is not None:
+            out["stack.thickness_spread"] = "1"
         return out
 
     def with_values(self, values: Mapping[str, float]) -> Stack:
@@ -167,28 +305,42 @@ class Stack:
         for lay in self.layers:
             p = dict(per.get(lay.name, {}))
             d = p.pop("thickness_nm", lay.thickness_nm)
-            layers.append(Layer(_with_params(lay.material, p), d, lay.name))
-        sub = _with_params(self.substrate, per.get("substrate", {}))
-        return Stack(layers, sub, self.ambient)
+            layers.append(replace(lay, material=_with_params(lay.material, p), thickness_nm=d))
+        p = dict(per.get("substrate", {}))
+        d_sub = p.pop("thickness_nm", self.substrate_thickness_nm)
+        spread = per.get("stack", {}).get("thickness_spread", self.thickness_spread)
+        return Stack(layers, _with_params(self.substrate, p), self.ambient, d_sub, spread)
 
     # ---- serialisation
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe form (inverse: :meth:`from_dict`)."""
-        return {
+        out: dict[str, Any] = {
             "ambient": self.ambient.to_dict(),
             "layers": [lay.to_dict() for lay in self.layers],
             "substrate": self.substrate.to_dict(),
         }
+        if self.substrate_thickness_nm is not None:
+            out["substrate_thickness_nm"] = self.substrate_thickness_nm
+        if self.thickness_spread is not None:
+            out["thickness_spread"] = self.thickness_spread
+        return out
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Stack:
         """A stack from :meth:`to_dict`'s form."""
         try:
             layers = [
-                Layer(as_material(x["material"]), float(x["thickness_nm"]), str(x.get("name", "")))
+                Layer(
+                    as_material(x["material"]),
+                    float(x["thickness_nm"]),
+                    str(x.get("name", "")),
+                    bool(x.get("coherent", True)),
+                )
                 for x in d.get("layers", [])
             ]
-            return cls(layers, as_material(d["substrate"]), as_material(d.get("ambient", 1.0)))
+            sub, amb = as_material(d["substrate"]), as_material(d.get("ambient", 1.0))
+            d_sub, spread = d.get("substrate_thickness_nm"), d.get("thickness_spread")
+            return cls(layers, sub, amb, d_sub, spread)
         except KeyError as exc:
             raise FilmError(f"stack: missing key {exc}") from None
 
@@ -199,9 +351,70 @@ class Stack:
 
     def __repr__(self) -> str:
         inner = ", ".join(
-            f"{lay.name}: {lay.material.name} {lay.thickness_nm:.4g} nm" for lay in self.layers
+            f"{lay.name}: {lay.material.name} {lay.thickness_nm:.4g} nm"
+            + ("" if lay.coherent else " incoherent")
+            for lay in self.layers
         )
-        return f"Stack([{inner}], substrate={self.substrate.name})"
+        d = self.substrate_thickness_nm
+        thick = "" if d is None else f", substrate_thickness_nm={d:.6g}"
+        if self.thickness_spread is not None:
+            thick += f", thickness_spread={self.thickness_spread:.4g}"
+        return f"Stack([{inner}], substrate={self.substrate.name}{thick})"
+
+
+def _check_references(layers: Sequence[Layer]) -> None:
+    """Every ``@NAME`` of an EMA names another layer of plain material, or the media."""
+    kinds = {lay.name: lay.material for lay in layers}
+    for lay in layers:
+        m = lay.material.base if isinstance(lay.material, Graded) else lay.material
+        if not isinstance(m, Ema):
+            continue
+        for ref in m.references:
+            if ref in ("substrate", "ambient"):
+                continue
+            if ref not in kinds or ref == lay.name:
+                others = sorted(set(kinds) - {lay.name})
+                raise FilmError(
+                    f"layer {lay.name!r}: ema constituent '@{ref}' names no other layer; "
+                    f"expected one of {others + ['substrate', 'ambient']}"
+                )
+            if isinstance(kinds[ref], (Roughness, Ema, Graded)):
+                raise FilmError(
+                    f"layer {lay.name!r}: ema constituent '@{ref}' is itself a mixture or "
+                    "graded; expected a layer of one material"
+                )
+
+
+def _spread(s: Any) -> float | None:
+    """None (no parameter) or a relative thickness spread in [0, MAX_SPREAD]."""
+    if s is None:
+        return None
+    try:
+        v = float(s)
+    except (TypeError, ValueError):
+        raise FilmError(f"thickness_spread: expected a number, got {s!r}") from None
+    if not 0.0 <= v <= nonuniform.MAX_SPREAD:
+        raise FilmError(
+            f"thickness_spread: expected a relative spread in [0, {nonuniform.MAX_SPREAD}], "
+            f"got {s!r}"
+        )
+    return v
+
+
+def _substrate_thickness(d: Any) -> float | None:
+    """None (semi-infinite) or a finite thickness in (0, MAX_THICKNESS_NM] [nm]."""
+    if d is None:
+        return None
+    try:
+        v = float(d)
+    except (TypeError, ValueError):
+        raise FilmError(f"substrate_thickness_nm: expected a number, got {d!r}") from None
+    if not (math.isfinite(v) and 0.0 < v <= MAX_THICKNESS_NM):
+        raise FilmError(
+            f"substrate_thickness_nm: expected a thickness in (0, {MAX_THICKNESS_NM:g}] nm "
+            f"(labbrdf.films.MAX_THICKNESS_NM), got {d!r}"
+        )
+    return v
 
 
 def read_fit_json(path: str | os.PathLike[str]) -> tuple[Stack, tuple[float, float]]:

@@ -26,7 +26,6 @@ from scipy import special
 
 from ..dataset import Measurement
 from ..films import FILM_QUANTITIES, NK_REPORT_NM, FilmError, FilmModel, Stack, load_model
-from ..films import matrices as stk
 from ..jsonsafe import jsonable
 from ..models import Model, Parameters
 from ..nk import dispersion as disp
@@ -83,21 +82,20 @@ class _FilmFitModel(Model):
             pairs, inv = np.unique(np.stack([wl, th]), axis=1, return_inverse=True)
             key = self._pairs = (wl.copy(), th.copy(), pairs[0], pairs[1], inv.ravel())
         u_wl, u_th, inv = key[2], key[3], key[4]
-        rs_u, rp_u, _, _, _, _ = stk._stack(s.indices(u_wl), s._thicknesses(), u_wl, u_th)
-        rs, rp = rs_u[inv], rp_u[inv]
+        sums = s.intensity_sums(u_wl, u_th)  # coherent or with incoherent layers
+        Rs, Rp = sums.Rs[inv], sums.Rp[inv]
         ch = self.channels
         out = np.full(ch.shape, np.nan)
-        psi = np.degrees(np.arctan2(np.abs(rp), np.abs(rs)))
-        delta = np.degrees(np.angle(rs * np.conj(rp)))
+        psi = np.degrees(np.arctan2(np.sqrt(Rp), np.sqrt(Rs)))
+        delta = np.degrees(np.angle(sums.X[inv]))
         d = (delta - self.y + 180.0) % 360.0 - 180.0
         out = np.where(ch == 0, psi, out)
         out = np.where(ch == 1, self.y + d, out)
-        Rs, Rp = np.abs(rs) ** 2, np.abs(rp) ** 2
         out = np.where(ch == 2, Rs, out)
         out = np.where(ch == 3, Rp, out)
         out = np.where(ch == 4, 0.5 * (Rs + Rp), out)
         if np.any(ch >= 5):
-            Ts, Tp = stk.transmittance(s.indices(wl), s._thicknesses(), wl, th)
+            Ts, Tp = sums.Ts[inv], sums.Tp[inv]
             out = np.where(ch == 5, Ts, out)
             out = np.where(ch == 6, Tp, out)
             out = np.where(ch == 7, 0.5 * (Ts + Tp), out)
@@ -418,7 +416,8 @@ class FilmFit:
                     f"nk_at_{NK_REPORT_NM:g}nm": nk.get(lay.name),
                 }
             )
-        sub_keys = [f"substrate.{k}" for k in self.stack.substrate.params]
+        sub_keys = [k for k in self.stack.values() if k.startswith("substrate.")]
+        stack_keys = [k for k in self.stack.values() if k.startswith("stack.")]
         return jsonable(
             {
                 "kind": "labbrdf film fit",
@@ -431,6 +430,7 @@ class FilmFit:
                     "parameters": {k.split(".", 1)[1]: param(k) for k in sub_keys},
                     f"nk_at_{NK_REPORT_NM:g}nm": nk.get("substrate"),
                 },
+                "stack_parameters": {k.split(".", 1)[1]: param(k) for k in stack_keys},
                 "wavelength_range_nm": [
                     float(self.data["wavelength_nm"].min()),
                     float(self.data["wavelength_nm"].max()),

@@ -115,6 +115,8 @@ def film_fit_report(summary: Mapping[str, Any]) -> str:
     for p_name, p in sub.get("parameters", {}).items():
         lines.append(f"  {p_name:<14s} {_param_text(p)}")
     lines.extend(_at_lines(summary.get("nk_at") or []))
+    for k, p in summary.get("stack_parameters", {}).items():  # e.g. thickness_spread
+        lines.append(f"stack {k:<14s} {_param_text(p)}")
     lines.append(_fit_line(summary))
     if not summary["success"]:
         lines.append(f"fit did not converge: {summary['message']}")
@@ -166,6 +168,7 @@ def film_fit_html(summary: Mapping[str, Any]) -> str:
     parts = [*(("layer " + lay["name"], lay) for lay in summary["layers"])]
     parts.append(("substrate", summary["substrate"]))
     facts.insert(0, ("substrate", summary["substrate"].get("name", "?")))
+    parts.append(("stack", {"parameters": summary.get("stack_parameters", {})}))
     rows = [
         (where, k, _param_text(p))
         for where, part in parts
