@@ -72,6 +72,8 @@ def as_material(m: Any) -> Material:
             return Roughness()
         if key in disp.MODELS and key != "tabulated":
             return disp.MODELS[key]()
+        if "+" in key:  # a sum of oscillator models, e.g. tauc_lorentz+drude
+            return disp.Sum.of(key)
         raise FilmError(
             f"unknown material {m!r}: expected a reference table {sorted(disp.REFERENCE_TABLES)}, "
             f"a dispersion model {sorted(k for k in disp.MODELS if k != 'tabulated')} or "
