@@ -237,6 +237,9 @@ def test_bspline_size_chosen_by_bic_and_aic_recovers_a_spline_model():
         chi2 = ch.scores[8][0]
         assert 120 - 9 - 5 * math.sqrt(2 * 111) < chi2 < 111 + 5 * math.sqrt(2 * 111)
     assert "<- chosen" in str(ch) and "AIC" in str(ch)
+    n_res = 2 * e.size
+    for n, (chi2, aic, bic) in ch.scores.items():
+        assert (aic, bic) == pytest.approx((chi2 + 2 * (n + 1), chi2 + (n + 1) * np.log(n_res)))
     # exact data: the spline is recovered to the kk accuracy
     exact, chi2 = bspline_fit.fit_eps(e, true.eps(HC_EV_NM / e), 8, 1.0, 9.0, 1e-6)
     np.testing.assert_allclose(exact.coefficients, true.coefficients, atol=1e-6)
@@ -283,3 +286,33 @@ def test_lorentz_is_a_valid_term_and_a_sums_kramers_kronig_is_its_terms():
         expected = 1.2 + _pv(eps2, e, [1.0, 3.0, 4.0], 1e4)
         # Lorentz tail beyond 1e4 eV: (2/pi) A E0^2 G / (3 xi^3) ~ 1e-12
         assert s.eps(HC_EV_NM / e).real == pytest.approx(expected, abs=1e-7)
+
+
+def test_bspline_basis_is_scipys_cubic_basis_elements_on_uniform_knots():
+    from scipy.interpolate import BSpline as ScipyBSpline
+
+    e = np.linspace(0.5, 8.5, 301)
+    t = np.linspace(1.0, 8.0, 7 + 4)
+    expected = sum(
+        c * np.nan_to_num(ScipyBSpline.basis_element(t[j : j + 5], extrapolate=False)(e))
+        for j, c in enumerate(SPLINE.coefficients)
+    )
+    np.testing.assert_allclose(SPLINE.eps2(e), expected, rtol=1e-12, atol=1e-14)
+
+
+def test_kk_helper_gives_the_lorentz_oscillators_closed_form_with_its_tail():
+    from labbrdf.nk.dispersion._kk import kk_eps1, panel_edges
+
+    a, e0, g = 2.0, 3.0, 0.5
+
+    def eps2(x):
+        return a * e0**2 * g * x / ((e0**2 - x**2) ** 2 + g**2 * x**2)
+
+    e = np.array([0.5, 2.9, 3.0, 4.0, 8.0])
+    exact = (a * e0**2 / (e0**2 - e**2 - 1j * g * e)).real
+    edges = panel_edges(100.0, e0 + g * np.linspace(-4, 4, 17))
+    # beyond 100 eV the tail A E0^2 G / xi^3 is worth 2e-6; the left-out next term of the
+    # expansion, (2/pi) A E0^2 G (2 E0^2 + E^2) / (5 xi^5), at most 2e-9
+    got = kk_eps1(eps2, e, edges, tail=a * e0**2 * g)
+    np.testing.assert_allclose(got, exact, atol=1e-8)
+    assert np.max(np.abs(kk_eps1(eps2, e, edges) - exact)) > 1e-6  # without its tail

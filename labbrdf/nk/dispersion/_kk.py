@@ -55,7 +55,8 @@ def kk_eps1(
     ``P int_0^M g/(xi^2 - E^2) = int_0^M (g(xi) - g(E))/(xi^2 - E^2) + g(E) ln((M - E)/(M +
     E)) / (2 E)``; the first integrand is as smooth as ``g`` and is integrated by
     Gauss-Legendre on the panels ``edges`` (put a panel edge at every kink of ``eps2``).
-    Beyond ``M``, ``eps2 ~ tail / xi^3`` adds ``tail (1/(3 M^3) + E^2/(5 M^5))``.
+    Beyond ``M``, ``eps2 ~ tail / xi^3`` adds ``tail (1/(3 M^3) + E^2/(5 M^5))``; the
+    left-out next order is ``(E0/M)^2`` smaller for a peak at ``E0`` (1e-15 at ``M = 10^4``).
 
     Parameters
     ----------
