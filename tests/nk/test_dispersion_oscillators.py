@@ -206,10 +206,16 @@ FITS = [
         Stack([Layer(TCO, 150.0, "ito")], "sio2"),
         {"ito.thickness_nm": 150.0, "ito.drude2_omega_p": 1.8, "ito.tauc_lorentz1_A": 60.0},
     ),
+    (
+        Stack([Layer(SPLINE, 90.0, "bs")], "si"),
+        {"bs.thickness_nm": 90.0, "bs.c3": 2.0, "bs.c4": 3.0},
+    ),
 ]
 
 
-@pytest.mark.parametrize(("stack", "truth"), FITS, ids=["cody_lorentz", "gaussian", "sum"])
+@pytest.mark.parametrize(
+    ("stack", "truth"), FITS, ids=["cody_lorentz", "gaussian", "sum", "bspline"]
+)
 def test_film_fit_recovers_the_model_that_made_the_data(stack, truth):
     from labbrdf.fitting.film import fit_film
 
@@ -316,3 +322,24 @@ def test_kk_helper_gives_the_lorentz_oscillators_closed_form_with_its_tail():
     got = kk_eps1(eps2, e, edges, tail=a * e0**2 * g)
     np.testing.assert_allclose(got, exact, atol=1e-8)
     assert np.max(np.abs(kk_eps1(eps2, e, edges) - exact)) > 1e-6  # without its tail
+
+
+def test_a_sum_layer_is_fitted_from_the_command_line(tmp_path, capsys):
+    from labbrdf.cli import main
+    from labbrdf.dataset import Measurement, write
+
+    df = _psi_delta_rows(FITS[2][0], np.linspace(300, 1000, 24))
+    df["quantity"] = df["quantity"].astype("category")
+    p = tmp_path / "ito.parquet"
+    write(Measurement(df, {}), p)
+    fixed = ":".join(f"{k}={v:g}" for k, v in TCO.params.items() if k not in ("drude2_omega_p",))
+    spec = f"ito:tauc_lorentz+drude:100..200:{fixed}:drude2_omega_p=1..3"
+    code = main(["film", str(p), "--substrate", "sio2", "--layer", spec, "--ci", "wald"])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "layer ito (sum)" in out
+    line = next(x for x in out.splitlines() if "drude2_omega_p" in x)
+    assert float(line.split()[1]) == pytest.approx(1.8, abs=1e-3)
+    code = main(["film", str(p), "--layer", "ito:drude+cauchy:100"])
+    err = capsys.readouterr().err
+    assert code == 2 and "'cauchy' cannot be a term" in err and "Traceback" not in err
