@@ -268,6 +268,7 @@ def test_bspline_size_chosen_by_bic_and_aic_recovers_a_spline_model():
         (lambda: BSpline.from_params({"c1": 1, "c3": 2}), "unknown.*c3"),
         (lambda: Sum.of("tauc_lorentz+cauchy"), "'cauchy' cannot be a term"),
         (lambda: Sum.of("drude+sum"), "'sum' cannot be a term"),
+        (lambda: Sum.of("drude+tabulated"), "'tabulated' cannot be a term"),
         (lambda: Sum(terms=()), "at least one term"),
         (lambda: Sum.from_params({"drude1_eps_inf": 1.0}), "own eps_inf excluded"),
         (lambda: Sum.from_params({"A": 1.0}), "<model><j>_<parameter>"),

@@ -118,7 +118,7 @@ class BSpline(Dispersion):
                 f"bspline: unknown parameter(s) {sorted(p)}; parameters are eps_inf, E_lo, "
                 "E_hi and c1, c2, ... numbered from 1 without gaps"
             )
-        return cls(**head, coefficients=c)  # type: ignore[arg-type]
+        return cls(**head, coefficients=c)
 
     def bounds(self) -> dict[str, tuple[float, float]]:
         """Default search box name -> (min, max) of every parameter."""

@@ -12,7 +12,7 @@ Gaussian log-likelihood with a known ``sigma``).
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,10 +47,11 @@ def _design(energy: FloatArray, e_lo: float, e_hi: float, n: int) -> FloatArray:
     b = basis(energy, e_lo, e_hi, n)
     upper = max(1e4, 100 * float(energy.max()))
     edges = panel_edges(upper, knots(e_lo, e_hi, n))
-    k = np.stack(
-        [kk_eps1(lambda x, j=j: basis(x, e_lo, e_hi, n)[:, j], energy, edges) for j in range(n)],
-        axis=1,
-    )
+
+    def column(j: int) -> Callable[[FloatArray], FloatArray]:
+        return lambda x: np.asarray(basis(x, e_lo, e_hi, n)[:, j])
+
+    k = np.stack([kk_eps1(column(j), energy, edges) for j in range(n)], axis=1)
     ones = np.concatenate([np.ones(energy.size), np.zeros(energy.size)])
     return np.column_stack([ones, np.vstack([k, b])])
 

@@ -20,13 +20,14 @@ _PREFIXED = re.compile(r"^([a-z][a-z_]*[a-z])(\d+)_(.+)$")
 
 def _model_class(name: str) -> type[Dispersion]:
     """The Dispersion subclass registered as ``name`` that can be a term of a sum."""
-    todo, seen = list(Dispersion.__subclasses__()), {}
+    todo = list(Dispersion.__subclasses__())
+    seen: dict[str, type[Dispersion]] = {}
     while todo:
-        cls = todo.pop()
-        seen[cls.name] = cls
-        todo.extend(cls.__subclasses__())
+        sub = todo.pop()
+        seen[sub.name] = sub
+        todo.extend(sub.__subclasses__())
     cls = seen.get(name)
-    if cls is None or cls is Sum or "eps_inf" not in cls().params:
+    if cls is None or cls is Sum or not _is_term(cls):
         terms = sorted(k for k, c in seen.items() if c is not Sum and _is_term(c))
         raise DispersionError(f"sum: {name!r} cannot be a term; terms are {terms}")
     return cls
@@ -34,7 +35,7 @@ def _model_class(name: str) -> type[Dispersion]:
 
 def _is_term(cls: type[Dispersion]) -> bool:
     try:
-        return "eps_inf" in cls().params  # type: ignore[call-arg]
+        return "eps_inf" in cls().params
     except TypeError:  # no default instance (a table)
         return False
 
@@ -85,7 +86,7 @@ class Sum(Dispersion):
     def of(cls, spec: str) -> Sum:
         """The sum ``"name+name+..."`` of the terms' default models, ``eps_inf = 1``."""
         names = [s.strip().lower() for s in spec.split("+")]
-        return cls(terms=tuple(_model_class(n)() for n in names))  # type: ignore[call-arg]
+        return cls(terms=tuple(_model_class(n)() for n in names))
 
     @property
     def params(self) -> dict[str, float]:
