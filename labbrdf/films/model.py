@@ -61,5 +61,10 @@ class FilmModel:
                     continue  # fixed unless asked: k_amp = 0 keeps the layer transparent
                 if isinstance(lay.material, disp.Cauchy) and k == "k_amp":
                     continue
+                if (
+                    isinstance(lay.material, disp.Dispersion)
+                    and k in lay.material.fixed_by_default()
+                ):
+                    continue
                 free[f"{lay.name}.{k}"] = b
         return cls(stack, free)

@@ -344,3 +344,10 @@ def test_a_sum_layer_is_fitted_from_the_command_line(tmp_path, capsys):
     code = main(["film", str(p), "--layer", "ito:drude+cauchy:100"])
     err = capsys.readouterr().err
     assert code == 2 and "'cauchy' cannot be a term" in err and "Traceback" not in err
+
+
+def test_a_default_fit_leaves_the_b_spline_knot_range_fixed():
+    spline_sum = Sum(1.0, (SPLINE, Drude(0.0, 1.0, 0.1)))
+    fm = FilmModel.default(Stack([Layer(SPLINE, 90.0, "bs"), Layer(spline_sum, 10.0, "t")], "si"))
+    assert {"bs.c1", "bs.eps_inf", "t.bspline1_c7", "t.drude2_gamma"} <= set(fm.free)
+    assert not {"bs.E_lo", "bs.E_hi", "t.bspline1_E_lo", "t.bspline1_E_hi"} & set(fm.free)

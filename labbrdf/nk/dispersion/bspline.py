@@ -128,6 +128,10 @@ class BSpline(Dispersion):
         """Units of every parameter."""
         return {k: self.UNITS.get(k, "1") for k in self.params}
 
+    def fixed_by_default(self) -> frozenset[str]:
+        """The knot range: a default fit varies the coefficients only."""
+        return frozenset({"E_lo", "E_hi"})
+
     def eps2(self, energy_ev: FloatArray) -> FloatArray:
         """Imaginary part ``eps2`` [1] at photon energies [eV]."""
         b = basis(energy_ev, self.E_lo, self.E_hi, len(self.coefficients))

@@ -135,6 +135,12 @@ class Sum(Dispersion):
             out.update({f"{t.name}{j}_{k}": u for k, u in t.units().items() if k != "eps_inf"})
         return out
 
+    def fixed_by_default(self) -> frozenset[str]:
+        """The terms' fixed parameters, prefixed."""
+        return frozenset(
+            f"{t.name}{j}_{k}" for j, t in enumerate(self.terms, 1) for k in t.fixed_by_default()
+        )
+
     def eps(self, wavelength_nm: ArrayLike) -> ComplexArray:
         """Dielectric function ``eps = N^2`` [1] at vacuum wavelength(s) [nm]."""
         out = self.eps_inf + sum(t.eps(wavelength_nm) for t in self.terms)
