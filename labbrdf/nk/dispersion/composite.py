@@ -36,7 +36,7 @@ def _model_class(name: str) -> type[Dispersion]:
 def _is_term(cls: type[Dispersion]) -> bool:
     try:
         return "eps_inf" in cls().params
-    except TypeError:  # no default instance (a table)
+    except (TypeError, DispersionError):  # no valid default instance (a table)
         return False
 
 
