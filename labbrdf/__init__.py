@@ -164,9 +164,9 @@ if TYPE_CHECKING:
     from .models import ModelError
     from .nk import NkError, bulk_index_at, combined_table, model_with_nk, nk_table, read_nk
     from .report import user_report
-    from .roughness.psd_result import psd
     from .roughness import smoothness, topography
     from .roughness import synthetic as surface
+    from .roughness.psd_result import psd
     from .roughness.topography import roughness_statistics
     from .sample import run as tracer_setup
     from .sample import trace_config_from_inputs

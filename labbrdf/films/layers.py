@@ -68,24 +68,24 @@ class Layer:
 #   ``--layer ...:A=1.5..2.2``; TOML also ``{value, min, max, vary}``);
 # - a parameter of a layer's material (a dispersion model, a roughness layer's fraction)
 #   that is not written is fitted in its default box (:func:`default_boxes`), started at the
-#   model's default value, except Cauchy's absorption (:data:`CAUCHY_FIXED`); a table has
+#   model's default value, except those the model fixes by default (Cauchy's absorption,
+#   a B-spline's knot range: ``Dispersion.fixed_by_default``); a table has
 #   none. The substrate's parameters stay at their values unless a box is written.
-
-#: Cauchy parameters kept at their values unless a box is written: k_amp = 0 keeps the
-#: layer transparent, and the Urbach exponent and band edge mean nothing without it
-CAUCHY_FIXED = ("k_amp", "exponent", "band_edge")
 
 
 def default_boxes(material: Any) -> dict[str, tuple[float, float]]:
     """The default search box of each parameter a layer's material frees when not written.
 
     Every parameter of a dispersion model (:meth:`labbrdf.nk.dispersion.Dispersion.bounds`)
-    except Cauchy's absorption (:data:`CAUCHY_FIXED`), and a roughness layer's fraction
+    except those it fixes by default
+    (:meth:`labbrdf.nk.dispersion.Dispersion.fixed_by_default`: Cauchy's absorption, a
+    B-spline's knot range), and a roughness layer's fraction
     (:meth:`labbrdf.films.Roughness.bounds`); none for a table.
     """
     if isinstance(material, disp.Tabulated) or not hasattr(material, "bounds"):
         return {}
-    skip = CAUCHY_FIXED if isinstance(material, disp.Cauchy) else ()
+    fixed = getattr(material, "fixed_by_default", None)
+    skip = fixed() if callable(fixed) else frozenset()
     return {k: b for k, b in material.bounds().items() if k not in skip}
 
 

@@ -105,6 +105,8 @@ def as_material(m: Any) -> Material:
             return _ema({"components": [c.strip() for c in ema.group(1).split(",")]})
         if key in disp.MODELS and key != "tabulated":
             return disp.MODELS[key]()
+        if "+" in key:  # a sum of oscillator models, e.g. tauc_lorentz+drude
+            return disp.Sum.of(key)
         raise FilmError(
             f"unknown material {m!r}: expected a reference table {sorted(disp.REFERENCE_TABLES)}, "
             f"a dispersion model {sorted(k for k in disp.MODELS if k != 'tabulated')}, "

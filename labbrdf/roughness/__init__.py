@@ -1,2 +1,5 @@
-"""Surface roughness beyond the microfacet distributions: height-map statistics, smoothness,
-synthetic surfaces, power spectra and their models, Rayleigh-Rice scatter."""
+"""Surface roughness beyond the microfacet distributions.
+
+Height-map statistics, smoothness, synthetic surfaces, power spectra and their models,
+Rayleigh-Rice scatter.
+"""

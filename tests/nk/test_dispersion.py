@@ -239,5 +239,9 @@ def test_every_model_module_of_the_package_is_in_the_registry():
         "tauc_lorentz",
         "drude",
         "lorentz",
+        "cody_lorentz",
+        "gaussian",
+        "bspline",
+        "sum",
         "tabulated",
     ]

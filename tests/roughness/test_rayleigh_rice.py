@@ -13,9 +13,8 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from labbrdf.roughness import smoothness
 from labbrdf.optics import fresnel
-from labbrdf.roughness import psd_models
+from labbrdf.roughness import psd_models, smoothness
 from labbrdf.roughness import rayleigh_rice as rr
 
 LAM = 633e-9

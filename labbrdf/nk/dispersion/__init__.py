@@ -21,9 +21,13 @@ convention), so a passive medium has ``Im(eps) >= 0``; oscillator formulas writt
 from __future__ import annotations
 
 from .base import HC_EV_NM, Dispersion, DispersionError
+from .bspline import BSpline
 from .cauchy import Cauchy
+from .cody_lorentz import CodyLorentz
+from .composite import Sum
 from .constant import Constant
 from .drude import Drude
+from .gaussian import Gaussian
 from .lorentz import Lorentz
 from .registry import MODELS, from_dict
 from .sellmeier import Sellmeier
@@ -34,13 +38,17 @@ __all__ = [
     "HC_EV_NM",
     "MODELS",
     "REFERENCE_TABLES",
+    "BSpline",
     "Cauchy",
+    "CodyLorentz",
     "Constant",
     "Dispersion",
     "DispersionError",
     "Drude",
+    "Gaussian",
     "Lorentz",
     "Sellmeier",
+    "Sum",
     "Tabulated",
     "TaucLorentz",
     "from_dict",

@@ -88,6 +88,10 @@ class Dispersion(ABC):
         """Units of every parameter."""
         return {k: self.UNITS.get(k, "1") for k in self.params}
 
+    def fixed_by_default(self) -> frozenset[str]:
+        """Parameters a default fit leaves fixed (structure, not optics: B-spline knots)."""
+        return frozenset()
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-safe form ``{"model": name, **params}`` (inverse: :func:`from_dict`)."""
         return {"model": self.name, **self.params}

@@ -64,6 +64,12 @@ class Cauchy(Dispersion):
         if self.k_amp < 0:
             raise DispersionError(f"cauchy: k_amp must be >= 0, got {self.k_amp}")
 
+    def fixed_by_default(self) -> frozenset[str]:
+        """The Urbach absorption: ``k_amp = 0`` keeps the layer transparent, and the
+        exponent and band edge mean nothing without it.
+        """
+        return frozenset({"k_amp", "exponent", "band_edge"})
+
     def nk(self, wavelength_nm: ArrayLike) -> ComplexArray:
         """Complex index ``n + ik`` (``k >= 0``) at vacuum wavelength(s) [nm]."""
         lam = _wavelength(wavelength_nm)

@@ -22,6 +22,10 @@ _MODULES = {
     "tauc_lorentz": "TaucLorentz",
     "drude": "Drude",
     "lorentz": "Lorentz",
+    "cody_lorentz": "CodyLorentz",
+    "gaussian": "Gaussian",
+    "bspline": "BSpline",
+    "composite": "Sum",
     "tabulated": "Tabulated",
 }
 
