@@ -1,7 +1,8 @@
 """Partial sums of a polynomial levelling: what a jackknife replicate's levelling needs.
 
 The least-squares polynomial of :func:`labbrdf.roughness.topography.level` is fixed by a
-few sums over the valid points (their count, the sum of heights, and the monomials' normal equations).
+few sums over the valid points (their count, the sum of heights, and the monomials' normal
+equations).
 Sums over disjoint regions add, so the sums of a map less one tile are the whole map's less
 the tile's: each leave-one-tile-out replicate is levelled without a pass over the map to
 form them (:func:`labbrdf.roughness.topography.roughness_statistics`' jackknife).

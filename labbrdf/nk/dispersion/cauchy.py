@@ -65,8 +65,10 @@ class Cauchy(Dispersion):
             raise DispersionError(f"cauchy: k_amp must be >= 0, got {self.k_amp}")
 
     def fixed_by_default(self) -> frozenset[str]:
-        """The Urbach absorption: ``k_amp = 0`` keeps the layer transparent, and the
-        exponent and band edge mean nothing without it.
+        """The Urbach absorption, fixed unless a box is written.
+
+        ``k_amp = 0`` keeps the layer transparent, and the exponent and band edge mean
+        nothing without it.
         """
         return frozenset({"k_amp", "exponent", "band_edge"})
 
