@@ -76,10 +76,14 @@ def test_the_right_model_gets_no_verdict(film_file, capsys):
     assert doc["substrate"]["name"] == "si (reference table, Green 2008)"
 
 
-def test_the_verdict_threshold_is_the_woollam_mse():
-    from labbrdf.fitting.film_verdict import wrong_model_verdict
+def test_the_verdict_thresholds_are_the_woollam_mse():
+    from labbrdf.fitting.film_verdict import MSE_INCOMPLETE, wrong_model_verdict
 
-    assert wrong_model_verdict(MSE_WRONG_MODEL, "si") is None
+    assert wrong_model_verdict(MSE_INCOMPLETE, "si") is None
+    incomplete = wrong_model_verdict(MSE_INCOMPLETE * 1.01, "si") or ""
+    assert incomplete.startswith("MSE 20.2 > 20: the model lacks something")
+    assert "not meaningful" not in incomplete and "interface" in incomplete
+    assert "lacks something" in (wrong_model_verdict(MSE_WRONG_MODEL, "si") or "")
     assert "not meaningful" in (wrong_model_verdict(MSE_WRONG_MODEL * 1.01, "si") or "")
 
 
@@ -152,4 +156,4 @@ def test_the_report_shows_the_verdict_of_a_wrong_model(film_file):
         _fit_shown(ctx, "0", "film.parquet", SimpleNamespace(text="stack"), fit)
     text = str(ctx.b.results)
     assert "parameters not meaningful" in text
-    assert f"MSE {fit.mse:.4g} > 20: the model does not describe this sample" in text
+    assert f"MSE {fit.mse:.4g} > 100: the model does not describe this sample" in text

@@ -32,6 +32,7 @@ import pandas as pd
 from ... import films
 from ... import nk as nkmod
 from ...fitting.film import FilmFit, fit_film
+from ...fitting.film_verdict import MSE_WRONG_MODEL
 from .. import figures
 from ..agreement import P_AGREE, chi_square
 from ..builder import Unavailable, slug
@@ -415,7 +416,8 @@ def _fit_shown(
         + (" Notes: " + "; ".join(s["notes"]) + "." if s["notes"] else "")
     )
     if s.get("verdict"):
-        b.note("parameters not meaningful", s["verdict"])
+        wrong = s["mse"] > MSE_WRONG_MODEL
+        b.note("parameters not meaningful" if wrong else "model incomplete", s["verdict"])
     b.table(
         f"film_{tag}_params",
         f"{src}: fitted parameters",
