@@ -10,6 +10,7 @@ from __future__ import annotations
 import inspect
 from typing import Any
 
+from .abg import ABg
 from .base import Model, ModelError, Parameter, Parameters
 from .five_param import FiveParam
 from .layered import Layered
@@ -33,6 +34,7 @@ MODELS: dict[str, type[Model]] = {
     "five_param": FiveParam,
     "microfacet": Microfacet,
     "layered": Layered,
+    "abg": ABg,
 }
 
 
