@@ -13,6 +13,7 @@ from typing import Any
 from .abg import ABg
 from .base import Model, ModelError, Parameter, Parameters
 from .five_param import FiveParam
+from .harvey_shack import HarveyShack
 from .layered import Layered
 from .microfacet import Microfacet
 from .smooth3 import Smooth3
@@ -35,6 +36,7 @@ MODELS: dict[str, type[Model]] = {
     "microfacet": Microfacet,
     "layered": Layered,
     "abg": ABg,
+    "harvey_shack": HarveyShack,
 }
 
 
