@@ -170,12 +170,12 @@ class Apertured(Model):
         wavelength: NDArray | None,
     ) -> NDArray:
         wl = None if wavelength is None else np.asarray(wavelength)[..., None]
-        return self._average(
-            lambda a, b, c: self.inner._evaluate(p, *np.broadcast_arrays(a, b, c), wl),
-            theta_i,
-            theta_r,
-            phi_r,
-        )
+
+        def value(a: NDArray, b: NDArray, c: NDArray) -> NDArray:
+            ta, tb, tc = np.broadcast_arrays(a, b, c)
+            return self.inner._evaluate(p, ta, tb, tc, wl)
+
+        return self._average(value, theta_i, theta_r, phi_r)
 
     def linear_components(
         self,
@@ -189,7 +189,8 @@ class Apertured(Model):
         wl = None if wavelength is None else np.asarray(wavelength)[..., None]
 
         def comps(a: NDArray, b: NDArray, c: NDArray) -> dict[str, NDArray] | None:
-            return self.inner.linear_components(p, *np.broadcast_arrays(a, b, c), wl)
+            ta, tb, tc = np.broadcast_arrays(a, b, c)
+            return self.inner.linear_components(p, ta, tb, tc, wl)
 
         one = np.zeros(1)
         if comps(one, one, one) is None:
