@@ -152,7 +152,7 @@ class ABg(Model):
     transmission : bool, default False
         The transmission form: fitted to BTDF data (quantity ``btdf``), ``beta0`` the
         direction of direct transmission (see the module docstring). The reflection form
-        takes BRDF data only.
+        takes BRDF data only (not specular intensities: the model is the scatter).
     diffuse : bool, default False
         Add a Lambertian floor ``kd / pi`` [sr^-1], ``kd`` its hemispherical albedo.
 
@@ -193,8 +193,8 @@ class ABg(Model):
         self.transmission = bool(transmission)
         if self._diffuse:
             self.linear = ("A", "kd")
-        if self.transmission:
-            self.quantities = ("btdf",)
+        # the scattered part only: BSDF data, never a specular intensity
+        self.quantities = ("btdf",) if self.transmission else ("brdf",)
         opts: dict[str, Any] = {}
         if self.transmission:
             opts["transmission"] = True

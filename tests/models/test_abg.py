@@ -122,6 +122,9 @@ def test_quantity_guard(tmp_path: Path) -> None:
         fit(models.get("microfacet", ideal_mirror=True), btdf)
     with pytest.raises(FitError, match=r"describes \['btdf'\], not 'brdf'"):
         fit(models.get("abg", transmission=True), brdf)
+    spec = brdf.data.assign(quantity="specular_intensity", unit="1")
+    with pytest.raises(FitError, match=r"'abg' describes \['brdf'\], not 'specular_intensity'"):
+        fit(models.get("abg"), spec)
 
 
 def test_bad_options_and_values() -> None:
