@@ -31,8 +31,9 @@ class FitError(LabbrdfError, ValueError):
     """Bad fit input (data, method, parameter names) or a fit that cannot be set up."""
 
 
-#: dataset quantities a reflectance/BRDF model can be fitted to
-FITTABLE_QUANTITIES = ("brdf", "specular_intensity")
+#: dataset quantities a model can be fitted to (each model says which it describes:
+#: :attr:`labbrdf.models.Model.quantities`; BTDF data need a transmission form)
+FITTABLE_QUANTITIES = ("brdf", "specular_intensity", "btdf")
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from .. import progress
 from ..models import Model, Parameters
 from .data import FitData, FitError
 
-__all__ = ["Objective"]
+__all__ = ["Objective", "check_quantity"]
 
 _PENALTY = 1e100  # objective value for non-finite model output (inf breaks local methods)
 
@@ -83,6 +83,26 @@ def _bounded_lsq(G: NDArray, g: NDArray, lo: NDArray, hi: NDArray) -> NDArray:
     return best
 
 
+def check_quantity(model: Model, quantity: str) -> None:
+    """Refuse data of a quantity the model does not describe (BTDF to a reflection model).
+
+    Raises
+    ------
+    FitError
+        Names the model, the quantity and what the model takes.
+    """
+    takes = getattr(model, "quantities", ("brdf", "specular_intensity"))
+    if quantity not in takes:
+        hint = (
+            "; fit transmission data with a transmission form, e.g. abg with transmission=True"
+            if quantity == "btdf"
+            else ""
+        )
+        raise FitError(
+            f"model {model.name!r} describes {list(takes)}, not {quantity!r} data{hint}"
+        )
+
+
 class Objective:
     """Weighted least squares of a model against data, as a function of a flat vector.
 
@@ -124,6 +144,7 @@ class Objective:
         linear_upper: Callable[[dict[str, float]], float] | None = None,
         absolute: bool = False,
     ) -> None:
+        check_quantity(model, data.quantity)
         self.model = model
         self.data = data
         self.params = params

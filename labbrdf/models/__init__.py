@@ -10,8 +10,10 @@ from __future__ import annotations
 import inspect
 from typing import Any
 
+from .abg import ABg
 from .base import Model, ModelError, Parameter, Parameters
 from .five_param import FiveParam
+from .harvey_shack import HarveyShack
 from .layered import Layered
 from .microfacet import Microfacet
 from .rayleigh_rice import RayleighRice
@@ -35,6 +37,8 @@ MODELS: dict[str, type[Model]] = {
     "microfacet": Microfacet,
     "layered": Layered,
     "rayleigh_rice": RayleighRice,
+    "abg": ABg,
+    "harvey_shack": HarveyShack,
 }
 
 

@@ -203,6 +203,9 @@ class Model(ABC):
     #: parameters that only shape the lobe away from the specular line: a fit to points on
     #: theta_r == theta_i alone cannot identify them (the fitting core refuses to vary them)
     specular_line_shape: tuple[str, ...] = ()
+    #: dataset quantities the model describes (a fit to other data is refused): reflection
+    #: models take BRDF and specular data, a transmission form ``("btdf",)``
+    quantities: tuple[str, ...] = ("brdf", "specular_intensity")
     #: what the model's form says about reciprocity, a sentence for reports
     reciprocity_note: str = ""
     #: smallest step, as a fraction of a parameter's search range, at which finite

@@ -29,6 +29,10 @@ CONFIGS = [
     ("layered", {"n": 1.55, "k": 7.71, "coherent": True}),
     ("layered", {"base": "diffuse"}),
     ("layered", {"n": 1.55, "k": 7.71, "floor": True}),
+    ("abg", {}),
+    ("abg", {"diffuse": True}),
+    ("harvey_shack", {}),
+    ("harvey_shack", {"diffuse": True}),
 ]
 
 
