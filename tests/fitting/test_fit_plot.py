@@ -55,7 +55,7 @@ def test_the_data_are_drawn_with_their_file_sigmas(result, osr_550) -> None:
 def test_the_model_line_is_the_fitted_model(result, osr_550) -> None:
     ax = result.plot().axes[0]
     model = models.get("smooth3")
-    curves = [ln for ln in ax.lines if ln.get_label().startswith("model")]
+    curves = [ln for ln in ax.lines if ln.get_gid() == "model"]
     assert len(curves) == 3
     for ln, (ti, _) in zip(curves, _groups(osr_550), strict=True):
         x = np.asarray(ln.get_xdata(), float)
@@ -98,7 +98,7 @@ def test_a_model_outside_the_registry_is_drawn_through_the_data_points(result, o
 
     res = fit(Custom(), osr_550)
     ax = res.plot().axes[0]
-    curves = [ln for ln in ax.lines if ln.get_label().startswith("model")]
+    curves = [ln for ln in ax.lines if ln.get_gid() == "model"]
     got = np.concatenate([ln.get_ydata() for ln in curves])
     d = osr_550.reset_index(drop=True)
     order = np.lexsort((d["theta_r_deg"].to_numpy(), d["theta_i_deg"].to_numpy()))
