@@ -22,11 +22,14 @@ __all__ = [
     "draw_cut",
     "draw_panel",
     "draw_polar_map",
+    "draw_polar_maps",
+    "draw_polar_pair",
     "axes_size_in",
     "draw_scan",
     "legend_outside",
     "scan_colours",
     "map_scale",
+    "polar_maps_size",
     "robust_ylim",
     "text",
     "wrap_label",
@@ -396,6 +399,90 @@ def draw_polar_map(
     ax.set_yticklabels(["30\u00b0", "60\u00b0", "90\u00b0"], color="0.15", path_effects=halo)
     ax.set_title(title)
     return mesh
+
+
+def polar_maps_size(n: int) -> tuple[float, float]:
+    """Figure size [inch] of :func:`draw_polar_maps` for ``n`` cases (3 per row at most)."""
+    from .figstyle import PAGE_WIDTH_IN
+
+    ncol = max(1, min(n, 3))
+    w = min(PAGE_WIDTH_IN / ncol, 4.6)
+    return w * ncol, 0.86 * w * 2 * (-(-max(n, 1) // ncol))
+
+
+def draw_polar_maps(
+    fig: Any,
+    labels: Sequence[str],
+    maps: tuple[Sequence[np.ndarray], Sequence[np.ndarray]],
+    edges: tuple[np.ndarray, np.ndarray],
+    s0_max: Sequence[float | None] | None = None,
+) -> None:
+    """S0 maps above DOP maps, one column per case, wrapped three cases to a row.
+
+    Parameters
+    ----------
+    fig : matplotlib Figure
+        Empty; sized by :func:`polar_maps_size`.
+    labels : sequence of str
+        One per case (literal text).
+    maps : (sequence of arrays, sequence of arrays)
+        The S0 [sr^-1] and the DOP [1] maps, (n_theta, n_phi) each.
+    edges : (array, array)
+        theta_r and phi_r bin edges [deg].
+    s0_max : sequence of float or None, optional
+        Top of each S0 scale. The cases share the kind of scale: all log when one needs
+        it (:func:`map_scale`), so that side-by-side maps read alike.
+    """
+    s0, dop = maps
+    n = max(1, len(labels))
+    ncol = min(n, 3)
+    nblk = -(-n // ncol)
+    axes = fig.subplots(2 * nblk, ncol, subplot_kw={"projection": "polar"}, squeeze=False)
+    tops = [None if s0_max is None else s0_max[j] for j in range(len(labels))]
+    log = any(map_scale(s0[j], tops[j])["log"] for j in range(len(labels)))
+    for j in range(nblk * ncol):
+        pair = (axes[2 * (j // ncol), j % ncol], axes[2 * (j // ncol) + 1, j % ncol])
+        if j >= len(labels):
+            pair[0].set_visible(False)
+            pair[1].set_visible(False)
+            continue
+        label = text(labels[j])
+        scale = map_scale(s0[j], tops[j], log=log)
+        draw_polar_pair(pair, (label, label), (s0[j], dop[j]), scale, edges)
+    fig.text(
+        0.01,
+        0.0,
+        r"angle: $\varphi_r$ [deg] (specular at 180); radius: $\theta_r$ [deg]",
+        va="top",
+    )
+
+
+def draw_polar_pair(
+    axes: tuple[Any, Any],
+    titles: tuple[str, str],
+    maps: tuple[np.ndarray, np.ndarray],
+    sc: Mapping[str, Any],
+    edges: tuple[np.ndarray, np.ndarray],
+) -> None:
+    """An S0 map and a DOP map on polar Axes, each with its colour bar.
+
+    ``maps`` = (S0 [sr^-1], DOP [1]), ``sc`` the S0 scale (:func:`map_scale`; the colour
+    bar says "log scale" when it is one, with arrows where bins lie beyond it), ``edges``
+    = (theta_r, phi_r) bin edges [deg].
+    """
+    s0, dop = maps
+    fig = axes[0].figure
+    s0_name = r"$S_0$ [sr$^{-1}$]" + (f", {sc['note']}" if sc["note"] else "")
+    over = bool(np.nanmax(np.asarray(s0, float), initial=0.0) > sc["vmax"])
+    s0_ext = ("both" if over else "min") if sc["log"] else ("max" if over else "neither")
+    for ax, title, data, name, cmap, lim, log, ext in (
+        (axes[0], titles[0], s0, s0_name, "inferno", (sc["vmin"], sc["vmax"]), sc["log"], s0_ext),
+        (axes[1], titles[1], dop, "DOP [1]", "viridis", (0.0, 1.0), False, "neither"),
+    ):
+        mesh = draw_polar_map(
+            ax, data, *edges, title=title, cmap=cmap, vmin=lim[0], vmax=lim[1], log=log
+        )
+        fig.colorbar(mesh, ax=ax, shrink=0.8, pad=0.12, extend=ext).set_label(name)
 
 
 def draw_cut(

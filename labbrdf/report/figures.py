@@ -32,10 +32,10 @@ from .._plotting import COLOURS as _COLOURS  # noqa: E402
 from .._plotting import MARKERS as _MARKERS  # noqa: E402
 from .._plotting import (  # noqa: E402
     draw_panel,
-    draw_polar_map,
+    draw_polar_maps,
     draw_scan,
     legend_outside,
-    map_scale,
+    polar_maps_size,
 )
 from .._plotting import text as _text  # noqa: E402
 from ..figstyle import DPI, PAGE_WIDTH_IN, PANEL_MIN_IN, grid_shape, styled  # noqa: E402
@@ -64,6 +64,15 @@ def to_uri(fig: Figure, dpi: int = DPI) -> str:
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
+def _layout(fig: Any, title: str | None) -> None:
+    """The figure's title (if any) in a band of its own above the tight layout."""
+    if not title:
+        fig.tight_layout()
+        return
+    fig.suptitle(_text(title))
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.32 / fig.get_size_inches()[1]))
+
+
 def _finish(fig: Any, ax: Any, title: str | None) -> str:
     """Grid, legend and title, then the figure as a PNG data URI."""
     ax.grid(alpha=0.3)
@@ -76,18 +85,14 @@ def _finish(fig: Any, ax: Any, title: str | None) -> str:
 
 def _finish_below(fig: Any, ax: Any, title: str | None) -> str:
     """Title, tight layout and the legend of ``ax`` below the figure, as a PNG data URI."""
-    if title:
-        fig.suptitle(_text(title))
-    fig.tight_layout()
+    _layout(fig, title)
     legend_outside(ax)
     return to_uri(fig)
 
 
 def _finish_grid(fig: Any, title: str | None) -> str:
     """Figure title (if any), tight layout, then the figure as a PNG data URI."""
-    if title:
-        fig.suptitle(_text(title))
-    fig.tight_layout()
+    _layout(fig, title)
     return to_uri(fig)
 
 
@@ -132,9 +137,7 @@ def scan_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
         if j % ncol == 0:
             ax.set_ylabel(r"BRDF [sr$^{-1}$]")
             axr.set_ylabel("residual [%]")
-    if title:
-        fig.suptitle(_text(title))
-    fig.tight_layout()
+    _layout(fig, title)
     _scan_legend(fig, axes, scales)
     return to_uri(fig)
 
@@ -363,77 +366,9 @@ def polar_maps_figure(
     s0_max : sequence of float or None, optional
         Upper end of each S0 colour scale (e.g. ignoring bins with few rays).
     """
-    n = max(1, len(labels))
-    ncol = min(n, 3)
-    nblk = -(-n // ncol)
-    w = min(PAGE_WIDTH_IN / ncol, 4.6)
-    fig, axes = plt.subplots(
-        2 * nblk,
-        ncol,
-        figsize=(w * ncol, 0.86 * w * 2 * nblk),
-        subplot_kw={"projection": "polar"},
-        squeeze=False,
-    )
-    tops = [None if s0_max is None else s0_max[j] for j in range(len(labels))]
-    # cases side by side share the kind of scale (all log if any needs it)
-    log = any(map_scale(s0[j], tops[j])["log"] for j in range(len(labels)))
-    for j in range(nblk * ncol):
-        top, bottom = axes[2 * (j // ncol), j % ncol], axes[2 * (j // ncol) + 1, j % ncol]
-        if j >= len(labels):
-            top.set_visible(False)
-            bottom.set_visible(False)
-            continue
-        _polar_pair(
-            fig,
-            (top, bottom),
-            _text(labels[j]),
-            (s0[j], dop[j]),
-            map_scale(s0[j], tops[j], log=log),
-            (theta_edges_deg, phi_edges_deg),
-        )
-    fig.text(
-        0.01,
-        0.0,
-        r"angle: $\varphi_r$ [deg] (specular at 180); radius: $\theta_r$ [deg]",
-        va="top",
-    )
+    fig = plt.figure(figsize=polar_maps_size(len(labels)))
+    draw_polar_maps(fig, labels, (s0, dop), (theta_edges_deg, phi_edges_deg), s0_max)
     return _finish_grid(fig, title)
-
-
-def _polar_pair(
-    fig: Any,
-    axes: tuple[Any, Any],
-    label: str,
-    maps: tuple[np.ndarray, np.ndarray],
-    sc: Mapping[str, Any],
-    edges: tuple[np.ndarray, np.ndarray],
-) -> None:
-    """The S0 map above the DOP map of one case.
-
-    ``maps`` = (S0, DOP), ``sc`` the S0 scale (:func:`labbrdf._plotting.map_scale`),
-    ``edges`` = (theta_r, phi_r) bin edges [deg].
-    """
-    s0, dop = maps
-    theta_edges_deg, phi_edges_deg = edges
-    s0_name = r"$S_0$ [sr$^{-1}$]" + (f", {sc['note']}" if sc["note"] else "")
-    over = bool(np.nanmax(np.asarray(s0, float), initial=0.0) > sc["vmax"])
-    s0_ext = ("both" if over else "min") if sc["log"] else ("max" if over else "neither")
-    for ax, data, name, cmap, lim, log, ext in (
-        (axes[0], s0, s0_name, "inferno", (sc["vmin"], sc["vmax"]), sc["log"], s0_ext),
-        (axes[1], dop, "DOP [1]", "viridis", (0.0, 1.0), False, "neither"),
-    ):
-        mesh = draw_polar_map(
-            ax,
-            data,
-            theta_edges_deg,
-            phi_edges_deg,
-            title=label,
-            cmap=cmap,
-            vmin=lim[0],
-            vmax=lim[1],
-            log=log,
-        )
-        fig.colorbar(mesh, ax=ax, shrink=0.8, pad=0.12, extend=ext).set_label(name)
 
 
 def save_trace_maps_png(result: Any, path: str | Any, stokes_in: Any = (1, 0, 0, 0)) -> Any:

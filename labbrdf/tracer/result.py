@@ -326,31 +326,13 @@ class TraceResult:
 
     def _draw(self, s: NDArray[np.float64], axes: list[Any]) -> None:
         """The two maps and the cut of :meth:`plot` on ``axes``."""
-        from .._plotting import draw_cut, draw_polar_map, map_scale
+        from .._plotting import draw_cut, draw_polar_pair, map_scale
 
-        fig = axes[0].figure
         s0 = self.s0(s)
+        edges = (self.theta_r_edges_deg, self.phi_r_edges_deg)
+        titles = ("S\u2080", "DOP")
         sc = map_scale(s0, self.s0_scale_max(s))
-        s0_label = r"$S_0$ [sr$^{-1}$]" + (f", {sc['note']}" if sc["note"] else "")
-        over = bool(np.nanmax(s0, initial=0.0) > sc["vmax"])
-        s0_ext = ("both" if over else "min") if sc["log"] else ("max" if over else "neither")
-        for a, data, label, cmap, lim, log, ext in (
-            (axes[0], s0, s0_label, "inferno", (sc["vmin"], sc["vmax"]), sc["log"], s0_ext),
-            (axes[1], self.readable_dop(s), "DOP [1]", "viridis", (0.0, 1.0), False, "neither"),
-        ):
-            mesh = draw_polar_map(
-                a,
-                data,
-                self.theta_r_edges_deg,
-                self.phi_r_edges_deg,
-                title=label,
-                cmap=cmap,
-                vmin=lim[0],
-                vmax=lim[1],
-                log=log,
-            )
-            cb = fig.colorbar(mesh, ax=a, shrink=0.8, pad=0.1, extend=ext)
-            cb.set_label(label)
+        draw_polar_pair((axes[0], axes[1]), titles, (s0, self.readable_dop(s)), sc, edges)
         c = self.in_plane(s)
         draw_cut(axes[2], c["theta_deg"], c["s0"], c["s0_stderr"], c["dop"], c["dop_stderr"])
         axes[2].set_title(
