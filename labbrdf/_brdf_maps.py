@@ -168,7 +168,7 @@ def _draw_row(fig: Any, axes: Sequence[Any], p: Mapping[str, Any], half: bool) -
 
     Returns the residual map (for the colour bar the rows share).
     """
-    from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullLocator
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullLocator
 
     meas = np.asarray(p["measured"], float)
     mod = np.asarray(p["model"], float)
@@ -192,7 +192,7 @@ def _draw_row(fig: Any, axes: Sequence[Any], p: Mapping[str, Any], half: bool) -
     cb.ax.set_title(r"BRDF [sr$^{-1}$]", loc="left")  # above: not read as the next map's
     # ticks at 1, 2 and 5 per decade, all labelled; no crowded minor labels
     cb.ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
-    cb.ax.yaxis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=False))
+    cb.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
     cb.ax.yaxis.set_minor_locator(NullLocator())
     tri, zt = triangulate(p, np.clip(np.asarray(p["residual"], float), -1.0, 1.0))
     res = axes[2].tripcolor(tri, facecolors=zt, cmap="RdBu_r", vmin=-1.0, vmax=1.0)
