@@ -72,7 +72,7 @@ def rc_context() -> Iterator[None]:
     """Draw inside the package's style (matplotlib ``rc_context`` with :data:`RC`)."""
     import matplotlib
 
-    with matplotlib.rc_context(RC):
+    with matplotlib.rc_context(RC):  # type: ignore[arg-type]  # str keys, checked by mpl
         yield
 
 
