@@ -26,6 +26,7 @@ __all__ = [
     "draw_polar_pair",
     "axes_size_in",
     "draw_scan",
+    "legend_below",
     "legend_outside",
     "scan_colours",
     "map_scale",
@@ -273,8 +274,13 @@ def draw_panel(ax: Any, panel: Mapping[str, Any], legend: bool = True) -> None:
     ax.set_title(wrap_label(text(panel.get("title", "")), w_in))
     ax.grid(alpha=0.3)
     if legend and any(s.get("label") for s in series) and len(series) <= 12:
-        # below the axes and their x label: a legend inside would cover data
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.5 / max(h_in, 0.5)), ncol=2)
+        legend_below(ax)
+
+
+def legend_below(ax: Any, ncol: int = 2) -> None:
+    """The legend of ``ax`` below its x label: a legend inside would cover data."""
+    h_in = axes_size_in(ax)[1]
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.5 / max(h_in, 0.5)), ncol=ncol)
 
 
 def axes_size_in(ax: Any) -> tuple[float, float]:

@@ -34,6 +34,7 @@ from .._plotting import (  # noqa: E402
     draw_panel,
     draw_polar_maps,
     draw_scan,
+    legend_below,
     legend_outside,
     polar_maps_size,
 )
@@ -74,12 +75,12 @@ def _layout(fig: Any, title: str | None) -> None:
 
 
 def _finish(fig: Any, ax: Any, title: str | None) -> str:
-    """Grid, legend and title, then the figure as a PNG data URI."""
+    """Grid, title and the legend below the axes, then the figure as a PNG data URI."""
     ax.grid(alpha=0.3)
-    ax.legend()
     if title:
         ax.set_title(_text(title))
     fig.tight_layout()
+    legend_outside(ax, ncol=2)
     return to_uri(fig)
 
 
@@ -489,10 +490,10 @@ def surface_figure(
         ax.plot(np.arange(r1.size) * px[0] * 1e6, r1, label="along x")
     ax.axhline(np.exp(-1.0), color="0.5", ls=":", lw=1, label="1/e")
     ax.set_xlabel("lag [\u00b5m]")
-    ax.set_ylabel("normalised ACF")
+    ax.set_ylabel("normalised ACF [1]")
     c_txt = f"{stats.c * 1e6:.3g} \u00b5m" if np.isfinite(stats.c) else "undefined"
     ax.set_title(f"autocorrelation (c = {c_txt})")
-    ax.legend()
+    legend_below(ax)
     ax = axes[2]
     sx, sy = slopes(z, px, valid)
     areal = sy is not None
@@ -514,9 +515,9 @@ def surface_figure(
             d = dist.radial_density(x, a) if areal else dist.p2(x, a)
             ax.plot(x, d, style, label=f"{fit.model} \u03b1 = {a:.3g} (KS {fit.ks:.2f})")
     ax.set_xlabel("slope magnitude |grad z| [1]" if areal else "slope dz/dx [1]")
-    ax.set_ylabel("density")
+    ax.set_ylabel("probability density [1]")
     ax.set_title("slope distribution")
-    ax.legend()
+    legend_below(ax)
     return _finish_grid(fig, title)
 
 
