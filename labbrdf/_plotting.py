@@ -401,8 +401,9 @@ def draw_polar_map(
     from matplotlib import patheffects  # drawing only: matplotlib is imported by then
 
     halo = [patheffects.withStroke(linewidth=2.5, foreground="w")]
-    # dark labels with a white halo: readable on a dark map and on blank bins alike
-    ax.set_yticklabels(["30\u00b0", "60\u00b0", "90\u00b0"], color="0.15", path_effects=halo)
+    # dark labels with a white halo: readable on a dark map and on blank bins alike (90 deg
+    # is the rim, unlabelled: its label would sit on the azimuth labels)
+    ax.set_yticklabels(["30\u00b0", "60\u00b0", ""], color="0.15", path_effects=halo)
     ax.set_title(title)
     return mesh
 
