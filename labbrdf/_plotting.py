@@ -135,12 +135,19 @@ def draw_scan(ax: Any, axr: Any, series: Sequence[Mapping[str, Any]]) -> Any:
     return scale
 
 
+def _viridis(x: float) -> Any:
+    """The viridis colour at ``x`` in [0, 1] (0.9 at most: the palest yellow is hard to see)."""
+    import matplotlib as mpl  # drawing only: matplotlib is imported by then
+
+    return mpl.colormaps["viridis"](0.9 * x)
+
+
 def robust_ylim(ax: Any, values: Sequence[Any]) -> int:
     """Limit the y axis to the bulk of ``values`` when a few outliers would flatten it.
 
-    When a value lies more than three times the 2-98 percentile span beyond that span
-    (e.g. a relative residual where the model is nearly 0), the axis shows the span with
-    a margin and says how many points are off scale.
+    When a value lies more than ten interquartile ranges beyond the quartiles (e.g. a
+    relative residual where the model is nearly 0), the axis shows the quartiles with a
+    margin of three interquartile ranges and says how many points are off scale.
 
     Returns
     -------
@@ -152,10 +159,10 @@ def robust_ylim(ax: Any, values: Sequence[Any]) -> int:
     v = v[np.isfinite(v)]
     if v.size < 5:
         return 0
-    lo, hi = (float(x) for x in np.percentile(v, [2.0, 98.0]))
+    lo, hi = (float(x) for x in np.percentile(v, [25.0, 75.0]))
     span = (hi - lo) or abs(hi) or 1.0
-    lim = (lo - 0.5 * span, hi + 0.5 * span)
-    if v.min() >= lo - 3.0 * span and v.max() <= hi + 3.0 * span:
+    lim = (lo - 3.0 * span, hi + 3.0 * span)
+    if v.min() >= lo - 10.0 * span and v.max() <= hi + 10.0 * span:
         return 0
     off = int(np.count_nonzero((v < lim[0]) | (v > lim[1])))
     ax.set_ylim(*lim)
@@ -233,8 +240,11 @@ def draw_panel(ax: Any, panel: Mapping[str, Any], legend: bool = True) -> None:
         caller draws one legend for several panels (:func:`legend_outside`).
     """
     series = list(panel.get("series", []))
+    # more series than distinct colours: a sequential scale in their order (never a
+    # repeated colour)
+    many = [_viridis(k / max(1, len(series) - 1)) for k in range(len(series))]
     for k, s in enumerate(series):
-        c = COLOURS[k % len(COLOURS)] if len(series) <= len(COLOURS) else None
+        c = COLOURS[k % len(COLOURS)] if len(series) <= len(COLOURS) else many[k]
         c = s.get("colour", c)
         x = np.asarray(s["x"], float)
         y = np.asarray(s["y"], float)
@@ -273,14 +283,24 @@ def draw_panel(ax: Any, panel: Mapping[str, Any], legend: bool = True) -> None:
     ax.set_ylabel(wrap_label(text(panel.get("ylabel", "")), h_in))
     ax.set_title(wrap_label(text(panel.get("title", "")), w_in))
     ax.grid(alpha=0.3)
-    if legend and any(s.get("label") for s in series) and len(series) <= 12:
+    if legend and any(s.get("label") for s in series) and len(series) <= 16:
         legend_below(ax)
 
 
 def legend_below(ax: Any, ncol: int = 2) -> None:
-    """The legend of ``ax`` below its x label: a legend inside would cover data."""
-    h_in = axes_size_in(ax)[1]
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.5 / max(h_in, 0.5)), ncol=ncol)
+    """The legend of ``ax`` below its tick labels and x label: inside it would cover data.
+
+    The gap is set in font sizes (``borderaxespad``), so it holds whatever the axes'
+    final size after the layout; more than eight entries take four columns.
+    """
+    lines = max(1, ax.get_xlabel().count("\n") + 1) if ax.get_xlabel() else 0
+    n = len(ax.get_legend_handles_labels()[0])
+    ax.legend(
+        loc="upper center",
+        bbox_to_anchor=(0.5, 0.0),
+        borderaxespad=2.2 + 1.4 * lines,
+        ncol=4 if n > 8 else ncol,
+    )
 
 
 def axes_size_in(ax: Any) -> tuple[float, float]:

@@ -454,7 +454,7 @@ def surface_figure(
     z = np.asarray(heights_m, float)
     px = tuple(float(p) for p in pixel_size_m)
     valid = np.isfinite(z)
-    fig, axes = plt.subplots(1, 3, figsize=(PAGE_WIDTH_IN, 3.6))
+    fig, axes = plt.subplots(1, 3, figsize=(PAGE_WIDTH_IN, 4.2))
     ax = axes[0]
     if z.ndim == 2:
         img, ext = height_map_image(z, px)
