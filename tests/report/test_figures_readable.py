@@ -201,7 +201,7 @@ MAKERS = {
     ),
     "brdf_maps": lambda: figures.brdf_maps_figure([_hemisphere_panel(t) for t in (20, 50)]),
     "residual_grid": lambda: figures.brdf_residual_grid_figure(
-        [_hemisphere_panel(t) for t in range(15, 76, 5)], title="residuals"
+        [_hemisphere_panel(t) for t in range(15, 76, 10)], title="residuals"
     ),
     "cuts": lambda: figures.brdf_cuts_figure(
         [
@@ -228,7 +228,7 @@ MAKERS = {
                 "value": [1, 2, 3],
                 "label": "d [nm]",
             }
-            for w in (400, 500, 600, 700, 800)
+            for w in (400, 500, 600)
         ]
     ),
 }
