@@ -434,7 +434,7 @@ def polar_maps_size(n: int) -> tuple[float, float]:
 
     ncol = max(1, min(n, 3))
     w = min(PAGE_WIDTH_IN / ncol, 4.6)
-    return w * ncol, 0.86 * w * 2 * (-(-max(n, 1) // ncol))
+    return w * ncol, 0.95 * w * 2 * (-(-max(n, 1) // ncol))
 
 
 def draw_polar_maps(
