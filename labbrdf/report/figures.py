@@ -693,7 +693,7 @@ def panels_figure(
     """
     n = max(1, len(panels))
     nrows, ncols, w = grid_shape(n, ncols, panel_size[0])
-    h = max(panel_size[1] * w / panel_size[0], PANEL_MIN_IN[1])
+    h = max(panel_size[1] * w / panel_size[0], PANEL_MIN_IN[1]) + _legend_height(panels)
     fig, axes = plt.subplots(
         nrows,
         ncols,
@@ -709,6 +709,12 @@ def panels_figure(
     if shared:
         return _finish_below(fig, axes[0, 0], title)
     return _finish_grid(fig, title)
+
+
+def _legend_height(panels: Sequence[Mapping[str, Any]]) -> float:
+    """Height [inch] the longest legend below a panel needs (two or four columns)."""
+    n = max((sum(1 for s in p.get("series", []) if s.get("label")) for p in panels), default=0)
+    return 0.0 if n <= 2 or n > 16 or _same_legend(panels) else 0.2 * -(-n // (4 if n > 8 else 2))
 
 
 def _same_legend(panels: Sequence[Mapping[str, Any]]) -> bool:
