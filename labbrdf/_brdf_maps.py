@@ -190,8 +190,10 @@ def _draw_row(fig: Any, axes: Sequence[Any], p: Mapping[str, Any], half: bool) -
         draw_disc(axes[j], half)
     cb = fig.colorbar(mesh, ax=list(axes[:2]), shrink=0.8 if half else 0.9)
     cb.ax.set_title(r"BRDF [sr$^{-1}$]", loc="left")  # above: not read as the next map's
-    # ticks at 1, 2 and 5 per decade, all labelled; no crowded minor labels
-    cb.ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+    # ticks at 1, 2 and 5 per decade over a short scale, decades only over a long one; all
+    # labelled, no crowded minor labels
+    subs = (1.0, 2.0, 5.0) if vmax < 30.0 * vmin else (1.0,)
+    cb.ax.yaxis.set_major_locator(LogLocator(subs=subs))
     cb.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))
     cb.ax.yaxis.set_minor_locator(NullLocator())
     tri, zt = triangulate(p, np.clip(np.asarray(p["residual"], float), -1.0, 1.0))
