@@ -191,6 +191,9 @@ MAKERS = {
         {"label": "spectrophotometer", "wavelength": [400, 500, 600], "value": [0.5, 0.6, 0.7]},
         [{"label": "integral", "wavelength": [500], "value": [0.6]}],
     ),
+    "spectrum": lambda: figures.spectrum_figure(
+        [400, 500, 600], [0.5, 0.6, 0.7], [380, 500, 780], [0.5, 0.6, 0.7], title="S"
+    ),
     "polar_maps": lambda: figures.polar_maps_figure(
         ["a", "b"],
         [_spike_map()] * N_POLAR_CASES,
