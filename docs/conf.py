@@ -55,7 +55,7 @@ nitpick_ignore_regex = [(r"py:.*", r"(?!labbrdf\b).*")]
 
 html_theme = "alabaster"
 html_title = "labbrdf"
-html_static_path: list[str] = []
+html_static_path = ["_static"]  # custom.css: code blocks wrap, the body takes the page
 templates_path = ["_templates"]
 html_theme_options = {
     "description": "Optical metrology of surfaces: files to fits to reports",

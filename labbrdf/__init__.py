@@ -28,8 +28,8 @@ so that ``import labbrdf`` stays cheap, and ``dir(labbrdf)`` lists them all:
 The subpackages and modules (``labbrdf.optics``, ``labbrdf.nk``, ...) are attributes too.
 The public face is written once, in the tables ``_LAZY`` (names) and ``_MODULES``
 (modules) below: ``__all__``, ``dir(labbrdf)`` and the attribute look-up follow from them.
-The plumbing modules (``_PLUMBING``: ``cli``, ``jsonsafe``, ``outputs``, ``progress``,
-``provenance``, ``richrepr``) are not offered; import them by path.
+The plumbing modules (``_PLUMBING``: ``cli``, ``figstyle``, ``jsonsafe``, ``outputs``,
+``progress``, ``provenance``, ``richrepr``) are not offered; import them by path.
 """
 
 from __future__ import annotations
@@ -118,9 +118,9 @@ _MOVED = {
 }
 
 #: plumbing the modules above share (the command line, JSON sanitising, output safety,
-#: the progress line, provenance, rich displays): importable by path
+#: the figure style, the progress line, provenance, rich displays): importable by path
 #: (``import labbrdf.cli``), not offered
-_PLUMBING = ("cli", "jsonsafe", "outputs", "progress", "provenance", "richrepr")
+_PLUMBING = ("cli", "figstyle", "jsonsafe", "outputs", "progress", "provenance", "richrepr")
 
 #: the public face, derived from the tables above; ``dir(labbrdf)`` lists it
 __all__ = ["__version__", *_LAZY, *_MODULES, *_MOVED]

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from .._plotting import curve_grid, draw_scan
+from .._plotting import curve_grid, draw_scan, legend_outside
 from ..jsonsafe import jsonable
 from ..models import ModelError, Parameters
 from ..models import get as get_model
@@ -194,59 +194,116 @@ class FitResult:
         return self.params.values()
 
     def plot(self, ax: Any = None) -> Any:
-        """Data with 1-sigma bars and the fitted model, residuals below, as lmfit's plot.
+        """The fit against its data: scans with residuals, or maps over the hemisphere.
 
-        One colour and marker per (incidence angle, detector azimuth) scan: the measured
+        In-plane data (every point in the plane of incidence, phi_r = 0 or 180 deg): one
+        colour and marker per (incidence angle, detector azimuth) scan, the measured
         points against theta_r with their file sigmas, the fitted model as a line (the
         report's scan figures draw the same way), and below the residuals ``y - f``
-        (:attr:`residual`) at the points.
+        (:attr:`residual`) at the points; more scans than seven are coloured by their
+        angle of incidence (a colour bar) and the legend, below the axes, names the
+        styles.
+
+        Hemispherical data (any other azimuth): per angle of incidence a row of three
+        maps of the projected hemisphere, measured, model and relative residual
+        ``(model - measured) / measured``, drawn as ``labbrdf fit --residual-maps`` draws
+        them (:func:`labbrdf._brdf_maps.draw_brdf_maps`): thousands of scans of a few
+        points each would be unreadable as lines, and slow to draw.
 
         Parameters
         ----------
         ax : pair of matplotlib Axes, optional
-            The data axes and the residual axes; default a new figure with the residuals
-            in a short panel below the data.
+            In-plane data: the data axes and the residual axes; default a new figure
+            with the residuals in a short panel below the data. Hemispherical data: not
+            accepted (the maps make their own figure).
 
         Returns
         -------
         matplotlib Figure
+            In the package's style (:mod:`labbrdf.figstyle`: readable at 96 dpi).
 
         Raises
         ------
         ValueError
             The result carries no data (built by hand) or is a film fit (its points
-            mix psi, Delta, R and T, which have no common axis).
+            mix psi, Delta, R and T, which have no common axis); ``ax`` given for
+            hemispherical data.
 
         Notes
         -----
         The model line is evaluated on 121 detector angles across the measured ones when
         the model is in the registry (:func:`labbrdf.models.get` with :attr:`options`);
         a model from outside the registry is drawn through its values at the data points.
+        The maps show the model at the data points (:attr:`best_fit`).
         """
+        from ..figstyle import rc_context
+
+        with rc_context():
+            if self._hemispherical():
+                if ax is not None:
+                    raise ValueError(
+                        "ax: hemispherical data are drawn as maps in a figure of their own; "
+                        "call plot() without ax"
+                    )
+                return self._plot_maps()
+            return self._plot_scans(ax)
+
+    def _hemispherical(self) -> bool:
+        """Whether the fitted points leave the plane of incidence (phi_r not 0 or 180 deg)."""
+        d = self._plot_data()
+        pr = np.mod(np.asarray(d.phi_r_deg, float), 360.0)
+        return bool(np.any((np.abs(pr) > 1e-6) & (np.abs(pr - 180.0) > 1e-6)))
+
+    def _plot_maps(self) -> Any:
+        """Measured, model and residual maps per angle of incidence (hemispherical data)."""
+        import matplotlib.pyplot as plt
+
+        from .._brdf_maps import draw_brdf_maps, map_panels, maps_size
+        from ..figstyle import PAGE_WIDTH_IN
+
+        d = self._plot_data()
+        y = np.asarray(d.value, float)
+        panels = map_panels(
+            np.broadcast_to(np.asarray(d.theta_i_deg, float), y.shape),
+            np.broadcast_to(np.asarray(d.theta_r_deg, float), y.shape),
+            np.broadcast_to(np.asarray(d.phi_r_deg, float), y.shape),
+            y,
+            np.asarray(self.best_fit, float),
+            f"{self.model} (one fit, all incidences)",
+        )
+        fig = plt.figure(figsize=maps_size(panels, PAGE_WIDTH_IN), layout="constrained")
+        draw_brdf_maps(fig, panels)
+        fig.suptitle(f"{self.model}: chisqr {self.chisqr:.6g}, redchi {self.redchi:.4g}")
+        return fig
+
+    def _plot_scans(self, ax: Any) -> Any:
+        """Scans with model lines and residuals below (in-plane data)."""
         series = self._scan_series()
         if ax is None:
             import matplotlib.pyplot as plt
+
+            from ..figstyle import PANEL_MIN_IN
 
             fig, ax = plt.subplots(
                 2,
                 1,
                 sharex=True,
-                figsize=(6.4, 5.2),
+                figsize=(2.4 * PANEL_MIN_IN[0], 5.6),
                 gridspec_kw={"height_ratios": [3, 1.2]},
                 layout="constrained",
             )
         axes = np.asarray(ax, dtype=object).ravel()
         if axes.size != 2:
             raise ValueError(f"ax: expected two Axes (data, residuals), got {axes.size}")
-        draw_scan(axes[0], axes[1], series)
+        scale = draw_scan(axes[0], axes[1], series)
         axes[0].set_ylabel(f"{self.quantity} [{self.unit}]")
         axes[1].set_ylabel(f"residual [{self.unit}]")
         axes[0].set_title(f"{self.model}: chisqr {self.chisqr:.6g}, redchi {self.redchi:.4g}")
-        axes[0].legend(fontsize=7, loc="best")
+        legend_outside(axes[0], scale, ncol=3)
         return axes[0].figure
 
-    def _scan_series(self) -> list[dict[str, Any]]:
-        """The data, model and residual of each (theta_i, phi_r) scan, for :meth:`plot`."""
+    def _plot_data(self) -> FitData:
+        """:attr:`data`, or the reason it cannot be drawn."""
         d = self.data
         if d is None or self.best_fit is None or self.residual is None:
             raise ValueError(
@@ -257,6 +314,11 @@ class FitResult:
                 "a film fit mixes psi, Delta, R and T in one residual vector: plot its "
                 "channels from FilmFit.data instead"
             )
+        return d
+
+    def _scan_series(self) -> list[dict[str, Any]]:
+        """The data, model and residual of each (theta_i, phi_r) scan, for :meth:`plot`."""
+        d = self._plot_data()
         try:
             model = get_model(self.model, **self.options)
         except ModelError:

@@ -20,10 +20,26 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
+from .._brdf_maps import (  # noqa: E402
+    draw_brdf_maps,
+    draw_disc,
+    is_half,
+    map_panels,
+    maps_size,
+    triangulate,
+)
 from .._plotting import COLOURS as _COLOURS  # noqa: E402
 from .._plotting import MARKERS as _MARKERS  # noqa: E402
-from .._plotting import draw_panel, draw_polar_map, draw_scan  # noqa: E402
+from .._plotting import (  # noqa: E402
+    draw_panel,
+    draw_polar_maps,
+    draw_scan,
+    legend_below,
+    legend_outside,
+    polar_maps_size,
+)
 from .._plotting import text as _text  # noqa: E402
+from ..figstyle import DPI, PAGE_WIDTH_IN, PANEL_MIN_IN, grid_shape, styled  # noqa: E402
 
 __all__ = [
     "save_trace_maps_png",
@@ -38,8 +54,6 @@ __all__ = [
     "xy_figure",
 ]
 
-DPI = 80
-
 
 def to_uri(fig: Figure, dpi: int = DPI) -> str:
     """Render ``fig`` to PNG and return it as a data URI; the figure is closed."""
@@ -51,24 +65,39 @@ def to_uri(fig: Figure, dpi: int = DPI) -> str:
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
+def _layout(fig: Any, title: str | None) -> None:
+    """The figure's title (if any) in a band of its own above the tight layout."""
+    if not title:
+        fig.tight_layout()
+        return
+    fig.suptitle(_text(title))
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - 0.32 / fig.get_size_inches()[1]))
+
+
 def _finish(fig: Any, ax: Any, title: str | None) -> str:
-    """Grid, legend and title, then the figure as a PNG data URI."""
+    """Grid, title and the legend below the axes, then the figure as a PNG data URI."""
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
     if title:
-        ax.set_title(_text(title), fontsize=10)
+        ax.set_title(_text(title))
     fig.tight_layout()
+    legend_outside(ax, ncol=2)
     return to_uri(fig)
 
 
-def _finish_grid(fig: Any, title: str | None, fontsize: float = 12.0, dpi: int = DPI) -> str:
+def _finish_below(fig: Any, ax: Any, title: str | None) -> str:
+    """Title, tight layout and the legend of ``ax`` below the figure, as a PNG data URI."""
+    _layout(fig, title)
+    legend_outside(ax)
+    return to_uri(fig)
+
+
+def _finish_grid(fig: Any, title: str | None) -> str:
     """Figure title (if any), tight layout, then the figure as a PNG data URI."""
-    if title:
-        fig.suptitle(_text(title), fontsize=fontsize)
-    fig.tight_layout()
-    return to_uri(fig, dpi=dpi)
+    _layout(fig, title)
+    return to_uri(fig)
 
 
+@styled
 def scan_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
     """Measured points and model curves per incidence angle, with residuals (Figs. 2-3 style).
 
@@ -88,20 +117,47 @@ def scan_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
         PNG data URI.
     """
     n = max(1, len(panels))
+    nrow, ncol, w = grid_shape(n, 4, min(PAGE_WIDTH_IN / min(n, 4), 6.5))
     fig, axes = plt.subplots(
-        2, n, figsize=(3.3 * n, 5.4), squeeze=False, gridspec_kw={"height_ratios": [3, 1.4]}
+        2 * nrow,
+        ncol,
+        figsize=(ncol * w, 5.2 * nrow),
+        squeeze=False,
+        gridspec_kw={"height_ratios": [3, 1.4] * nrow},
     )
-    for j, panel in enumerate(panels):
-        ax, axr = axes[0, j], axes[1, j]
-        draw_scan(ax, axr, panel["series"])
-        ax.set_title(_text(panel["label"]), fontsize=10)
-        if j == 0:
+    scales: dict[int, Any] = {}
+    for j in range(nrow * ncol):
+        ax, axr = axes[2 * (j // ncol), j % ncol], axes[2 * (j // ncol) + 1, j % ncol]
+        if j >= len(panels):
+            ax.set_visible(False)
+            axr.set_visible(False)
+            continue
+        panel = panels[j]
+        scales[j] = draw_scan(ax, axr, panel["series"])
+        ax.set_title(_text(panel["label"]))
+        if j % ncol == 0:
             ax.set_ylabel(r"BRDF [sr$^{-1}$]")
             axr.set_ylabel("residual [%]")
-    axes[0, 0].legend(fontsize=6.5, loc="best")
-    return _finish_grid(fig, title, fontsize=11)
+    _layout(fig, title)
+    _scan_legend(fig, axes, scales)
+    return to_uri(fig)
 
 
+def _scan_legend(fig: Any, axes: Any, scales: Mapping[int, Any]) -> None:
+    """One legend below the figure; the incidence angle's colour bar beside each panel.
+
+    Only panels whose scans are coloured by the angle (:func:`labbrdf._plotting.draw_scan`)
+    get one.
+    """
+    ncol = axes.shape[1]
+    for j, scale in scales.items():
+        if scale is not None:
+            pair = [axes[2 * (j // ncol), j % ncol], axes[2 * (j // ncol) + 1, j % ncol]]
+            fig.colorbar(scale, ax=pair, pad=0.02).set_label(r"$\theta_i$ [deg]")
+    legend_outside(axes[0, 0], None)
+
+
+@styled
 def spectra_figure(
     params: Sequence[str],
     units: Mapping[str, str],
@@ -121,9 +177,12 @@ def spectra_figure(
         "lo": {p: array}, "hi": {p: array}, "style": "fit" | "published"}``.
     """
     n = max(1, len(params))
-    fig, axes = plt.subplots(1, n, figsize=(3.4 * n, 3.2), squeeze=False)
+    nrow, ncol, w = grid_shape(n, 4, 3.6)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(ncol * w, 3.2 * nrow), squeeze=False)
+    for ax in axes.ravel()[n:]:
+        ax.set_visible(False)
     for j, p in enumerate(params):
-        ax = axes[0, j]
+        ax = axes.ravel()[j]
         for k, s in enumerate(series):
             wl = np.asarray(s["wavelength"], float)
             v = np.asarray(s["values"][p], float)
@@ -154,10 +213,10 @@ def spectra_figure(
         ax.set_xlabel("wavelength [nm]")
         ax.set_ylabel(f"{p} [{units.get(p, '1')}]")
         ax.grid(alpha=0.3)
-    axes[0, 0].legend(fontsize=7)
-    return _finish_grid(fig, title, fontsize=11)
+    return _finish_below(fig, axes[0, 0], title)
 
 
+@styled
 def compare_models_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
     """Measured BRDF against two fitted models at one incidence angle (Fig. 4 style).
 
@@ -165,9 +224,12 @@ def compare_models_figure(panels: Sequence[Mapping[str, Any]], title: str = "") 
     "curves": {name: array}}``.
     """
     n = max(1, len(panels))
-    fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.2), squeeze=False)
+    nrow, ncol, w = grid_shape(n, 3, 3.6)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(ncol * w, 3.4 * nrow), squeeze=False)
+    for ax in axes.ravel()[n:]:
+        ax.set_visible(False)
     for j, p in enumerate(panels):
-        ax = axes[0, j]
+        ax = axes.ravel()[j]
         ax.plot(p["theta_r"], p["value"], "*", color="0.15", ms=6, label="measured")
         for q, (name, curve) in enumerate(p["curves"].items()):
             ax.plot(
@@ -180,15 +242,15 @@ def compare_models_figure(panels: Sequence[Mapping[str, Any]], title: str = "") 
                 lw=1.2,
                 label=_text(name),
             )
-        ax.set_title(_text(p["label"]), fontsize=10)
+        ax.set_title(_text(p["label"]))
         ax.set_xlabel(r"$\theta_r$ [deg]")
-        if j == 0:
+        if j % ncol == 0:
             ax.set_ylabel(r"BRDF [sr$^{-1}$]")
         ax.grid(alpha=0.3)
-    axes[0, 0].legend(fontsize=7)
-    return _finish_grid(fig, title, fontsize=11)
+    return _finish_below(fig, axes[0, 0], title)
 
 
+@styled
 def hemispherical_figure(
     measured: Mapping[str, Any] | None,
     points: Sequence[Mapping[str, Any]],
@@ -224,6 +286,7 @@ def hemispherical_figure(
     return _finish(fig, ax, title)
 
 
+@styled
 def spectrum_figure(
     wavelength: Any,
     value: Any,
@@ -248,6 +311,7 @@ def spectrum_figure(
     return _finish(fig, ax, title)
 
 
+@styled
 def xy_figure(
     series: Sequence[Mapping[str, Any]],
     xlabel: str,
@@ -275,6 +339,7 @@ def xy_figure(
     return _finish(fig, ax, title)
 
 
+@styled
 def polar_maps_figure(
     labels: Sequence[str],
     s0: Sequence[np.ndarray],
@@ -288,7 +353,8 @@ def polar_maps_figure(
 
     Polar axes: azimuth = phi_r (outward, source at 0, specular half-plane at 180 deg),
     radius = theta_r [deg]. S0 is the pBRDF element M00 [sr^-1] for unpolarized input
-    (shared colour scale per row is NOT used: each case gets its own, the paper's way);
+    (shared colour scale per row is NOT used: each case gets its own, the paper's way;
+    but all are log scales when one case needs it, :func:`labbrdf._plotting.map_scale`);
     DOP is dimensionless in [0, 1].
 
     Parameters
@@ -301,49 +367,20 @@ def polar_maps_figure(
     s0_max : sequence of float or None, optional
         Upper end of each S0 colour scale (e.g. ignoring bins with few rays).
     """
-    n = max(1, len(labels))
-    fig, axes = plt.subplots(
-        2, n, figsize=(3.3 * n, 6.6), subplot_kw={"projection": "polar"}, squeeze=False
-    )
-    for j in range(len(labels)):
-        for i, (data, name, cmap, lim) in enumerate(
-            (
-                (s0[j], r"$S_0$ [sr$^{-1}$]", "inferno", (None, None)),
-                (dop[j], "DOP [1]", "viridis", (0.0, 1.0)),
-            )
-        ):
-            ax = axes[i, j]
-            if i == 0 and s0_max is not None and s0_max[j] is not None:
-                lim = (0.0, s0_max[j])
-            mesh = draw_polar_map(
-                ax,
-                data,
-                theta_edges_deg,
-                phi_edges_deg,
-                title=f"{_text(labels[j])}\n{name}",
-                cmap=cmap,
-                vmin=lim[0],
-                vmax=lim[1],
-            )
-            cb = fig.colorbar(mesh, ax=ax, shrink=0.7, pad=0.1)
-            cb.ax.tick_params(labelsize=6)
-    fig.text(
-        0.01,
-        0.01,
-        r"angle: $\varphi_r$ [deg] (specular at 180); radius: "
-        r"$\theta_r$ [deg]",
-        fontsize=7,
-    )
-    return _finish_grid(fig, title, fontsize=11)
+    fig = plt.figure(figsize=polar_maps_size(len(labels)))
+    draw_polar_maps(fig, labels, (s0, dop), (theta_edges_deg, phi_edges_deg), s0_max)
+    return _finish_grid(fig, title)
 
 
 def save_trace_maps_png(result: Any, path: str | Any, stokes_in: Any = (1, 0, 0, 0)) -> Any:
-    """Write the S0 and DOP hemisphere maps of one tracer result to a PNG file.
+    """Write the S0 and DOP hemisphere maps and the in-plane cut of a tracer result to PNG.
+
+    The figure is :meth:`labbrdf.tracer.TraceResult.plot` (the same as in a notebook) at
+    :data:`labbrdf.figstyle.DPI`.
 
     Parameters
     ----------
     result : labbrdf.tracer.TraceResult
-        Needs ``mueller`` (n_theta, n_phi, 4, 4) [sr^-1] and the bin edges [deg].
     path : path-like
         Output ``.png``.
     stokes_in : sequence of 4 floats
@@ -353,20 +390,7 @@ def save_trace_maps_png(result: Any, path: str | Any, stokes_in: Any = (1, 0, 0,
     -------
     pathlib.Path
     """
-    m = np.asarray(result.mueller, float)
-    s = m @ np.asarray(stokes_in, float)
-    s0 = s[..., 0]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        dop = np.where(s0 > 0, np.sqrt(np.sum(s[..., 1:] ** 2, axis=-1)) / s0, np.nan)
-    uri = polar_maps_figure(
-        ["tracer"],
-        [s0],
-        [dop],
-        np.asarray(result.theta_r_edges_deg, float),
-        np.asarray(result.phi_r_edges_deg, float),
-        title=f"input Stokes {list(stokes_in)}",
-    )
-    return save_png(uri, path)
+    return save_png(to_uri(result.plot(stokes_in)), path)
 
 
 def height_map_image(heights_m: Any, pixel_size_m: Sequence[float]) -> tuple[Any, list[float]]:
@@ -392,6 +416,7 @@ def height_map_image(heights_m: Any, pixel_size_m: Sequence[float]) -> tuple[Any
     return z.T, [0.0, z.shape[0] * dx * 1e6, z.shape[1] * dy * 1e6, 0.0]
 
 
+@styled
 def surface_figure(
     heights_m: Any, pixel_size_m: Sequence[float], stats: Any, title: str = ""
 ) -> str:
@@ -429,7 +454,7 @@ def surface_figure(
     z = np.asarray(heights_m, float)
     px = tuple(float(p) for p in pixel_size_m)
     valid = np.isfinite(z)
-    fig, axes = plt.subplots(1, 3, figsize=(13.5, 4.0))
+    fig, axes = plt.subplots(1, 3, figsize=(PAGE_WIDTH_IN, 4.2))
     ax = axes[0]
     if z.ndim == 2:
         img, ext = height_map_image(z, px)
@@ -465,10 +490,10 @@ def surface_figure(
         ax.plot(np.arange(r1.size) * px[0] * 1e6, r1, label="along x")
     ax.axhline(np.exp(-1.0), color="0.5", ls=":", lw=1, label="1/e")
     ax.set_xlabel("lag [\u00b5m]")
-    ax.set_ylabel("normalised ACF")
+    ax.set_ylabel("normalised ACF [1]")
     c_txt = f"{stats.c * 1e6:.3g} \u00b5m" if np.isfinite(stats.c) else "undefined"
     ax.set_title(f"autocorrelation (c = {c_txt})")
-    ax.legend(fontsize=8)
+    legend_below(ax)
     ax = axes[2]
     sx, sy = slopes(z, px, valid)
     areal = sy is not None
@@ -490,9 +515,9 @@ def surface_figure(
             d = dist.radial_density(x, a) if areal else dist.p2(x, a)
             ax.plot(x, d, style, label=f"{fit.model} \u03b1 = {a:.3g} (KS {fit.ks:.2f})")
     ax.set_xlabel("slope magnitude |grad z| [1]" if areal else "slope dz/dx [1]")
-    ax.set_ylabel("density")
+    ax.set_ylabel("probability density [1]")
     ax.set_title("slope distribution")
-    ax.legend(fontsize=8)
+    legend_below(ax)
     return _finish_grid(fig, title)
 
 
@@ -523,36 +548,12 @@ def save_png(uri: str, path: Any) -> Any:
 # --------------------------------------------------------------------------- measured BRDF
 
 
-def _disc(ax: Any, half: bool) -> None:
-    """Guide circles at theta_r = 30, 60, 90 deg on a projected-hemisphere axis [deg]."""
-    t = np.linspace(0.0, np.pi if half else 2.0 * np.pi, 181)
-    for r in (30.0, 60.0, 90.0):
-        ax.plot(r * np.cos(t), r * np.sin(t), color="0.6", lw=0.5)
-    ax.set_aspect("equal")
-    ax.set_xlim(-92, 92)
-    ax.set_ylim(-2 if half else -92, 92)
-    ax.tick_params(labelsize=6)
-
-
-def _tri(panel: Mapping[str, Any], z: np.ndarray) -> tuple[Any, np.ndarray]:
-    """Delaunay triangulation of a panel's directions in the projected disc; z per triangle."""
-    from matplotlib.tri import Triangulation
-
-    tr = np.radians(np.asarray(panel["phi_r"], float))
-    x = np.asarray(panel["theta_r"], float) * np.cos(tr)
-    y = np.asarray(panel["theta_r"], float) * np.sin(tr)
-    tri = Triangulation(x, y)
-    zt = np.mean(np.asarray(z, float)[tri.triangles], axis=1)
-    bad = ~np.isfinite(zt)
-    # no triangle wider than 25 deg (bridging a hole in the sampling)
-    xy = np.stack([x, y], axis=1)[tri.triangles]
-    span = np.max(np.linalg.norm(xy - np.roll(xy, 1, axis=1), axis=2), axis=1)
-    tri.set_mask(bad | (span > 25.0))
-    return tri, np.where(bad, 0.0, zt)
-
-
+@styled
 def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
     """Measured BRDF, fitted model and relative residual per angle of incidence (one row each).
+
+    Drawn by :func:`labbrdf._brdf_maps.draw_brdf_maps` (as ``fit --residual-maps`` and
+    :meth:`labbrdf.FitResult.plot` of hemispherical data).
 
     Parameters
     ----------
@@ -569,60 +570,27 @@ def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
         PNG data URI. Projected hemisphere: x = theta_r cos phi_r, y = theta_r sin phi_r
         [deg]; BRDF on a log10 colour scale shared by measured and model in a row.
     """
-    from matplotlib.colors import LogNorm
-
-    n = max(1, len(panels))
-    half = all(np.all(np.asarray(p["phi_r"]) <= 180.0 + 1e-9) for p in panels)
-    h = 2.1 if half else 3.4
-    fig, axes = plt.subplots(n, 3, figsize=(11.0, h * n + 0.6), squeeze=False)
-    for i, p in enumerate(panels):
-        meas = np.asarray(p["measured"], float)
-        mod = np.asarray(p["model"], float)
-        pos = np.concatenate([meas[meas > 0], mod[mod > 0]])
-        vmin = float(np.percentile(pos, 1)) if pos.size else 1e-3
-        vmax = float(np.max(pos)) if pos.size else 1.0
-        norm = LogNorm(vmin=vmin, vmax=max(vmax, vmin * 10))
-        mod_name = str(p.get("model_label", "model (per-incidence fit)"))
-        for j, (z, name) in enumerate(((meas, "measured"), (mod, mod_name))):
-            zz = np.where(z > 0, np.clip(z, vmin, None), np.nan)
-            tri, zt = _tri(p, zz)
-            ax = axes[i, j]
-            mesh = ax.tripcolor(
-                tri, facecolors=np.where(zt > 0, zt, vmin), cmap="inferno", norm=norm
-            )
-            _disc(ax, half)
-            ax.set_title(f"{_text(p['label'])}: {name}", fontsize=8)
-            cb = fig.colorbar(mesh, ax=ax, shrink=0.6 if half else 0.8)
-            cb.set_label(r"BRDF [sr$^{-1}$]", fontsize=7)
-            cb.ax.tick_params(which="both", labelsize=6)
-        tri, zt = _tri(p, np.clip(np.asarray(p["residual"], float), -1.0, 1.0))
-        ax = axes[i, 2]
-        mesh = ax.tripcolor(tri, facecolors=zt, cmap="RdBu_r", vmin=-1.0, vmax=1.0)
-        _disc(ax, half)
-        rname = str(p.get("residual_label", "(model - measured) / measured"))
-        ax.set_title(f"{_text(p['label'])}: {rname}", fontsize=8)
-        cb = fig.colorbar(mesh, ax=ax, shrink=0.6 if half else 0.8)
-        cb.set_label("relative residual [1]", fontsize=7)
-        cb.ax.tick_params(which="both", labelsize=6)
-        axes[i, 0].set_ylabel(r"$\theta_r \sin\varphi_r$ [deg]", fontsize=7)
-    for ax in axes[-1]:
-        ax.set_xlabel(r"$\theta_r \cos\varphi_r$ [deg]", fontsize=7)
-    return _finish_grid(fig, title, fontsize=10, dpi=100)
+    fig = plt.figure(figsize=maps_size(panels, PAGE_WIDTH_IN), layout="constrained")
+    draw_brdf_maps(fig, panels)
+    if title:
+        fig.suptitle(_text(title))
+    return to_uri(fig)
 
 
+@styled
 def brdf_residual_grid_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
     """Relative residual maps of every angle of incidence as small multiples (5 per row).
 
     ``panels`` as for :func:`brdf_maps_figure` (``residual`` [1] is used).
     """
     n = max(1, len(panels))
-    ncol = min(5, n)
+    ncol = min(4, n)
     nrow = -(-n // ncol)
-    half = all(np.all(np.asarray(p["phi_r"]) <= 180.0 + 1e-9) for p in panels)
+    half = is_half(panels)
     fig, axes = plt.subplots(
         nrow,
         ncol,
-        figsize=(2.4 * ncol + 1.0, (1.45 if half else 2.4) * nrow + 0.6),
+        figsize=(2.5 * ncol + 1.0, (1.6 if half else 2.6) * nrow + 0.6),
         squeeze=False,
     )
     mesh = None
@@ -631,22 +599,20 @@ def brdf_residual_grid_figure(panels: Sequence[Mapping[str, Any]], title: str = 
             ax.axis("off")
             continue
         p = panels[k]
-        tri, zt = _tri(p, np.clip(np.asarray(p["residual"], float), -1.0, 1.0))
+        tri, zt = triangulate(p, np.clip(np.asarray(p["residual"], float), -1.0, 1.0))
         mesh = ax.tripcolor(tri, facecolors=zt, cmap="RdBu_r", vmin=-1.0, vmax=1.0)
-        _disc(ax, half)
-        ax.set_title(_text(p["label"]), fontsize=8)
+        draw_disc(ax, half)
+        ax.set_title(_text(p["label"]))
     if mesh is not None:
         cb = fig.colorbar(mesh, ax=axes.ravel().tolist(), shrink=0.8)
-        cb.set_label("(model - measured) / measured [1]", fontsize=7)
-        cb.ax.tick_params(which="both", labelsize=6)
-    fig.text(
-        0.01, 0.005, r"axes: $\theta_r\cos\varphi_r$, $\theta_r\sin\varphi_r$ [deg]", fontsize=7
-    )
+        cb.set_label("(model - measured) / measured [1]")
+    fig.text(0.01, 0.005, r"axes: $\theta_r\cos\varphi_r$, $\theta_r\sin\varphi_r$ [deg]")
     if title:
-        fig.suptitle(_text(title), fontsize=10)
-    return to_uri(fig, dpi=100)
+        fig.suptitle(_text(title))
+    return to_uri(fig)
 
 
+@styled
 def brdf_cuts_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
     """In-plane BRDF cuts with model curves, one small panel per angle of incidence.
 
@@ -658,10 +624,9 @@ def brdf_cuts_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
     title : str
     """
     n = max(1, len(panels))
-    ncol = min(4, n)
-    nrow = -(-n // ncol)
+    nrow, ncol, w = grid_shape(n, 3, 3.6)
     fig, axes = plt.subplots(
-        nrow, ncol, figsize=(2.9 * ncol, 2.3 * nrow + 0.4), squeeze=False, sharex=True
+        nrow, ncol, figsize=(ncol * w, 2.8 * nrow + 0.4), squeeze=False, sharex=True
     )
     for k, ax in enumerate(axes.ravel()):
         if k >= len(panels):
@@ -684,21 +649,20 @@ def brdf_cuts_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> st
         ax.axvline(float(p["specular"]), color="0.5", ls=":", lw=0.8)
         if ok.any():
             ax.set_ylim(0.5 * float(y[ok].min()), 2.0 * float(y[ok].max()))
-        ax.set_title(_text(p["label"]), fontsize=8)
-        ax.tick_params(which="both", labelsize=6, labelbottom=True)
+        ax.set_title(_text(p["label"]))
+        ax.tick_params(which="both", labelbottom=True)
         ax.grid(alpha=0.3)
         if k % ncol == 0:
-            ax.set_ylabel(r"BRDF [sr$^{-1}$]", fontsize=7)
+            ax.set_ylabel(r"BRDF [sr$^{-1}$]")
         if k >= len(panels) - ncol:
-            ax.set_xlabel(r"signed $\theta_r$ [deg] (+: specular side)", fontsize=7)
-        if k == 0:
-            ax.legend(fontsize=6)
-    return _finish_grid(fig, title, fontsize=10)
+            ax.set_xlabel(r"signed $\theta_r$ [deg] (+: specular side)")
+    return _finish_below(fig, axes[0, 0], title)
 
 
 # --------------------------------------------------------------------------- measured data
 
 
+@styled
 def panels_figure(
     panels: Sequence[Mapping[str, Any]],
     title: str = "",
@@ -728,22 +692,38 @@ def panels_figure(
         PNG data URI.
     """
     n = max(1, len(panels))
-    ncols = max(1, min(ncols, n))
-    nrows = (n + ncols - 1) // ncols
+    nrows, ncols, w = grid_shape(n, ncols, panel_size[0])
+    h = max(panel_size[1] * w / panel_size[0], PANEL_MIN_IN[1]) + _legend_height(panels)
     fig, axes = plt.subplots(
         nrows,
         ncols,
-        figsize=(panel_size[0] * ncols, panel_size[1] * nrows + (0.4 if title else 0.0)),
+        figsize=(w * ncols, h * nrows + (0.4 if title else 0.0)),
         squeeze=False,
     )
+    shared = _same_legend(panels)
     for j, ax in enumerate(axes.ravel()):
         if j >= len(panels):
             ax.set_visible(False)
             continue
-        draw_panel(ax, panels[j])
-    return _finish_grid(fig, title, fontsize=10)
+        draw_panel(ax, panels[j], legend=not shared)
+    if shared:
+        return _finish_below(fig, axes[0, 0], title)
+    return _finish_grid(fig, title)
 
 
+def _legend_height(panels: Sequence[Mapping[str, Any]]) -> float:
+    """Height [inch] the longest legend below a panel needs (two or four columns)."""
+    n = max((sum(1 for s in p.get("series", []) if s.get("label")) for p in panels), default=0)
+    return 0.0 if n <= 2 or n > 16 or _same_legend(panels) else 0.2 * -(-n // (4 if n > 8 else 2))
+
+
+def _same_legend(panels: Sequence[Mapping[str, Any]]) -> bool:
+    """Whether every panel has the same, non-empty series labels (one legend for all)."""
+    keys = {tuple(str(s.get("label", "")) for s in p.get("series", [])) for p in panels}
+    return len(panels) > 1 and len(keys) == 1 and any(next(iter(keys)))
+
+
+@styled
 def map_figure(
     panels: Sequence[Mapping[str, Any]],
     title: str = "",
@@ -767,9 +747,8 @@ def map_figure(
         PNG data URI.
     """
     n = max(1, len(panels))
-    ncols = max(1, min(ncols, n))
-    nrows = (n + ncols - 1) // ncols
-    fig, axes = plt.subplots(nrows, ncols, figsize=(3.3 * ncols, 2.9 * nrows), squeeze=False)
+    nrows, ncols, w = grid_shape(n, ncols, 3.6)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(w * ncols, 0.88 * w * nrows), squeeze=False)
     for j, ax in enumerate(axes.ravel()):
         if j >= len(panels):
             ax.set_visible(False)
@@ -777,15 +756,13 @@ def map_figure(
         p = panels[j]
         sc = ax.scatter(p["x"], p["y"], c=p["value"], s=60, cmap="viridis", edgecolors="k")
         cb = fig.colorbar(sc, ax=ax)
-        cb.set_label(_text(p.get("label", "")), fontsize=7)
-        cb.ax.tick_params(labelsize=6)
-        ax.set_xlabel("stage x [mm]", fontsize=8)
-        ax.set_ylabel("stage y [mm]", fontsize=8)
-        ax.set_title(_text(p.get("title", "")), fontsize=8.5)
+        cb.set_label(_text(p.get("label", "")))
+        ax.set_xlabel("stage x [mm]")
+        ax.set_ylabel("stage y [mm]")
+        ax.set_title(_text(p.get("title", "")))
         ax.set_aspect("equal", adjustable="datalim")
-        ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3)
-    return _finish_grid(fig, title, fontsize=10)
+    return _finish_grid(fig, title)
 
 
 def reflectance_comparison_figure(
@@ -819,6 +796,7 @@ def reflectance_comparison_figure(
     )
 
 
+@styled
 def fit_maps_figure(model: Any, params: Mapping[str, float], rows: Any, title: str = "") -> str:
     """Measured BRDF, one fitted model and the relative residual, one row per incidence.
 
@@ -842,33 +820,16 @@ def fit_maps_figure(model: Any, params: Mapping[str, float], rows: Any, title: s
     str
         PNG data URI.
     """
-    panels = []
-    for ti, g in rows.groupby("theta_i_deg", sort=True):
-        tr = g["theta_r_deg"].to_numpy(float)
-        pr = g["phi_r_deg"].to_numpy(float)
-        v = g["value"].to_numpy(float)
-        wl = g["wavelength_nm"].to_numpy(float) if "wavelength_nm" in g else None
-        f = np.asarray(
-            model.evaluate(
-                np.radians(np.full(tr.size, float(ti))),
-                np.radians(tr),
-                np.radians(pr),
-                wavelength=wl,
-                params=dict(params),
-            ),
-            float,
-        )
-        with np.errstate(divide="ignore", invalid="ignore"):
-            res = np.where(v > 0, (f - v) / v, np.nan)
-        panels.append(
-            {
-                "label": f"\u03b8i = {float(ti):g}\u00b0",
-                "theta_r": tr,
-                "phi_r": pr,
-                "measured": v,
-                "model": f,
-                "residual": res,
-                "model_label": "model (one fit, all incidences)",
-            }
-        )
+    ti = rows["theta_i_deg"].to_numpy(float)
+    tr = rows["theta_r_deg"].to_numpy(float)
+    pr = rows["phi_r_deg"].to_numpy(float)
+    v = rows["value"].to_numpy(float)
+    wl = rows["wavelength_nm"].to_numpy(float) if "wavelength_nm" in rows else None
+    f = np.asarray(
+        model.evaluate(
+            np.radians(ti), np.radians(tr), np.radians(pr), wavelength=wl, params=dict(params)
+        ),
+        float,
+    )
+    panels = map_panels(ti, tr, pr, v, f, "model (one fit, all incidences)")
     return brdf_maps_figure(panels, title=title)

@@ -9,6 +9,7 @@ report itself. Table cells are rendered with :func:`labbrdf.report.builder.fmt` 
 
 from __future__ import annotations
 
+import base64
 from collections.abc import Mapping
 from typing import Any
 
@@ -16,7 +17,21 @@ import jinja2
 
 from .builder import esc_pointer, fmt
 
-__all__ = ["render"]
+__all__ = ["png_size", "render"]
+
+
+def png_size(uri: str) -> tuple[int, int]:
+    """Width and height [px] of a ``data:image/png;base64,...`` figure (its IHDR chunk).
+
+    Raises
+    ------
+    ValueError
+        Not a PNG.
+    """
+    head = base64.b64decode(uri.split(",", 1)[1][:32])  # the first 24 bytes
+    if head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
+        raise ValueError("not a PNG")
+    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
 
 
 def _env() -> jinja2.Environment:
@@ -52,10 +67,13 @@ def render(
     -------
     str
         One self-contained HTML document (inline CSS, embedded figures, no external
-        resources).
+        resources). Every figure is shown at its natural size (``width`` and ``height``
+        attributes of its pixels, never scaled down: :mod:`labbrdf.figstyle` sizes it for
+        that); one wider than the text column scrolls inside its own box.
     """
     for fid, uri in images.items():
         if not uri.startswith("data:image/png;base64,"):
             raise ValueError(f"figure {fid!r} is not an embedded PNG data URI")
     tpl = _env().get_template("report.html")
-    return tpl.render(r=results, images=images, swatches=swatches or {})
+    sizes = {fid: png_size(uri) for fid, uri in images.items()}
+    return tpl.render(r=results, images=images, sizes=sizes, swatches=swatches or {})

@@ -287,8 +287,10 @@ class TraceResult:
 
         The maps are drawn as the report's tracer maps (polar: azimuth phi_r with the
         specular half-plane at 180 deg, radius theta_r; the DOP blank where it cannot be
-        read, :meth:`readable_dop`; the S0 scale up to :meth:`s0_scale_max`); the cut is
-        :meth:`in_plane` with 1-sigma error bars (S0) and a band (DOP).
+        read, :meth:`readable_dop`; the S0 scale up to :meth:`s0_scale_max`, logarithmic
+        when a peak dominates the map, :func:`labbrdf._plotting.map_scale`); the cut is
+        :meth:`in_plane` with 1-sigma error bars (S0) and a band (DOP). The new figure is
+        in the package's style (:mod:`labbrdf.figstyle`: readable at 96 dpi).
 
         Parameters
         ----------
@@ -296,51 +298,48 @@ class TraceResult:
             Input Stokes vector (default unpolarized).
         ax : sequence of 3 matplotlib Axes, optional
             Where to draw: S0 map and DOP map (both with ``projection="polar"``) and the
-            cut. Default a new figure with the three side by side.
+            cut. Default a new figure with the two maps side by side above the cut.
 
         Returns
         -------
         matplotlib Figure
         """
-        from .._plotting import draw_cut, draw_polar_map  # matplotlib only when drawing
+        from ..figstyle import PAGE_WIDTH_IN, rc_context
 
         s = _stokes(stokes_in)
-        if ax is None:
-            import matplotlib.pyplot as plt
+        with rc_context():
+            if ax is None:
+                import matplotlib.pyplot as plt
 
-            fig = plt.figure(figsize=(13.0, 3.9), layout="constrained")
-            ax = [
-                fig.add_subplot(1, 3, 1, projection="polar"),
-                fig.add_subplot(1, 3, 2, projection="polar"),
-                fig.add_subplot(1, 3, 3),
-            ]
-        axes = list(np.asarray(ax, dtype=object).ravel())
-        if len(axes) != 3 or any(a.name != "polar" for a in axes[:2]):
-            raise ValueError("ax: expected three Axes, the first two with projection='polar'")
-        fig = axes[0].figure
-        for a, data, title, cmap, lim in (
-            (axes[0], self.s0(s), r"$S_0$ [sr$^{-1}$]", "inferno", (0.0, self.s0_scale_max(s))),
-            (axes[1], self.readable_dop(s), "DOP [1]", "viridis", (0.0, 1.0)),
-        ):
-            mesh = draw_polar_map(
-                a,
-                data,
-                self.theta_r_edges_deg,
-                self.phi_r_edges_deg,
-                title=title,
-                cmap=cmap,
-                vmin=lim[0],
-                vmax=lim[1],
-            )
-            fig.colorbar(mesh, ax=a, shrink=0.7, pad=0.1)
+                fig = plt.figure(figsize=(PAGE_WIDTH_IN, 8.6), layout="constrained")
+                grid = fig.add_gridspec(2, 2, height_ratios=[1.35, 1.0])
+                ax = [
+                    fig.add_subplot(grid[0, 0], projection="polar"),
+                    fig.add_subplot(grid[0, 1], projection="polar"),
+                    fig.add_subplot(grid[1, :]),
+                ]
+            axes = list(np.asarray(ax, dtype=object).ravel())
+            if len(axes) != 3 or any(a.name != "polar" for a in axes[:2]):
+                raise ValueError("ax: expected three Axes, the first two with projection='polar'")
+            self._draw(s, axes)
+        return axes[0].figure
+
+    def _draw(self, s: NDArray[np.float64], axes: list[Any]) -> None:
+        """The two maps and the cut of :meth:`plot` on ``axes``."""
+        from .._plotting import draw_cut, draw_polar_pair, map_scale
+
+        s0 = self.s0(s)
+        edges = (self.theta_r_edges_deg, self.phi_r_edges_deg)
+        titles = ("S\u2080", "DOP")
+        sc = map_scale(s0, self.s0_scale_max(s))
+        draw_polar_pair((axes[0], axes[1]), titles, (s0, self.readable_dop(s)), sc, edges)
         c = self.in_plane(s)
         draw_cut(axes[2], c["theta_deg"], c["s0"], c["s0_stderr"], c["dop"], c["dop_stderr"])
         axes[2].set_title(
-            f"plane of incidence (theta_i {self.config.theta_i_deg:g} deg), "
-            f"input Stokes {[float(v) for v in s]}",
-            fontsize=8,
+            f"plane of incidence (\u03b8i = {self.config.theta_i_deg:g}\u00b0), "
+            f"input Stokes {[float(v) for v in s]}; maps: azimuth \u03c6r (specular at "
+            "180\u00b0), radius \u03b8r [deg]"
         )
-        return fig
 
     def albedo(self, stokes_in: ArrayLike = UNPOLARIZED) -> float:
         """Directional-hemispherical reflectance: exited S0 / incident S0 [1]."""

@@ -55,7 +55,7 @@ def test_the_data_are_drawn_with_their_file_sigmas(result, osr_550) -> None:
 def test_the_model_line_is_the_fitted_model(result, osr_550) -> None:
     ax = result.plot().axes[0]
     model = models.get("smooth3")
-    curves = [ln for ln in ax.lines if ln.get_label().startswith("model")]
+    curves = [ln for ln in ax.lines if ln.get_gid() == "model"]
     assert len(curves) == 3
     for ln, (ti, _) in zip(curves, _groups(osr_550), strict=True):
         x = np.asarray(ln.get_xdata(), float)
@@ -98,7 +98,7 @@ def test_a_model_outside_the_registry_is_drawn_through_the_data_points(result, o
 
     res = fit(Custom(), osr_550)
     ax = res.plot().axes[0]
-    curves = [ln for ln in ax.lines if ln.get_label().startswith("model")]
+    curves = [ln for ln in ax.lines if ln.get_gid() == "model"]
     got = np.concatenate([ln.get_ydata() for ln in curves])
     d = osr_550.reset_index(drop=True)
     order = np.lexsort((d["theta_r_deg"].to_numpy(), d["theta_i_deg"].to_numpy()))
@@ -113,3 +113,31 @@ def test_a_result_without_data_or_of_a_film_fit_says_why_it_cannot_plot(result) 
     film = FitData([60.0, 70.0], [60.0, 70.0], [1.0, 2.0], quantity="film", unit="mixed")
     with pytest.raises(ValueError, match="film fit"):
         dataclasses.replace(result, data=film).plot()
+
+
+@pytest.fixture(scope="module")
+def hemispherical():
+    """A five_param fit to points over the whole hemisphere at two incidences."""
+    ti, tr, pr = np.meshgrid([30.0, 60.0], np.arange(5.0, 86.0, 10.0), np.arange(0.0, 181.0, 20.0))
+    ti, tr, pr = ti.ravel(), tr.ravel(), pr.ravel()
+    model = models.get("five_param")
+    y = model.evaluate(np.radians(ti), np.radians(tr), np.radians(pr), params=model.values())
+    data = FitData(ti, tr, y * (1.0 + 0.05 * np.cos(3.0 * np.radians(pr))), phi_r_deg=pr)
+    return fit("five_param", data, maxeval=[60, 60])
+
+
+def test_hemispherical_data_are_drawn_as_maps_not_one_line_per_scan(hemispherical) -> None:
+    fig = hemispherical.plot()
+    maps = [ax for ax in fig.axes if ax.collections and ax.get_aspect() == 1.0]
+    assert len(maps) == 2 * 3  # measured, model and residual per incidence
+    # guide circles only: the 20 scans of each incidence are not drawn as lines
+    assert sum(len(ax.lines) for ax in fig.axes) <= 3 * len(maps)
+    (measured,) = maps[0].collections
+    # the measured map spans the data of its incidence (log colour scale)
+    d = hemispherical.data
+    y30 = np.asarray(d.value)[np.asarray(d.theta_i_deg) == 30.0]
+    assert measured.norm.vmax == pytest.approx(
+        max(y30.max(), hemispherical.best_fit[np.asarray(d.theta_i_deg) == 30.0].max())
+    )
+    with pytest.raises(ValueError, match="maps"):
+        hemispherical.plot(ax=plt.subplots(2)[1])

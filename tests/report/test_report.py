@@ -520,16 +520,21 @@ def test_progress_lines_go_to_stderr(tmp_path, capsys):
 
 
 def test_save_trace_maps_png_writes_a_png(tmp_path):
-    from types import SimpleNamespace
-
+    import labbrdf
     from labbrdf.report.figures import save_trace_maps_png
 
-    th = np.concatenate([[0.0], np.arange(1, 31) * 3 - 1.5, [90.0]])
-    ph = (np.arange(121) - 0.5) * 3
-    m = np.zeros((31, 120, 4, 4))
-    m[..., 0, 0] = 1.0
-    m[..., 1, 0] = 0.5  # DOP 0.5 everywhere for unpolarized input
-    res = SimpleNamespace(mueller=m, theta_r_edges_deg=th[:32], phi_r_edges_deg=ph)
+    # the PNG is the result's own figure (TraceResult.plot): a real, small result
+    res = labbrdf.trace(
+        labbrdf.TraceConfig(
+            wavelength_nm=650,
+            theta_i_deg=45,
+            rays=500,
+            seed=1,
+            substrate=labbrdf.Substrate(n=1.55, k=7.71, alpha=0.2),
+            scattering="single",
+            estimator="counting",
+        )
+    )
     p = save_trace_maps_png(res, tmp_path / "maps.png")
     assert p.read_bytes().startswith(PNG_MAGIC)
 
