@@ -201,6 +201,15 @@ def exit_map(
     """
     su = _Setup(cfg)
     grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
+    if su.sampled_exit:
+        # the walk summed its exit weights into output bins already (exit_sampled): the
+        # bin average of the BRDF is the sum over the cos-weighted solid angle
+        out = cells / grid.cos_solid_angle_sr[None, :, :, None, None]
+        if cfg.scalar:
+            m00 = out[..., 0, 0].copy()
+            out[...] = 0.0
+            out[..., 0, 0] = m00
+        return out, {"operator_seconds": 0.0, "operator_mb": 0.0, "exit_sampled": 1.0}
     # one output node per degree of bin width (a coarse bin is not one point)
     nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
     op = exit_operator(grid, su.n_coat, su.alpha_top, nodes=nodes)
@@ -241,6 +250,11 @@ def nee_exit(
     if cfg.resolved_estimator != "evaluated" or cfg.coating is None or cfg.coherent:
         raise ValueError("nee_exit needs an evaluated run with an incoherent coating")
     su = _Setup(cfg)
+    if su.sampled_exit:
+        raise ValueError(
+            "nee_exit checks the exit operator; this coating's top is too smooth for it "
+            "(its exit is sampled, see labbrdf.tracer.exit_sampled)"
+        )
     grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
     theta, dphi, w = bin_nodes(grid, nodes, nodes)
     phi_c = np.radians(grid.phi_centres_deg)
