@@ -49,6 +49,10 @@ __all__ = [
 #: 2.9 (alpha 0.03 / 0.04 / 0.05 / 0.07 / 0.1)
 MIN_LOBE_NODES = 2.0
 
+#: with the operator, rays in this many polar rows of cells around the pole exit through
+#: their own facet (the centroid of the polar cap is off the pole)
+POLE_ROWS = 4
+
 F64 = NDArray[np.float64]
 
 
@@ -105,8 +109,8 @@ def deposit_exit(
     rid : ndarray of int, shape (n,)
         Global ray indices (batch = index modulo ``batches``).
     keys, rows : list
-        Receive the flat keys ``batch * n_bins + bin`` and the Mueller rows (16, n_sel)
-        in the exit frames ``phi_hat(phi_o)``.
+        Receive the flat keys ``(batches + batch) * n_bins + bin`` (after the operator's
+        cells) and the Mueller rows (16, n_sel) in the exit frames ``phi_hat(phi_o)``.
     """
     tr, cos_t, eta = transmission
     idx = np.flatnonzero(sel)
@@ -128,7 +132,8 @@ def deposit_exit(
     bin_, phi = grid.index(kt)
     s_out = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
     rotate_frame(Mt, kt, s_loc[:, idx], s_out)
-    keys.append((rid[idx] % batches) * grid.n_bins + bin_)
+    # after the operator's cells (record_up): keys from batches * n_bins on
+    keys.append((batches + rid[idx] % batches) * grid.n_bins + bin_)
     rows.append(Mt.reshape(16, -1))
 
 
@@ -180,9 +185,13 @@ def record_up(
     k, s_loc, m = rays
     sampled, alpha, scalar = how
     keys, rows, raw = into
-    if sampled:
-        deposit_exit(
-            grid, batches, k, s_loc, m, M, transmission, alpha, scalar, sel, rid, keys, rows
-        )
-    else:
-        deposit_cells(grid, batches, k, s_loc, M, sel, rid, keys, rows, raw)
+    if not sampled:
+        # near the pole the operator's centroid rule moves a lobe centred on the pole off
+        # it: the rays of the first POLE_ROWS rows of cells exit through their own facet
+        cut = np.cos(np.radians(grid.theta_edges_deg[min(POLE_ROWS, grid.n_theta)]))
+        near = sel & (k[2] > cut)
+        deposit_cells(grid, batches, k, s_loc, M, sel & ~near, rid, keys, rows, raw)
+        sel = near
+        if not sel.any():
+            return
+    deposit_exit(grid, batches, k, s_loc, m, M, transmission, alpha, scalar, sel, rid, keys, rows)

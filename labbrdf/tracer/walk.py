@@ -703,7 +703,7 @@ def _cell_tally(
         return np.zeros(0, dtype=np.int64), np.zeros((0, 16)), batch_rays
     key = np.concatenate(dep_key)
     rows_d = np.concatenate(dep_rows, axis=1)
-    nkeys = cfg.batches * grid.n_bins
+    nkeys = 2 * cfg.batches * grid.n_bins  # cells for the operator, then sampled exits
     cnt = np.bincount(key, minlength=nkeys)
     cell_keys = np.flatnonzero(cnt)
     dense = np.empty((16, nkeys))
@@ -868,7 +868,7 @@ def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
     bh = np.zeros((len(blocks), 16))
     br = np.zeros(len(blocks), dtype=np.int64)
     ev = cfg.resolved_estimator == "evaluated"
-    cells = np.zeros((cfg.batches * nb, 16)) if ev else None
+    cells = np.zeros((2 * cfg.batches * nb, 16)) if ev else None
     brays = np.zeros(cfg.batches, dtype=np.int64) if ev else None
     for i, b in enumerate(blocks):
         t = trace_block(cfg, b)
