@@ -3,7 +3,9 @@
 Rays reaching the top interface from below are recorded either in internal direction
 cells, for the exit operator (:func:`deposit_cells`, :mod:`.operator`), or, through a
 nearly smooth top, as exits in output bins (:func:`deposit_exit`); :func:`record_up`
-chooses by :func:`exit_is_sampled`.
+chooses by :func:`exit_is_sampled`, and with the operator also sends the rays of the
+first :data:`POLE_ROWS` polar rows of cells to the exit bins (the polar cap's centroid is
+off the pole: at normal incidence the operator made the rows at 0-6 deg 2-9 % low).
 
 The exit operator (:mod:`.operator`) evaluates the closed-form BTDF from each internal
 cell's centroid at about one node per degree of each output bin. Through a GGX interface of
