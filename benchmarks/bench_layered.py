@@ -21,7 +21,16 @@ traces), the synthetic file 194 s (115 evaluations, 351 traces); microfacet + La
 (166 points), 4000 rays, Al + floor (``--file /none --incidences 45 --rays 4000``): one
 seed 32 s (112 evaluations, alpha_top 0.267), three seeds (the default) 91 s (331
 evaluations): alpha_top 0.267, 0.172, 0.134, s_between 0.069, reported 0.191 +- 0.040
-against the truth 0.15 (load average 1.4-1.6). Not a
+against the truth 0.15 (load average 1.4-1.6). Where the
+time goes (cProfile of three evaluations of the vinyl at 15, 45 and 75 deg, diffuse base,
+2e4 rays, 3 x 6 grid, load average ~11): 2.6 s per evaluation, of which the three walks
+1.4 s (53 %), one exit-operator build per new alpha_top 1.0 s (37 %; the memory cache
+keeps two, so every new alpha_top value builds one), the first-surface maps and the
+operator's application the rest. A fit of ~124 evaluations is therefore ~2/3 walks and
+~1/3 operator builds: reusing operators across alpha_top (interpolating their spectra) and
+reusing the walks across the base albedo (the diffuse base multiplies a ray's weight by
+the albedo at each base event, so cells kept per number of base events make the map a
+polynomial in the albedo) are the two largest savings; neither is done yet. Not a
 timed test: numbers depend on the machine and its load (report ``uptime`` with them), and
 on OpenBLAS's thread count (``OPENBLAS_NUM_THREADS=1`` is 2.5x faster on a loaded machine).
 """

@@ -108,6 +108,13 @@ class Layered(Model):
     Single scattering (the separable Smith G1 G1 per interface) loses energy for rough
     interfaces; the multiple-scattering walk would count rays, whose noise no fit can
     use (``docs/tracer.md``).
+    A nearly smooth top (``alpha_top`` below about ``0.035 / (n_coat - 1)``, 0.07 for
+    n_coat = 1.5) has an exit lobe narrower than the tracer's exit operator resolves; there
+    the tracer exits through the walk's own sampled facet instead (unbiased, no operator to
+    build, but the light that went through the coating is then about as noisy per bin as
+    counting: :meth:`point_variance` says how much). The two exits are different
+    estimates of the same BRDF: at the switch the model moves by about its Monte Carlo
+    error (``docs/tracer.md``, a nearly smooth coating top).
     """
 
     name = "layered"

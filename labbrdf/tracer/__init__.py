@@ -143,7 +143,8 @@ def trace(
     block_hemi = np.zeros((config.n_blocks, 4, 4))
     block_rays = np.zeros(config.n_blocks, dtype=np.int64)
     evaluated = config.resolved_estimator == "evaluated"
-    cells = np.zeros((config.batches * nb, 16)) if evaluated else None
+    # evaluated: per batch, the cells for the exit operator, then the sampled exits' bins
+    cells = np.zeros((2 * config.batches * nb, 16)) if evaluated else None
     batch_rays = np.zeros(config.batches, dtype=np.int64)
     expected = 0
     for tallies in map(_unit, work_units(config, blocks_per_unit)):
@@ -223,7 +224,7 @@ def _evaluated(
     info = {"first_surface_seconds": time.perf_counter() - t0}
     shape = (config.batches, grid.n_theta, grid.n_phi, 4, 4)
     if config.coating is not None and not config.coherent:
-        sums, more = exit_map(config, cells.reshape(shape))
+        sums, more = exit_map(config, cells.reshape((2, *shape)))
         info.update(more)
     else:
         sums = np.zeros(shape)

@@ -187,35 +187,51 @@ def _ggx(alpha: float, what: str):  # noqa: ANN202
 def exit_map(
     cfg: TraceConfig, cells: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], dict[str, float]]:
-    """Exit sums ``sum_cells T10 W`` per batch from the internal cell sums.
+    """Exit sums per batch from the walk's records under the top interface.
 
     Parameters
     ----------
-    cells : ndarray, shape (batches, n_theta, n_phi, 4, 4)
+    cells : ndarray, shape (2, batches, n_theta, n_phi, 4, 4)
+        ``cells[0]``: the internal cell sums for the exit operator; ``cells[1]``: the
+        sampled exits' weight sums per output bin (:mod:`.exit_sampled`).
 
     Returns
     -------
     sums : ndarray, shape (batches, n_theta, n_phi, 4, 4) [sr^-1 x rays]
     info : dict
-        ``operator_seconds``, ``operator_mb``.
+        ``operator_seconds``, ``operator_mb``, ``exit_sampled`` (1: no operator used).
     """
     su = _Setup(cfg)
     grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
+    # the sampled exits are weight sums per output bin: the bin average of the BRDF is
+    # the sum over the cos-weighted solid angle
+    out = cells[1] / grid.cos_solid_angle_sr[None, :, :, None, None]
+    info = {"operator_seconds": 0.0, "operator_mb": 0.0, "exit_sampled": 1.0}
+    if not su.sampled_exit:
+        op_sums, info = _operator_map(cfg, su, grid, cells[0])
+        out = out + op_sums
+    if cfg.scalar:
+        m00 = out[..., 0, 0].copy()
+        out[...] = 0.0
+        out[..., 0, 0] = m00
+    return out, info
+
+
+def _operator_map(
+    cfg: TraceConfig, su: _Setup, grid: Grid, cells: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], dict[str, float]]:
+    """The exit operator applied to the internal cell sums (B, n_theta, n_phi, 4, 4)."""
     # one output node per degree of bin width (a coarse bin is not one point)
     nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
     op = exit_operator(grid, su.n_coat, su.alpha_top, nodes=nodes)
+    info = {"operator_seconds": op.seconds, "operator_mb": op.nbytes / 1e6}
     if cfg.scalar:
         # the scalar walk carries M00 alone; the operator's (0, 0) element is the scalar
         # transmission (A of the transmission matrix: B = 0 leaves M00 unrotated)
         cells = cells.copy()
         cells[..., 1:, :] = 0.0
         cells[..., :, 1:] = 0.0
-        out = op.apply(cells)
-        m00 = out[..., 0, 0].copy()
-        out[...] = 0.0
-        out[..., 0, 0] = m00
-        return out, {"operator_seconds": op.seconds, "operator_mb": op.nbytes / 1e6}
-    return op.apply(cells), {"operator_seconds": op.seconds, "operator_mb": op.nbytes / 1e6}
+    return op.apply(cells), info
 
 
 def nee_exit(
@@ -241,6 +257,11 @@ def nee_exit(
     if cfg.resolved_estimator != "evaluated" or cfg.coating is None or cfg.coherent:
         raise ValueError("nee_exit needs an evaluated run with an incoherent coating")
     su = _Setup(cfg)
+    if su.sampled_exit:
+        raise ValueError(
+            "nee_exit checks the exit operator; this coating's top is too smooth for it "
+            "(its exit is sampled, see labbrdf.tracer.exit_sampled)"
+        )
     grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
     theta, dphi, w = bin_nodes(grid, nodes, nodes)
     phi_c = np.radians(grid.phi_centres_deg)
@@ -256,9 +277,11 @@ def nee_exit(
     d_of, g1_of = _ggx(alpha, "d"), _ggx(alpha, "g1")
     nb = cfg.batches
     acc = np.zeros((nb, len(bins), 4, 4))
+    omega = grid.cos_solid_angle_sr
     for block in range(cfg.n_blocks):
         raw: list = []
-        trace_block(cfg, block, raw=raw)
+        tally = trace_block(cfg, block, raw=raw)
+        _add_sampled(acc, tally, grid, bins, omega)
         if not raw:
             continue
         rid = np.concatenate([r[0] for r in raw])
@@ -288,3 +311,26 @@ def nee_exit(
     mean = acc.sum(axis=0) / cfg.rays
     var = (n_b[:, None, None, None] * (per - mean) ** 2).sum(axis=0) / cfg.rays / (nb - 1)
     return mean, np.sqrt(var)
+
+
+def _add_sampled(
+    acc: NDArray[np.float64],
+    tally: object,
+    grid: Grid,
+    bins: list[tuple[int, int]],
+    omega: NDArray[np.float64],
+) -> None:
+    """Add a block's sampled exits (rays near the pole, :mod:`.exit_sampled`) to ``acc``.
+
+    They do not go through the operator, so the direct evaluation takes them as they are.
+    """
+    keys, sums = tally.cell_keys, tally.cell_sums  # type: ignore[attr-defined]
+    nb, nbins = acc.shape[0], grid.n_bins
+    if keys is None or keys.size == 0:
+        return
+    ex = keys >= nb * nbins
+    batch, flat = keys[ex] // nbins - nb, keys[ex] % nbins
+    for q, (i, j) in enumerate(bins):
+        hit = flat == i * grid.n_phi + j
+        for b, row in zip(batch[hit], sums[ex][hit], strict=True):
+            acc[b, q] += row.reshape(4, 4) / omega[i, j]

@@ -60,6 +60,7 @@ from ..microfacet import ggx
 from ..microfacet.height import sample_height
 from .binning import Grid, bin_exits
 from .config import TraceConfig
+from .exit_sampled import exit_is_sampled, record_up
 from .interfaces import apply_fresnel, fresnel_abcs, rotate_frame, s_axis
 
 __all__ = ["BlockTally", "GroupTally", "run_unit", "trace_block", "trace_group"]
@@ -115,6 +116,12 @@ class _Setup:
         # tabulated top interface (seen from above; from below: its point reflection)
         self.ndf_top = coat.ndf if (coat is not None and self.layered) else None
         self.evaluated = cfg.resolved_estimator == "evaluated"
+        # evaluated, nearly smooth top: the exit is the walk's own facet (exit_sampled)
+        self.sampled_exit = (
+            self.evaluated
+            and self.layered
+            and exit_is_sampled(_grid(cfg), self.n_coat, self.alpha_top)
+        )
         self.scalar = bool(cfg.scalar)
         # Lambertian base instead of the conductor's microsurface (None: the conductor)
         self.albedo = sub.albedo
@@ -528,17 +535,16 @@ def _layered_event(
             wt = np.where(trans, 1.0, 0.0)
             up_ = on_top & below
             if up_.any():
-                _deposit(
+                record_up(
                     grid,
                     cfg.batches,
-                    k,
-                    hit.s_loc,
-                    M,
-                    up_,
                     rays.rid,
-                    led.dep_key,
-                    led.dep_rows,
-                    raw,
+                    (k, hit.s_loc, hit.m),
+                    M,
+                    (tr, cos_t, eta),
+                    up_,
+                    (su.sampled_exit, su.alpha_top, su.scalar),
+                    (led.dep_key, led.dep_rows, raw),
                 )
         else:
             trans = hit.u >= pr
@@ -697,7 +703,7 @@ def _cell_tally(
         return np.zeros(0, dtype=np.int64), np.zeros((0, 16)), batch_rays
     key = np.concatenate(dep_key)
     rows_d = np.concatenate(dep_rows, axis=1)
-    nkeys = cfg.batches * grid.n_bins
+    nkeys = 2 * cfg.batches * grid.n_bins  # cells for the operator, then sampled exits
     cnt = np.bincount(key, minlength=nkeys)
     cell_keys = np.flatnonzero(cnt)
     dense = np.empty((16, nkeys))
@@ -819,35 +825,6 @@ def _scalar(abcs: tuple) -> tuple:
     return abcs[0], z, z, z
 
 
-def _deposit(
-    grid: Grid,
-    batches: int,
-    k: NDArray[np.float64],
-    s: NDArray[np.float64],
-    M: NDArray[np.float64],
-    sel: NDArray[np.bool_],
-    rid: NDArray[np.int64],
-    keys: list[NDArray],
-    rows: list[NDArray],
-    raw: list[tuple[NDArray, NDArray, NDArray]] | None = None,
-) -> None:
-    """Record the selected up-going rays just below the top interface.
-
-    Each ray's Mueller matrix is expressed in the meridional frame ``phi_hat(phi_u)`` of
-    its direction (the frame call of the exit binning) and keyed by its batch
-    (global ray index modulo ``batches``) and its direction cell.
-    """
-    ks = k[:, sel]
-    Mc = M[:, :, sel].copy()
-    idx, phi = grid.index(ks)
-    s_det = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
-    rotate_frame(Mc, ks, s[:, sel], s_det)
-    keys.append((rid[sel] % batches) * grid.n_bins + idx)
-    rows.append(Mc.reshape(16, -1))
-    if raw is not None:
-        raw.append((rid[sel], ks, Mc.reshape(16, -1)))
-
-
 @dataclass
 class GroupTally:
     """The folded tallies of one fold group of consecutive blocks (see ``fold_blocks``).
@@ -891,7 +868,7 @@ def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
     bh = np.zeros((len(blocks), 16))
     br = np.zeros(len(blocks), dtype=np.int64)
     ev = cfg.resolved_estimator == "evaluated"
-    cells = np.zeros((cfg.batches * nb, 16)) if ev else None
+    cells = np.zeros((2 * cfg.batches * nb, 16)) if ev else None
     brays = np.zeros(cfg.batches, dtype=np.int64) if ev else None
     for i, b in enumerate(blocks):
         t = trace_block(cfg, b)

@@ -16,13 +16,15 @@ import pytest
 
 from labbrdf import optics
 from labbrdf.tracer import Coating, Grid, Substrate, TraceConfig, trace
+from labbrdf.tracer.agreement import agreement
 from labbrdf.tracer.cache import CacheWarning
 from labbrdf.tracer.operator import PARITY, build_exit_operator, cache_dir, exit_operator
 
 AL = Substrate(n=1.55, k=7.71, alpha=0.2)
 # counting bins with fewer rays have a skewed per-ray error (not yet Gaussian): the
 # off-diagonal elements' ray weights at a rough dielectric have both signs and heavy tails,
-# and with ~100 rays their per-ray error estimate still gives |z| ~ 5-6 once in ~1e4
+# and with ~100 rays their per-ray error estimate still gives |z| ~ 5-6 once in ~1e4; such
+# bins are pooled with their neighbours (labbrdf.tracer.agreement), never left out
 MIN_COUNT = 400
 
 
@@ -163,9 +165,8 @@ def _pair(key: str):
 
 
 def _z(ev, ct):
-    se = np.sqrt(ev.mueller_stderr**2 + ct.mueller_stderr**2)
-    ok = (ct.counts >= MIN_COUNT)[..., None, None] & (ct.mueller_stderr > 0)
-    return ((ev.mueller - ct.mueller) / np.where(ok, se, 1.0))[ok]
+    """z over every bin: sparse bins pooled into groups of MIN_COUNT rays (agreement)."""
+    return agreement(ev, ct, min_count=MIN_COUNT).z
 
 
 @pytest.mark.slow
@@ -183,13 +184,16 @@ def _z(ev, ct):
     ],
 )
 def test_evaluated_agrees_with_counting_in_the_mean(key):
-    """z = difference / combined standard error over all populated bins and 16 elements:
-    RMS in [0.8, 1.2], none beyond 5 (~1e4 values: a Gaussian exceeds 5 with p < 1 %)."""
+    """z = difference / combined standard error over every bin (the pole's and the grazing
+    rows' pooled, none left out) and 16 elements: RMS in [0.8, 1.3], none beyond 5.
+
+    The evaluated error comes from 8 batches, so z is t-like (7 degrees of freedom) where
+    it dominates the pooled groups' combined error: E[z^2] up to 7/5, RMS up to 1.18."""
     ev, ct = _pair(key)
     z = _z(ev, ct)
-    assert z.size > 500
+    assert z.size > 200
     rms = float(np.sqrt(np.mean(z**2)))
-    assert 0.8 < rms < 1.2, rms
+    assert 0.8 < rms < 1.3, rms
     assert np.abs(z).max() < 5.0
     # and the albedo
     za = (ev.albedo() - ct.albedo()) / np.hypot(ev.albedo_stderr(), ct.albedo_stderr())
@@ -483,11 +487,10 @@ def test_scalar_evaluated_agrees_with_scalar_counting():
     )
     ev = trace(cfg.replace(rays=60_000))
     ct = trace(cfg.replace(rays=400_000, seed=1, estimator="counting"))
-    ok = ct.counts >= MIN_COUNT
-    se = np.hypot(ev.mueller_stderr[..., 0, 0], ct.mueller_stderr[..., 0, 0])[ok]
-    z = (ev.s0() - ct.s0())[ok] / se
-    assert z.size > 100
-    assert 0.8 < np.sqrt(np.mean(z**2)) < 1.2
+    # every bin, sparse ones pooled; z t-like where the 8-batch error dominates
+    z = agreement(ev, ct, min_count=MIN_COUNT, elements="m00").z
+    assert z.size > 50
+    assert 0.8 < np.sqrt(np.mean(z**2)) < 1.3
     assert np.abs(z).max() < 5.0
 
 
