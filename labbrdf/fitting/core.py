@@ -24,7 +24,7 @@ from .defaults import MAX_SEED, METHOD
 from .objective import Objective
 from .replicates import ONE_SEED_WARNING, run_replicates
 from .result import FitResult
-from .uncertainty import AT_BOUND_FRAC, jacobian, noise_meat, uncertainties
+from .uncertainty import at_bound, jacobian, noise_meat, uncertainties
 from .weighting import _weighting
 
 __all__ = [
@@ -1099,20 +1099,6 @@ def _budgets(
     ]
 
 
-def _at_bound(q: Any, bound: float) -> bool:
-    """Whether ``q`` ended within :data:`AT_BOUND_FRAC` of its box from ``bound``.
-
-    On the scale the parameter was searched on: a log-scale parameter (``q.log``) is at its
-    bound when ``log q`` is within that fraction of ``log(max / min)``, so a value of 1e-4 in
-    a box [1e-12, 1e4] is not at its lower bound, as it would be on the linear scale.
-    """
-    if q.log and q.min > 0 and q.value > 0:
-        tol = AT_BOUND_FRAC * math.log(q.max / q.min)
-        return math.isfinite(tol) and abs(math.log(q.value / bound)) <= tol
-    tol = AT_BOUND_FRAC * (q.max - q.min)
-    return math.isfinite(tol) and abs(q.value - bound) <= tol
-
-
 def _fitted_params(
     p: Parameters,
     vals: dict[str, float],
@@ -1131,7 +1117,7 @@ def _fitted_params(
             continue
         fl = []
         for side in ("min", "max"):
-            if _at_bound(q, getattr(q, side)):
+            if at_bound(q, getattr(q, side)):
                 fl.append("at_bound")
                 reasons[k].insert(
                     0, f"at bound: {q.value:.6g} at its {side} {getattr(q, side):.6g}"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -15,6 +16,7 @@ __all__ = [
     "CORREL_MAX",
     "REL_STDERR_MAX",
     "REL_STDERR_POOR",
+    "at_bound",
     "jacobian",
     "noise_meat",
     "uncertainties",
@@ -174,3 +176,17 @@ def uncertainties(
 
 def _var_ok(covar: NDArray, i: int) -> bool:
     return bool(np.isfinite(covar[i, i]) and covar[i, i] > 0)
+
+
+def at_bound(q: Any, bound: float) -> bool:
+    """Whether ``q`` ended within :data:`AT_BOUND_FRAC` of its box from ``bound``.
+
+    On the scale the parameter was searched on: a log-scale parameter (``q.log``) is at its
+    bound when ``log q`` is within that fraction of ``log(max / min)``, so a value of 1e-4 in
+    a box [1e-12, 1e4] is not at its lower bound, as it would be on the linear scale.
+    """
+    if q.log and q.min > 0 and q.value > 0:
+        tol = AT_BOUND_FRAC * math.log(q.max / q.min)
+        return math.isfinite(tol) and abs(math.log(q.value / bound)) <= tol
+    tol = AT_BOUND_FRAC * (q.max - q.min)
+    return math.isfinite(tol) and abs(q.value - bound) <= tol

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from labbrdf.fitting.core import _at_bound
 from labbrdf.fitting.uncertainty import AT_BOUND_FRAC
+from labbrdf.fitting.uncertainty import at_bound as _at_bound
 from labbrdf.models.base import Parameter
 
 
