@@ -39,7 +39,7 @@ from .limits import (
 )
 from .materials import Material, Roughness, as_material
 from .model import FilmModel
-from .modelfile import load_model, named_inputs
+from .modelfile import load_model, load_samples, named_inputs
 from .stack import Stack, read_fit_json
 
 __all__ = [
@@ -63,6 +63,7 @@ __all__ = [
     "coating_from_fit",
     "coating_of_stack",
     "load_model",
+    "load_samples",
     "named_inputs",
     "read_fit_json",
 ]
