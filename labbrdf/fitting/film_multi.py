@@ -137,6 +137,16 @@ class MultiFilmFit:
             return None
         return math.sqrt(res.redchi)
 
+    @property
+    def verdict(self) -> str | None:
+        """Words saying that the model is wrong (MSE above ``MSE_WRONG_MODEL``), or None.
+
+        As :attr:`labbrdf.fitting.film.FilmFit.verdict`, on the MSE over all samples.
+        """
+        from .film_verdict import material_label, wrong_model_verdict
+
+        return wrong_model_verdict(self.mse, material_label(self.model.stack.substrate))
+
     def notes(self) -> list[str]:
         """Plain-language notes: misfit, trade-offs, bounds (as a one-sample fit's)."""
         return FilmFit.notes(self)  # type: ignore[arg-type]  # uses result, misfit_scale
@@ -209,6 +219,7 @@ class MultiFilmFit:
                 },
                 "notes": self.notes(),
                 "warnings": list(res.warnings),
+                "verdict": self.verdict,
             }
         )
 

@@ -35,4 +35,6 @@ def multi_fit_report(s: Mapping[str, Any]) -> str:
         lines.append(f"  optimiser: {s['message']}")
     lines += [f"note: {n}" for n in s["notes"]]
     lines += [f"warning: {w}" for w in s["warnings"]]
+    if s.get("verdict"):
+        lines.append(f"VERDICT: {s['verdict']}")
     return "\n".join(lines)

@@ -107,6 +107,16 @@ def test_summary_names_each_sample_and_report_shows_them(multi):
     assert "film.thickness_nm[w3]" in s["correlations"]
     text = str(multi)
     assert "sample w2 (w2.csv)" in text and "film.A = " in text
+    assert s["verdict"] is None and "VERDICT" not in text
+
+
+def test_a_wrong_model_ends_with_the_verdict(samples):
+    """Glass instead of the substrate measured: MSE far above 20, the report says so."""
+    fm = _model()
+    wrong = FilmModel(Stack(fm.stack.layers, Constant(n=1.5, k=0.0)), fm.free)
+    f = fit_film_samples(wrong, samples, per_sample=["film.thickness_nm"], maxeval=(300, 300))
+    assert f.mse > 20
+    assert "VERDICT: MSE" in str(f) and f.summary()["verdict"] == f.verdict
 
 
 def test_model_file_samples_table_and_cli(tmp_path, samples, capsys):
