@@ -9,6 +9,7 @@ from . import (
     cache,
     export,
     film,
+    film_map,
     fit,
     formats,
     hemispherical,
@@ -22,8 +23,8 @@ from . import (
 from ._paths import path_actions
 
 #: the commands in the order ``labbrdf --help`` lists them
-COMMANDS = (ingest, formats, fit, nk, film, surface, export, hemispherical, trace, validate,
-            report, cache)  # fmt: skip
+COMMANDS = (ingest, formats, fit, nk, film, film_map, surface, export, hemispherical, trace,
+            validate, report, cache)  # fmt: skip
 
 
 class _Parser(argparse.ArgumentParser):
