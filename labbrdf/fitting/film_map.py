@@ -176,6 +176,7 @@ class FilmMap:
         matplotlib Figure
         """
         import matplotlib.pyplot as plt
+        from matplotlib.ticker import ScalarFormatter
 
         if ax is None:
             fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), layout="constrained")
@@ -192,7 +193,7 @@ class FilmMap:
                 f"n_{NK_REPORT_NM:g}nm", f"n at {NK_REPORT_NM:g} nm"
             )
             cb = fig.colorbar(sc, ax=a, label=label)
-            cb.formatter.set_useOffset(False)  # read the values, not an offset
+            cb.formatter = ScalarFormatter(useOffset=False)  # the values, not an offset
             cb.update_ticks()
             a.set(xlabel="x [mm]", ylabel="y [mm]", aspect="equal", title=label)
         return fig
