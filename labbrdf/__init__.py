@@ -14,7 +14,8 @@ so that ``import labbrdf`` stays cheap, and ``dir(labbrdf)`` lists them all:
   file), :func:`fit_records` (a batch as JSON records), :class:`FitResult`,
   :func:`hemispherical_reflectance`
 - films: :class:`Stack`, :class:`Layer`, :func:`fit_film`, :class:`FilmFit` (thin-film
-  stacks fitted to psi/Delta and reflectance)
+  stacks fitted to psi/Delta and reflectance), :func:`fit_film_samples` (several samples),
+  :func:`fit_film_map` (wafer maps)
 - roughness: :func:`read_height_map`, :func:`roughness_statistics`, :func:`psd` (power
   spectra of height maps, their composite and a PSD model fit)
 - the tracer: :func:`trace`, :class:`TraceConfig`, :class:`Substrate`, :class:`Coating`,
@@ -63,6 +64,8 @@ _LAZY: dict[str, tuple[str, str]] = {
     "Layer": ("labbrdf.films", "Layer"),
     "fit_film": ("labbrdf.fitting.film", "fit_film"),
     "FilmFit": ("labbrdf.fitting.film", "FilmFit"),
+    "fit_film_samples": ("labbrdf.fitting.film_multi", "fit_film_samples"),
+    "fit_film_map": ("labbrdf.fitting.film_map", "fit_film_map"),
     "read_height_map": ("labbrdf.adapters.topography", "read_height_map"),
     "roughness_statistics": ("labbrdf.roughness.topography", "roughness_statistics"),
     "psd": ("labbrdf.roughness.psd_result", "psd"),
@@ -160,6 +163,8 @@ if TYPE_CHECKING:
     from .films import Layer, Stack
     from .fitting import FitError, FitResult, fit, fit_many, fit_many_nk, fit_records
     from .fitting.film import FilmFit, fit_film
+    from .fitting.film_map import fit_film_map
+    from .fitting.film_multi import fit_film_samples
     from .integrate import hemispherical_reflectance
     from .models import ModelError
     from .nk import NkError, bulk_index_at, combined_table, model_with_nk, nk_table, read_nk

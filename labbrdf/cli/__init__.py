@@ -1,8 +1,8 @@
 """The ``labbrdf`` command: a thin argparse layer over the library.
 
-Subcommands: ``ingest``, ``formats``, ``fit``, ``nk``, ``film``, ``surface``, ``export``,
-``psd``, ``hemispherical``, ``trace``, ``validate``, ``report``, ``cache``; each is one module of
-this package, its parser (``add_parser``) beside its command (``cmd_<name>``). Every
+Subcommands: ``ingest``, ``formats``, ``fit``, ``nk``, ``film``, ``film-map``, ``surface``,
+``psd``, ``export``, ``hemispherical``, ``trace``, ``validate``, ``report``, ``cache``; each is
+one module of this package, its parser (``add_parser``) beside its command (``cmd_<name>``). Every
 subcommand returns an exit code: 0 success, 1 a check of a report (``validate``,
 ``report``) failed, 2 a usage, input or output error (unreadable file, unknown name, an
 output path that is refused or cannot be written, ...), 3 ``fit``: some groups could not be

@@ -26,6 +26,7 @@ COMMANDS: dict[str, str] = {
     "fit": "fit a model per group (sample, wavelength)",
     "nk": "optical constants n, k from ellipsometer psi/Delta",
     "film": "fit a thin-film stack (thicknesses, n, k) to psi/Delta, R and T of one sample",
+    "film-map": "fit a film model to every point of a wafer map (thickness, index maps)",
     "surface": "roughness statistics of a height map or profile",
     "psd": "power spectral density of height maps (composite over maps, model fit)",
     "export": "write a model BRDF in an exchange format",
@@ -54,8 +55,11 @@ class _Parser(argparse.ArgumentParser):
 
 
 def command_module(name: str) -> ModuleType:
-    """The module of the command ``name`` (imported on this call, not before)."""
-    return importlib.import_module(f"{__package__}.{name}")
+    """The module of the command ``name`` (imported on this call, not before).
+
+    A hyphen in a command's name is an underscore in its module's (``film-map``).
+    """
+    return importlib.import_module(f"{__package__}.{name.replace('-', '_')}")
 
 
 def chosen_command(argv: Sequence[str]) -> str | None:

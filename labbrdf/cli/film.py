@@ -118,7 +118,7 @@ def _one_sample(args: argparse.Namespace, parts: list[Any], data: Any) -> bool:
 
 def cmd_film(args: argparse.Namespace) -> int:
     """Fit the film model of the options to the files; print the layers and the fit."""
-    from .. import adapters
+    from .. import adapters, films
     from ..dataset import concat
     from ..films import FilmError
     from ..fitting.film import fit_film
@@ -139,6 +139,13 @@ def cmd_film(args: argparse.Namespace) -> int:
                 "0 <= MIN < MAX [nm]"
             )
         wl_range = (r.lo, r.hi)
+    spec = films.load_samples(args.model) if args.model is not None else None
+    if args.per_sample or spec is not None:  # several samples in one fit
+        from .film_multi import cmd_film_samples
+
+        return cmd_film_samples(args, fm, spec, wl_range)
+    if not args.files:
+        raise UsageError("give the FILE(s) to fit (or a --model with a [samples] table)")
     parts = [adapters.read(p) for p in args.files]
     data = _selected(args, concat(parts))
     res = fit_film(
@@ -177,10 +184,10 @@ def add_parser(sub: Any) -> None:
     )
     s.add_argument(
         "files",
-        nargs="+",
+        nargs="*",
         action=InputPath,
         metavar="FILE",
-        help="files of one sample (joint fit)",
+        help="files of one sample (joint fit), or of several with --per-sample",
     )
     s.add_argument(
         "--model",
@@ -220,6 +227,13 @@ def add_parser(sub: Any) -> None:
         metavar="A,B[,...]",
         help="these FILE inputs are one sample although they state different sample names "
         "(files that do are refused without it)",
+    )
+    s.add_argument(
+        "--per-sample",
+        action="append",
+        metavar="LAYER.PARAM[,...]",
+        help="each FILE is a sample of its own (named after it) and these free "
+        "parameters are fitted per sample, the others shared, e.g. film.thickness_nm",
     )
     s.add_argument(
         "--ci",

@@ -46,7 +46,7 @@ from .limits import (
 )
 from .materials import Material, Roughness, as_material
 from .model import FilmModel
-from .modelfile import load_model, named_inputs
+from .modelfile import load_model, load_samples, named_inputs
 from .stack import Stack, read_fit_json
 
 __all__ = [
@@ -70,6 +70,7 @@ __all__ = [
     "as_material",
     "check_wavelength_range",
     "load_model",
+    "load_samples",
     "named_inputs",
     "read_fit_json",
 ]

@@ -1,6 +1,7 @@
 """Film model files (TOML): one model read with every error naming the file and the line.
 
 :func:`load_model` reads a file into a :class:`~labbrdf.films.FilmModel`;
+:func:`load_samples` its ``[samples]`` table (several samples in one fit);
 :func:`named_inputs` lists the table files a model or a fit JSON names (inputs of whoever
 reads it, never to be overwritten).
 """
@@ -30,6 +31,7 @@ from .limits import (
 from .materials import Material, Roughness, _table_file, _with_params, as_material
 from .model import FilmModel
 from .nonuniform import MAX_SPREAD
+from .modelsamples import ModelSamples, parse_samples, sample_files
 from .stack import Stack
 
 _LAYER_KEYS = {
@@ -47,7 +49,7 @@ _LAYER_KEYS = {
 }
 
 
-_TOP_KEYS = ("ambient", "wavelength_nm", "thickness_spread", "substrate", "layer")
+_TOP_KEYS = ("ambient", "wavelength_nm", "thickness_spread", "substrate", "layer", "samples")
 
 
 class _KeyLines:
@@ -267,7 +269,7 @@ def _check_top(doc: Mapping[str, Any], where: str, text: str, lines: _KeyLines) 
         line = next((i for i, raw in enumerate(text.splitlines(), 1) if re.match(pattern, raw)), 1)
         raise FilmError(
             f"{where}, line {line}: unknown key or table {key!r}; expected ambient, "
-            "wavelength_nm, thickness_spread, [substrate], [[layer]]"
+            "wavelength_nm, thickness_spread, [substrate], [[layer]], [samples]"
         )
     layers = doc.get("layer", [])
     if not isinstance(layers, list) or not all(isinstance(t, dict) for t in layers):
@@ -443,6 +445,18 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
     return FilmModel(st, free, wl_range, where)
 
 
+def load_samples(path: str | os.PathLike[str]) -> ModelSamples | None:
+    """The ``[samples]`` table of a model file (:mod:`~labbrdf.films.modelsamples`), or None.
+
+    Raises
+    ------
+    FilmError
+        As :func:`load_model`, naming the file and the line.
+    """
+    p, text, doc = _read_model(path)
+    return parse_samples(doc, str(p), _KeyLines(text), p.parent)
+
+
 def _model_files(doc: Mapping[str, Any], base: Path) -> list[Path]:
     """The ``file = ...`` paths of a parsed model file, as :func:`load_model` opens them."""
     tables = [doc.get("substrate")]
@@ -451,11 +465,12 @@ def _model_files(doc: Mapping[str, Any], base: Path) -> list[Path]:
     for t in list(tables):
         comps = t.get("components") if isinstance(t, dict) else None
         tables += comps if isinstance(comps, list) else []
-    return [
+    named = [
         _named_file(t["file"], base)
         for t in tables
         if isinstance(t, dict) and isinstance(t.get("file"), str)
     ]
+    return named + sample_files(doc, base)  # the [samples] data files are inputs too
 
 
 def named_inputs(path: str | os.PathLike[str], kind: str) -> list[Path]:
