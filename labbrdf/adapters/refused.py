@@ -6,12 +6,6 @@ Woollam CompleteEASE ``.SE`` (``woollam-completeease-se``)
     ``woollam-completeease``), so a binary ``.SE`` is refused with that advice. A file named
     ``.se`` that is text is not this format: it is dispatched on its content like any text
     export (a Woollam ASCII file saved as ``.se`` is read as such).
-
-Ansys Speos ``.anisotropicbsdf`` (``speos-bsdf``)
-    A BSDF table for Speos (first line ``OPTIS - Anisotropic BSDF surface file``). It is
-    usually a conversion of a measurement that the instrument also writes in the
-    Zemax/Radiant ``.bsdf`` exchange format (read by ``zemax-bsdf``), so it is refused with
-    that advice instead of being taken for a table of numbers after a preamble.
 """
 
 from __future__ import annotations
@@ -27,7 +21,6 @@ __all__ = [
     "refuse_completeease_se",
     "refuse_completeease_sesnap",
     "refuse_spectrapen",
-    "refuse_speos_bsdf",
 ]
 
 _SE_HINT = (
@@ -142,37 +135,6 @@ def refuse_spectrapen(path: str | os.PathLike[str]) -> Measurement:
     )
 
 
-#: first line of every Speos BSDF text file (the version follows)
-_SPEOS_MAGIC = b"OPTIS - Anisotropic BSDF surface file"
-
-
-def _sniff_speos(head: bytes) -> bool:
-    return head.lstrip(b"\xef\xbb\xbf").startswith(_SPEOS_MAGIC)
-
-
-def refuse_speos_bsdf(path: str | os.PathLike[str]) -> Measurement:
-    """Refuse an Ansys Speos ``.anisotropicbsdf`` text file with what to do instead.
-
-    Raises
-    ------
-    AdapterError
-        Always: the Speos layout (one table per incidence on a theta x phi grid, a spectrum
-        of TIS values) is recognised but not read; the same measurement in the Zemax/Radiant
-        ``.bsdf`` exchange format is read by ``zemax-bsdf``.
-    """
-    if not _sniff_speos(read_head(path)):
-        raise AdapterError(
-            path, f"expected a Speos BSDF file starting {_SPEOS_MAGIC.decode()!r}", 1
-        )
-    raise AdapterError(
-        path,
-        "an Ansys Speos anisotropic BSDF file: recognised but not read; write the measurement "
-        "in the Zemax/Radiant .bsdf exchange format (read as format 'zemax-bsdf'), which "
-        "Speos, Zemax and the instrument software export",
-        1,
-    )
-
-
 FORMATS = (
     Format(
         "woollam-completeease-se",
@@ -200,14 +162,5 @@ FORMATS = (
         refuse_spectrapen,
         (),
         keywords=(b"Irradiance",),
-    ),
-    Format(
-        "speos-bsdf",
-        "Ansys Speos .anisotropicbsdf: recognised and refused (use the Zemax .bsdf export)",
-        (".anisotropicbsdf",),
-        _sniff_speos,
-        refuse_speos_bsdf,
-        (),
-        keywords=(_SPEOS_MAGIC,),
     ),
 )

@@ -272,6 +272,7 @@ TRUNCATION_FORMATS = (
     "filmsense",
     "jcamp-dx",
     "zemax-bsdf",
+    "speos-bsdf",
     "labbrdf-specular-scan",
     "labbrdf-hemispherical-reflectance",
     "oceanoptics-text",

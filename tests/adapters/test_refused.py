@@ -40,26 +40,3 @@ def test_spectrapen_photon_irradiance_variant(tmp_path: Path) -> None:
     )
     with pytest.raises(AdapterError, match=r"Irradiance \[µE/m2/s/nm\]"):
         labbrdf.read(p)
-
-
-def test_speos_bsdf_is_refused_with_the_zemax_advice(tmp_path: Path) -> None:
-    # the first lines of a Speos table: without its own sniffer it looked like numbers after
-    # a five-line preamble and was offered --skip-lines, which would read the grid as data
-    p = tmp_path / "vinyl.anisotropicbsdf"
-    p.write_text(
-        "OPTIS - Anisotropic BSDF surface file v8.0\n0\nComment\n23\nMeasurement description\n"
-        "0\t1\t0\n1\t0\n1\n1\n0.0\t\n13\n15.0\t20.0\t25.0\t\n"
-    )
-    assert sniff(p) == ["speos-bsdf"]
-    with pytest.raises(AdapterError, match=r"line 1: an Ansys Speos .*'zemax-bsdf'"):
-        labbrdf.read(p)
-    other = tmp_path / "other.anisotropicbsdf"
-    other.write_text("1 2\n3 4\n")
-    with pytest.raises(AdapterError, match="expected a Speos BSDF file"):
-        labbrdf.read(other, format="speos-bsdf")
-
-
-def test_real_speos_bsdf_is_refused_by_name(real_exports: Path) -> None:
-    p = next((real_exports / "speos-anisotropicbsdf").glob("*.anisotropicbsdf"))
-    with pytest.raises(AdapterError, match="Ansys Speos anisotropic BSDF file"):
-        labbrdf.read(p)
