@@ -6,12 +6,25 @@ Woollam CompleteEASE ``.SE`` (``woollam-completeease-se``)
     ``woollam-completeease``), so a binary ``.SE`` is refused with that advice. A file named
     ``.se`` that is text is not this format: it is dispatched on its content like any text
     export (a Woollam ASCII file saved as ``.se`` is read as such).
+
+RGL tensor ``.bsdf`` (``rgl-tensor-bsdf``)
+    The measured materials of the EPFL Realistic Graphics Lab database: a binary "tensor
+    file" (magic ``tensor_file`` and a NUL byte, then a version and named fields: the adaptive
+    parametrisation of Dupuy and Jakob, 2018, not a table of BRDF values on angles). It
+    shares the ``.bsdf`` extension with the Zemax/Radiant text format and is refused by its
+    header.
+
+MERL BRDF database ``.binary`` (``merl-binary``)
+    Three int32 dimensions (90, 90, 180) and then 3 x 90 x 90 x 180 float64 values in the
+    Rusinkiewicz half/difference-angle parametrisation (Matusik et al., 2003), RGB and
+    without the wavelength or geometry of a measurement; refused by its header.
 """
 
 from __future__ import annotations
 
 import os
 import re
+import struct
 
 from ..dataset import Measurement
 from ._base import AdapterError, Format, read_head
@@ -20,6 +33,8 @@ __all__ = [
     "FORMATS",
     "refuse_completeease_se",
     "refuse_completeease_sesnap",
+    "refuse_merl_binary",
+    "refuse_rgl_tensor",
     "refuse_spectrapen",
 ]
 
@@ -135,6 +150,66 @@ def refuse_spectrapen(path: str | os.PathLike[str]) -> Measurement:
     )
 
 
+#: the first bytes of an RGL tensor file (the database's ``.bsdf``)
+_RGL_MAGIC = b"tensor_file\x00"
+#: the first bytes of a MERL BRDF: int32 dimensions 90 x 90 x 180 (theta_h, theta_d, phi_d/2)
+_MERL_DIMS = struct.pack("<3i", 90, 90, 180)
+
+
+def _sniff_rgl(head: bytes) -> bool:
+    return head.startswith(_RGL_MAGIC)
+
+
+def _sniff_merl(head: bytes) -> bool:
+    return head.startswith(_MERL_DIMS)
+
+
+def refuse_rgl_tensor(path: str | os.PathLike[str]) -> Measurement:
+    """Refuse a binary RGL tensor ``.bsdf`` (EPFL material database) by name.
+
+    Raises
+    ------
+    AdapterError
+        Always: the tensor file is named and not read; a file without its header is told
+        so.
+    """
+    head = read_head(path)
+    if not _sniff_rgl(head):
+        raise AdapterError(path, "expected an RGL tensor file starting 'tensor_file\\0'", 1)
+    version = ".".join(str(b) for b in head[12:14])
+    raise AdapterError(
+        path,
+        f"a binary RGL tensor file (version {version}, the EPFL measured-material database's "
+        ".bsdf): an adaptive parametrisation for rendering, not a table of BRDF values on "
+        "angles; it is recognised and not read (the Zemax/Radiant text .bsdf is 'zemax-bsdf')",
+        1,
+        unit="byte",
+    )
+
+
+def refuse_merl_binary(path: str | os.PathLike[str]) -> Measurement:
+    """Refuse a MERL BRDF database ``.binary`` file by name.
+
+    Raises
+    ------
+    AdapterError
+        Always: the MERL layout is named and not read; a file without its header is told
+        so.
+    """
+    if not _sniff_merl(read_head(path)):
+        raise AdapterError(
+            path, "expected a MERL BRDF: int32 dimensions 90 90 180 at the start", 1, unit="byte"
+        )
+    raise AdapterError(
+        path,
+        "a MERL BRDF database file (int32 dimensions 90 x 90 x 180, then float64 RGB values "
+        "in half/difference angles): recognised and not read; it has no wavelength and no "
+        "measurement geometry of its own",
+        1,
+        unit="byte",
+    )
+
+
 FORMATS = (
     Format(
         "woollam-completeease-se",
@@ -162,5 +237,23 @@ FORMATS = (
         refuse_spectrapen,
         (),
         keywords=(b"Irradiance",),
+    ),
+    Format(
+        "rgl-tensor-bsdf",
+        "RGL material database binary tensor .bsdf: recognised and refused (not a table "
+        "of BRDF values)",
+        (".bsdf",),
+        _sniff_rgl,
+        refuse_rgl_tensor,
+        (),
+        keywords=(_RGL_MAGIC,),
+    ),
+    Format(
+        "merl-binary",
+        "MERL BRDF database .binary: recognised and refused (RGB in half/difference angles)",
+        (".binary",),
+        _sniff_merl,
+        refuse_merl_binary,
+        (),
     ),
 )
