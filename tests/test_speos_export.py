@@ -1,0 +1,52 @@
+"""Speos ``.anisotropicbsdf`` export: a model written and read back by the reader."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import labbrdf
+from labbrdf import models
+from labbrdf.adapters.speos_bsdf import read_speos_table
+from labbrdf.outputs import OutputError, write_policy
+from labbrdf.speos_export import model_to_speos, write_speos_bsdf
+
+
+def test_model_written_as_speos_reads_back_to_the_model(tmp_path):
+    model = models.get("five_param")
+    ti = np.array([20.0, 50.0])
+    p = model_to_speos(
+        model, None, tmp_path / "m.anisotropicbsdf", theta_i_deg=ti, wavelength_nm=633.0
+    )
+    m = labbrdf.read(p)
+    assert m.meta["format"] == "speos-bsdf"
+    assert set(m.data["wavelength_nm"]) == {633.0}
+    d = m.data
+    # the model at the angles the reader reports: the writer's phi = phi_r - 180 and the
+    # reader's phi_r = phi + 180 must be inverse, and the spectrum scale must cancel
+    want = model.evaluate(
+        np.radians(d.theta_i_deg), np.radians(d.theta_r_deg), np.radians(d.phi_r_deg)
+    )
+    np.testing.assert_allclose(d.value, want, rtol=1e-12)
+    # the spectrum is the first table's hemispherical reflectance; against the model's own
+    # integral: trapezoid on 1 x 5 deg steps, second order (h^2/12 of the curvature)
+    t = read_speos_table(p)
+    rho = labbrdf.integrate.hemispherical_reflectance(model, None, ti[:1])
+    np.testing.assert_allclose(t.coefficient_pct[0] / 100, rho, rtol=0.02)
+
+
+def test_speos_writer_refuses_bad_grids_and_existing_files(tmp_path):
+    kw = dict(theta_i_deg=[10.0], theta_deg=[0.0, 45.0, 90.0], phi_deg=[0.0, 180.0, 360.0])
+    good = np.full((1, 3, 3), 0.1)
+    p = write_speos_bsdf(tmp_path / "a.anisotropicbsdf", values=good, **kw)
+    with write_policy(overwrite=False), pytest.raises(OutputError, match="exists"):
+        write_speos_bsdf(p, values=good, **kw)
+    with pytest.raises(ValueError, match="shape"):
+        write_speos_bsdf(tmp_path / "b.anisotropicbsdf", values=good[:, :2], **kw)
+    with pytest.raises(ValueError, match="theta_deg"):
+        write_speos_bsdf(
+            tmp_path / "b.anisotropicbsdf", values=good, **dict(kw, theta_deg=[0, 95, 96])
+        )
+    with pytest.raises(ValueError, match="reflectance in"):
+        write_speos_bsdf(tmp_path / "b.anisotropicbsdf", values=good * 100, **kw)
+    assert not (tmp_path / "b.anisotropicbsdf").exists()
