@@ -50,3 +50,24 @@ def test_speos_writer_refuses_bad_grids_and_existing_files(tmp_path):
     with pytest.raises(ValueError, match="reflectance in"):
         write_speos_bsdf(tmp_path / "b.anisotropicbsdf", values=good * 100, **kw)
     assert not (tmp_path / "b.anisotropicbsdf").exists()
+
+
+def test_cli_exports_a_model_as_speos_and_it_reads_back(tmp_path, capsys):
+    from labbrdf.cli import main
+
+    out = tmp_path / "m.anisotropicbsdf"
+    argv = ["export", "--format", "speos-bsdf", "--model", "five_param", "--theta-i", "30",
+            "-o", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    assert main(argv) == 2  # never over an existing file without --overwrite
+    assert "exists" in capsys.readouterr().err
+    d = labbrdf.read(out).data
+    model = models.get("five_param")
+    want = model.evaluate(
+        np.radians(d.theta_i_deg), np.radians(d.theta_r_deg), np.radians(d.phi_r_deg)
+    )
+    np.testing.assert_allclose(d.value, want, rtol=1e-12)
+    trace = ["export", "--format", "speos-bsdf", "--trace", str(out), "-o",
+             str(tmp_path / "t.anisotropicbsdf")]  # fmt: skip
+    assert main(trace) == 2
+    assert "zemax-bsdf only" in capsys.readouterr().err

@@ -1,4 +1,4 @@
-"""``labbrdf export``: a model's BRDF or a trace's S0 as a Zemax BSDF file."""
+"""``labbrdf export``: a model's BRDF or a trace's S0 as a BSDF file (Zemax or Speos)."""
 
 from __future__ import annotations
 
@@ -9,6 +9,9 @@ from typing import Any
 from ._options import UsageError, _angle_value, _model_from_args, _wavelength_value
 from ._paths import InputPath, OutputPath, _add_overwrite
 
+#: the file each --format writes
+_SUFFIX = {"zemax-bsdf": ".bsdf", "speos-bsdf": ".anisotropicbsdf"}
+
 
 def cmd_export(args: argparse.Namespace) -> int:
     """Write ``--model``'s BRDF or ``--trace``'s S0 as a Zemax BSDF file."""
@@ -16,11 +19,15 @@ def cmd_export(args: argparse.Namespace) -> int:
 
     from ..bsdf_export import model_to_bsdf
 
-    if args.format != "zemax-bsdf":
-        raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
+    if args.format not in _SUFFIX:
+        raise UsageError(f"--format {args.format!r}: export writes {' or '.join(_SUFFIX)}")
+    if not str(args.output).lower().endswith(_SUFFIX[args.format]):
+        raise UsageError(f"--format {args.format} writes a {_SUFFIX[args.format]} file (-o)")
     if (args.model is None) == (args.trace is None):
         raise UsageError("export a model (--model NAME --param ...) or a trace (--trace RUN.npz)")
     if args.trace is not None:
+        if args.format == "speos-bsdf":
+            raise UsageError("--trace is written as zemax-bsdf only")
         return _export_trace(args)
     if args.theta_i is None:
         raise UsageError("--model needs --theta-i DEG [DEG ...]")
@@ -29,6 +36,18 @@ def cmd_export(args: argparse.Namespace) -> int:
     if unknown:
         raise UsageError(f"--param {unknown}: {args.model} parameters are {list(model.params)}")
     out = Path(args.output)  # checked with the inputs by _checked_outputs
+    if args.format == "speos-bsdf":
+        from ..speos_export import model_to_speos
+
+        model_to_speos(
+            model,
+            values,
+            out,
+            theta_i_deg=np.asarray(args.theta_i, float),
+            wavelength_nm=args.wavelength,
+        )
+        print(f"wrote {out}")
+        return 0
     model_to_bsdf(
         model,
         values,
@@ -87,7 +106,11 @@ def _grid(text: str, option: str) -> Any:
 def add_parser(sub: Any) -> None:
     """The ``export`` subcommand's options."""
     s = sub.add_parser("export", help="write a model BRDF in an exchange format")
-    s.add_argument("--format", default="zemax-bsdf", help="zemax-bsdf")
+    s.add_argument(
+        "--format",
+        default="zemax-bsdf",
+        help="zemax-bsdf, or speos-bsdf (a model on theta 0:90:1, phi 0:360:5 from the normal)",
+    )
     s.add_argument("--model", default=None, help="a model (with --param) ...")
     s.add_argument(
         "--trace", action=InputPath, default=None, metavar="RUN.npz", help="... or a trace's S0"
@@ -104,6 +127,8 @@ def add_parser(sub: Any) -> None:
     s.add_argument("--theta-i", type=_angle_value, nargs="+", default=None, metavar="DEG")
     s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")
     s.add_argument("--azimuth", default="0:180:5", help="START:STOP:STEP [deg]")
-    s.add_argument("-o", "--output", action=OutputPath, suffixes=(".bsdf",), required=True)
+    s.add_argument(
+        "-o", "--output", action=OutputPath, suffixes=tuple(_SUFFIX.values()), required=True
+    )
     _add_overwrite(s)
     s.set_defaults(func=cmd_export)

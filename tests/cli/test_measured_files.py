@@ -104,6 +104,7 @@ def test_exported_model_is_fitted_back_exactly(tmp_path: Path, capsys):
         (["--param", "n=1.5", "--radial", "0:x:1"], "START:STOP:STEP"),
         (["--param", "n=1.5", "--nk-from", "x.dat"], "needs --wavelength"),
         (["--param", "n=1.5", "--format", "csv"], "export writes zemax-bsdf"),
+        (["--param", "n=1.5", "--format", "speos-bsdf"], "writes a .anisotropicbsdf file"),
     ],
 )
 def test_export_errors_are_exit_2(tmp_path: Path, capsys, argv, message):
