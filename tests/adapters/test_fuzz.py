@@ -273,6 +273,7 @@ TRUNCATION_FORMATS = (
     "jcamp-dx",
     "zemax-bsdf",
     "speos-bsdf",
+    "pab-pgii",
     "labbrdf-specular-scan",
     "labbrdf-hemispherical-reflectance",
     "oceanoptics-text",
@@ -331,8 +332,24 @@ def _avantes_rows(n: int) -> str:
     return "".join(rows)
 
 
-#: synthetic files of the formats whose only real file is refused whole (irradiance)
+def _pgii_rows(n: int) -> str:
+    """pgII rows of a diffuse reflector: theta phi DSF, 3 decimals as Mountain writes them."""
+    return "".join(
+        f"{5.0 + 0.25 * i:.3f}\t{(37.0 * i) % 360:.3f}\t{0.3 * (1 - 0.002 * i):.6f}\n"
+        for i in range(n)
+    )
+
+
+#: synthetic files of the formats with no real file here, or whose only real file is
+#: refused whole (irradiance)
 _SYNTHETIC = {
+    "pab-pgii": [
+        (
+            "f30_Rvis.txt",
+            '#sample_name "white"\n#format: theta phi DSF\n#incident_angle 30 0\n'
+            + _pgii_rows(40),
+        )
+    ],
     "avantes-avasoft": [
         (
             "feather_reflection.txt",
@@ -341,7 +358,7 @@ _SYNTHETIC = {
             "Wave   ;Sample   ;Dark     ;Reference;Reflectance\r\n"
             "[nm]   ;[counts] ;[counts] ;[counts] ;[%]\r\n\r\n" + _avantes_rows(40),
         )
-    ]
+    ],
 }
 
 
