@@ -17,6 +17,7 @@ from typing import Any
 from ..dataset import Measurement, concat
 from . import (
     accurion,
+    astm_brdf,
     avantes,
     cary,
     cid,
@@ -77,6 +78,7 @@ _VENDOR_MODULES = (
     zemax_bsdf,
     speos_bsdf,
     pab_mountain,
+    astm_brdf,
     nexus,
     refused,
     columns,

@@ -274,6 +274,7 @@ TRUNCATION_FORMATS = (
     "zemax-bsdf",
     "speos-bsdf",
     "pab-pgii",
+    "astm-brdf",
     "labbrdf-specular-scan",
     "labbrdf-hemispherical-reflectance",
     "oceanoptics-text",
@@ -340,9 +341,23 @@ def _pgii_rows(n: int) -> str:
     )
 
 
+def _astm_rows(n: int) -> str:
+    """ASTM-style rows (radians, two wavelengths), 6 decimals throughout."""
+    return "".join(
+        f"0.523599,0.000000,{0.02 * i:.6f},3.141593,{0.3 - 0.001 * i:.6f},{0.4 - 0.001 * i:.6f}\n"
+        for i in range(n)
+    )
+
+
 #: synthetic files of the formats with no real file here, or whose only real file is
 #: refused whole (irradiance)
 _SYNTHETIC = {
+    "astm-brdf": [
+        (
+            "paint.astm",
+            'NAME "paint"\nVARS theta_i,phi_i,theta_s,phi_s,450nm,550nm\n' + _astm_rows(40),
+        )
+    ],
     "pab-pgii": [
         (
             "f30_Rvis.txt",
