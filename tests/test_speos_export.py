@@ -71,3 +71,34 @@ def test_cli_exports_a_model_as_speos_and_it_reads_back(tmp_path, capsys):
              str(tmp_path / "t.anisotropicbsdf")]  # fmt: skip
     assert main(trace) == 2
     assert "zemax-bsdf only" in capsys.readouterr().err
+
+
+def test_model_written_as_astm_reads_back_to_the_model(tmp_path):
+    from labbrdf.astm_export import model_to_astm
+
+    model = models.get("five_param")
+    p = model_to_astm(
+        model, None, tmp_path / "m.astm", theta_i_deg=[20.0, 60.0], wavelength_nm=633.0
+    )
+    m = labbrdf.read(p)
+    assert m.meta["format"] == "astm-brdf" and set(m.data["wavelength_nm"]) == {633.0}
+    d = m.data
+    assert len(d) == 2 * 90 * 2
+    want = model.evaluate(
+        np.radians(d.theta_i_deg), np.radians(d.theta_r_deg), np.radians(d.phi_r_deg)
+    )
+    np.testing.assert_allclose(d.value, want, rtol=1e-12)
+    with write_policy(overwrite=False), pytest.raises(OutputError):
+        model_to_astm(model, None, p, theta_i_deg=[20.0], wavelength_nm=633.0)
+
+
+def test_cli_exports_an_astm_table_and_needs_its_wavelength(tmp_path, capsys):
+    from labbrdf.cli import main
+
+    out = tmp_path / "m.astm"
+    base = ["export", "--format", "astm-brdf", "--model", "five_param", "--theta-i", "30",
+            "-o", str(out)]  # fmt: skip
+    assert main(base) == 2
+    assert "needs --wavelength" in capsys.readouterr().err
+    assert main([*base, "--wavelength", "550"]) == 0
+    assert labbrdf.read(out).meta["format"] == "astm-brdf"

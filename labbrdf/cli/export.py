@@ -10,7 +10,7 @@ from ._options import UsageError, _angle_value, _model_from_args, _wavelength_va
 from ._paths import InputPath, OutputPath, _add_overwrite
 
 #: the file each --format writes
-_SUFFIX = {"zemax-bsdf": ".bsdf", "speos-bsdf": ".anisotropicbsdf"}
+_SUFFIX = {"zemax-bsdf": ".bsdf", "speos-bsdf": ".anisotropicbsdf", "astm-brdf": ".astm"}
 
 
 def cmd_export(args: argparse.Namespace) -> int:
@@ -26,7 +26,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     if (args.model is None) == (args.trace is None):
         raise UsageError("export a model (--model NAME --param ...) or a trace (--trace RUN.npz)")
     if args.trace is not None:
-        if args.format == "speos-bsdf":
+        if args.format != "zemax-bsdf":
             raise UsageError("--trace is written as zemax-bsdf only")
         return _export_trace(args)
     if args.theta_i is None:
@@ -36,6 +36,20 @@ def cmd_export(args: argparse.Namespace) -> int:
     if unknown:
         raise UsageError(f"--param {unknown}: {args.model} parameters are {list(model.params)}")
     out = Path(args.output)  # checked with the inputs by _checked_outputs
+    if args.format == "astm-brdf":
+        from ..astm_export import model_to_astm
+
+        if args.wavelength is None:
+            raise UsageError("--format astm-brdf needs --wavelength NM (its value column)")
+        model_to_astm(
+            model,
+            values,
+            out,
+            theta_i_deg=np.asarray(args.theta_i, float),
+            wavelength_nm=args.wavelength,
+        )
+        print(f"wrote {out}")
+        return 0
     if args.format == "speos-bsdf":
         from ..speos_export import model_to_speos
 
@@ -109,7 +123,8 @@ def add_parser(sub: Any) -> None:
     s.add_argument(
         "--format",
         default="zemax-bsdf",
-        help="zemax-bsdf, or speos-bsdf (a model on theta 0:90:1, phi 0:360:5 from the normal)",
+        help="zemax-bsdf, speos-bsdf (a model on theta 0:90:1, phi 0:360:5 from the normal) "
+        "or astm-brdf (the plane of incidence, theta_r 0:89:1; needs --wavelength)",
     )
     s.add_argument("--model", default=None, help="a model (with --param) ...")
     s.add_argument(
@@ -122,7 +137,7 @@ def add_parser(sub: Any) -> None:
         type=_wavelength_value,
         default=None,
         metavar="NM",
-        help="[nm] for --nk-from",
+        help="[nm] for --nk-from; also the wavelength written by speos-bsdf and astm-brdf",
     )
     s.add_argument("--theta-i", type=_angle_value, nargs="+", default=None, metavar="DEG")
     s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")
