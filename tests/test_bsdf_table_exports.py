@@ -1,4 +1,4 @@
-"""Speos ``.anisotropicbsdf`` export: a model written and read back by the reader."""
+"""Speos, ASTM and pgII exports: a model written and read back by the readers."""
 
 from __future__ import annotations
 
@@ -102,3 +102,17 @@ def test_cli_exports_an_astm_table_and_needs_its_wavelength(tmp_path, capsys):
     assert "needs --wavelength" in capsys.readouterr().err
     assert main([*base, "--wavelength", "550"]) == 0
     assert labbrdf.read(out).meta["format"] == "astm-brdf"
+
+
+def test_model_written_as_pgii_reads_back_to_the_model(tmp_path):
+    from labbrdf.pgii_export import model_to_pgii
+
+    model = models.get("five_param")
+    p = model_to_pgii(model, None, tmp_path / "f40_Rvis.txt", theta_i_deg=40.0)
+    m = labbrdf.read(p)
+    assert m.meta["format"] == "pab-pgii" and len(m) == 90 * 72
+    d = m.data
+    want = model.evaluate(
+        np.radians(d.theta_i_deg), np.radians(d.theta_r_deg), np.radians(d.phi_r_deg)
+    )
+    np.testing.assert_allclose(d.value, want, rtol=1e-12)
