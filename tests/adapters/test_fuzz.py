@@ -377,6 +377,19 @@ _SYNTHETIC = {
 }
 
 
+@pytest.mark.parametrize("fmt", ["pab-pgii", "astm-brdf"])
+def test_mutated_synthetic_files_raise_adaptererror_or_keep_their_count(
+    tmp_path: Path, fmt: str
+) -> None:
+    """The formats with no real export here: their synthetic file, mutated the same way."""
+    ((name, text),) = _SYNTHETIC[fmt]
+    src = tmp_path / name
+    src.write_text(text)
+    n0 = _points(READERS[fmt].read(src))
+    assert n0 > 0
+    _fuzz_file(fmt, text.encode(), n0, tmp_path / f"mutated-{name}")
+
+
 def _truncation_cases(real_exports: Path, fmt: str) -> list[tuple[str, bytes, Any]]:
     """(file name, its bytes, the reader) of every real file, fixture or synthetic file."""
     if fmt == "columns":
