@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from .adapters.speos_bsdf import MAGIC, SpeosTable, hemispherical_integral
 from .outputs import atomic_output, check_file_output
 
-__all__ = ["model_to_speos", "write_speos_bsdf"]
+__all__ = ["binned_to_speos", "model_to_speos", "write_speos_bsdf"]
 
 #: the default table grid [deg]: theta from the normal step 1, phi step 5
 THETA_DEG = tuple(float(x) for x in range(91))
@@ -201,4 +201,64 @@ def model_to_speos(
         wavelength_nm=wavelength_nm,
         comment=f"labbrdf model {name}",
         description=f"labbrdf model {name}, BRDF [sr-1] at {wavelength_nm or '-'} nm",
+    )
+
+
+def binned_to_speos(
+    path: str | os.PathLike[str],
+    *,
+    theta_i_deg: float,
+    values: ArrayLike,
+    theta_edges_deg: ArrayLike,
+    phi_edges_deg: ArrayLike,
+    wavelength_nm: float | None = None,
+    comment: str = "labbrdf trace",
+) -> Path:
+    """Write a BRDF binned on a (theta_r, phi_r) grid (a tracer's S0) as a Speos file.
+
+    The table's nodes are the bin centres (theta), and the bin centres' azimuths turned to
+    the normal reference (``phi = phi_r - 180``, sorted): the values are written as binned,
+    without interpolation.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Output file (see :func:`write_speos_bsdf`).
+    theta_i_deg : float
+        Angle of incidence [deg].
+    values : array_like, shape (n_theta, n_phi)
+        Bin-averaged BRDF [sr^-1], e.g. :meth:`labbrdf.TraceResult.s0`; empty bins (NaN)
+        are written as 0.
+    theta_edges_deg, phi_edges_deg : array_like
+        Bin edges [deg], ``n_theta + 1`` in [0, 90] and ``n_phi + 1`` in [0, 360] (source
+        at 0).
+    wavelength_nm : float, optional
+        The spectrum's wavelength [nm].
+    comment : str
+        The comment line.
+
+    Notes
+    -----
+    The spectrum is the trapezoid integral over the span of the bin centres, so a trace
+    whose bins do not reach the pole or the horizon states a slightly smaller reflectance
+    than its rays carried; the reader scales back by the same integral, so the values read
+    are the values written.
+    """
+    te = np.asarray(theta_edges_deg, float)
+    pe = np.asarray(phi_edges_deg, float)
+    v = np.nan_to_num(np.asarray(values, float), nan=0.0)
+    if v.shape != (te.size - 1, pe.size - 1):
+        raise ValueError(f"values: expected shape {(te.size - 1, pe.size - 1)}, got {v.shape}")
+    theta = 0.5 * (te[1:] + te[:-1])
+    phi = np.mod(0.5 * (pe[1:] + pe[:-1]) - 180.0, 360.0)
+    order = np.argsort(phi)
+    return write_speos_bsdf(
+        path,
+        theta_i_deg=[float(theta_i_deg)],
+        theta_deg=theta,
+        phi_deg=phi[order],
+        values=v[None][..., order],
+        wavelength_nm=wavelength_nm,
+        comment=comment,
+        description=comment,
     )

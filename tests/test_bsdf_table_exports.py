@@ -67,10 +67,27 @@ def test_cli_exports_a_model_as_speos_and_it_reads_back(tmp_path, capsys):
         np.radians(d.theta_i_deg), np.radians(d.theta_r_deg), np.radians(d.phi_r_deg)
     )
     np.testing.assert_allclose(d.value, want, rtol=1e-12)
-    trace = ["export", "--format", "speos-bsdf", "--trace", str(out), "-o",
-             str(tmp_path / "t.anisotropicbsdf")]  # fmt: skip
+    trace = ["export", "--format", "astm-brdf", "--trace", str(out), "-o",
+             str(tmp_path / "t.astm")]  # fmt: skip
     assert main(trace) == 2
-    assert "zemax-bsdf only" in capsys.readouterr().err
+    assert "zemax-bsdf or speos-bsdf" in capsys.readouterr().err
+
+
+def test_binned_brdf_written_as_speos_reads_back_bin_by_bin(tmp_path):
+    from labbrdf.speos_export import binned_to_speos
+
+    te = np.linspace(0.0, 90.0, 19)  # 5-deg bins
+    pe = np.linspace(0.0, 360.0, 37)  # 10-deg bins, source at 0
+    tc, pc = 0.5 * (te[1:] + te[:-1]), 0.5 * (pe[1:] + pe[:-1])
+    # a lobe towards the specular side (phi_r 180) that tells the azimuth origin apart
+    v = 0.05 + 0.2 * np.cos(np.radians(tc))[:, None] * (1 - np.cos(np.radians(pc)))[None]
+    p = binned_to_speos(tmp_path / "t.anisotropicbsdf", theta_i_deg=40.0, values=v,
+                        theta_edges_deg=te, phi_edges_deg=pe)  # fmt: skip
+    d = labbrdf.read(p).data
+    assert len(d) == v.size
+    i = np.searchsorted(te, d["theta_r_deg"]) - 1
+    j = np.searchsorted(pe, d["phi_r_deg"]) - 1
+    np.testing.assert_allclose(d["value"], v[i, j], rtol=1e-12)
 
 
 def test_model_written_as_astm_reads_back_to_the_model(tmp_path):

@@ -26,8 +26,8 @@ def cmd_export(args: argparse.Namespace) -> int:
     if (args.model is None) == (args.trace is None):
         raise UsageError("export a model (--model NAME --param ...) or a trace (--trace RUN.npz)")
     if args.trace is not None:
-        if args.format != "zemax-bsdf":
-            raise UsageError("--trace is written as zemax-bsdf only")
+        if args.format == "astm-brdf":
+            raise UsageError("--trace is written as zemax-bsdf or speos-bsdf")
         return _export_trace(args)
     if args.theta_i is None:
         raise UsageError("--model needs --theta-i DEG [DEG ...]")
@@ -90,6 +90,20 @@ def _export_trace(args: argparse.Namespace) -> int:
     except (OSError, KeyError, ValueError) as exc:
         raise UsageError(f"--trace {args.trace}: not a labbrdf trace file ({exc})") from None
     cfg = res.config
+    if args.format == "speos-bsdf":
+        from ..speos_export import binned_to_speos
+
+        binned_to_speos(
+            out,
+            theta_i_deg=cfg.theta_i_deg,
+            values=res.s0(),
+            theta_edges_deg=res.theta_r_edges_deg,
+            phi_edges_deg=res.phi_r_edges_deg,
+            wavelength_nm=cfg.wavelength_nm,
+            comment=f"labbrdf trace S0 (unpolarized), {res.rays} rays, seed {cfg.seed}",
+        )
+        print(f"wrote {out}")
+        return 0
     binned_to_bsdf(
         out,
         theta_i_deg=cfg.theta_i_deg,
