@@ -88,6 +88,7 @@ _LAZY: dict[str, tuple[str, str]] = {
 #: subpackages and modules offered as attributes of the package
 _MODULES = (
     "adapters",
+    "astm_export",
     "bsdf_export",
     "bsdf_geometry",
     "dataset",
@@ -101,6 +102,7 @@ _MODULES = (
     "nk",
     "optics",
     "parallel",
+    "pgii_export",
     "prediction",
     "report",
     "roughness",
@@ -109,6 +111,7 @@ _MODULES = (
     "samples",
     "selection",
     "specular_dop",
+    "speos_export",
     "tracer",
 )
 
@@ -133,6 +136,7 @@ __all__ = ["__version__", *_LAZY, *_MODULES, *_MOVED]
 if TYPE_CHECKING:
     from . import (
         adapters,
+        astm_export,
         bsdf_export,
         bsdf_geometry,
         dataset,
@@ -146,6 +150,7 @@ if TYPE_CHECKING:
         nk,
         optics,
         parallel,
+        pgii_export,
         prediction,
         report,
         roughness,
@@ -154,6 +159,7 @@ if TYPE_CHECKING:
         samples,
         selection,
         specular_dop,
+        speos_export,
         tracer,
     )
     from .adapters import AdapterError, Inputs, formats, read, read_inputs, read_many

@@ -7,17 +7,24 @@ Woollam CompleteEASE ``.SE`` (``woollam-completeease-se``)
     ``.se`` that is text is not this format: it is dispatched on its content like any text
     export (a Woollam ASCII file saved as ``.se`` is read as such).
 
-Ansys Speos ``.anisotropicbsdf`` (``speos-bsdf``)
-    A BSDF table for Speos (first line ``OPTIS - Anisotropic BSDF surface file``). It is
-    usually a conversion of a measurement that the instrument also writes in the
-    Zemax/Radiant ``.bsdf`` exchange format (read by ``zemax-bsdf``), so it is refused with
-    that advice instead of being taken for a table of numbers after a preamble.
+RGL tensor ``.bsdf`` (``rgl-tensor-bsdf``)
+    The measured materials of the EPFL Realistic Graphics Lab database: a binary "tensor
+    file" (magic ``tensor_file`` and a NUL byte, then a version and named fields: the adaptive
+    parametrisation of Dupuy and Jakob, 2018, not a table of BRDF values on angles). It
+    shares the ``.bsdf`` extension with the Zemax/Radiant text format and is refused by its
+    header.
+
+MERL BRDF database ``.binary`` (``merl-binary``)
+    Three int32 dimensions (90, 90, 180) and then 3 x 90 x 90 x 180 float64 values in the
+    Rusinkiewicz half/difference-angle parametrisation (Matusik et al., 2003), RGB and
+    without the wavelength or geometry of a measurement; refused by its header.
 """
 
 from __future__ import annotations
 
 import os
 import re
+import struct
 
 from ..dataset import Measurement
 from ._base import AdapterError, Format, read_head
@@ -26,8 +33,9 @@ __all__ = [
     "FORMATS",
     "refuse_completeease_se",
     "refuse_completeease_sesnap",
+    "refuse_merl_binary",
+    "refuse_rgl_tensor",
     "refuse_spectrapen",
-    "refuse_speos_bsdf",
 ]
 
 _SE_HINT = (
@@ -142,34 +150,63 @@ def refuse_spectrapen(path: str | os.PathLike[str]) -> Measurement:
     )
 
 
-#: first line of every Speos BSDF text file (the version follows)
-_SPEOS_MAGIC = b"OPTIS - Anisotropic BSDF surface file"
+#: the first bytes of an RGL tensor file (the database's ``.bsdf``)
+_RGL_MAGIC = b"tensor_file\x00"
+#: the first bytes of a MERL BRDF: int32 dimensions 90 x 90 x 180 (theta_h, theta_d, phi_d/2)
+_MERL_DIMS = struct.pack("<3i", 90, 90, 180)
 
 
-def _sniff_speos(head: bytes) -> bool:
-    return head.lstrip(b"\xef\xbb\xbf").startswith(_SPEOS_MAGIC)
+def _sniff_rgl(head: bytes) -> bool:
+    return head.startswith(_RGL_MAGIC)
 
 
-def refuse_speos_bsdf(path: str | os.PathLike[str]) -> Measurement:
-    """Refuse an Ansys Speos ``.anisotropicbsdf`` text file with what to do instead.
+def _sniff_merl(head: bytes) -> bool:
+    return head.startswith(_MERL_DIMS)
+
+
+def refuse_rgl_tensor(path: str | os.PathLike[str]) -> Measurement:
+    """Refuse a binary RGL tensor ``.bsdf`` (EPFL material database) by name.
 
     Raises
     ------
     AdapterError
-        Always: the Speos layout (one table per incidence on a theta x phi grid, a spectrum
-        of TIS values) is recognised but not read; the same measurement in the Zemax/Radiant
-        ``.bsdf`` exchange format is read by ``zemax-bsdf``.
+        Always: the tensor file is named and not read; a file without its header is told
+        so.
     """
-    if not _sniff_speos(read_head(path)):
+    head = read_head(path)
+    if not _sniff_rgl(head):
+        raise AdapterError(path, "expected an RGL tensor file starting 'tensor_file\\0'", 1)
+    version = ".".join(str(b) for b in head[12:14])
+    raise AdapterError(
+        path,
+        f"a binary RGL tensor file (version {version}, the EPFL measured-material database's "
+        ".bsdf): an adaptive parametrisation for rendering, not a table of BRDF values on "
+        "angles; it is recognised and not read (the Zemax/Radiant text .bsdf is 'zemax-bsdf')",
+        1,
+        unit="byte",
+    )
+
+
+def refuse_merl_binary(path: str | os.PathLike[str]) -> Measurement:
+    """Refuse a MERL BRDF database ``.binary`` file by name.
+
+    Raises
+    ------
+    AdapterError
+        Always: the MERL layout is named and not read; a file without its header is told
+        so.
+    """
+    if not _sniff_merl(read_head(path)):
         raise AdapterError(
-            path, f"expected a Speos BSDF file starting {_SPEOS_MAGIC.decode()!r}", 1
+            path, "expected a MERL BRDF: int32 dimensions 90 90 180 at the start", 1, unit="byte"
         )
     raise AdapterError(
         path,
-        "an Ansys Speos anisotropic BSDF file: recognised but not read; write the measurement "
-        "in the Zemax/Radiant .bsdf exchange format (read as format 'zemax-bsdf'), which "
-        "Speos, Zemax and the instrument software export",
+        "a MERL BRDF database file (int32 dimensions 90 x 90 x 180, then float64 RGB values "
+        "in half/difference angles): recognised and not read; it has no wavelength and no "
+        "measurement geometry of its own",
         1,
+        unit="byte",
     )
 
 
@@ -202,12 +239,21 @@ FORMATS = (
         keywords=(b"Irradiance",),
     ),
     Format(
-        "speos-bsdf",
-        "Ansys Speos .anisotropicbsdf: recognised and refused (use the Zemax .bsdf export)",
-        (".anisotropicbsdf",),
-        _sniff_speos,
-        refuse_speos_bsdf,
+        "rgl-tensor-bsdf",
+        "RGL material database binary tensor .bsdf: recognised and refused (not a table "
+        "of BRDF values)",
+        (".bsdf",),
+        _sniff_rgl,
+        refuse_rgl_tensor,
         (),
-        keywords=(_SPEOS_MAGIC,),
+        keywords=(_RGL_MAGIC,),
+    ),
+    Format(
+        "merl-binary",
+        "MERL BRDF database .binary: recognised and refused (RGB in half/difference angles)",
+        (".binary",),
+        _sniff_merl,
+        refuse_merl_binary,
+        (),
     ),
 )

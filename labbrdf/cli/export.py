@@ -1,4 +1,4 @@
-"""``labbrdf export``: a model's BRDF or a trace's S0 as a Zemax BSDF file."""
+"""``labbrdf export``: a model's BRDF or a trace's S0 as a BSDF file (Zemax or Speos)."""
 
 from __future__ import annotations
 
@@ -9,6 +9,9 @@ from typing import Any
 from ._options import UsageError, _angle_value, _model_from_args, _wavelength_value
 from ._paths import InputPath, OutputPath, _add_overwrite
 
+#: the file each --format writes
+_SUFFIX = {"zemax-bsdf": ".bsdf", "speos-bsdf": ".anisotropicbsdf", "astm-brdf": ".astm"}
+
 
 def cmd_export(args: argparse.Namespace) -> int:
     """Write ``--model``'s BRDF or ``--trace``'s S0 as a Zemax BSDF file."""
@@ -16,14 +19,18 @@ def cmd_export(args: argparse.Namespace) -> int:
 
     from ..bsdf_export import model_to_bsdf
 
-    if args.format != "zemax-bsdf":
-        raise UsageError(f"--format {args.format!r}: export writes zemax-bsdf")
+    if args.format not in _SUFFIX:
+        raise UsageError(f"--format {args.format!r}: export writes {' or '.join(_SUFFIX)}")
+    if not str(args.output).lower().endswith(_SUFFIX[args.format]):
+        raise UsageError(f"--format {args.format} writes a {_SUFFIX[args.format]} file (-o)")
     if sum(x is not None for x in (args.model, args.trace, args.from_fit)) != 1:
         raise UsageError(
             "export a model (--model NAME --param ...), a fit (--from-fit FIT.json) or a "
             "trace (--trace RUN.npz)"
         )
     if args.trace is not None:
+        if args.format == "astm-brdf":
+            raise UsageError("--trace is written as zemax-bsdf or speos-bsdf")
         return _export_trace(args)
     if args.theta_i is None:
         raise UsageError(
@@ -31,6 +38,32 @@ def cmd_export(args: argparse.Namespace) -> int:
         )
     model, values, wl, comments = _from_fit(args) if args.from_fit else _from_model(args)
     out = Path(args.output)  # checked with the inputs by _checked_outputs
+    if args.format == "astm-brdf":
+        from ..astm_export import model_to_astm
+
+        if wl is None:
+            raise UsageError("--format astm-brdf needs --wavelength NM (its value column)")
+        model_to_astm(
+            model,
+            values,
+            out,
+            theta_i_deg=np.asarray(args.theta_i, float),
+            wavelength_nm=wl,
+        )
+        print(f"wrote {out}")
+        return 0
+    if args.format == "speos-bsdf":
+        from ..speos_export import model_to_speos
+
+        model_to_speos(
+            model,
+            values,
+            out,
+            theta_i_deg=np.asarray(args.theta_i, float),
+            wavelength_nm=wl,
+        )
+        print(f"wrote {out}")
+        return 0
     model_to_bsdf(
         model,
         values,
@@ -88,6 +121,20 @@ def _export_trace(args: argparse.Namespace) -> int:
     except (OSError, KeyError, ValueError) as exc:
         raise UsageError(f"--trace {args.trace}: not a labbrdf trace file ({exc})") from None
     cfg = res.config
+    if args.format == "speos-bsdf":
+        from ..speos_export import binned_to_speos
+
+        binned_to_speos(
+            out,
+            theta_i_deg=cfg.theta_i_deg,
+            values=res.s0(),
+            theta_edges_deg=res.theta_r_edges_deg,
+            phi_edges_deg=res.phi_r_edges_deg,
+            wavelength_nm=cfg.wavelength_nm,
+            comment=f"labbrdf trace S0 (unpolarized), {res.rays} rays, seed {cfg.seed}",
+        )
+        print(f"wrote {out}")
+        return 0
     binned_to_bsdf(
         out,
         theta_i_deg=cfg.theta_i_deg,
@@ -118,7 +165,12 @@ def _grid(text: str, option: str) -> Any:
 def add_parser(sub: Any) -> None:
     """The ``export`` subcommand's options."""
     s = sub.add_parser("export", help="write a model BRDF in an exchange format")
-    s.add_argument("--format", default="zemax-bsdf", help="zemax-bsdf")
+    s.add_argument(
+        "--format",
+        default="zemax-bsdf",
+        help="zemax-bsdf, speos-bsdf (a model on theta 0:90:1, phi 0:360:5 from the normal) "
+        "or astm-brdf (the plane of incidence, theta_r 0:89:1; needs --wavelength)",
+    )
     s.add_argument("--model", default=None, help="a model (with --param) ...")
     s.add_argument(
         "--trace", action=InputPath, default=None, metavar="RUN.npz", help="... or a trace's S0"
@@ -138,11 +190,14 @@ def add_parser(sub: Any) -> None:
         type=_wavelength_value,
         default=None,
         metavar="NM",
-        help="[nm] for --nk-from, the group of --from-fit; recorded in the output",
+        help="[nm] for --nk-from, the group of --from-fit; recorded in the output (the "
+        "wavelength speos-bsdf and astm-brdf write)",
     )
     s.add_argument("--theta-i", type=_angle_value, nargs="+", default=None, metavar="DEG")
     s.add_argument("--radial", default="0:80:2", help="START:STOP:STEP [deg] about specular")
     s.add_argument("--azimuth", default="0:180:5", help="START:STOP:STEP [deg]")
-    s.add_argument("-o", "--output", action=OutputPath, suffixes=(".bsdf",), required=True)
+    s.add_argument(
+        "-o", "--output", action=OutputPath, suffixes=tuple(_SUFFIX.values()), required=True
+    )
     _add_overwrite(s)
     s.set_defaults(func=cmd_export)

@@ -30,8 +30,8 @@ from .limits import (
 )
 from .materials import Material, Roughness, _table_file, _with_params, as_material
 from .model import FilmModel
-from .nonuniform import MAX_SPREAD
 from .modelsamples import ModelSamples, parse_samples, sample_files
+from .nonuniform import MAX_SPREAD
 from .stack import Stack
 
 _LAYER_KEYS = {

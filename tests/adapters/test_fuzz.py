@@ -272,6 +272,9 @@ TRUNCATION_FORMATS = (
     "filmsense",
     "jcamp-dx",
     "zemax-bsdf",
+    "speos-bsdf",
+    "pab-pgii",
+    "astm-brdf",
     "labbrdf-specular-scan",
     "labbrdf-hemispherical-reflectance",
     "oceanoptics-text",
@@ -330,8 +333,38 @@ def _avantes_rows(n: int) -> str:
     return "".join(rows)
 
 
-#: synthetic files of the formats whose only real file is refused whole (irradiance)
+def _pgii_rows(n: int) -> str:
+    """pgII rows of a diffuse reflector: theta phi DSF, 3 decimals as Mountain writes them."""
+    return "".join(
+        f"{5.0 + 0.25 * i:.3f}\t{(37.0 * i) % 360:.3f}\t{0.3 * (1 - 0.002 * i):.6f}\n"
+        for i in range(n)
+    )
+
+
+def _astm_rows(n: int) -> str:
+    """ASTM-style rows (radians, two wavelengths), 6 decimals throughout."""
+    return "".join(
+        f"0.523599,0.000000,{0.02 * i:.6f},3.141593,{0.3 - 0.001 * i:.6f},{0.4 - 0.001 * i:.6f}\n"
+        for i in range(n)
+    )
+
+
+#: synthetic files of the formats with no real file here, or whose only real file is
+#: refused whole (irradiance)
 _SYNTHETIC = {
+    "astm-brdf": [
+        (
+            "paint.astm",
+            'NAME "paint"\nVARS theta_i,phi_i,theta_s,phi_s,450nm,550nm\n' + _astm_rows(40),
+        )
+    ],
+    "pab-pgii": [
+        (
+            "f30_Rvis.txt",
+            '#sample_name "white"\n#format: theta phi DSF\n#incident_angle 30 0\n'
+            + _pgii_rows(40),
+        )
+    ],
     "avantes-avasoft": [
         (
             "feather_reflection.txt",
@@ -340,8 +373,21 @@ _SYNTHETIC = {
             "Wave   ;Sample   ;Dark     ;Reference;Reflectance\r\n"
             "[nm]   ;[counts] ;[counts] ;[counts] ;[%]\r\n\r\n" + _avantes_rows(40),
         )
-    ]
+    ],
 }
+
+
+@pytest.mark.parametrize("fmt", ["pab-pgii", "astm-brdf"])
+def test_mutated_synthetic_files_raise_adaptererror_or_keep_their_count(
+    tmp_path: Path, fmt: str
+) -> None:
+    """The formats with no real export here: their synthetic file, mutated the same way."""
+    ((name, text),) = _SYNTHETIC[fmt]
+    src = tmp_path / name
+    src.write_text(text)
+    n0 = _points(READERS[fmt].read(src))
+    assert n0 > 0
+    _fuzz_file(fmt, text.encode(), n0, tmp_path / f"mutated-{name}")
 
 
 def _truncation_cases(real_exports: Path, fmt: str) -> list[tuple[str, bytes, Any]]:

@@ -106,6 +106,14 @@ def _jws(real: Path, tmp: Path) -> Path:
     return p
 
 
+def _speos(real: Path, tmp: Path) -> Path:
+    raw = (real / _reference("speos-bsdf")).read_bytes()
+    p = tmp / "huge.anisotropicbsdf"
+    p.write_bytes(raw.replace(b"\n19 37\n", b"\n1999999999 37\n", 1))
+    assert p.read_bytes() != raw
+    return p
+
+
 CASES = {
     "jcamp-dup-past-npoints": ("jcamp-dx", _jcamp_dup, "DUP count"),
     "jcamp-npoints-above-cap": ("jcamp-dx", _jcamp_npoints, "exceeds the limit"),
@@ -115,6 +123,7 @@ CASES = {
     "perkinelmer-npoints": ("perkinelmer-uvwinlab-asc", _pe, "NPOINTS = 1999999 needs"),
     "jasco-text-npoints": ("jasco-spectramanager-text", _jasco_text, "NPOINTS = 1999999"),
     "jasco-jws-npoints": ("jasco-jws", _jws, "NPOINTS = 2147483647 exceeds"),
+    "speos-table-size": ("speos-bsdf", _speos, "more than the file of"),
 }
 
 

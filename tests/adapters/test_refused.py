@@ -1,10 +1,13 @@
-"""Formats recognised and refused with advice: CompleteEASE .SEsnap, PSI SpectraPen."""
+"""Formats recognised and refused with advice: CompleteEASE .SEsnap, PSI SpectraPen, RGL
+tensor .bsdf, MERL .binary."""
 
 from __future__ import annotations
 
+import struct
 import zipfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import labbrdf
@@ -42,24 +45,28 @@ def test_spectrapen_photon_irradiance_variant(tmp_path: Path) -> None:
         labbrdf.read(p)
 
 
-def test_speos_bsdf_is_refused_with_the_zemax_advice(tmp_path: Path) -> None:
-    # the first lines of a Speos table: without its own sniffer it looked like numbers after
-    # a five-line preamble and was offered --skip-lines, which would read the grid as data
-    p = tmp_path / "vinyl.anisotropicbsdf"
-    p.write_text(
-        "OPTIS - Anisotropic BSDF surface file v8.0\n0\nComment\n23\nMeasurement description\n"
-        "0\t1\t0\n1\t0\n1\n1\n0.0\t\n13\n15.0\t20.0\t25.0\t\n"
-    )
-    assert sniff(p) == ["speos-bsdf"]
-    with pytest.raises(AdapterError, match=r"line 1: an Ansys Speos .*'zemax-bsdf'"):
+def test_rgl_tensor_bsdf_is_refused_by_its_header(tmp_path: Path) -> None:
+    # an RGL database file shares .bsdf with the Zemax text format: the header decides
+    p = tmp_path / "acrylic_felt_green_rgb.bsdf"
+    p.write_bytes(b"tensor_file\x00\x01\x00" + struct.pack("<I", 9) + b"\x00" * 64)
+    assert sniff(p) == ["rgl-tensor-bsdf"]
+    with pytest.raises(AdapterError, match=r"byte 1: a binary RGL tensor file \(version 1\.0"):
         labbrdf.read(p)
-    other = tmp_path / "other.anisotropicbsdf"
-    other.write_text("1 2\n3 4\n")
-    with pytest.raises(AdapterError, match="expected a Speos BSDF file"):
-        labbrdf.read(other, format="speos-bsdf")
+    (tmp_path / "rows.txt").write_text("1 2\n")
+    with pytest.raises(AdapterError, match="expected an RGL tensor file"):
+        labbrdf.read(tmp_path / "rows.txt", format="rgl-tensor-bsdf")
 
 
-def test_real_speos_bsdf_is_refused_by_name(real_exports: Path) -> None:
-    p = next((real_exports / "speos-anisotropicbsdf").glob("*.anisotropicbsdf"))
-    with pytest.raises(AdapterError, match="Ansys Speos anisotropic BSDF file"):
+def test_merl_binary_is_refused_by_its_header(tmp_path: Path) -> None:
+    p = tmp_path / "gold-metallic-paint.binary"
+    p.write_bytes(struct.pack("<3i", 90, 90, 180) + np.zeros(64).tobytes())
+    assert sniff(p) == ["merl-binary"]
+    with pytest.raises(AdapterError, match="a MERL BRDF database file"):
         labbrdf.read(p)
+    other = tmp_path / "other.binary"
+    other.write_bytes(struct.pack("<3i", 90, 90, 360))
+    with pytest.raises(AdapterError, match="expected a MERL BRDF"):
+        labbrdf.read(other, format="merl-binary")
+    # with no format forced, the one reader of the extension says what is wrong
+    with pytest.raises(AdapterError, match="expected a MERL BRDF"):
+        labbrdf.read(other)

@@ -161,7 +161,6 @@ def test_every_real_export_reads_through_one_entry_point(real_exports):
         "oceanoptics-pi": "raw detector",
         "avantes-avasoft": "radiometric",
         "psi-spectrapen": "not an optical property",
-        "speos-anisotropicbsdf": "Speos anisotropic BSDF file: recognised but not read",
     }
     for p in files:
         if p.parent.name in refused:

@@ -104,6 +104,7 @@ def test_exported_model_is_fitted_back_exactly(tmp_path: Path, capsys):
         (["--param", "n=1.5", "--radial", "0:x:1"], "START:STOP:STEP"),
         (["--param", "n=1.5", "--nk-from", "x.dat"], "needs --wavelength"),
         (["--param", "n=1.5", "--format", "csv"], "export writes zemax-bsdf"),
+        (["--param", "n=1.5", "--format", "speos-bsdf"], "writes a .anisotropicbsdf file"),
     ],
 )
 def test_export_errors_are_exit_2(tmp_path: Path, capsys, argv, message):
@@ -312,6 +313,15 @@ def test_trace_exported_as_bsdf_is_read_back_and_fitted(tmp_path: Path, capsys, 
     phi = pe[0] + np.mod(d.phi_r_deg.to_numpy() - pe[0], 360.0)
     j = np.searchsorted(pe, phi, side="right") - 1
     np.testing.assert_allclose(d.value.to_numpy(), s0[i, j], rtol=5e-6, atol=1e-12)
+    # the same run for Speos: the bins as written, at their centres
+    sp = tmp_path / "al.anisotropicbsdf"
+    assert main(["export", "--format", "speos-bsdf", "--trace", str(run), "-o", str(sp)]) == 0
+    capsys.readouterr()
+    ds = labbrdf.read(sp).data
+    assert len(ds) == s0.size
+    i = np.searchsorted(te, ds.theta_r_deg.to_numpy(), side="right") - 1
+    j = np.searchsorted(pe, pe[0] + np.mod(ds.phi_r_deg.to_numpy() - pe[0], 360.0), "right") - 1
+    np.testing.assert_allclose(ds.value.to_numpy(), np.nan_to_num(s0)[i, j], rtol=1e-12)
     # single scattering is the microfacet model: alpha comes back to the bins' smearing
     # (1 deg bins against a lobe ~ 2 alpha = 23 deg wide: about 1 %)
     fit = ["fit", str(out), "--model", "microfacet", "--param", "n=1.55", "--param", "k=7.71",
