@@ -34,7 +34,7 @@ import numpy as np
 
 import labbrdf
 from labbrdf.adapters.zemax_bsdf import read_table
-from labbrdf.bsdf_export import write_bsdf
+from labbrdf.writers.zemax import write_bsdf
 
 
 def make_file(folder: Path) -> Path:
@@ -84,7 +84,7 @@ def main() -> None:
 def make_microfacet_file(folder: Path) -> Path:
     """A noisy Asymmetrical .bsdf of a microfacet surface (about 30 000 points)."""
     from labbrdf import models
-    from labbrdf.bsdf_export import model_to_bsdf
+    from labbrdf.writers.zemax import model_to_bsdf
 
     m = models.get("microfacet", n=1.5, k=0.0, diffuse=True)
     clean = model_to_bsdf(

@@ -47,8 +47,8 @@ from typing import Any
 import numpy as np
 
 from labbrdf import adapters, fit, models
-from labbrdf.bsdf_export import write_bsdf
 from labbrdf.bsdf_geometry import scatter_to_angles
+from labbrdf.writers.zemax import write_bsdf
 
 ROOT = Path(__file__).resolve().parents[1]
 REAL = ROOT.parent / "shared/real-exports/zemax-bsdf/test_13_planesymmetric_brdf_zemax.bsdf"

@@ -88,8 +88,6 @@ _LAZY: dict[str, tuple[str, str]] = {
 #: subpackages and modules offered as attributes of the package
 _MODULES = (
     "adapters",
-    "astm_export",
-    "bsdf_export",
     "bsdf_geometry",
     "dataset",
     "ellipsometry",
@@ -102,7 +100,6 @@ _MODULES = (
     "nk",
     "optics",
     "parallel",
-    "pgii_export",
     "prediction",
     "report",
     "roughness",
@@ -111,8 +108,8 @@ _MODULES = (
     "samples",
     "selection",
     "specular_dop",
-    "speos_export",
     "tracer",
+    "writers",
 )
 
 #: modules that moved into a subpackage, still offered by their old name
@@ -121,6 +118,7 @@ _MOVED = {
     "surface": "roughness.synthetic",
     "topography": "roughness.topography",
     "tracer_setup": "sample.run",
+    "bsdf_export": "writers.zemax",
 }
 
 #: plumbing the modules above share (the command line, JSON sanitising, output safety,
@@ -136,8 +134,6 @@ __all__ = ["__version__", *_LAZY, *_MODULES, *_MOVED]
 if TYPE_CHECKING:
     from . import (
         adapters,
-        astm_export,
-        bsdf_export,
         bsdf_geometry,
         dataset,
         ellipsometry,
@@ -150,7 +146,6 @@ if TYPE_CHECKING:
         nk,
         optics,
         parallel,
-        pgii_export,
         prediction,
         report,
         roughness,
@@ -159,8 +154,8 @@ if TYPE_CHECKING:
         samples,
         selection,
         specular_dop,
-        speos_export,
         tracer,
+        writers,
     )
     from .adapters import AdapterError, Inputs, formats, read, read_inputs, read_many
     from .adapters.topography import read_height_map
@@ -183,6 +178,7 @@ if TYPE_CHECKING:
     from .sample import trace_config_from_inputs
     from .selection import select
     from .tracer import Coating, Substrate, TraceConfig, TraceResult, trace
+    from .writers import zemax as bsdf_export
 
 
 def __getattr__(name: str) -> Any:

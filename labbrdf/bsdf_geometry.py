@@ -9,7 +9,7 @@ specification does not say from which side "counter-clockwise" is seen; labbrdf 
 seen by an observer looking back at the sample along the specular direction, so azimuth 90
 is the +y side when the source is at phi_i = 0. The conversions here are exact (unit
 vectors, no small-angle approximation); ``docs/bsdf.md`` has the derivation. The reader
-(:mod:`labbrdf.adapters.zemax_bsdf`), the writer (:mod:`labbrdf.bsdf_export`) and the grid
+(:mod:`labbrdf.adapters.zemax_bsdf`), the writer (:mod:`labbrdf.writers.zemax`) and the grid
 quadrature (:func:`grid_integral`, the total integrated scatter of a grid) share them, and
 the cells each grid node owns (:func:`radial_weights`, :func:`azimuth_weights`): the
 quadrature's weights, and the reader's average over the polar cap.

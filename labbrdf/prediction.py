@@ -32,7 +32,7 @@ What is compared
 The tracer returns bin averages on its (theta_r, phi_r) grid (``step_deg`` bins, the cos-
 weighted average of f over the bin); a ``.bsdf`` file holds point values on its scatter grid.
 Each file point takes the value of the tracer bin it falls in (as
-:func:`labbrdf.bsdf_export.binned_to_bsdf` writes a trace), so where f curves strongly across
+:func:`labbrdf.writers.zemax.binned_to_bsdf` writes a trace), so where f curves strongly across
 a bin (a lobe narrower than a few bins) the two differ by about
 ``(step / lobe width)^2 / 24`` (docs/tracer.md). Prediction and measurement are integrated by
 the same first-order grid rule (:func:`labbrdf.integrate.grid_integral`) on the file's own

@@ -3,7 +3,7 @@
 The three files a lab would bring for "predict, then measure", written in formats labbrdf
 reads: a Gaussian surface saved as a NetCDF height map (SurfaceTopography), a WVASE psi/Delta
 file computed with :mod:`labbrdf.optics` for a known index, and a ``.bsdf`` written from a
-trace (:func:`labbrdf.bsdf_export.binned_to_bsdf`) of a substrate with that index and the
+trace (:func:`labbrdf.writers.zemax.binned_to_bsdf`) of a substrate with that index and the
 height map's GGX alpha.
 
 The validation report's bundled set (``labbrdf/data/fixtures/predict_measure/``) is made the
@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 
 from labbrdf import optics
-from labbrdf.bsdf_export import binned_to_bsdf
 from labbrdf.roughness.synthetic import gaussian_surface
 from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
+from labbrdf.writers.zemax import binned_to_bsdf
 
 #: the sample's index (aluminium near 600 nm) and a wrong one (a poorer metal)
 TRUE_NK = 1.2 + 7.26j

@@ -263,7 +263,17 @@ def test_report_sections_import_no_other_section() -> None:
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     (
         "plumbing",
-        ("errors", "jsonsafe", "richrepr", "provenance", "outputs", "parallel", "_plotting"),
+        (
+            "errors",
+            "jsonsafe",
+            "richrepr",
+            "provenance",
+            "outputs",
+            "parallel",
+            "progress",
+            "_plotting",
+            "figstyle",
+        ),
     ),
     (
         "physics",
@@ -289,14 +299,15 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "fitting",
             "prediction",
             "rr_prediction",
-            "bsdf_export",
+            "_brdf_maps",
+            "writers",
             # a PSD fitted with the fitting core's intervals; spectra of files as read
             "roughness.psd_fit",
             "roughness.psd_result",
         ),
     ),
     ("report", ("report",)),
-    ("command line", ("cli",)),
+    ("command line", ("cli", "__main__")),
 )
 #: the package's face (lazy names of every layer) and the fixtures' generator script
 ABOVE_ALL = ("labbrdf", "labbrdf.data.fixtures.make_fixtures")

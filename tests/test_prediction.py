@@ -303,7 +303,7 @@ def test_real_depolarization_is_matched_by_file_wavelength_and_angle(
 
 
 def test_several_rotations_are_refused(sample_set: dict, tmp_path) -> None:
-    from labbrdf.bsdf_export import write_bsdf
+    from labbrdf.writers.zemax import write_bsdf
 
     p = write_bsdf(
         tmp_path / "rot.bsdf",

@@ -27,7 +27,7 @@ say from which side "counter-clockwise" is seen; labbrdf takes it as seen by an 
 looking back at the sample along the specular direction, so azimuth 90 is the +y side when
 the source is at phi_i = 0. Every point is converted exactly (unit vectors, no small-angle
 approximation) to the dataset's ``theta_i_deg``, ``theta_r_deg``, ``phi_r_deg``.
-The writer is :mod:`labbrdf.bsdf_export`; the grid quadrature is
+The writer is :mod:`labbrdf.writers.zemax`; the grid quadrature is
 :func:`labbrdf.integrate.grid_integral`.
 """
 

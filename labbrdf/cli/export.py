@@ -17,7 +17,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     """Write ``--model``'s BRDF or ``--trace``'s S0 as a Zemax BSDF file."""
     import numpy as np
 
-    from ..bsdf_export import model_to_bsdf
+    from ..writers.zemax import model_to_bsdf
 
     if args.format not in _SUFFIX:
         raise UsageError(f"--format {args.format!r}: export writes {' or '.join(_SUFFIX)}")
@@ -39,7 +39,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     model, values, wl, comments = _from_fit(args) if args.from_fit else _from_model(args)
     out = Path(args.output)  # checked with the inputs by _checked_outputs
     if args.format == "astm-brdf":
-        from ..astm_export import model_to_astm
+        from ..writers.astm import model_to_astm
 
         if wl is None:
             raise UsageError("--format astm-brdf needs --wavelength NM (its value column)")
@@ -53,7 +53,7 @@ def cmd_export(args: argparse.Namespace) -> int:
         print(f"wrote {out}")
         return 0
     if args.format == "speos-bsdf":
-        from ..speos_export import model_to_speos
+        from ..writers.speos import model_to_speos
 
         model_to_speos(
             model,
@@ -108,8 +108,8 @@ def _from_fit(args: argparse.Namespace) -> tuple[Any, dict[str, float], float | 
 
 def _export_trace(args: argparse.Namespace) -> int:
     """``export --trace RUN.npz``: the tracer's unpolarized S0 on the scatter grid."""
-    from ..bsdf_export import binned_to_bsdf
     from ..tracer import TraceResult
+    from ..writers.zemax import binned_to_bsdf
 
     out = Path(args.output)  # checked with the inputs by _checked_outputs
     if args.theta_i is not None or args.param or args.nk_from:
@@ -122,7 +122,7 @@ def _export_trace(args: argparse.Namespace) -> int:
         raise UsageError(f"--trace {args.trace}: not a labbrdf trace file ({exc})") from None
     cfg = res.config
     if args.format == "speos-bsdf":
-        from ..speos_export import binned_to_speos
+        from ..writers.speos import binned_to_speos
 
         binned_to_speos(
             out,
@@ -153,8 +153,8 @@ def _export_trace(args: argparse.Namespace) -> int:
 
 
 def _grid(text: str, option: str) -> Any:
-    """``--radial`` or ``--azimuth``: :func:`labbrdf.bsdf_export.angle_grid` of the text."""
-    from ..bsdf_export import angle_grid
+    """``--radial`` or ``--azimuth``: :func:`labbrdf.writers.zemax.angle_grid` of the text."""
+    from ..writers.zemax import angle_grid
 
     try:
         return angle_grid(text)

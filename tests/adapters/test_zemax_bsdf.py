@@ -15,7 +15,7 @@ import pytest
 import labbrdf
 from labbrdf.adapters import AdapterError, sniff
 from labbrdf.adapters import zemax_bsdf as zb
-from labbrdf.bsdf_export import write_bsdf
+from labbrdf.writers.zemax import write_bsdf
 
 REAL = "zemax-bsdf/test_13_planesymmetric_brdf_zemax.bsdf"
 AOI = [15, 20, 25, 30, 35, 40, 45, 50, 55, 60, 65, 70, 75]
@@ -280,7 +280,7 @@ def test_reading_needs_neither_scipy_nor_the_writer(tmp_path):
         "import sys, labbrdf\n"
         f"m = labbrdf.read({str(p)!r})\n"
         "assert m.meta['pole']['repeats_left_out'] == 2, m.meta['pole']\n"
-        "print(sorted(k for k in ('scipy', 'labbrdf.bsdf_export') if k in sys.modules))\n"
+        "print(sorted(k for k in ('scipy', 'labbrdf.writers.zemax') if k in sys.modules))\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr[-2000:]

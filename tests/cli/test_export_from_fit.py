@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import labbrdf
-from labbrdf.bsdf_export import model_to_bsdf
 from labbrdf.cli import main
 from labbrdf.dataset import Measurement, write_csv
+from labbrdf.writers.zemax import model_to_bsdf
 
 
 @pytest.fixture(scope="module")

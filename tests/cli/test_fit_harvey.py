@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from labbrdf.bsdf_export import write_bsdf
 from labbrdf.bsdf_geometry import scatter_to_angles
 from labbrdf.cli import main
+from labbrdf.writers.zemax import write_bsdf
 
 
 @pytest.fixture

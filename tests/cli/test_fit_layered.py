@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from labbrdf import models
-from labbrdf.bsdf_export import model_to_bsdf
 from labbrdf.cli import main
+from labbrdf.writers.zemax import model_to_bsdf
 
 AL = ["--param", "n=1.55", "--param", "k=7.71"]
 

@@ -154,8 +154,8 @@ def test_nk_writes_csv_and_refuses_files_without_psi_delta(
 def test_fit_nk_from_a_psi_delta_file(real_exports: Path, tmp_path: Path, capsys):
     # a microfacet BRDF at 500 nm written with the Ta file's own n, k is fitted back with
     # --nk-from that file: the index comes from the ellipsometer, alpha from the BRDF
-    from labbrdf.bsdf_export import model_to_bsdf
     from labbrdf.nk import combined_table, nk_at
+    from labbrdf.writers.zemax import model_to_bsdf
 
     at = nk_at(combined_table(labbrdf.read(real_exports / TA)), 500.0)
     m = labbrdf.models.get("microfacet", n=float(at["n"]), k=float(at["k"]))

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from labbrdf import adapters, fit, models
-from labbrdf.bsdf_export import write_bsdf
 from labbrdf.bsdf_geometry import scatter_to_angles
+from labbrdf.writers.zemax import write_bsdf
 
 AL = {"n": 1.55, "k": 7.71}
 RADIAL = np.array([0, 5, 10, 15, 20, 30, 40, 50, 60, 70, 80.0])

@@ -11,13 +11,13 @@ from scipy import integrate
 
 from labbrdf import fit, models
 from labbrdf.adapters.zemax_bsdf import read_table, read_zemax_bsdf
-from labbrdf.bsdf_export import write_bsdf
 from labbrdf.bsdf_geometry import scatter_to_angles
 from labbrdf.fitting import FitError
 from labbrdf.fitting.scatter_tis import model_on_grid, tis_comparison
 from labbrdf.integrate import hemispherical_reflectance
 from labbrdf.models import ModelError
 from labbrdf.models.abg import abg_tis, disk_integral
+from labbrdf.writers.zemax import write_bsdf
 
 TRUE = {"A": 0.004, "B": 2e-4, "g": 1.6}
 TI = np.array([0.0, 20.0, 40.0])

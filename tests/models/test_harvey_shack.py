@@ -10,11 +10,11 @@ import pytest
 
 from labbrdf import fit, models
 from labbrdf.adapters.zemax_bsdf import read_zemax_bsdf
-from labbrdf.bsdf_export import write_bsdf
 from labbrdf.bsdf_geometry import scatter_to_angles
 from labbrdf.integrate import hemispherical_reflectance
 from labbrdf.models import ModelError
 from labbrdf.models.harvey_shack import knee_integral
+from labbrdf.writers.zemax import write_bsdf
 
 TRUE = {"b0": 40.0, "L": 0.012, "S": -2.6}
 TI = np.array([0.0, 20.0, 40.0])

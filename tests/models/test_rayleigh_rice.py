@@ -10,11 +10,11 @@ import pytest
 
 from labbrdf import adapters, models
 from labbrdf.adapters.zemax_bsdf import WAVELENGTH_COMMENT
-from labbrdf.bsdf_export import write_bsdf
 from labbrdf.bsdf_geometry import scatter_to_angles
 from labbrdf.cli import main
 from labbrdf.fitting import fit
 from labbrdf.roughness import rayleigh_rice as rr
+from labbrdf.writers.zemax import write_bsdf
 
 TRUE = {"A": 3e-4, "B": 12.0, "C": 1.6}
 WL_NM = 633.0

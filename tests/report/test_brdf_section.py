@@ -15,8 +15,8 @@ import pytest
 
 from labbrdf import models
 from labbrdf.adapters import zemax_bsdf as z
-from labbrdf.bsdf_export import model_to_bsdf, write_bsdf
 from labbrdf.report.user import user_report
+from labbrdf.writers.zemax import model_to_bsdf, write_bsdf
 
 MICRO = {"n": 1.5, "k": 0.0, "diffuse": True}
 TRUTH = {"alpha": 0.2, "scale": 1.0, "kd": 0.1}

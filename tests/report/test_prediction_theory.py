@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from labbrdf import models
-from labbrdf.bsdf_export import model_to_bsdf
 from labbrdf.report.builder import Builder
 from labbrdf.report.context import Context
 from labbrdf.report.inputs import ingest_inputs
@@ -17,6 +16,7 @@ from labbrdf.report.pairing import sample_groups
 from labbrdf.report.sections.prediction import prediction_section
 from labbrdf.report.smooth_prediction import choose
 from labbrdf.roughness import psd_models
+from labbrdf.writers.zemax import model_to_bsdf
 
 pytest.importorskip("SurfaceTopography")
 

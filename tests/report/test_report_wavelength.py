@@ -7,7 +7,6 @@ from pathlib import Path
 import pytest
 
 import labbrdf
-from labbrdf.bsdf_export import model_to_bsdf
 from labbrdf.cli import main
 from labbrdf.report.builder import Builder
 from labbrdf.report.context import Context
@@ -15,6 +14,7 @@ from labbrdf.report.inputs import ingest_inputs
 from labbrdf.report.sections.smoothness import _tis_rows
 from labbrdf.report.user import _given_wavelength
 from labbrdf.samples import SampleGroup
+from labbrdf.writers.zemax import model_to_bsdf
 
 
 def _bsdf(path: Path, wavelength: float | None = None) -> Path:

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from .outputs import OutputError, atomic_output, check_file_output
+from ..outputs import OutputError, atomic_output, check_file_output
 
 __all__ = ["FRED_MODELS", "write_fred_script"]
 

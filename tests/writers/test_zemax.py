@@ -1,4 +1,4 @@
-"""The .bsdf writer and the model / trace export (labbrdf.bsdf_export)."""
+"""The .bsdf writer and the model / trace export (labbrdf.writers.zemax)."""
 
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import labbrdf
-from labbrdf import bsdf_export as bx
 from labbrdf import bsdf_geometry, models
 from labbrdf.adapters import zemax_bsdf as zb
+from labbrdf.writers import zemax as bx
 
 
 def test_writer_refuses_overwrite_and_leaves_no_temp(tmp_path):
@@ -72,7 +72,7 @@ def _imported_modules(path: str) -> set[str]:
 def test_the_reader_does_not_import_the_export_workflow():
     imported = _imported_modules(zb.__file__)
     assert "labbrdf.adapters._base" in imported  # the resolution of relative imports works
-    assert not any(m.startswith("labbrdf.bsdf_export") for m in imported)
+    assert not any(m.startswith("labbrdf.writers.zemax") for m in imported)
 
 
 def test_the_geometry_is_numpy_only():

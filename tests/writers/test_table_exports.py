@@ -9,7 +9,7 @@ import labbrdf
 from labbrdf import models
 from labbrdf.adapters.speos_bsdf import read_speos_table
 from labbrdf.outputs import OutputError, write_policy
-from labbrdf.speos_export import model_to_speos, write_speos_bsdf
+from labbrdf.writers.speos import model_to_speos, write_speos_bsdf
 
 
 def test_model_written_as_speos_reads_back_to_the_model(tmp_path):
@@ -74,7 +74,7 @@ def test_cli_exports_a_model_as_speos_and_it_reads_back(tmp_path, capsys):
 
 
 def test_binned_brdf_written_as_speos_reads_back_bin_by_bin(tmp_path):
-    from labbrdf.speos_export import binned_to_speos
+    from labbrdf.writers.speos import binned_to_speos
 
     te = np.linspace(0.0, 90.0, 19)  # 5-deg bins
     pe = np.linspace(0.0, 360.0, 37)  # 10-deg bins, source at 0
@@ -91,7 +91,7 @@ def test_binned_brdf_written_as_speos_reads_back_bin_by_bin(tmp_path):
 
 
 def test_model_written_as_astm_reads_back_to_the_model(tmp_path):
-    from labbrdf.astm_export import model_to_astm
+    from labbrdf.writers.astm import model_to_astm
 
     model = models.get("five_param")
     p = model_to_astm(
@@ -122,7 +122,7 @@ def test_cli_exports_an_astm_table_and_needs_its_wavelength(tmp_path, capsys):
 
 
 def test_model_written_as_pgii_reads_back_to_the_model(tmp_path):
-    from labbrdf.pgii_export import model_to_pgii
+    from labbrdf.writers.pgii import model_to_pgii
 
     model = models.get("five_param")
     p = model_to_pgii(model, None, tmp_path / "f40_Rvis.txt", theta_i_deg=40.0)

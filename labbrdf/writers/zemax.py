@@ -18,10 +18,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .adapters.zemax_bsdf import HEADER_LISTS, SCATTER_TYPES, SPECTRAL, WAVELENGTH_COMMENT
-from .bsdf_geometry import SYMMETRIES, scatter_to_angles
-from .dataset import atomic_output
-from .integrate import grid_integral
+from ..adapters.zemax_bsdf import HEADER_LISTS, SCATTER_TYPES, SPECTRAL, WAVELENGTH_COMMENT
+from ..bsdf_geometry import SYMMETRIES, scatter_to_angles
+from ..dataset import atomic_output
+from ..integrate import grid_integral
 
 __all__ = ["angle_grid", "binned_to_bsdf", "model_to_bsdf", "write_bsdf"]
 

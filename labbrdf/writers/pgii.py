@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .outputs import atomic_output, check_file_output
+from ..outputs import atomic_output, check_file_output
 
 __all__ = ["model_to_pgii"]
 

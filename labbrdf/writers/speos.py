@@ -1,6 +1,6 @@
 """Export to Ansys Speos ``.anisotropicbsdf`` text files: arrays and fitted models.
 
-Workflow layer, the counterpart of :mod:`labbrdf.bsdf_export` for Speos. The layout, the
+Workflow layer, the counterpart of :mod:`labbrdf.writers.zemax` for Speos. The layout, the
 normal-reference angles (theta from the normal, phi = 0 at the specular direction, so
 ``phi = phi_r - 180``) and the units (tables proportional to the BRDF, scaled by the spectrum
 so that the table at the spectrum's incidence integrates to its coefficient) are those of
@@ -20,8 +20,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .adapters.speos_bsdf import MAGIC, SpeosTable, hemispherical_integral
-from .outputs import atomic_output, check_file_output
+from ..adapters.speos_bsdf import MAGIC, SpeosTable, hemispherical_integral
+from ..outputs import atomic_output, check_file_output
 
 __all__ = ["binned_to_speos", "model_to_speos", "write_speos_bsdf"]
 

@@ -11,7 +11,7 @@ import pytest
 from labbrdf import fit, models
 from labbrdf.fitting import FitData
 from labbrdf.outputs import OutputError
-from labbrdf.scatter_export import write_fred_script
+from labbrdf.writers.fred import write_fred_script
 
 
 def _members(path: Path) -> dict[str, float]:
