@@ -128,7 +128,8 @@ def refine_intervals(
         ``profile(names, delta)`` puts the profile intervals of ``names`` (level chi2_min +
         delta) into ``res.params`` and returns a warning per interval not found.
     on_wald : callable, optional
-        Called with a copy of the Wald answer before any profile is computed.
+        Called with a copy of the Wald answer (``ci_method`` ``"wald"``, ``ci_reasons``
+        naming the parameters about to be profiled) before any profile is computed.
 
     Returns
     -------
@@ -149,8 +150,12 @@ def refine_intervals(
         return False
     if on_wald is not None:
         params = Parameters({k: copy.copy(q) for k, q in res.params.items()})
-        wald_res = dataclasses.replace(
-            res, params=params, warnings=list(res.warnings), ci_methods=dict(res.ci_methods)
+        wald_res = dataclasses.replace(  # the Wald answer, saying what will be profiled
+            res,
+            params=params,
+            warnings=list(res.warnings),
+            ci_method="wald",
+            ci_methods=dict(res.ci_methods),
         )
         on_wald(wald_res)
     wald = {k: res.params[k].ci95 for k in why}
@@ -233,8 +238,8 @@ def _curvature_reason(
         ratio = rise / delta
         if not (RISE_LOW <= ratio <= RISE_HIGH):  # NaN included
             return (
-                f"chi2 rises by {ratio:.3g} x the level at its Wald end {end:.6g} "
-                f"(quadratic: 1; kept within [{RISE_LOW:.3g}, {RISE_HIGH:.3g}])"
+                f"chi2 not quadratic over its Wald interval: rises by {ratio:.3g} x the "
+                f"level at {end:.6g}"
             )
     return None
 
