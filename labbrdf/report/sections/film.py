@@ -436,7 +436,7 @@ def _fit_shown(
             ("flags", "flags", ""),
         ],
         _param_rows(s),
-        caption=f"95 % intervals from the files' sigmas ({intervals_text(s)}); 'scaled': times "
+        caption=f"95 % intervals from the files' sigmas: {intervals_text(s)}; 'scaled': times "
         "sqrt(chi2/nu), given where chi-square rejects the film model (p < 0.01), which "
         "then misses the data by more than the sigmas; units [1] where none is given.",
     )
