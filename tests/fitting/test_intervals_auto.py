@@ -141,3 +141,33 @@ def test_a_film_parameter_at_its_bound_is_profiled_as_with_ci_profile() -> None:
     assert b["ci_method"] == "profile" and "bound" in b["ci_reason"]
     assert "95 % profile [" in auto.fit_report()
     assert "profile for film.B (its Wald interval reaches a bound)" in auto.fit_report()
+
+
+class Bent(Model):
+    """f = a + (c + 10 a^2) theta_r: linear in (a, v = c + 10 a^2), a curved valley in (a, c).
+
+    The profile over a (c free) is exactly quadratic in a, so its interval is Wald's; the
+    straight quadratic path leaves the valley by 10 delta^2 in v, which only the
+    Gauss-Newton step of c brings back.
+    """
+
+    name = "test-auto-bent"
+
+    def default_params(self) -> Parameters:
+        p = Parameters()
+        p.add("a", 0.0, -5.0, 5.0)
+        p.add("c", 0.0, -500.0, 500.0)
+        return p
+
+    def _evaluate(self, p: Mapping[str, float], theta_i, theta_r, phi_r, wavelength):
+        return p["a"] + (p["c"] + 10.0 * p["a"] ** 2) * theta_r
+
+
+def test_a_curved_valley_with_a_quadratic_profile_keeps_its_wald_interval() -> None:
+    fd = _data(lambda x: 0.0 + 1.0 * x, 0.2, n=20)
+    res = fit(Bent(), fd, ci="auto")
+    assert res.ci_methods["a"] == "wald", res.ci_reasons
+    prof = fit(Bent(), fd, ci="profile")
+    half = res.params["a"].ci95[1] - res.params["a"].value
+    for w, p in zip(res.params["a"].ci95, prof.params["a"].ci95, strict=True):
+        assert abs(w - p) <= END_SHIFT_MAX * half
