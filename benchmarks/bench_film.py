@@ -1,6 +1,6 @@
 """Speed of the film fit: one Cauchy layer on Si, 700 wavelengths x 3 angles of psi/Delta.
 
-Run: ``python benchmarks/bench_film.py [--repeat N]``
+Run: ``python benchmarks/bench_film.py [--repeat N] [--real]``
 
 Synthetic data (a 105 nm Cauchy film, A = 1.46, B = 0.004 um^2, on Green's c-Si) at
 300-1000 nm and 55/65/75 deg, with Gaussian noise of 0.01 deg (psi) and 0.03 deg (Delta),
@@ -14,7 +14,12 @@ the sigmas of a WVASE file in the visible. Prints, for
   examples run (only when pyElli is installed);
 
 the median wall time, the number of model evaluations, chi-square and the fitted
-thickness. Not a timed test: numbers depend on the machine and its load.
+thickness. With ``--real``, the intervals' cost on a real file instead: the Ta2O5 wafer
+``w1_12082006.dat`` (WVASE psi/Delta, 10816 values) with one Cauchy layer on the bare Ta
+wafer's n, k (``w2_10102006.dat``) from ``../shared/real-exports``, fitted with ``ci``
+``wald``, ``auto`` and ``profile``: CPU time (this process's, so other work on a loaded
+machine does not count) and which parameters were profiled. Not a timed test: numbers
+depend on the machine and its load.
 """
 
 from __future__ import annotations
@@ -22,6 +27,7 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -30,6 +36,7 @@ from labbrdf.films import FilmModel, Layer, Stack
 from labbrdf.fitting.film import fit_film
 from labbrdf.nk.dispersion import Cauchy
 
+WVASE = Path(__file__).resolve().parents[1].parent / "shared/real-exports/woollam-wvase-ascii"
 TRUE = Stack([Layer(Cauchy(A=1.46, B=0.004), 105.0, "film")], "si")
 BOX = {"film.thickness_nm": (0.0, 300.0), "film.A": (1.3, 1.8), "film.B": (0.0, 0.02)}
 SIG_PSI, SIG_DELTA = 0.01, 0.03
@@ -114,10 +121,38 @@ def bench_pyelli(df: pd.DataFrame) -> dict | None:
     return {"time_s": dt, "nfev": nfev, "chi2": float(res.fun @ res.fun), "d_nm": float(res.x[0])}
 
 
+def bench_real_intervals() -> None:
+    """CPU time of the Ta2O5 film fit with each ``ci``, and what each one profiled."""
+    from labbrdf import adapters
+    from labbrdf.nk import tabulated_from_file
+
+    film, bare = WVASE / "w1_12082006.dat", WVASE / "w2_10102006.dat"
+    if not (film.is_file() and bare.is_file()):
+        print(f"{WVASE}: w1_12082006.dat or w2_10102006.dat absent")
+        return
+    stack = Stack([Layer(Cauchy(A=2.0, B=0.05), 200.0, "film")], tabulated_from_file(bare))
+    box = {"film.thickness_nm": (0.0, 400.0), "film.A": (1.5, 2.5), "film.B": (0.0, 0.1)}
+    data = adapters.read(film)
+    for ci in ("wald", "auto", "profile"):
+        t0 = time.process_time()
+        f = fit_film(FilmModel(stack, box), data, ci=ci)
+        dt = time.process_time() - t0
+        prof = [k for k, how in f.result.ci_methods.items() if how == "profile"]
+        lo, hi = f.result.params["film.thickness_nm"].ci95
+        print(
+            f"ci={ci:8s} {dt:6.1f} CPU-s  d {f.result.params['film.thickness_nm'].value:.4f} nm "
+            f"[{lo:.4f}, {hi:.4f}]  profiled: {', '.join(prof) or 'none'}"
+        )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--real", action="store_true", help="the intervals' cost on a real file")
     args = ap.parse_args()
+    if args.real:
+        bench_real_intervals()
+        return
     df = synthetic()
     print(f"{len(df) // 2} (psi, Delta) pairs: 700 wavelengths x 3 angles; true d = 105 nm")
     for name, fn in (("labbrdf", bench_labbrdf), ("pyElli", bench_pyelli)):

@@ -116,6 +116,29 @@ def _one_sample(args: argparse.Namespace, parts: list[Any], data: Any) -> bool:
     )
 
 
+def _wald_first(args: argparse.Namespace, at_nm: list[float]) -> Any:
+    """On a terminal (no --json), a callback printing the Wald answer before the profile."""
+    import sys
+
+    if args.json or not sys.stdout.isatty():
+        return None
+
+    def show(fit: Any) -> None:
+        from .. import progress
+        from ..fitting.film_display import film_fit_report
+
+        progress.clear()  # the Wald answer starts on a clean line
+        try:
+            text = film_fit_report(fit.summary(at_nm))
+        except ValueError:  # an --at outside the tables: said once, with the final answer
+            text = film_fit_report(fit.summary())
+        names = ", ".join(fit.result.ci_reasons)
+        print(f"{text}\n\nWald intervals above; computing the profile intervals of {names} ...")
+        sys.stdout.flush()
+
+    return show
+
+
 def cmd_film(args: argparse.Namespace) -> int:
     """Fit the film model of the options to the files; print the layers and the fit."""
     from .. import adapters, films
@@ -157,6 +180,7 @@ def cmd_film(args: argparse.Namespace) -> int:
         seed=args.seed,
         ci=args.ci,
         one_sample=_one_sample(args, parts, data),
+        on_wald=_wald_first(args, at_nm),
     )
     try:
         summary = res.summary(at_nm)
@@ -237,9 +261,11 @@ def add_parser(sub: Any) -> None:
     )
     s.add_argument(
         "--ci",
-        choices=("wald", "profile"),
-        default="profile",
-        help="95%% intervals from the profile of chi2 (default) or the covariance",
+        choices=("auto", "wald", "profile"),
+        default="auto",
+        help="95%% intervals: auto (default) prints the covariance (Wald) answer first, "
+        "then profiles chi2 only for parameters where that can change the interval (at a "
+        "bound, correlated, chi2 not quadratic); wald: none profiled; profile: all",
     )
     s.add_argument(
         "--at",

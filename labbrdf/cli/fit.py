@@ -58,11 +58,16 @@ def _fit_settings(args: argparse.Namespace) -> tuple[Any, dict[str, Any], dict[s
                 f"--replicates {args.replicates}: model {args.model!r} is deterministic (no "
                 "Monte Carlo seed), every replicate would be the same fit; leave --replicates out"
             )
+    if args.ci != "wald" and (args.replicates or getattr(model, "default_replicates", 1)) > 1:
+        raise UsageError(
+            f"--ci {args.ci}: seed replicates combine Wald errors; use --ci wald, or "
+            "--replicates 1 for one seed with profile intervals"
+        )
     _check_values(bounds, fix, start, args.free)
     params: dict[str, Any] = {k: {"value": v} for k, v in start.items()}
     for name in args.free or ():
         params.setdefault(name, {})["vary"] = True
-    kw: dict[str, Any] = {"fix": fix or None, "params": params or None}
+    kw: dict[str, Any] = {"fix": fix or None, "params": params or None, "ci": args.ci}
     if args.replicates is not None:
         kw["replicates"] = args.replicates
     return model, options, kw
@@ -294,6 +299,14 @@ def add_parser(sub: Any) -> None:
         metavar="R",
         help="fit a Monte Carlo model (layered) with R model seeds and report their mean, "
         "with the seed spread in the standard error (default: the model's, 3 for layered)",
+    )
+    s.add_argument(
+        "--ci",
+        choices=("wald", "auto", "profile"),
+        default="wald",
+        help="95%% intervals: wald (default, from the covariance); auto: wald, then the "
+        "profile of chi2 where it can change an interval (at a bound, correlated, chi2 not "
+        "quadratic); profile: every parameter's",
     )
     s.add_argument("--fix", action="append", metavar="NAME=VALUE", help="fix a parameter")
     s.add_argument(

@@ -88,6 +88,7 @@ def _row(row: dict[str, Any], s: dict[str, Any], param_names: list[str]) -> dict
         row[name] = ps.get("value", np.nan)
         row[f"{name}_stderr"] = ps.get("stderr")
         row[f"{name}_ci95_lo"], row[f"{name}_ci95_hi"] = ci
+        row[f"{name}_ci"] = ps.get("ci_method")  # wald or profile: which interval it is
         row[f"{name}_flags"] = ";".join(ps.get("flags", []))
         if s.get("replicates"):
             row[f"{name}_seed_spread"] = (s.get("seed_spread") or {}).get(name)
@@ -486,6 +487,8 @@ def fit_records(
                     "weighting": s["weighting"],
                     "nmasked": s["nmasked"],
                     "flags": {k: v["flags"] for k, v in s["params"].items() if v["flags"]},
+                    "ci_methods": s["ci_methods"],  # which interval each "ci95" is
+                    "ci_reasons": s["ci_reasons"],
                     "nfev": s["nfev"],
                     "replicates": s["replicates"],
                     "seed_spread": s["seed_spread"],

@@ -7,13 +7,14 @@ import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import nlopt
 import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike, NDArray
-from scipy import optimize, special
+from scipy import optimize
 
 from .. import parallel, progress
 from ..dataset import Measurement
@@ -21,10 +22,11 @@ from ..models import Model, ModelError, Parameters
 from ..models import get as get_model
 from .data import FitData, FitError, as_fit_data, clean_fit_data
 from .defaults import MAX_SEED, METHOD
+from .intervals import CI_METHODS, refine_intervals, wald_params
 from .objective import Objective
 from .replicates import ONE_SEED_WARNING, run_replicates
 from .result import FitResult
-from .uncertainty import at_bound, jacobian, noise_meat, uncertainties
+from .uncertainty import jacobian, noise_meat, uncertainties
 from .weighting import _weighting
 
 __all__ = [
@@ -447,6 +449,7 @@ def fit(
     relative_floor: float = RELATIVE_FLOOR,
     mask_zeros: bool = True,
     replicates: int | None = None,
+    on_wald: Callable[[FitResult], None] | None = None,
 ) -> FitResult:
     """Fit a reflectance/BRDF model: an nlopt global stage inside the bounds, then a local one.
 
@@ -490,9 +493,10 @@ def fit(
     guess : bool
         Start the varying parameters not given in ``params`` from the model's data-driven
         guess (kept in the global stage's population).
-    ci : {"wald", "profile"}
-        95% intervals from the covariance (value +- t stderr) or from the profile of
-        chi-square (docs/models.md 5.3). Not combined with ``energy_constraint``.
+    ci : {"wald", "auto", "profile"}
+        95% intervals value +- t stderr, or the profile of chi-square (docs/models.md 5.3)
+        for every varying parameter or (``"auto"``) where it can change the Wald interval;
+        ``FitResult.ci_methods`` says which. Not combined with ``energy_constraint``.
     weighting : {"auto", "sigma", "relative", "uniform", None}
         ``"auto"`` (default, as the CLI and the report): ``1/sigma^2`` with sigmas, else
         ``"relative"``: sigma_i = max(|y_i|, ``relative_floor x max|y|``), covariance
@@ -505,6 +509,9 @@ def fit(
     replicates : int, optional
         R > 1: a stochastic model fitted with R seeds, combined (:func:`fit_replicates`);
         None: the model's ``default_replicates`` (1 for a deterministic model).
+    on_wald : callable, optional
+        Called with the Wald answer (a FitResult of its own) before profile intervals are
+        computed, when some are (a command line prints it first).
 
     Returns
     -------
@@ -524,6 +531,7 @@ def fit(
     """
     # every argument but the model, the data and the count: the same for each replicate
     kw = {k: v for k, v in locals().items() if k not in ("model", "data", "replicates")}
+    kw.pop("on_wald")  # the Wald answer first: a single fit's, not a replicate's
     check_seed(seed)
     model = get_model(model) if isinstance(model, str) else model
     R = getattr(model, "default_replicates", 1) if replicates is None else replicates
@@ -534,7 +542,10 @@ def fit(
     x, stage_info, last_code, message = _search(
         pb.obj, pb.x0, pb.stages, pb.budgets, int(seed), pb.cons, pb.nfree, pb.use_sigma
     )
-    return _finish(pb, x, stage_info, last_code, message, seed=seed, ci=ci, t0=t0)
+    res = _finish(pb, x, stage_info, last_code, message, seed=seed, ci=ci, t0=t0)
+    if ci != "wald" and _profiles(pb, res, ci, int(seed), on_wald):
+        res.elapsed_s = time.perf_counter() - t0
+    return res
 
 
 @dataclass
@@ -636,10 +647,10 @@ def _problem(
     if not isinstance(model, Model):
         raise FitError(f"model: expected a Model or a model name, got {type(model).__name__}")
     stages = parse_method(method)
-    if ci not in ("wald", "profile"):
-        raise FitError(f"ci must be 'wald' or 'profile', got {ci!r}")
-    if ci == "profile" and energy_constraint not in (False, None):
-        raise FitError("ci='profile' is not combined with energy_constraint; use ci='wald'")
+    if ci not in CI_METHODS:
+        raise FitError(f"ci must be one of {', '.join(map(repr, CI_METHODS))}, got {ci!r}")
+    if ci != "wald" and energy_constraint not in (False, None):
+        raise FitError(f"ci={ci!r} is not combined with energy_constraint; use ci='wald'")
     fd, ndropped, nmasked = _select_points(data, quantity, unit, nan_policy, mask_zeros)
     p = setup_params(model, params, fix)
     guessed = guess and _apply_guess(model, fd, p, set(params or ()))
@@ -703,7 +714,7 @@ def _finish(
     covar, stderr, correl, reasons, cond = uncertainties(
         J, varying, vals, 1.0 if use_sigma else redchi, nfree, noise_meat(obj, vals, J)
     )
-    out, flags = _fitted_params(p, vals, stderr, correl, reasons, nfree)
+    out, flags = wald_params(p, vals, stderr, correl, reasons, nfree)
     warn = [f"{pb.ndropped} point(s) with NaN/inf values dropped (nan_policy='omit')"] * (
         pb.ndropped > 0
     ) + [f"{pb.nmasked} point(s) with value 0 excluded as instrument-masked (mask_zeros)"] * (
@@ -712,9 +723,6 @@ def _finish(
     warn += [ONE_SEED_WARNING] * bool(model.stochastic)
     domain = model.outside_domain(fd.theta_i_deg, fd.phi_r_deg) or ""  # warned, not refused
     warn += [f"outside the model's domain: {domain}"] * bool(domain)
-    if ci == "profile" and finite:
-        delta = float(special.stdtrit(nfree, 0.975)) ** 2 * (1.0 if use_sigma else redchi)
-        warn += _profile_intervals(model, fd, out, pb.weights, prof, varying, chisqr, delta, seed)
     success, message = _verdict(finite, last_code, pb.stages, obj.n, message)
     energy_info = None
     if rho_fn is not None:
@@ -758,6 +766,7 @@ def _finish(
         warnings=warn,
         outside_domain=domain,
         ci_method=ci,
+        ci_methods=dict.fromkeys(varying, "wald"),
         cond=cond,
         nlopt_version=".".join(
             str(v) for v in (nlopt.version_major(), nlopt.version_minor(), nlopt.version_bugfix())
@@ -892,6 +901,15 @@ def _profile_intervals(
             except (ValueError, RuntimeError) as exc:  # keep the Wald interval
                 warn.append(f"{k}: profile interval not found ({exc}); Wald interval kept")
     return warn
+
+
+def _profiles(
+    pb: _Problem, res: FitResult, ci: str, seed: int, on_wald: Callable[[FitResult], None] | None
+) -> bool:
+    """Profile intervals in ``res`` where ``ci`` asks (:func:`.intervals.refine_intervals`)."""
+    obj = Objective(pb.model, pb.fd, res.params, pb.weights)
+    prof = partial(_profile_intervals, pb.model, pb.fd, res.params, pb.weights, pb.prof)
+    return refine_intervals(res, obj, ci, lambda ks, d: prof(ks, res.chisqr, d, seed), on_wald)
 
 
 def _verdict(
@@ -1097,43 +1115,6 @@ def _budgets(
         else (per * (n + 1) if _is_global(s) else LOCAL_ROUNDS * _LOCAL_MAXEVAL_PER_DIM * n)
         for s, b in zip(stages, given, strict=True)
     ]
-
-
-def _fitted_params(
-    p: Parameters,
-    vals: dict[str, float],
-    stderr: dict[str, float | None],
-    correl: dict[str, dict[str, float]],
-    reasons: dict[str, list[str]],
-    nfree: int,
-) -> tuple[Parameters, dict[str, list[str]]]:
-    """Parameters with fitted values, stderr, 95% intervals, correlations; the flags."""
-    tq = float(special.stdtrit(nfree, 0.975))  # Student t 97.5 % quantile
-    out = _copy_params(p)
-    flags: dict[str, list[str]] = {}
-    for k, q in out.items():
-        q.value = vals[k]
-        if not q.vary:
-            continue
-        fl = []
-        for side in ("min", "max"):
-            if at_bound(q, getattr(q, side)):
-                fl.append("at_bound")
-                reasons[k].insert(
-                    0, f"at bound: {q.value:.6g} at its {side} {getattr(q, side):.6g}"
-                )
-        if any(r.startswith("not identifiable") for r in reasons[k]):
-            fl.append("not_identifiable")
-        elif any(r.startswith("poorly determined") for r in reasons[k]):
-            fl.append("poorly_determined")
-        if fl:
-            flags[k] = fl
-        se = stderr[k]
-        q.stderr = se
-        if se is not None:
-            q.ci95 = (max(q.value - tq * se, q.min), min(q.value + tq * se, q.max))
-        q.correl = correl[k] or None
-    return out, flags
 
 
 def _code_message(code: int) -> str:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 import math
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -388,7 +388,9 @@ class FilmFit:
             if q.vary:
                 d["stderr"] = q.stderr
                 d["ci95"] = list(q.ci95) if q.ci95 is not None else None
-                d["ci_method"] = res.ci_method
+                d["ci_method"] = res.ci_methods.get(k, res.ci_method)
+                if k in res.ci_reasons:
+                    d["ci_reason"] = res.ci_reasons[k]
                 if q.stderr is not None:
                     d["ci95_wald"] = [
                         max(q.value - tq * q.stderr, q.min),
@@ -638,9 +640,10 @@ def fit_film(
     default_sigma: Mapping[str, float] | None = None,
     method: str = METHOD,
     seed: int = 0,
-    ci: str = "wald",
+    ci: str = "auto",
     maxeval: int | Sequence[int | None] | None = None,
     one_sample: bool = False,
+    on_wald: Callable[[FilmFit], None] | None = None,
 ) -> FilmFit:
     """Fit a film stack's thicknesses and dispersion parameters to measured data.
 
@@ -662,12 +665,20 @@ def fit_film(
         quantity -> sigma for rows whose file gives none.
     method, seed, maxeval
         As :func:`labbrdf.fitting.fit` (global then local; seeded).
-    ci : {"wald", "profile"}
-        95 % intervals from the covariance or from the profile of chi-square.
+    ci : {"auto", "wald", "profile"}
+        95 % intervals from the covariance (``"wald"``, the fast answer), from the profile
+        of chi-square (``"profile"``), or (default) Wald first and the profile only for the
+        parameters whose interval it can change: one at a bound, without a standard
+        error, correlated above 0.99 with another, or over whose Wald interval chi-square
+        is not quadratic (:func:`labbrdf.fitting.intervals.profile_reasons`). The summary
+        says per parameter which interval it carries (``ci_method``).
     one_sample : bool
         The caller says that the files are one sample although they state different
         sample names (a relabelled sample, a typo in a header). Without it such data are
         refused: a joint fit of two samples is no sample's film.
+    on_wald : callable, optional
+        Called with the fit carrying Wald intervals before any profile is computed (a
+        command line prints this fast answer first); not called when nothing is profiled.
 
     Returns
     -------
@@ -719,14 +730,13 @@ def fit_film(
         "film",
         "mixed",
     )
+    sources = sorted(set(rows["source"].astype(str))) if "source" in rows else []
+
+    def film(res: FitResult) -> FilmFit:
+        best = fm.stack.with_values({k: res.params[k].value for k in fm.free})
+        return FilmFit(res, fm, best, rows, codes, sources)
+
+    first = None if on_wald is None else (lambda res: on_wald(film(res)))
     res = fit(model, fd, method=method, seed=seed, ci=ci, maxeval=maxeval, guess=False,
-              weighting="sigma", mask_zeros=False)  # fmt: skip
-    best = fm.stack.with_values({k: res.params[k].value for k in fm.free})
-    return FilmFit(
-        result=res,
-        model=fm,
-        stack=best,
-        data=rows,
-        channels=codes,
-        sources=sorted(set(rows["source"].astype(str))) if "source" in rows else [],
-    )
+              weighting="sigma", mask_zeros=False, on_wald=first)  # fmt: skip
+    return film(res)

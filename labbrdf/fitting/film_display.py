@@ -18,7 +18,13 @@ from .film_verdict import material_label
 if TYPE_CHECKING:
     from .film import FilmFit
 
-__all__ = ["film_fit_html", "film_fit_panels", "film_fit_plot", "film_fit_report"]
+__all__ = [
+    "film_fit_html",
+    "film_fit_panels",
+    "film_fit_plot",
+    "film_fit_report",
+    "intervals_text",
+]
 
 #: the fit's channel codes (:attr:`labbrdf.FilmFit.channels`): name and axis label
 CHANNELS = {
@@ -51,7 +57,8 @@ def _param_text(p: Mapping[str, Any]) -> str:
     if se is not None:
         out += f" +- {se:.2g}"
     if ci:
-        out += f"  [{ci[0]:.6g}, {ci[1]:.6g}]"
+        how = " profile" if p.get("ci_method") == "profile" else ""
+        out += f"  95 %{how} [{ci[0]:.6g}, {ci[1]:.6g}]"
     sc = p.get("ci95_scaled")
     if sc:
         out += f"  scaled [{sc[0]:.6g}, {sc[1]:.6g}]"
@@ -83,8 +90,27 @@ def _fit_line(summary: Mapping[str, Any]) -> str:
         f"fit: {summary['ndata']} values, {wl[0]:g}-{wl[1]:g} nm, {summary['nvarys']} free; "
         f"chi2/nu = {summary['redchi']:.4g}, MSE = {summary['mse']:.4g} (Woollam); "
         f"{summary['nfev']} evaluations, {summary['method']}, seed {summary['seed']}, "
-        f"intervals: {summary['ci_method']}"
+        f"intervals: {intervals_text(summary)}"
     )
+
+
+def intervals_text(summary: Mapping[str, Any]) -> str:
+    """Which 95 % intervals a film fit's summary carries, in words.
+
+    ``Wald``, ``profile``, or (``ci="auto"``) ``Wald; profile for NAME (why), ...``.
+    """
+    how = summary["ci_method"]
+    if how != "auto":
+        return "Wald" if how == "wald" else how
+    groups = [(lay["name"], lay["parameters"]) for lay in summary["layers"]]
+    groups.append(("substrate", summary["substrate"].get("parameters", {})))
+    prof = [
+        f"{owner}.{k} ({p.get('ci_reason', '?')})"
+        for owner, params in groups
+        for k, p in params.items()
+        if p.get("ci_method") == "profile"
+    ]
+    return "Wald" + (f"; profile for {', '.join(prof)}" if prof else " (no profile needed)")
 
 
 def film_fit_report(summary: Mapping[str, Any]) -> str:
@@ -162,7 +188,7 @@ def film_fit_html(summary: Mapping[str, Any]) -> str:
         ("chi2/nu", f"{summary['redchi']:.4g}"),
         ("MSE (Woollam)", f"{summary['mse']:.4g}"),
         ("method", f"{summary['method']} (seed {summary['seed']})"),
-        ("intervals", summary["ci_method"]),
+        ("intervals", intervals_text(summary)),
         ("success", f"{summary['success']} ({summary['message']})"),
     ]
     parts = [*(("layer " + lay["name"], lay) for lay in summary["layers"])]

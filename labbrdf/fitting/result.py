@@ -111,8 +111,15 @@ class FitResult:
     warnings : list of str
         Notes on the data or the fit (dropped points, intervals not found).
     ci_method : str
-        ``wald`` (value +- t stderr, Student t with ``nfree`` degrees of freedom) or
-        ``profile`` (profile of chi-square); see :func:`labbrdf.fitting.fit`.
+        What was asked: ``wald`` (value +- t stderr, Student t with ``nfree`` degrees of
+        freedom), ``profile`` (profile of chi-square) or ``auto`` (Wald, and the profile
+        where it can change the interval); see :func:`labbrdf.fitting.fit`.
+    ci_methods : dict
+        name -> ``"wald"`` or ``"profile"``: the interval each varying parameter carries.
+    ci_reasons : dict
+        name -> why its profile was computed (``ci="auto"``: the rule of
+        :func:`labbrdf.fitting.intervals.profile_reasons`; ``"requested"`` with
+        ``ci="profile"``).
     cond : float or None
         Condition number of the scaled Jacobian at the optimum.
     nlopt_version : str or None
@@ -172,6 +179,8 @@ class FitResult:
     energy: dict[str, Any] | None = None
     warnings: list[str] = field(default_factory=list)
     ci_method: str = "wald"
+    ci_methods: dict[str, str] = field(default_factory=dict)
+    ci_reasons: dict[str, str] = field(default_factory=dict)
     cond: float | None = None
     nlopt_version: str | None = None
     residual: NDArray | None = field(default=None, repr=False)
@@ -412,6 +421,8 @@ class FitResult:
                 "units": p.units,
                 "init_value": self.init_values.get(k),
                 "profiled": k in self.profiled,
+                "ci_method": self.ci_methods.get(k, self.ci_method) if p.vary else None,
+                "ci_reason": self.ci_reasons.get(k),
                 "flags": list(self.flags.get(k, [])),
                 "at_bound": "at_bound" in self.flags.get(k, []),
                 "flag_reasons": list(self.flag_reasons.get(k, [])),
@@ -452,6 +463,8 @@ class FitResult:
             "warnings": self.warnings,
             "cond": self.cond,
             "ci_method": self.ci_method,
+            "ci_methods": self.ci_methods,
+            "ci_reasons": self.ci_reasons,
             "nlopt_version": self.nlopt_version,
             "replicates": self.replicates,
             "seed_spread": self.seed_spread,
@@ -503,7 +516,8 @@ class FitResult:
         for k, val, ci, note in self._param_lines():
             s = f"    {k + ':':<6} {val}"
             if ci:
-                s += f"  95%{' (profile)' if self.ci_method == 'profile' else ''} {ci}"
+                how = self.ci_methods.get(k, self.ci_method)
+                s += f"  95%{' (profile)' if how == 'profile' else ''} {ci}"
             if note:
                 s += f"  ({note})"
             lines.append(s)
@@ -516,6 +530,8 @@ class FitResult:
             lines.append(f"[[Correlations]] (unreported correlations are < {min_correl:.3f})")
             lines += [s for _, s in sorted(pairs, reverse=True)]
         notes = [f"{k}: {r}" for k, rs in self.flag_reasons.items() for r in rs]
+        if self.ci_method == "auto":
+            notes += [f"{k}: profile interval, {r}" for k, r in self.ci_reasons.items()]
         notes += self.warnings
         if self.replicates:
             for k, sb in (self.seed_spread or {}).items():

@@ -327,3 +327,40 @@ def test_film_prints_the_fits_own_report(film_file, capsys):
     stack = Stack([Layer(Cauchy(A=1.55, B=0.01), 150.0, "film")], "si")
     fit = fit_film(FilmModel(stack, box), read(film_file), ci="wald")
     assert capsys.readouterr().out == fit.fit_report() + "\n"
+
+
+# ------------------------------------------------------------------- intervals: Wald first
+
+# B ends at its max; A, correlated with B (-0.77), then has a narrower profile interval
+PINNED = ["--layer", "film:cauchy:0..300:A=1.3..1.8:B=0..0.002"]
+
+
+def test_film_prints_the_wald_answer_first_on_a_terminal(film_file, capsys, monkeypatch):
+    import sys
+
+    monkeypatch.setattr(sys.stdout, "isatty", lambda: True)
+    assert main(["film", str(film_file), *PINNED]) == 0  # the default: --ci auto
+    out = capsys.readouterr().out
+    first, sep, final = out.partition("computing the profile intervals of film.A, film.B ...")
+    assert sep and "intervals: Wald; profile for" not in first
+    assert "95 % profile [" not in first and "95 % profile [" in final
+    assert "film.B (its Wald interval reaches a bound)" in final
+
+
+@pytest.mark.parametrize("ci", [None, "auto", "wald", "profile"])
+def test_film_says_which_interval_each_parameter_carries(film_file, capsys, ci):
+    argv = ["film", str(film_file), *PINNED, "--json"] + (["--ci", ci] if ci else [])
+    assert main(argv) == 0  # piped: no Wald answer before the JSON
+    doc = json.loads(capsys.readouterr().out)
+    got = {k: p["ci_method"] for k, p in doc["layers"][0]["parameters"].items() if p["vary"]}
+    want = {"auto": {"thickness_nm": "wald", "A": "profile", "B": "profile"}}.get(
+        ci or "auto", dict.fromkeys(got, ci)
+    )
+    assert doc["ci_method"] == (ci or "auto") and got == want
+
+
+def test_film_refuses_an_unknown_ci(film_file, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["film", str(film_file), "--ci", "fast"])
+    assert exc.value.code == 2
+    assert "invalid choice: 'fast'" in capsys.readouterr().err

@@ -645,7 +645,9 @@ def test_unknown_model_and_parameter_names_are_refused() -> None:
 
 def test_bad_settings_are_refused() -> None:
     fd = noisy(ZOU2013["OSR"][550], seed=16)
-    with pytest.raises(FitError, match="ci must be 'wald' or 'profile', got 'bootstrap'"):
+    with pytest.raises(
+        FitError, match="ci must be one of 'auto', 'wald', 'profile', got 'bootstrap'"
+    ):
         fit("smooth3", fd, ci="bootstrap")
     with pytest.raises(FitError, match="ci='profile' is not combined with energy_constraint"):
         fit("smooth3", fd, ci="profile", energy_constraint=True)

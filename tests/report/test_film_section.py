@@ -103,6 +103,8 @@ def test_film_fit_recovers_the_synthetic_stack(fitted: dict) -> None:
     assert rows["oxide.B"]["value"] == pytest.approx(B, abs=5e-4)
     for r in rows.values():
         assert r["ci_lo"] <= r["value"] <= r["ci_hi"]
+    # noise-free and well determined: chi2 is quadratic over the intervals, no profile
+    assert {r["interval"] for r in rows.values()} == {"wald"}
 
 
 def test_reflectance_predicted_by_the_stack_agrees(fitted: dict) -> None:

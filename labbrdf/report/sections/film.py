@@ -32,6 +32,7 @@ import pandas as pd
 from ... import films
 from ... import nk as nkmod
 from ...fitting.film import FilmFit, fit_film
+from ...fitting.film_display import intervals_text
 from ...fitting.film_verdict import MSE_WRONG_MODEL
 from .. import figures
 from ..agreement import P_AGREE, chi_square
@@ -117,6 +118,7 @@ def _param_rows(summary: dict[str, Any]) -> list[dict[str, Any]]:
                     "stderr": d.get("stderr"),
                     "ci_lo": ci[0],
                     "ci_hi": ci[1],
+                    "interval": d.get("ci_method") or "",
                     "ci_lo_scaled": cis[0],
                     "ci_hi_scaled": cis[1],
                     "units": d.get("units", ""),
@@ -427,6 +429,7 @@ def _fit_shown(
             ("stderr", "\u03c3", ".2g"),
             ("ci_lo", "95 % low", ".6g"),
             ("ci_hi", "95 % high", ".6g"),
+            ("interval", "interval", ""),
             ("ci_lo_scaled", "95 % low, scaled", ".6g"),
             ("ci_hi_scaled", "95 % high, scaled", ".6g"),
             ("units", "units", ""),
@@ -435,7 +438,7 @@ def _fit_shown(
             ("flags", "flags", ""),
         ],
         _param_rows(s),
-        caption=f"{s['ci_method']} intervals from the files' sigmas; 'scaled': times "
+        caption=f"95 % intervals from the files' sigmas: {intervals_text(s)}; 'scaled': times "
         "sqrt(chi2/nu), given where chi-square rejects the film model (p < 0.01), which "
         "then misses the data by more than the sigmas; units [1] where none is given.",
     )
