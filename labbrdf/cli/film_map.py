@@ -48,7 +48,7 @@ def cmd_film_map(args: argparse.Namespace) -> int:
 
 def add_parser(sub: Any) -> None:
     """The ``film-map`` subcommand's options."""
-    from ..fitting.core import METHOD
+    from ..fitting.defaults import METHOD
 
     s = sub.add_parser(
         "film-map", help="fit a film model to every point of a wafer map (thickness, index maps)"

@@ -106,6 +106,14 @@ class Graded:
         p = self.parameter
         return {**out, f"{p}_top": self.top, f"{p}_bottom": self.bottom, "shape": self.shape}
 
+    def fixed_by_default(self) -> frozenset[str]:
+        """The base's structural parameters, and the profile's ``shape``.
+
+        The profile stays linear unless a box is written for ``shape``.
+        """
+        fixed = getattr(self.base, "fixed_by_default", None)
+        return (fixed() if callable(fixed) else frozenset()) | {"shape"}
+
     def bounds(self) -> dict[str, tuple[float, float]]:
         """Default search box."""
         b = dict(self.base.bounds())

@@ -48,6 +48,8 @@ class _FilmFitModel(Model):
     """
 
     name = "film"
+    #: the film fit's rows (psi, Delta, R, T channels), as the core's data name them
+    quantities = ("film",)
     reference = (
         "coherent transfer matrices (labbrdf.films.matrices) with labbrdf.nk.dispersion materials"
     )

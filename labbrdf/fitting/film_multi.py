@@ -43,6 +43,7 @@ class _MultiFilmModel(Model):
     """One film model over the rows of several samples (each sample's rows a slice)."""
 
     name = "film (several samples)"
+    quantities = _FilmFitModel.quantities
     reference = _FilmFitModel.reference
 
     def __init__(

@@ -332,7 +332,7 @@ def test_film_prints_the_fits_own_report(film_file, capsys):
 # ------------------------------------------------------------------- intervals: Wald first
 
 # B ends at its max; A, correlated with B (-0.77), then has a narrower profile interval
-PINNED = ["--layer", "film:cauchy:0..300:A=1.3..1.8:B=0..0.002"]
+PINNED = ["--layer", "film:cauchy:0..300:A=1.3..1.8:B=0..0.002:C=0"]
 
 
 def test_film_prints_the_wald_answer_first_on_a_terminal(film_file, capsys, monkeypatch):

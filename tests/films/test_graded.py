@@ -126,7 +126,8 @@ def test_model_file_reads_a_graded_layer(tmp_path):
     g = m.stack.layers[0].material
     assert isinstance(g, Graded) and (g.parameter, g.sublayers) == ("A", 10)
     assert g.top == g.bottom == pytest.approx(2.1)  # the middle of the boxes
-    assert set(m.free) == {"film.A_top", "film.A_bottom", "film.thickness_nm"}
+    # the one rule: the unwritten C is free; Cauchy's absorption and the profile shape fixed
+    assert set(m.free) == {"film.A_top", "film.A_bottom", "film.C", "film.thickness_nm"}
 
 
 @pytest.mark.parametrize(

@@ -175,7 +175,7 @@ def test_model_file_reads_a_thick_substrate_and_an_incoherent_layer(tmp_path):
     m = load_model(p)
     assert m.stack.substrate_thickness_nm == 1e6
     assert [lay.coherent for lay in m.stack.layers] == [True, False]
-    assert set(m.free) == {"film.A", "film.thickness_nm"}
+    assert set(m.free) == {"film.A", "film.C", "film.thickness_nm"}  # C unwritten: free
 
 
 @pytest.mark.parametrize(
@@ -236,6 +236,6 @@ def test_film_on_glass_is_fitted_from_spectrophotometer_r_and_t(tmp_path):
     assert s["redchi"] < 1.5
     back = Stack.from_fit_json(fit.save_json(tmp_path / "fit.json"))
     assert back.substrate_thickness_nm == 1e6
-    assert "1e+06 (fixed)" in fit.fit_report().split("substrate (")[1]  # the glass shown
+    assert "1e+06 (fixed)" in fit.fit_report().split("substrate: ")[1]  # the glass shown
     semi = Stack(truth.layers, "sio2")
     assert fit_film(FilmModel(semi, box), data, seed=1).summary()["redchi"] > 50

@@ -33,6 +33,9 @@ CONFIGS = [
     ("abg", {"diffuse": True}),
     ("harvey_shack", {}),
     ("harvey_shack", {"diffuse": True}),
+    ("rayleigh_rice", {"n": 1.2, "k": 7.0}),
+    ("rayleigh_rice", {"n": 1.2, "k": 7.0, "free_index": True}),
+    ("rayleigh_rice", {"n": 1.2, "k": 7.0, "psd": "gaussian"}),
 ]
 
 

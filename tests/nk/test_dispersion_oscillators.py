@@ -171,7 +171,9 @@ def test_a_sum_is_a_material_by_name_in_python_toml_and_with_parameters(tmp_path
         "drude2_omega_p = [0.5, 3.0]\ndrude2_gamma = 0.12\n"
     )
     fm = load_model(p)
-    assert set(fm.free) == {"ito.thickness_nm", "ito.drude2_omega_p"}
+    # the one rule: what is not written is fitted in its default box
+    taucs = {f"ito.tauc_lorentz1_{k}" for k in ("A", "E0", "C", "Eg")}
+    assert set(fm.free) == {"ito.thickness_nm", "ito.drude2_omega_p", *taucs}
     assert fm.stack.layers[0].material.params["drude2_gamma"] == 0.12
     p.write_text(p.read_text().replace("drude2_gamma", "drude3_gamma"))
     with pytest.raises(FilmError, match="line 10: unknown parameter 'drude3_gamma'"):
