@@ -14,7 +14,7 @@ extension and those whose typical keywords occur in the first bytes. Readers nev
 other under ``except``: a parse error is reported as is.
 
 Height maps (profilometer, AFM and interferometer files, :mod:`labbrdf.adapters.topography`)
-are an input kind of their own (:data:`~labbrdf.adapters.topography.HEIGHT_MAP_FORMATS`):
+are an input kind of their own (:data:`~labbrdf.adapters.heightmap_formats.HEIGHT_MAP_FORMATS`):
 :func:`input_kind` tells them from optical exports before anything is parsed -- an extension
 only height maps have, or, for an extension optical exports share (MetroPro ``.dat``), magic
 bytes a height-map sniffer claims and no optical sniffer does. :func:`read` refuses a height

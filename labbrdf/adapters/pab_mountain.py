@@ -153,7 +153,7 @@ def read_pab_mountain(path: str | os.PathLike[str]) -> Measurement:
         line with the wrong number of fields or a non-number (its line named), angles out
         of range, front and back directions mixed, no data, or an unterminated last line
         cut inside its number (a shorter one is warned about,
-        :func:`~labbrdf.adapters._numblock.check_last_field`).
+        ``labbrdf.adapters._numblock.check_last_field``).
     """
     text, _ = decode(read_bytes(path), path)
     lines = split_lines(text)

@@ -209,7 +209,7 @@ def input_kind(path: str | os.PathLike[str]) -> str:
     -------
     str
         ``"height_map"`` for an extension only topography instruments write
-        (:data:`~labbrdf.adapters.topography.HEIGHT_MAP_FORMATS`), or for a file whose
+        (:data:`~labbrdf.adapters.heightmap_formats.HEIGHT_MAP_FORMATS`), or for a file whose
         first bytes a height-map sniffer claims and no optical sniffer does, when its
         extension is one the height-map format shares with optical exports (a MetroPro
         ``.dat`` beside WVASE ``.dat``) or belongs to no format; ``"optical"`` otherwise.

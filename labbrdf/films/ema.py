@@ -142,7 +142,7 @@ class Ema:
     Notes
     -----
     A constituent's own parameters stay as given; ``@NAME`` follows the referenced layer's
-    material, fitted or not. Evaluated by :meth:`labbrdf.films.Stack.indices` with
+    material, fitted or not. Evaluated by :meth:`labbrdf.Stack.indices` with
     :func:`bruggeman_mix`.
     """
 

@@ -100,7 +100,7 @@ class MultiFilmFit:
     per_sample : tuple of str
         The ``"<layer>.<parameter>"`` names fitted per sample.
     stacks : dict
-        Sample name -> its best-fit :class:`~labbrdf.films.Stack`.
+        Sample name -> its best-fit :class:`labbrdf.Stack`.
     data : pandas.DataFrame
         The fitted rows, with a ``fit_sample`` column naming each row's sample.
     sources : dict
@@ -128,7 +128,7 @@ class MultiFilmFit:
     def misfit_scale(self) -> float | None:
         """``sqrt(chi2/nu)`` when chi-square rejects the model at the 1 % level, else None.
 
-        As :attr:`labbrdf.fitting.film.FilmFit.misfit_scale`: ``*_scaled`` intervals are
+        As :attr:`labbrdf.FilmFit.misfit_scale`: ``*_scaled`` intervals are
         the stderr times this factor.
         """
         res = self.result
@@ -142,7 +142,7 @@ class MultiFilmFit:
     def verdict(self) -> str | None:
         """Words saying that the model is wrong (MSE above ``MSE_WRONG_MODEL``), or None.
 
-        As :attr:`labbrdf.fitting.film.FilmFit.verdict`, on the MSE over all samples.
+        As :attr:`labbrdf.FilmFit.verdict`, on the MSE over all samples.
         """
         from .film_verdict import material_label, wrong_model_verdict
 

@@ -216,7 +216,7 @@ class FitResult:
         Hemispherical data (any other azimuth): per angle of incidence a row of three
         maps of the projected hemisphere, measured, model and relative residual
         ``(model - measured) / measured``, drawn as ``labbrdf fit --residual-maps`` draws
-        them (:func:`labbrdf._brdf_maps.draw_brdf_maps`): thousands of scans of a few
+        them (``labbrdf._brdf_maps.draw_brdf_maps``): thousands of scans of a few
         points each would be unreadable as lines, and slow to draw.
 
         Parameters

@@ -354,7 +354,7 @@ def polar_maps_figure(
     Polar axes: azimuth = phi_r (outward, source at 0, specular half-plane at 180 deg),
     radius = theta_r [deg]. S0 is the pBRDF element M00 [sr^-1] for unpolarized input
     (shared colour scale per row is NOT used: each case gets its own, the paper's way;
-    but all are log scales when one case needs it, :func:`labbrdf._plotting.map_scale`);
+    but all are log scales when one case needs it, ``labbrdf._plotting.map_scale``);
     DOP is dimensionless in [0, 1].
 
     Parameters
@@ -375,7 +375,7 @@ def polar_maps_figure(
 def save_trace_maps_png(result: Any, path: str | Any, stokes_in: Any = (1, 0, 0, 0)) -> Any:
     """Write the S0 and DOP hemisphere maps and the in-plane cut of a tracer result to PNG.
 
-    The figure is :meth:`labbrdf.tracer.TraceResult.plot` (the same as in a notebook) at
+    The figure is :meth:`labbrdf.TraceResult.plot` (the same as in a notebook) at
     :data:`labbrdf.figstyle.DPI`.
 
     Parameters
@@ -552,7 +552,7 @@ def save_png(uri: str, path: Any) -> Any:
 def brdf_maps_figure(panels: Sequence[Mapping[str, Any]], title: str = "") -> str:
     """Measured BRDF, fitted model and relative residual per angle of incidence (one row each).
 
-    Drawn by :func:`labbrdf._brdf_maps.draw_brdf_maps` (as ``fit --residual-maps`` and
+    Drawn by ``labbrdf._brdf_maps.draw_brdf_maps`` (as ``fit --residual-maps`` and
     :meth:`labbrdf.FitResult.plot` of hemispherical data).
 
     Parameters

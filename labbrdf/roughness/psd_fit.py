@@ -7,7 +7,7 @@ guesses, energy constraint and replicates are those of BRDF models). A PSD is a 
 of one spatial frequency spanning decades in value, so it is fitted here in log space with
 the same machinery and conventions as the core:
 
-* the same optimiser chain (:data:`labbrdf.fitting.core.METHOD`: nlopt ``GN_CRS2_LM``
+* the same optimiser chain (``labbrdf.fitting.defaults.METHOD``: nlopt ``GN_CRS2_LM``
   inside the bounds, then ``LN_BOBYQA`` from its best point, seeded with ``nlopt.srand``),
   then scipy ``least_squares`` (trf) as the core's polish;
 * the same uncertainties: the covariance from the Jacobian at the optimum by

@@ -288,7 +288,7 @@ class TraceResult:
         The maps are drawn as the report's tracer maps (polar: azimuth phi_r with the
         specular half-plane at 180 deg, radius theta_r; the DOP blank where it cannot be
         read, :meth:`readable_dop`; the S0 scale up to :meth:`s0_scale_max`, logarithmic
-        when a peak dominates the map, :func:`labbrdf._plotting.map_scale`); the cut is
+        when a peak dominates the map, ``labbrdf._plotting.map_scale``); the cut is
         :meth:`in_plane` with 1-sigma error bars (S0) and a band (DOP). The new figure is
         in the package's style (:mod:`labbrdf.figstyle`: readable at 96 dpi).
 

@@ -66,7 +66,7 @@ class BSpline(Dispersion):
     -----
     Johs & Hale place the knots over the measured range and transform each basis function in
     closed form; here the knots span ``[E_lo, E_hi]`` with ``eps2`` vanishing at both ends, and
-    ``eps1`` is the numerical principal value of :func:`~labbrdf.nk.dispersion._kk.kk_eps1`
+    ``eps1`` is the numerical principal value of ``labbrdf.nk.dispersion._kk.kk_eps1``
     with a panel per knot interval (where ``xi eps2`` is a quartic): it agrees with adaptive
     quadrature to 1e-9 (``tests/nk/test_dispersion_oscillators.py``).
     """

@@ -55,7 +55,7 @@ class CodyLorentz(Dispersion):
 
     Notes
     -----
-    ``eps1`` is the numerical principal value of :func:`~labbrdf.nk.dispersion._kk.kk_eps1`
+    ``eps1`` is the numerical principal value of ``labbrdf.nk.dispersion._kk.kk_eps1``
     (the paper's closed form, their eq. (A1), is not used): Gauss-Legendre panels with
     edges at ``Eg``, on the Urbach tail, across the Lorentz peak and graded towards the kink
     at ``Et``, up to 10^4 eV plus the ``A E0 C / xi^3`` tail beyond. Against the same sum
