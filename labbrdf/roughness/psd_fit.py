@@ -366,7 +366,7 @@ def _finish(
     }
     flags = {k: r for k, r in flags.items() if r}
     params = tuple(values.values())
-    notes = _knee_notes(m.name, values, band)
+    notes = _knee_notes(m.name, values, band) + _misfit_notes(redchi, nfree)
     return PSDFit(
         model=m.name,
         kind=kind,
@@ -385,6 +385,32 @@ def _finish(
         success=bool(np.isfinite(chisqr)),
         message="converged" if np.isfinite(chisqr) else "non-finite chi-square",
         notes=notes,
+    )
+
+
+#: upper-tail probability below which chi^2/dof says the model does not describe the spectrum
+MISFIT_P = 1e-3
+
+
+def _misfit_notes(redchi: float, nfree: int) -> tuple[str, ...]:
+    """Say so when chi^2/dof exceeds what the bins' own uncertainties allow.
+
+    The bins' log values have the stated standard errors; for a model that describes the
+    spectrum, chi^2 follows the chi-square law with ``nfree`` degrees of freedom, so a
+    value beyond its upper :data:`MISFIT_P` point means a model of the wrong shape: its
+    parameters are then a compromise over the band, and the intervals (scaled by
+    sqrt(chi^2/dof)) do not include that bias.
+    """
+    if nfree < 1 or not math.isfinite(redchi):
+        return ()
+    limit = float(special.chdtri(nfree, MISFIT_P)) / nfree
+    if redchi <= limit:
+        return ()
+    return (
+        f"chi^2/dof {redchi:.3g} is beyond what the bins' uncertainties allow ({limit:.3g} "
+        f"at p = {MISFIT_P:g}): the model does not describe this spectrum; its parameters are "
+        "a compromise over the band, biased beyond their (scaled) intervals; use the measured "
+        "sigma over the band, or another model or band",
     )
 
 

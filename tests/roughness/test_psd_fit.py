@@ -61,6 +61,15 @@ def test_fit_band_is_stated_and_respected(synth):
     assert set(d["interval_95"]) == {"A", "B", "C"} and d["units"]["A"] == "m^4"
 
 
+def test_a_model_of_the_wrong_shape_says_its_parameters_are_a_compromise(synth):
+    z = synth.surface("k-correlation", CASES["k-correlation"], 128, DX, seed=11)
+    s = P.map_psd(z, DX, window="none", degree=0)
+    right, wrong = fit_psd(s, "k-correlation"), fit_psd(s, "gaussian")
+    assert not any("does not describe" in n for n in right.notes)
+    assert wrong.redchi > 2 and any("does not describe this spectrum" in n for n in wrong.notes)
+    assert "does not describe" in str(wrong)
+
+
 def test_fit_is_reproducible(synth):
     z = synth.surface("exponential", CASES["exponential"], 64, DX, seed=4)
     s = P.map_psd(z, DX, window="none", degree=0)
