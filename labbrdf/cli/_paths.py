@@ -18,7 +18,8 @@ class InputPath(argparse.Action):
     Every output of the command refuses all of them (see :func:`_checked_outputs`), so
     an option declared with ``action=InputPath`` cannot be forgotten by a writer. A file
     that names other files (``inside="model"``: a film model file, ``inside="fit"``: a film
-    fit JSON) brings those in as inputs too (:func:`labbrdf.films.named_inputs`).
+    fit JSON, ``inside="map"``: a wafer map's listing) brings those in as inputs too
+    (:func:`labbrdf.films.named_inputs`, :func:`labbrdf.fitting.film_map.read_map_listing`).
     """
 
     def __init__(
@@ -26,7 +27,7 @@ class InputPath(argparse.Action):
         option_strings: Sequence[str],
         dest: str,
         *,
-        inside: Literal["model", "fit"] | None = None,
+        inside: Literal["model", "fit", "map"] | None = None,
         **kw: Any,
     ) -> None:
         super().__init__(option_strings, dest, **kw)
@@ -107,13 +108,22 @@ def _named_inside(args: argparse.Namespace) -> list[str]:
     for a, p in _named_paths(args, InputPath):
         kind = getattr(a, "inside", None)
         if kind is not None:
-            from ..films import named_inputs
-
             try:
-                inner += [str(f) for f in named_inputs(p, kind)]
+                inner += _files_named_by(p, kind)
             except ValueError as exc:  # the loader's message, naming the file
                 raise UsageError(f"{_option_name(a)} {exc}") from None
     return inner
+
+
+def _files_named_by(path: str, kind: str) -> list[str]:
+    """The files an input names: a film model's or fit's tables, a map listing's points."""
+    if kind == "map":
+        from ..fitting.film_map import read_map_listing
+
+        return [pt.file for pt in read_map_listing(path)]
+    from ..films import named_inputs
+
+    return [str(f) for f in named_inputs(path, kind)]
 
 
 def _check_outputs(args: argparse.Namespace) -> None:

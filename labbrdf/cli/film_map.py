@@ -56,6 +56,7 @@ def add_parser(sub: Any) -> None:
     s.add_argument(
         "listing",
         action=InputPath,
+        inside="map",
         metavar="MAP.csv",
         help="CSV with columns file,x,y: each point's file (relative to the CSV) and its "
         "position [mm]",

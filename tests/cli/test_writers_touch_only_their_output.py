@@ -321,6 +321,10 @@ def _argv_naming(
             value = [output]
         elif not a.required:
             continue
+        elif isinstance(a, InputPath) and a.inside:  # a file that names the filler
+            fill_dir = Path(filler).parent / f"fill-{a.dest}"
+            fill_dir.mkdir(exist_ok=True)
+            value = [str(_naming_file(a.inside, fill_dir, Path(filler)))]
         elif isinstance(a, InputPath):
             value = [filler]
         else:
@@ -373,7 +377,12 @@ TABLE = "300,1.5,3.0\n1200,2.0,4.0\n"
 
 
 def _naming_file(kind: str, folder: Path, table: Path) -> Path:
-    """A film model file (``kind="model"``) or fit JSON (``"fit"``) naming ``table``."""
+    """A film model file (``kind="model"``), fit JSON (``"fit"``) or map listing (``"map"``)
+    naming ``table``."""
+    if kind == "map":
+        p = folder / "map.csv"
+        p.write_text(f"file,x,y\n{table},0,0\n")
+        return p
     if kind == "model":
         p = folder / "model.toml"
         p.write_text(
@@ -411,6 +420,8 @@ def test_the_options_whose_files_name_files_are_declared():
         ("trace", "coating_from", "output"),
         ("trace", "coating_from", "png"),
         ("report", "film_model", "output"),
+        ("film-map", "listing", "output"),
+        ("film-map", "listing", "png"),
     ]:
         assert pair in INSIDE_PAIRS
 

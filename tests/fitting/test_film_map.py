@@ -80,3 +80,16 @@ def test_map_errors_name_the_listing_line_or_the_point_file(listing, tmp_path, c
     empty = FilmModel(Stack([Layer(Cauchy(A=1.5), 100.0, "film")], Constant(n=3.9, k=0.02)))
     with pytest.raises(FilmError, match="at least one point"):
         fit_film_map(empty, [])
+
+
+@pytest.mark.parametrize("overwrite", [False, True])
+def test_map_output_never_replaces_a_point_file_the_listing_names(listing, capsys, overwrite):
+    # -o TABLE.csv naming p1.csv (listed inside map.csv) is refused before any fit
+    path, model = listing
+    point = path.parent / "p1.csv"
+    before = point.read_bytes()
+    args = ["film-map", str(path), "--model", str(model), "--scheduler", "serial"]
+    assert main([*args, "-o", str(point), *(["--overwrite"] if overwrite else [])]) == 2
+    err = capsys.readouterr().err
+    assert "p1.csv" in err and "Traceback" not in err
+    assert point.read_bytes() == before
