@@ -34,7 +34,8 @@ import numpy as np
 import pandas as pd
 
 import labbrdf
-from labbrdf.adapters._numblock import build_frame, head_lines, parse_block
+from labbrdf.adapters._frame import build_frame
+from labbrdf.adapters._numblock import head_lines, parse_block
 from labbrdf.dataset import validate
 
 HEADER = (

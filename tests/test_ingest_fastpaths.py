@@ -14,7 +14,8 @@ import pandas as pd
 import pytest
 
 import labbrdf
-from labbrdf.adapters._numblock import _count_lf, _slow, parse_block, within
+from labbrdf.adapters._frame import within
+from labbrdf.adapters._numblock import _count_lf, _slow, parse_block
 from labbrdf.adapters.woollam import _ascii_head, _wrap
 from labbrdf.dataset import DatasetError, Measurement, make_frame, validate, wrap_delta
 

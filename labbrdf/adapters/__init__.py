@@ -22,8 +22,8 @@ map with an :class:`AdapterError` that says so (a height map is not a :class:`Me
 :func:`read_inputs` reads a list of paths of either kind, each file once.
 """
 
+from ..errors import AdapterWarning
 from ._base import AdapterError, Example, Format
-from ._numblock import AdapterWarning
 from .inputs import InputFile, Inputs, read_inputs
 from .registry import (
     KINDS,

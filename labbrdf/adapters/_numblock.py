@@ -1,55 +1,51 @@
-"""Numeric blocks of text exports: a vectorised parser with line-numbered errors.
+"""Numeric blocks of text exports: vectorised parsers with line-numbered errors.
 
-Private helpers shared by the text adapters (Woollam, Accurion, Film Sense, SENTECH,
-Shimadzu UVProbe text, declared columns). The block parser reads a block of delimited numbers with
-:func:`pandas.read_csv` (C engine) and falls back to a strict line-by-line parser only when
-the fast path meets something it cannot read; the slow parser is the authority: it either
-returns the same table or raises :class:`AdapterError` naming the file, the line and what
-was expected. A reader therefore never returns a half-read file, and a good file is parsed
-at pandas speed.
+Private helpers shared by the text adapters. Two parsers, one per kind of block:
 
-A file cut short in the middle of its last number (a copy or download that stopped) still
-parses: ``0,289`` cut to ``0,`` reads as 0. :func:`check_last_field` compares the last
-field of an unterminated last line with the same column in the rows before it and refuses
-or warns (see its docstring); :func:`parse_block` applies it to every block it reads.
+* :func:`parse_block` (Woollam, Accurion, Film Sense, SENTECH, Shimadzu UVProbe text,
+  declared columns): a block of delimited numbers, rows of up to ``ncols`` fields, optional
+  row tags, empty fields read as NaN, ``inf``/``nan`` spellings accepted (:data:`NUMBER`). It
+  reads with :func:`pandas.read_csv` (C engine) and falls back to a strict line-by-line
+  parser only when the fast path meets something it cannot read; the slow parser is the
+  authority: it either returns the same table or raises :class:`AdapterError` naming the
+  file, the line and what was expected. A reader therefore never returns a half-read file,
+  and a good file is parsed at pandas speed. Every block it reads goes through
+  :func:`labbrdf.adapters._truncation.check_last_field` (a last number cut short).
+* :func:`parse_rows` (the ``.bsdf`` tables: Zemax, SPEOS, PAB Mountain): rows the reader has
+  already picked out of the file, each with exactly ``ncols`` blank-separated numbers, every
+  one finite ASCII decimal (no tags, no empty fields, no ``inf``/``nan``), for formats whose
+  grids the header states.
+
+A field holding one number is read by :func:`finite_number`.
 """
 
 from __future__ import annotations
 
 import csv
 import io
-import itertools
+import math
 import os
 import re
 import warnings
-from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 import pandas as pd
+from numpy.typing import NDArray
 
-from ..dataset import DatasetError, Measurement
-from ..errors import AdapterWarning
 from ._base import DECIMAL, NONFINITE, AdapterError
+from ._truncation import TAIL_ROWS, check_last_field, tail_lines, unterminated
 
 __all__ = [
-    "AdapterWarning",
     "Block",
     "NUMBER",
-    "build_frame",
-    "check_last_field",
-    "check_last_row",
-    "check_joined",
-    "unterminated",
-    "labels",
     "body_bytes",
-    "group_angles",
+    "finite_number",
     "head_lines",
-    "measurement",
     "parse_block",
+    "parse_rows",
     "split_head",
-    "within",
 ]
 
 #: What a number may look like in an export: ASCII digits (:data:`._base.DECIMAL`), or
@@ -94,324 +90,6 @@ class Block:
 
 
 _EOL = re.compile(r"\r\n|\n|\r")
-
-
-def warn(path: str | os.PathLike[str], message: str, line: int | None = None) -> str:
-    """Issue an :class:`AdapterWarning` naming the file and line; return its text."""
-    where = f"{os.fspath(path)}" + (f", line {line}" if line is not None else "")
-    text = f"{where}: {message}"
-    warnings.warn(AdapterWarning(text), stacklevel=3)
-    return text
-
-
-#: Rows before the last one that give a column its precision (the most recent ones).
-TAIL_ROWS = 200
-#: Rows that must agree on a column's decimals (or exponent digits) for a shorter last
-#: value to be refused rather than warned about: fewer could agree by chance.
-FIXED_ROWS = 5
-
-_SHAPE = re.compile(
-    r"[+-]?(?P<int>[0-9]*)(?P<mark>[.,]?)(?P<frac>[0-9]*)(?:(?P<e>[eE])[+-]?(?P<exp>[0-9]*))?"
-)
-
-
-@dataclass(frozen=True)
-class _Shape:
-    """How a number is written: decimals, exponent digits, significant digits."""
-
-    decimals: int
-    exponent: int | None
-    digits: int
-    dangling: bool
-
-
-def _shape(field: str) -> _Shape | None:
-    """The shape of a numeric field (None for text, ``nan``, ``inf`` or an empty field)."""
-    m = _SHAPE.fullmatch(field)
-    if m is None or not (m["int"] or m["frac"] or m["mark"]):
-        return None
-    digits = len((m["int"] + m["frac"]).lstrip("0"))
-    dangling = (
-        (m["mark"] != "" and m["frac"] == "" and m["e"] is None)  # "0," or "300."
-        or (m["e"] is not None and m["exp"] == "")  # "4.5E-" or "4.5e"
-        or not (m["int"] or m["frac"])  # "," alone
-    )
-    exp = len(m["exp"]) if m["e"] is not None else None
-    return _Shape(len(m["frac"]), exp, digits, dangling)
-
-
-def _fields(line: str, sep: str | None, tagged: bool) -> list[str]:
-    fields = [f.strip() for f in (line.split(sep) if sep is not None else line.split())]
-    while fields and not fields[-1]:
-        fields.pop()
-    if tagged and fields and fields[0][:1].isalpha():
-        fields = fields[1:]
-    return fields
-
-
-def _decimals(n: int) -> str:
-    return f"{n} decimal" + ("" if n == 1 else "s")
-
-
-def unterminated(text: str | bytes) -> bool:
-    """Whether the last line of ``text`` holds something and has no line end."""
-    if not text:
-        return False
-    tail = text[-1:]
-    if tail in ("\n", "\r", b"\n", b"\r"):
-        return False
-    return not text[-1:].isspace()
-
-
-def _check_missing_cells(
-    path: str | os.PathLike[str],
-    last: str,
-    previous: list[str],
-    line: int,
-    sep: str | None,
-    tagged: bool,
-) -> str | None:
-    """Refuse (or warn about) a last line that ends in a separator before cells every
-    earlier row fills: ``550,30,31.8,180,0.0694797,`` where each row has its sigma."""
-    have = len(_fields(last, sep, tagged))
-    ref = [len(_fields(p, sep, tagged)) for p in previous[-TAIL_ROWS:] if p.strip()]
-    if not have or not ref or min(ref) <= have:
-        return None
-    what = (
-        f"the last line, which has no line end, stops after {have} field(s) where every "
-        f"other row has at least {min(ref)}"
-    )
-    fix = "if the row is complete, end the line with a line break"
-    if len(ref) >= FIXED_ROWS:
-        raise AdapterError(path, f"{what}: the file looks truncated ({fix})", line)
-    return warn(path, f"{what}: the file may be truncated ({fix})", line)
-
-
-def check_last_field(
-    path: str | os.PathLike[str],
-    last: str,
-    previous: list[str],
-    line: int,
-    sep: str | None,
-    *,
-    tagged: bool = False,
-) -> str | None:
-    """Refuse or warn when the unterminated last line of a file looks cut mid-number.
-
-    Only the last field of such a line can be cut (every other field is followed by a
-    separator); it is compared with the same column in ``previous``, the rows before it
-    (the most recent :data:`TAIL_ROWS` are enough). A line that ends in a separator may
-    have lost the fields after it: it is refused where at least :data:`FIXED_ROWS` earlier
-    rows all have more fields (``...,0.0694797,`` where every row has a sigma after the
-    value), warned about where fewer do.
-
-    Refused (the file looks truncated): the field ends in a decimal separator or in an
-    exponent without digits (``0,``, ``300.``, ``4.5E-``); or the column has a precision of
-    its own, every one of at least :data:`FIXED_ROWS` rows written with the same number of
-    decimals (or of exponent digits), and the field has fewer (``0,4`` where the column is
-    written ``0,322``; ``4.522`` or ``4.522E-0`` where it is written ``4.522E-02``).
-    Warned (the column's own writing varies, so a shorter value may be a real one, e.g.
-    ``0.13`` beside ``0.1308`` from a writer that drops trailing zeros): the field has fewer
-    significant digits than some other row (a cut always removes significant digits), or
-    no exponent where other rows have one; or no other row has the column to compare with.
-    Fewer decimals alone is no sign of a cut where the decimals vary: a writer of
-    significant digits writes ``0.278168`` beside ``0.0775003``.
-
-    Parameters
-    ----------
-    path : str or path-like
-        The file (for the message).
-    last : str
-        The last line, without line end (the caller checked it has none: :func:`unterminated`).
-    previous : list of str
-        The data rows before it, oldest first.
-    line : int
-        1-based number of the last line.
-    sep : str or None
-        Field separator; None for runs of blanks.
-    tagged : bool
-        Whether a row may start with an alphabetic tag (not a column).
-
-    Returns
-    -------
-    str or None
-        The warning issued (an :class:`AdapterWarning`), or None when the field is complete.
-
-    Raises
-    ------
-    AdapterError
-        The field is certainly cut short; the message names the line.
-    """
-    if last[-1:].isspace() or (sep is not None and last.endswith(sep)):
-        # the last field is followed by a separator: complete, but the cells after it may
-        # be missing
-        return _check_missing_cells(path, last, previous, line, sep, tagged)
-    fields = _fields(last, sep, tagged)
-    if not fields:
-        return None
-    j, text = len(fields) - 1, fields[-1]
-    f = _shape(text)
-    if f is None:
-        return None  # not a number: the reader's own parser refuses or keeps it
-    cut = f"field {j + 1} {text!r} on the last line, which has no line end,"
-    fix = "if the value is complete, end the line with a line break"
-    if f.dangling:
-        raise AdapterError(
-            path, f"{cut} ends without its digits: the file looks truncated ({fix})", line
-        )
-    ref = [s for p in previous[-TAIL_ROWS:] if len(fs := _fields(p, sep, tagged)) > j
-           for s in [_shape(fs[j])] if s is not None]  # fmt: skip
-    if not ref:  # nothing to compare with: say so rather than vouch for the value
-        return warn(
-            path,
-            f"{cut} has no other row of its column to compare with: the file may be "
-            f"truncated ({fix})",
-            line,
-        )
-    decimals = [r.decimals for r in ref]
-    exps = [r.exponent for r in ref if r.exponent is not None]
-    fixed = len(ref) >= FIXED_ROWS and min(decimals) == max(decimals)
-    if fixed and f.decimals < min(decimals):
-        raise AdapterError(
-            path,
-            f"{cut} has {_decimals(f.decimals)} where every other row of the column has "
-            f"at least {_decimals(min(decimals))}: the file looks truncated ({fix})",
-            line,
-        )
-    fixed_exp = len(ref) >= FIXED_ROWS and len(exps) == len(ref) and min(exps) == max(exps)
-    if fixed_exp and (f.exponent is None or f.exponent < min(exps)):
-        raise AdapterError(
-            path,
-            f"{cut} lacks the {min(exps)}-digit exponent every other row of the column has: "
-            f"the file looks truncated ({fix})",
-            line,
-        )
-    # where the decimals vary, the writer keeps significant digits (%g: 0.0775003 beside
-    # 0.278168) or drops trailing zeros (0.13 beside 0.1308): a cut value has fewer
-    # significant digits than the most any row has, while a complete one may well have
-    # fewer decimals than another row (0.278168 is not short beside 0.0775003)
-    short = (
-        (f.exponent is None and exps)
-        or (f.exponent is not None and exps and f.exponent < min(exps))
-        or f.digits < max(r.digits for r in ref)
-    )
-    if not short:
-        return None
-    return warn(
-        path,
-        f"{cut} is written shorter than other values of its column (up to "
-        f"{_decimals(max(decimals))}, {max(r.digits for r in ref)} significant digits): "
-        f"the file may be truncated ({fix})",
-        line,
-    )
-
-
-def check_last_row(
-    path: str | os.PathLike[str],
-    text: str | bytes,
-    lines: list[str],
-    rows: Sequence[int],
-    sep: str | None,
-    *,
-    tagged: bool = False,
-) -> str | None:
-    """:func:`check_last_field` for a reader that parses its rows itself.
-
-    Does nothing unless the file's last line has no line end and is the last data row.
-
-    Parameters
-    ----------
-    path : str or path-like
-        The file (for the message).
-    text : str or bytes
-        The whole file (only its last characters are looked at).
-    lines : list of str
-        Its lines, split at CR, LF or CRLF (:func:`labbrdf.adapters._base.split_lines`).
-    rows : sequence of int
-        1-based line numbers of the data rows, in file order.
-    sep : str or None
-        Field separator; None for runs of blanks.
-    tagged : bool
-        Whether a row may start with an alphabetic tag.
-
-    Returns
-    -------
-    str or None
-        The warning issued, if any.
-
-    Raises
-    ------
-    AdapterError
-        The last number (or the cells after the last separator) was certainly cut short.
-    """
-    if not rows or rows[-1] != len(lines) or not unterminated(text):
-        return None
-    previous = [lines[k - 1] for k in rows[-TAIL_ROWS - 1 : -1]]
-    return check_last_field(path, lines[-1].strip(), previous, rows[-1], sep, tagged=tagged)
-
-
-def check_joined(path: str | os.PathLike[str], lines: list[str]) -> None:
-    """Refuse a single-export file whose first line comes again: two exports joined.
-
-    The first non-blank line of an export (its magic, title or column line) is written
-    once; ``cat a.txt a.txt > b.txt`` repeats it where the second export starts, and the
-    reader would otherwise read the second copy as more data, a footer or a confusing
-    error further on.
-
-    Parameters
-    ----------
-    path : str or path-like
-        The file (for the message).
-    lines : list of str
-        Its lines (:func:`labbrdf.adapters._base.split_lines`).
-
-    Raises
-    ------
-    AdapterError
-        Naming the line where the second export starts.
-    """
-    heads = list(itertools.islice((i for i, ln in enumerate(lines) if ln.strip()), 2))
-    if not heads:
-        return
-    first = heads[0]
-    head = lines[first]
-    at = _index(lines, head, first + 1)
-    if at < 0 and len(heads) == 2:  # "a" without a final line end: its last line and the
-        # copy's first line are one line, found by the copy's second line after it
-        j = _index(lines, lines[heads[1]], heads[1] + 1)
-        if j > 0 and head.strip() and lines[j - 1].rstrip().endswith(head.strip()):
-            at = j - 1
-    if at >= 0:
-        raise AdapterError(
-            path,
-            f"the first line of the export ({head.strip()[:40]!r}, line {first + 1}) comes "
-            "again here: the file holds two exports joined (a copy starts at this line); "
-            "split it into one file per export",
-            at + 1,
-        )
-
-
-def _index(lines: list[str], line: str, start: int) -> int:
-    """``lines.index(line, start)`` (C speed), or -1."""
-    try:
-        return lines.index(line, start)
-    except ValueError:
-        return -1
-
-
-def tail_lines(data: bytes, start: int, n: int) -> list[str]:
-    """The last ``n`` lines of ``data[start:]`` (any line end), decoded as Latin-1."""
-    pos, count = len(data), 0
-    while count < n:
-        k = max(data.rfind(b"\n", start, pos), data.rfind(b"\r", start, pos))
-        if k < start:
-            pos = start
-            break
-        pos, count = k, count + 1
-        if k > start and data[k - 1 : k + 1] == b"\r\n":
-            pos = k - 1
-    chunk = data[pos:].decode("latin-1")
-    return [ln for ln in _EOL.split(chunk) if ln.strip()][-n:]
 
 
 def head_lines(text: str, n: int) -> tuple[list[str], int]:
@@ -793,178 +471,84 @@ def parse_block(
     return block
 
 
-def group_angles(angles: Any, tol: float = 0.05) -> list[dict[str, float | int]]:
-    """Group nearly equal angles for a summary (goniometer readings such as 64.999634).
+#: A character no row of finite ASCII decimals (blank-separated) holds.
+_NOT_NUMERIC = re.compile(r"[^0-9eE+\-. \t\n]")
+
+
+def finite_number(path: str | os.PathLike[str], text: str, line: int, what: str) -> float:
+    """One finite ASCII decimal number (no blanks around it), else AdapterError.
 
     Parameters
     ----------
-    angles : array_like
-        Angles [deg]; NaN ignored.
-    tol : float
-        Largest gap inside one group [deg].
+    path : str or path-like
+        The file (for the message).
+    text : str
+        The field.
+    line : int
+        Its 1-based line.
+    what : str
+        What the field is (the message starts with it).
+    """
+    if not DECIMAL.fullmatch(text):
+        raise AdapterError(path, f"{what}: expected an ASCII decimal number, found {text!r}", line)
+    v = float(text)
+    if not math.isfinite(v):
+        raise AdapterError(path, f"{what}: {text!r} is not a finite number", line)
+    return v
+
+
+def parse_rows(
+    path: str | os.PathLike[str], rows: list[str], lines: list[int], ncols: int
+) -> NDArray[np.float64]:
+    """Parse rows of exactly ``ncols`` finite numbers each, vectorised and strict.
+
+    Unlike :func:`parse_block`, a row holds no tag and no empty field, ``inf`` and ``nan``
+    are refused, and a row with fewer fields than ``ncols`` is an error (not NaN-padded).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file (for error messages).
+    rows : list of str
+        The rows' text, blank-separated numbers (the reader picked them out of the file).
+    lines : list of int
+        The 1-based line of each row.
+    ncols : int
+        Numbers per row.
 
     Returns
     -------
-    list of dict
-        One ``{"nominal", "min", "max", "rows"}`` per group, ascending; ``nominal`` is the
-        group mean rounded to 3 decimals. The data themselves are never rounded.
+    numpy.ndarray
+        ``(len(rows), ncols)`` float64.
+
+    Raises
+    ------
+    AdapterError
+        A character that belongs in no number, a row with another number of values, or a
+        field that is not a finite number (:func:`finite_number`), naming its line.
     """
-    a = np.asarray(angles, dtype=float).ravel()
-    a = np.sort(a[np.isfinite(a)])
-    if a.size == 0:
-        return []
-    cuts = np.flatnonzero(np.diff(a) > tol) + 1
-    out = []
-    for g in np.split(a, cuts):
-        out.append(
-            {
-                "nominal": round(float(g.mean()), 3),
-                "min": float(g[0]),
-                "max": float(g[-1]),
-                "rows": int(g.size),
-            }
+    text = "\n".join(rows)
+    bad = _NOT_NUMERIC.search(text)
+    if bad is not None:
+        i = text.count("\n", 0, bad.start())
+        raise AdapterError(
+            path, f"expected numbers, found the character {bad.group()!r}", lines[i]
         )
-    return out
-
-
-def build_frame(
-    *,
-    sample: str,
-    instrument: str,
-    source: str,
-    quantity: Any,
-    value: Any,
-    unit: Any,
-    wavelength_nm: Any,
-    sigma: Any = np.nan,
-    theta_i_deg: Any = np.nan,
-    theta_r_deg: Any = np.nan,
-    phi_r_deg: Any = np.nan,
-    **optional: Any,
-) -> pd.DataFrame:
-    """Build a schema table from arrays and scalars without per-row Python work.
-
-    Like :func:`labbrdf.dataset.make_frame`, but string columns are built as categoricals
-    (a constant string, an object array, or a :class:`pandas.Categorical` made with
-    :func:`labels`), which keeps files of millions of rows fast; :func:`measurement`
-    validates the result (and :func:`labbrdf.dataset.validate` turns them into plain
-    strings).
-    """
-    value = np.asarray(value, dtype=float).ravel()
-    n = value.size
-
-    def num(v: Any) -> np.ndarray:
-        if np.ndim(v) == 0:
-            return np.full(n, v, dtype=float)
-        arr = np.asarray(v, dtype=float).ravel()
-        if arr.size != n:  # pragma: no cover - programming error
-            raise ValueError(f"column has {arr.size} values, expected {n}")
-        return arr
-
-    def text(v: Any) -> pd.Categorical:
-        if isinstance(v, str):
-            return pd.Categorical.from_codes(np.zeros(n, dtype=np.int8), categories=[v])
-        if isinstance(v, pd.Categorical):
-            out = v
-        else:
-            out = pd.Categorical(np.asarray(v, dtype=object).ravel())
-        if len(out) != n:  # pragma: no cover - programming error
-            raise ValueError(f"column has {len(out)} values, expected {n}")
-        return out
-
-    cols: dict[str, Any] = {
-        "sample": text(sample),
-        "instrument": text(instrument),
-        "source": text(source),
-        "quantity": text(quantity),
-        "value": value,
-        "sigma": num(sigma),
-        "unit": text(unit),
-        "wavelength_nm": num(wavelength_nm),
-        "theta_i_deg": num(theta_i_deg),
-        "theta_r_deg": num(theta_r_deg),
-        "phi_r_deg": num(phi_r_deg),
-    }
-    for k, v in optional.items():
-        cols[k] = text(v) if k == "channel" else num(v)
-    return pd.DataFrame(cols, copy=False)
-
-
-#: Mueller elements whose sign differs between the vendors' convention (Woollam, SENTECH:
-#: ``M12 = M21 = -cos 2psi`` for an isotropic sample, i.e. ``S1 = Ip - Is``) and
-#: :mod:`labbrdf.optics` (``S1 = Is - Ip``, ``M12 = M21 = +cos 2psi``, ``M33 = sin 2psi cos
-#: Delta``, ``M34 = sin 2psi sin Delta``): ``M_optics = D M_vendor D`` with ``D = diag(1, -1,
-#: 1, 1)`` flips every element with exactly one index 2.
-MUELLER_S1_FLIP = frozenset(
-    {"mueller_12", "mueller_21", "mueller_23", "mueller_24", "mueller_32", "mueller_42"}
-)
-
-
-def mueller_convention(vendor: str) -> dict[str, str]:
-    """The ``meta["mueller_convention"]`` record of a reader that converted Mueller data."""
-    return {
-        "vendor": f"{vendor}: S1 = Ip - Is, M12 = M21 = -cos 2psi for an isotropic sample",
-        "converted": "labbrdf.optics: S1 = Is - Ip, M12 = M21 = +cos 2psi, M33 = sin 2psi "
-        "cos Delta, M34 = sin 2psi sin Delta; M = D M_vendor D, D = diag(1, -1, 1, 1) "
-        "(M12, M21, M23, M24, M32, M42 change sign)",
-    }
-
-
-def labels(names: list[str], counts: list[int] | np.ndarray) -> pd.Categorical:
-    """``names[k]`` repeated ``counts[k]`` times, as a categorical (no per-row strings)."""
-    uniq = list(dict.fromkeys(names))
-    codes = np.array([uniq.index(x) for x in names], dtype=np.int16)
-    return pd.Categorical.from_codes(np.repeat(codes, counts), categories=uniq)
-
-
-def measurement(
-    path: str | os.PathLike[str], frame: pd.DataFrame, meta: dict[str, Any]
-) -> Measurement:
-    """Validate into a :class:`Measurement`; a schema problem becomes an :class:`AdapterError`."""
-    if len(frame) == 0:
-        raise AdapterError(path, "no data rows found")
+    counts = np.fromiter((len(r.split()) for r in rows), dtype=np.int64, count=len(rows))
+    wrong = np.flatnonzero(counts != ncols)
+    if wrong.size:
+        i = int(wrong[0])
+        raise AdapterError(
+            path, f"expected {ncols} values in the row, found {counts[i]}", lines[i]
+        )
+    toks = text.split()
     try:
-        return Measurement(frame, meta)
-    except DatasetError as exc:
-        raise AdapterError(path, f"data do not fit the labbrdf schema: {exc}") from None
-
-
-def first_bad(mask: np.ndarray) -> int | None:
-    """Index of the first True in ``mask`` or None."""
-    idx = np.flatnonzero(mask)
-    return int(idx[0]) if idx.size else None
-
-
-def check_rows(path: str | os.PathLike[str], block: Block, mask: np.ndarray, message: str) -> None:
-    """Raise ``AdapterError(path, message, line)`` for the first row where ``mask`` is True."""
-    i = first_bad(mask)
-    if i is not None:
-        raise AdapterError(path, message, int(block.lines[i]))
-
-
-def delta_range(delta: np.ndarray) -> list[float] | None:
-    """[min, max] of the Delta values as written in the file (JSON-safe), None if empty."""
-    d = np.asarray(delta, dtype=float)
-    if within(d):
-        return [float(d.min()), float(d.max())]
-    d = d[np.isfinite(d)]
-    if d.size == 0:
-        return None
-    return [float(d.min()), float(d.max())]
-
-
-def within(
-    a: np.ndarray, lo: float = -np.inf, hi: float = np.inf, *, hi_open: bool = False
-) -> bool:
-    """True when every value of ``a`` is finite and within [lo, hi] ([lo, hi) with ``hi_open``).
-
-    Two reductions (NaN propagates into min and max) instead of several full-length masks:
-    the fast path of a range check; when it says no, the caller builds the exact row mask
-    to name the first offending line. True for an empty array.
-    """
-    if a.size == 0:
-        return True
-    mn, mx = float(np.min(a)), float(np.max(a))
-    if not (np.isfinite(mn) and np.isfinite(mx)):
-        return False
-    return mn >= lo and (mx < hi if hi_open else mx <= hi)
+        vals = np.array(toks, dtype=np.float64)
+    except ValueError:
+        vals = None
+    if vals is None or not np.isfinite(vals).all():
+        for row, ln in zip(rows, lines, strict=True):
+            for t in row.split():
+                finite_number(path, t, ln, "value")
+        raise AdapterError(path, "unreadable numbers in the data section")  # pragma: no cover
+    return vals.reshape(len(rows), ncols)

@@ -32,16 +32,8 @@ import pandas as pd
 
 from ..dataset import Measurement, wrap_delta
 from ._base import AdapterError, Example, Format, decode, read_bytes, split_lines
-from ._numblock import (
-    Block,
-    build_frame,
-    check_rows,
-    delta_range,
-    group_angles,
-    measurement,
-    parse_block,
-    split_head,
-)
+from ._frame import build_frame, check_rows, delta_range, group_angles, measurement
+from ._numblock import Block, parse_block, split_head
 
 __all__ = ["COLUMN_MAP", "FORMATS", "read_accurion", "sniff_accurion"]
 

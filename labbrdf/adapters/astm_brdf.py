@@ -33,7 +33,8 @@ import pandas as pd
 
 from ..dataset import Measurement
 from ._base import AdapterError, Format, decode, read_bytes, split_lines
-from ._numblock import build_frame, check_last_row
+from ._frame import build_frame
+from ._truncation import check_last_row
 
 __all__ = ["FORMATS", "read_astm_brdf"]
 

@@ -52,8 +52,8 @@ import numpy as np
 from ..dataset import Measurement
 from ._base import MAX_POINTS, AdapterError, Format, check_regular_file, decode, split_lines
 from ._base import read_bytes as _read_bytes
-from ._numblock import check_joined, check_last_row
 from ._spectro import PERCENT, finish, number, spectrum_frame
+from ._truncation import check_joined, check_last_row
 
 __all__ = ["FORMATS", "read_avasoft"]
 

@@ -40,8 +40,8 @@ import pandas as pd
 
 from ..dataset import Measurement
 from ._base import DECIMAL, AdapterError, Example, Format, decode, read_bytes, split_lines
-from ._numblock import check_joined, warn
 from ._spectro import PERCENT, finish, number, spectrum_frame
+from ._truncation import check_joined, warn
 
 __all__ = ["FORMATS", "read_cary_csv"]
 

@@ -48,8 +48,8 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import DECIMAL, AdapterError, Format, check_count, decode, read_bytes, split_lines
-from ._numblock import TAIL_ROWS, check_last_field, unterminated
 from ._spectro import PERCENT, finish, number, spectrum_frame
+from ._truncation import TAIL_ROWS, check_last_field, unterminated
 
 __all__ = [
     "ABSCISSAE",

@@ -32,14 +32,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..dataset import Measurement, wrap_delta
 from ._base import AdapterError, Example, Format, decode, read_bytes, split_lines
-from ._numblock import (
-    NUMBER,
-    build_frame,
-    check_joined,
-    check_last_row,
-    group_angles,
-    measurement,
-)
+from ._frame import build_frame, group_angles, measurement
+from ._numblock import NUMBER
+from ._truncation import check_joined, check_last_row
 
 __all__ = ["FORMATS", "filmsense_psi_delta", "read_filmsense", "sniff_filmsense"]
 

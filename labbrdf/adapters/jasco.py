@@ -62,9 +62,9 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import AdapterError, Example, Format, check_count, decode, read_bytes, split_lines
-from ._numblock import check_joined, check_last_row
 from ._ole2 import ole_names, open_ole2, read_stream
 from ._spectro import PERCENT, finish, number, spectrum_frame
+from ._truncation import check_joined, check_last_row
 
 __all__ = ["FORMATS", "read_jasco_jws", "read_jasco_text"]
 

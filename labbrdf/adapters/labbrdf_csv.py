@@ -90,8 +90,8 @@ from typing import Any
 
 from ..dataset import Measurement, make_frame
 from ._base import AdapterError, Format, decode, read_bytes, split_lines
-from ._numblock import check_last_row
 from ._spectro import finish, number
+from ._truncation import check_last_row
 
 __all__ = ["FORMATS", "read_hemispherical", "read_specular_scan"]
 

@@ -55,7 +55,7 @@ import pandas as pd
 
 from ..dataset import Measurement, wrap_delta
 from ._base import MAX_POINTS, AdapterError, Example, Format, check_regular_file
-from ._numblock import build_frame, group_angles, measurement
+from ._frame import build_frame, group_angles, measurement
 
 __all__ = ["FORMATS", "HDF5_MAGIC", "is_hdf5", "read_nexus"]
 

@@ -75,8 +75,8 @@ from ._base import (
     read_head,
     split_lines,
 )
-from ._numblock import check_joined, check_last_row
 from ._spectro import PERCENT, finish, number, spectrum_frame
+from ._truncation import check_joined, check_last_row
 
 __all__ = ["FORMATS", "read_jaz", "read_oceanoptics", "refuse_raspberry_pi"]
 

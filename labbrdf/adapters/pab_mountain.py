@@ -39,8 +39,9 @@ import pandas as pd
 
 from ..dataset import Measurement
 from ._base import AdapterError, Format, decode, parse_number, read_bytes, split_lines
-from ._numblock import build_frame, check_last_row
-from .zemax_bsdf import _parse_numbers
+from ._frame import build_frame
+from ._numblock import parse_rows
+from ._truncation import check_last_row
 
 __all__ = ["FORMATS", "read_pab_mountain"]
 
@@ -153,7 +154,7 @@ def read_pab_mountain(path: str | os.PathLike[str]) -> Measurement:
         line with the wrong number of fields or a non-number (its line named), angles out
         of range, front and back directions mixed, no data, or an unterminated last line
         cut inside its number (a shorter one is warned about,
-        ``labbrdf.adapters._numblock.check_last_field``).
+        ``labbrdf.adapters._truncation.check_last_field``).
     """
     text, _ = decode(read_bytes(path), path)
     lines = split_lines(text)
@@ -173,7 +174,7 @@ def read_pab_mountain(path: str | os.PathLike[str]) -> Measurement:
         raise AdapterError(path, "expected every '#' header line before the data", bad[0])
     nums = [n for n, _ in rows]
     check_last_row(path, text, lines, nums, None)  # a file cut inside its last number
-    data = _parse_numbers(path, [s for _, s in rows], nums, 2 + nval)
+    data = parse_rows(path, [s for _, s in rows], nums, 2 + nval)
     theta, phi, vals = data[:, 0], data[:, 1], data[:, 2:]
     out = np.flatnonzero((theta < 0) | (theta > 180) | (phi < -360) | (phi > 720))
     if out.size:

@@ -35,8 +35,8 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import AdapterError, Example, Format, check_count, decode, read_bytes, split_lines
-from ._numblock import check_joined, check_last_row
 from ._spectro import PERCENT, finish, number, spectrum_frame
+from ._truncation import check_joined, check_last_row
 
 __all__ = ["FORMATS", "read_perkinelmer_asc"]
 

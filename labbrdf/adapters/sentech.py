@@ -26,19 +26,16 @@ import numpy as np
 
 from ..dataset import Measurement, wrap_delta
 from ._base import AdapterError, Example, Format, decode, read_bytes
-from ._numblock import (
+from ._frame import (
     MUELLER_S1_FLIP,
-    NUMBER,
-    Block,
     build_frame,
     check_rows,
     delta_range,
     group_angles,
     measurement,
     mueller_convention,
-    parse_block,
-    split_head,
 )
+from ._numblock import NUMBER, Block, parse_block, split_head
 
 __all__ = ["FORMATS", "read_sentech", "sniff_sentech"]
 

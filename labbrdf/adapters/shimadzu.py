@@ -50,9 +50,9 @@ import numpy as np
 
 from ..dataset import Measurement
 from ._base import AdapterError, Format, check_count, decode, read_bytes, split_lines
-from ._numblock import check_last_field, unterminated
 from ._ole2 import ole_names, open_ole2, read_stream
 from ._spectro import PERCENT, finish, number, spectrum_frame
+from ._truncation import check_last_field, unterminated
 
 __all__ = ["FORMATS", "read_uvprobe_spc", "read_uvprobe_text"]
 

@@ -54,8 +54,8 @@ from numpy.typing import NDArray
 
 from ..dataset import Measurement
 from ._base import AdapterError, Example, Format, decode, parse_number, read_bytes, split_lines
-from ._numblock import build_frame
-from .zemax_bsdf import _parse_numbers
+from ._frame import build_frame
+from ._numblock import parse_rows
 
 __all__ = ["FORMATS", "SpeosTable", "read_speos_bsdf", "read_speos_table"]
 
@@ -232,7 +232,7 @@ def _table(
             n, s = cur.line(f"table {b + 1}: {nth} rows of theta and {nph} values")
             rows.append(s)
             lines.append(n)
-        block = _parse_numbers(cur.path, rows, lines, nph + 1)
+        block = parse_rows(cur.path, rows, lines, nph + 1)
         if theta is None:
             theta, phi = block[:, 0], np.array(ph)
             _check_grid(cur.path, theta, phi, ln)

@@ -70,21 +70,18 @@ import pandas as pd
 
 from ..dataset import Measurement, wrap_delta
 from ._base import DECIMAL, AdapterError, Example, Format, decode, read_bytes
-from ._numblock import (
+from ._frame import (
     MUELLER_S1_FLIP,
-    Block,
-    body_bytes,
     build_frame,
     check_rows,
     delta_range,
     group_angles,
-    head_lines,
     labels,
     measurement,
     mueller_convention,
-    parse_block,
     within,
 )
+from ._numblock import Block, body_bytes, head_lines, parse_block
 
 __all__ = [
     "FORMATS",

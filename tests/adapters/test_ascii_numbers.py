@@ -152,7 +152,7 @@ def test_a_complete_last_value_of_a_significant_digits_writer_is_not_doubted(
     """WVASE writes sigmas with 6 significant digits (``0.0775003`` beside ``0.278168``): a
     last value with all six is complete even with fewer decimals than another row; one with
     five is doubted (a cut always removes significant digits)."""
-    from labbrdf.adapters._numblock import check_last_field
+    from labbrdf.adapters._truncation import check_last_field
 
     rows = ["1.0\t0.0775003", "2.0\t0.0935513", "3.0\t0.106933", "4.0\t0.145151", "5.0\t0.171798"]
     with warnings.catch_warnings():

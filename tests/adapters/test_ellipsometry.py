@@ -18,7 +18,8 @@ import pytest
 
 import labbrdf
 from labbrdf.adapters import READERS, AdapterError, sniff
-from labbrdf.adapters._numblock import _fast, _slow, group_angles, parse_block, split_head
+from labbrdf.adapters._frame import group_angles
+from labbrdf.adapters._numblock import _fast, _slow, parse_block, split_head
 from labbrdf.adapters.accurion import read_accurion
 from labbrdf.adapters.filmsense import read_filmsense
 from labbrdf.adapters.sentech import read_sentech
@@ -221,7 +222,7 @@ def test_file_of_another_vendor_forced_with_format_is_refused(
 
 
 def test_categorical_frames_of_the_adapters_are_still_validated_row_by_row():
-    from labbrdf.adapters._numblock import build_frame, labels, measurement
+    from labbrdf.adapters._frame import build_frame, labels, measurement
 
     kw = dict(instrument="i", source="f", value=[1.0, 2.0], wavelength_nm=500.0)
     ok = measurement("f", build_frame(sample="s", quantity="psi", unit="deg", **kw), {})

@@ -256,7 +256,7 @@ def test_reading_never_writes(real_exports: Path, tmp_path: Path, monkeypatch) -
 # ----------------------------------------------------------------------- truncation sweep
 
 #: text formats cut at byte offsets: those whose readers check the last line of a file cut
-#: short (:func:`labbrdf.adapters._numblock.check_last_field`: UVProbe text, Woollam,
+#: short (:func:`labbrdf.adapters._truncation.check_last_field`: UVProbe text, Woollam,
 #: Accurion, SENTECH, declared columns, labbrdf's own CSV layouts...) and those whose files
 #: state their point count or end with a footer or end marker
 TRUNCATION_FORMATS = (

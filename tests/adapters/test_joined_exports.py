@@ -1,5 +1,5 @@
 """A single-spectrum text export joined with itself (``cat a a > b``) is refused at the line
-where the copy starts (:func:`labbrdf.adapters._numblock.check_joined`), in every reader of
+where the copy starts (:func:`labbrdf.adapters._truncation.check_joined`), in every reader of
 such exports, real files and bundled fixtures alike; never read as one spectrum with every
 wavelength twice, a footer, or a confusing error further on."""
 
@@ -12,7 +12,7 @@ import pytest
 import labbrdf
 from labbrdf.adapters import READERS, AdapterError
 from labbrdf.adapters._base import split_lines
-from labbrdf.adapters._numblock import check_joined
+from labbrdf.adapters._truncation import check_joined
 
 FIXTURES = Path(labbrdf.__file__).parent / "data" / "fixtures"
 
