@@ -16,7 +16,8 @@ import pytest
 import labbrdf
 from labbrdf.adapters._frame import within
 from labbrdf.adapters._numblock import _count_lf, _slow, parse_block
-from labbrdf.adapters.woollam import _ascii_head, _wrap
+from labbrdf.adapters.woollam_header import ascii_head
+from labbrdf.adapters.woollam_rows import wrap_finite
 from labbrdf.dataset import DatasetError, Measurement, make_frame, validate, wrap_delta
 
 HEAD = (
@@ -162,9 +163,9 @@ def test_fast_delta_wrap_is_bitwise_np_mod():
     rng = np.random.default_rng(11)
     edges = [-0.0, 0.0, -360.0, -1e-20, -5e-14, -1e-300, 359.99999999999994, -359.99999999999994]
     d = np.concatenate([rng.uniform(-360.0, 360.0, 100_000), edges])
-    np.testing.assert_array_equal(_wrap(d).view(np.int64), wrap_delta(d).view(np.int64))
+    np.testing.assert_array_equal(wrap_finite(d).view(np.int64), wrap_delta(d).view(np.int64))
     wide = np.array([-720.5, 725.0, 30.0])  # outside [-360, 360): the general path
-    np.testing.assert_array_equal(_wrap(wide), wrap_delta(wide))
+    np.testing.assert_array_equal(wrap_finite(wide), wrap_delta(wide))
 
 
 def test_line_feed_count_across_chunks_is_bytes_count():
@@ -175,8 +176,8 @@ def test_line_feed_count_across_chunks_is_bytes_count():
 
 def test_ascii_head_stops_after_whole_lines():
     raw = b"a\r\nb\r\nc\r\nd"
-    assert _ascii_head(raw, 2) == "a\r\nb\r\n"
-    assert _ascii_head(raw, 9) == raw.decode()
+    assert ascii_head(raw, 2) == "a\r\nb\r\n"
+    assert ascii_head(raw, 9) == raw.decode()
 
 
 # ----------------------------------------------------------------------------- parser
