@@ -8,6 +8,8 @@ is 1100 CSS pixels wide; a figure no wider is shown whole, at its natural size.
 from __future__ import annotations
 
 import base64
+import importlib
+import pkgutil
 import re
 
 import matplotlib
@@ -85,6 +87,14 @@ def _spy(seen: list[dict], real):
     return spy
 
 
+#: the modules of the figure package that call ``to_uri`` (the spy replaces it in each)
+_FIGURE_MODULES = [
+    importlib.import_module(f"labbrdf.report.figures.{m.name}")
+    for m in pkgutil.iter_modules(figures.__path__)
+    if hasattr(importlib.import_module(f"labbrdf.report.figures.{m.name}"), "to_uri")
+]
+
+
 @pytest.fixture(scope="module")
 def rendered():
     """Each maker's figure drawn once: name -> (record, PNG data URI)."""
@@ -93,7 +103,9 @@ def rendered():
     with pytest.MonkeyPatch.context() as mp:
         for name, make in MAKERS.items():
             seen: list[dict] = []
-            mp.setattr(figures, "to_uri", _spy(seen, real))
+            spy = _spy(seen, real)
+            for module in _FIGURE_MODULES:  # every module that renders with to_uri
+                mp.setattr(module, "to_uri", spy)
             uri = make()
             (entry,) = seen
             out[name] = (entry, uri)
