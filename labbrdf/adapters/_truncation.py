@@ -4,7 +4,7 @@ Private checks shared by the text adapters. A file cut short in the middle of it
 (a copy or download that stopped) still parses: ``0,289`` cut to ``0,`` reads as 0.
 :func:`check_last_field` compares the last field of an unterminated last line with the same
 column in the rows before it and refuses or warns (see its docstring); the block parser
-(:func:`labbrdf.adapters._numblock.parse_block`) applies it to every block it reads, and
+(``labbrdf.adapters._numblock.parse_block``) applies it to every block it reads, and
 :func:`check_last_row` serves the readers that parse their rows themselves.
 :func:`check_joined` refuses a file that holds two exports joined end to end.
 """

@@ -5,7 +5,7 @@ The layout is described in :mod:`labbrdf.adapters.zemax_bsdf`, which turns the
 lists with their counts, checked against caps and against the file's size before anything
 is allocated), the wavelength comments (the format has no wavelength field), and the data
 blocks, one ``TIS`` line and one row per azimuth each, parsed by
-:func:`labbrdf.adapters._numblock.parse_rows`. Every error names the file and the line.
+``labbrdf.adapters._numblock.parse_rows``. Every error names the file and the line.
 """
 
 from __future__ import annotations

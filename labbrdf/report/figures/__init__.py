@@ -6,7 +6,7 @@ labels, which matplotlib draws as text), labels its axes with units, and returns
 
 One module per figure family; this package holds their names:
 
-* :mod:`~labbrdf.report.figures._common`: the Agg backend, layout, :func:`to_uri`,
+* ``_common``: the Agg backend, layout, :func:`to_uri`,
   :func:`save_png`;
 * :mod:`~labbrdf.report.figures.scans`: measured scans beside fitted models;
 * :mod:`~labbrdf.report.figures.spectra`: curves against wavelength and plain x-y curves;
