@@ -299,7 +299,7 @@ def _field_counts(
 
 
 def wrap_finite(delta: np.ndarray) -> np.ndarray:
-    """:func:`~labbrdf.dataset.wrap_delta` of finite values, without the division.
+    """``labbrdf.dataset.wrap_delta`` of finite values, without the division.
 
     Notes
     -----
