@@ -59,11 +59,15 @@ class WalkSetup:
             facets(self.alpha_top, coat.ndf) if (coat is not None and self.layered) else None
         )
         self.evaluated = cfg.resolved_estimator == "evaluated"
-        # evaluated, nearly smooth top: the exit is the walk's own facet (exit_sampled)
+        # evaluated, with a nearly smooth top, or one the GGX exit operator does not
+        # describe (a slope table): the exit is the walk's own facet (exit_sampled)
         self.sampled_exit = (
             self.evaluated
-            and self.layered
-            and exit_is_sampled(grid_of(cfg), self.n_coat, self.alpha_top)
+            and self.top is not None
+            and (
+                not self.top.ggx_closed_form
+                or exit_is_sampled(grid_of(cfg), self.n_coat, self.alpha_top)
+            )
         )
         self.scalar = bool(cfg.scalar)
         # Lambertian base instead of the conductor's microsurface (None: the conductor)
