@@ -26,6 +26,7 @@ BSDFs with the Smith model", ACM TOG 35(4) (2016) (Lambda of downward directions
 
 from __future__ import annotations
 
+import functools
 from types import ModuleType
 from typing import Protocol
 
@@ -33,9 +34,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from . import ggx
+from .registry import get
 from .tabulated import TabulatedNDF
 
-__all__ = ["ClosedForm", "Facets", "Table", "facets"]
+__all__ = ["ClosedForm", "Facets", "Table", "facets", "table_for"]
 
 F64 = NDArray[np.float64]
 Side = NDArray[np.bool_] | None
@@ -193,3 +195,27 @@ def facets(alpha: float, table: TabulatedNDF | None = None) -> ClosedForm | Tabl
     if table is None:
         return ClosedForm(ggx, alpha)
     return Table(table, alpha)
+
+
+@functools.lru_cache(maxsize=8)
+def table_for(distribution: str, alpha: float) -> TabulatedNDF | None:
+    """What an interface of a registered distribution at ``alpha`` stores as its ``ndf``.
+
+    None for GGX (the walk's closed form, ``ndf=None``); otherwise the distribution's slope
+    table, :meth:`TabulatedNDF.of` with its default 256 cells per axis (the table
+    ``labbrdf trace --distribution`` builds), kept for the last 8 (name, alpha) pairs: a
+    table takes about 0.5 s to build.
+
+    Raises
+    ------
+    KeyError
+        An unknown distribution (the message lists the registered ones).
+    ValueError
+        A tabulated distribution without a roughness ``alpha > 0``.
+    """
+    dist = get(distribution)
+    if dist is ggx:
+        return None
+    if not alpha > 0:
+        raise ValueError(f"the {dist.LABEL} table needs a roughness alpha > 0, got {alpha!r}")
+    return TabulatedNDF.of(dist, alpha)

@@ -9,7 +9,7 @@ import pytest
 from scipy import stats
 
 from labbrdf.microfacet import TabulatedNDF, beckmann, ggx
-from labbrdf.microfacet.interface import ClosedForm, Table, facets
+from labbrdf.microfacet.interface import ClosedForm, Table, facets, table_for
 
 ALPHA = 0.3
 
@@ -82,3 +82,14 @@ def test_facets_chooses_the_kind_and_refuses_a_closed_form_without_a_sampler():
     assert isinstance(face, Table) and not face.ggx_closed_form and face.table is t
     with pytest.raises(ValueError, match="beckmann has no closed-form visible-normal sampling"):
         ClosedForm(beckmann, 0.2)
+
+
+def test_table_for_gives_what_an_interface_stores_as_its_ndf():
+    assert table_for("ggx", 0.2) is None
+    t = table_for("beckmann", 0.25)
+    assert t is not None and t.name == "beckmann(0.25)" and t.mass.shape == (256, 256)
+    assert table_for("beckmann", 0.25) is t  # kept, not rebuilt
+    with pytest.raises(KeyError, match="expected one of ggx, beckmann"):
+        table_for("cosine", 0.2)
+    with pytest.raises(ValueError, match="Beckmann table needs a roughness alpha > 0"):
+        table_for("beckmann", 0.0)
