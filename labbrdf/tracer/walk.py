@@ -341,6 +341,7 @@ def _layered_event(
             wt = np.where(trans, 1.0, 0.0)
             up_ = on_top & below
             if up_.any():
+                assert su.top is not None  # rays below a top interface: a layered run
                 record_up(
                     grid,
                     cfg.batches,
