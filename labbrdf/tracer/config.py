@@ -222,7 +222,8 @@ class Coating:
         :meth:`TabulatedNDF.beckmann` / :meth:`TabulatedNDF.ggx`), seen from above; seen
         from below the walk uses its mirror image (the point reflection of the slopes).
         None = GGX with ``alpha``. The exit operator of the evaluated estimator is built
-        for GGX, so a table on the coating is traced with counting.
+        for GGX, so with a table on the coating the evaluated walk exits through the
+        facets it samples (:mod:`labbrdf.tracer.exit_sampled`).
     """
 
     n: float = 1.5
@@ -442,8 +443,7 @@ class TraceConfig:
             self.estimator != "evaluated" or self.evaluated_applies,
             "estimator",
             "'counting' or 'auto' here: 'evaluated' needs scattering='single' and a rough "
-            "first interface (alpha > 0; a GGX coating top, not a table), or a bare "
-            "Lambertian base",
+            "first interface (alpha > 0), or a bare Lambertian base",
             self.estimator,
         )
         # the incoherent walk treats the coating as a separate rough layer between two
@@ -483,7 +483,7 @@ class TraceConfig:
 
         It needs single scattering (the multiple-scattering walk's exits are counted) and a
         rough first interface (the coating's top, or the substrate, or the coherent facets),
-        whose reflection has a closed form; a coating's top must be GGX. A bare Lambertian
+        whose reflection has a closed form (GGX, or a slope table's). A bare Lambertian
         base is its own closed form (``albedo / pi``) in either scattering mode.
         """
         if self.coating is None and self.substrate.albedo is not None:
@@ -491,7 +491,7 @@ class TraceConfig:
         if self.scattering != "single":
             return False
         if self.coating is not None:
-            return self.coating.alpha > 0 and self.coating.ndf is None
+            return self.coating.alpha > 0
         return self.substrate.ndf is not None or self.substrate.alpha > 0
 
     @property

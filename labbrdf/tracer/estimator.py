@@ -16,12 +16,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..microfacet import ggx
+from ..microfacet.interface import ClosedForm
 from .binning import Grid
 from .config import TraceConfig
 from .evaluate import bin_nodes, reflection_mueller, transmission_mueller
 from .operator import PARITY, exit_operator
-from .walk import _Setup
+from .setup import WalkSetup, scalar_abcs
 
 __all__ = [
     "exit_map",
@@ -45,9 +45,9 @@ def first_surface_nodes(alpha: float, step_deg: float) -> int:
 
 def _first_surface(cfg: TraceConfig) -> tuple:  # noqa: ANN401
     """(abcs, D, G1, alpha for the node count) of the config's first interface."""
-    su = _Setup(cfg)
-    if su.layered:
-        alpha = su.alpha_top
+    su = WalkSetup(cfg)
+    if su.top is not None:
+        face = su.top
         n_c = su.n_coat
 
         def abcs(c: NDArray) -> tuple:
@@ -55,19 +55,12 @@ def _first_surface(cfg: TraceConfig) -> tuple:  # noqa: ANN401
 
             return fresnel_abcs(1.0, n_c, c)[0]
 
-        d_of = _ggx(alpha, "d")
-        g1_of = _ggx(alpha, "g1")
     else:
-        alpha = su.alpha_sub
+        face = su.sub
         abcs = su.substrate_abcs  # type: ignore[assignment]
-        if su.ndf_sub is not None:
-            d_of, g1_of = su.ndf_sub.d, su.ndf_sub.smith_g1
-        else:
-            d_of = _ggx(su.alpha_sub, "d")
-            g1_of = _ggx(su.alpha_sub, "g1")
     if cfg.scalar:
         abcs = _scalar_abcs(abcs)
-    return abcs, d_of, g1_of, alpha
+    return abcs, face.d, face.smith_g1, face.alpha
 
 
 def first_surface_point(
@@ -109,23 +102,25 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
     -------
     ndarray, shape (n_theta, n_phi, 4, 4)
     """
-    su = _Setup(cfg)
+    su = WalkSetup(cfg)
     grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
     if _bare_base(cfg):
         return _lambert(cfg, (grid.n_theta, grid.n_phi))
+    # a slope table's D is piecewise smooth between its cells (no h^(2n) law for the
+    # node count) and need not be symmetric about the plane of incidence
+    table = not isinstance(su.sub if su.top is None else su.top, ClosedForm)
     th = np.radians(cfg.theta_i_deg)
     k_in = np.array([-np.sin(th), 0.0, -np.cos(th)])
     s_in = np.array([0.0, 1.0, 0.0])
     abcs, d_of, g1_of, alpha = _first_surface(cfg)
     n = first_surface_nodes(alpha, min(cfg.theta_step_deg, cfg.phi_step_deg))
-    if su.ndf_sub is not None and not su.layered:
-        n = 6  # a table's D is piecewise smooth between its cells: no h^(2n) law
+    if table:
+        n = 6
     theta, dphi, w = bin_nodes(grid, n, n)
     nt, npf = grid.n_theta, grid.n_phi
     phi_c = np.radians(grid.phi_centres_deg)
     # the incidence plane is a mirror plane of an isotropic interface: evaluate phi in
     # [0, 180] deg and mirror the rest; a slope table need not be symmetric: all of it
-    table = su.ndf_sub is not None and not su.layered
     half = npf if table else npf // 2 + 1
     it, jp, a, b = np.meshgrid(
         np.arange(nt), np.arange(half), np.arange(n), np.arange(n), indexing="ij"
@@ -171,17 +166,9 @@ def _lambert(cfg: TraceConfig, shape: tuple[int, ...]) -> NDArray[np.float64]:
 
 def _scalar_abcs(abcs):  # noqa: ANN001, ANN202
     def inner(c: NDArray) -> tuple:
-        a = abcs(c)[0]
-        z = np.zeros_like(a)
-        return a, z, z, z
+        return scalar_abcs(abcs(c))
 
     return inner
-
-
-def _ggx(alpha: float, what: str):  # noqa: ANN202
-    if what == "d":
-        return lambda m: ggx.d(m[2], alpha)
-    return lambda v: ggx.smith_g1(v[2], alpha)
 
 
 def exit_map(
@@ -201,7 +188,7 @@ def exit_map(
     info : dict
         ``operator_seconds``, ``operator_mb``, ``exit_sampled`` (1: no operator used).
     """
-    su = _Setup(cfg)
+    su = WalkSetup(cfg)
     grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
     # the sampled exits are weight sums per output bin: the bin average of the BRDF is
     # the sum over the cos-weighted solid angle
@@ -218,7 +205,7 @@ def exit_map(
 
 
 def _operator_map(
-    cfg: TraceConfig, su: _Setup, grid: Grid, cells: NDArray[np.float64]
+    cfg: TraceConfig, su: WalkSetup, grid: Grid, cells: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], dict[str, float]]:
     """The exit operator applied to the internal cell sums (B, n_theta, n_phi, 4, 4)."""
     # one output node per degree of bin width (a coarse bin is not one point)
@@ -256,7 +243,7 @@ def nee_exit(
 
     if cfg.resolved_estimator != "evaluated" or cfg.coating is None or cfg.coherent:
         raise ValueError("nee_exit needs an evaluated run with an incoherent coating")
-    su = _Setup(cfg)
+    su = WalkSetup(cfg)
     if su.sampled_exit:
         raise ValueError(
             "nee_exit checks the exit operator; this coating's top is too smooth for it "
@@ -265,7 +252,7 @@ def nee_exit(
     grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
     theta, dphi, w = bin_nodes(grid, nodes, nodes)
     phi_c = np.radians(grid.phi_centres_deg)
-    nc, alpha = su.n_coat, su.alpha_top
+    nc = su.n_coat
 
     def abcs_t(c: NDArray) -> tuple:
         a, b, c_, s = fresnel_abcs(nc, 1.0, c)[1]
@@ -274,7 +261,8 @@ def nee_exit(
             return a, z, z, z
         return a, b, c_, s
 
-    d_of, g1_of = _ggx(alpha, "d"), _ggx(alpha, "g1")
+    assert su.top is not None
+    d_of, g1_of = su.top.d, su.top.smith_g1
     nb = cfg.batches
     acc = np.zeros((nb, len(bins), 4, 4))
     omega = grid.cos_solid_angle_sr

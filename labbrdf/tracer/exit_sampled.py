@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from ..microfacet import ggx
+from ..microfacet.interface import Facets
 from .binning import Grid
 from .interfaces import apply_fresnel, rotate_frame
 
@@ -85,7 +85,7 @@ def deposit_exit(
     m: F64,
     M: F64,
     transmission: tuple[tuple, F64, F64],
-    alpha: float,
+    face: Facets,
     scalar: bool,
     sel: NDArray[np.bool_],
     rid: NDArray[np.int64],
@@ -105,8 +105,9 @@ def deposit_exit(
     transmission : ((A, B, C, S), cos_t, eta)
         The facet's Fresnel transmission numbers (beam factor included; zero under total
         internal reflection), the cosine of refraction and ``n_below / n_above``.
-    alpha : float
-        GGX roughness of the interface (Smith ``G1`` of the exit direction).
+    face : Facets
+        The interface's distribution (Smith ``G1`` of the exit direction, seen from
+        above).
     scalar : bool
         Keep the intensity row only (scalar mode).
     sel : ndarray of bool, shape (n,)
@@ -133,7 +134,7 @@ def deposit_exit(
     apply_fresnel(Mt, *(t[idx] for t in tr))
     if scalar:
         Mt[1:] = 0.0
-    Mt *= ggx.smith_g1(kt[2], alpha)
+    Mt *= face.smith_g1(kt)
     bin_, phi = grid.index(kt)
     s_out = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
     rotate_frame(Mt, kt, s_loc[:, idx], s_out)
@@ -179,16 +180,16 @@ def record_up(
     M: F64,
     transmission: tuple[tuple, F64, F64],
     sel: NDArray[np.bool_],
-    how: tuple[bool, float, bool],
+    how: tuple[bool, Facets, bool],
     into: tuple[list[NDArray], list[NDArray], list | None],
 ) -> None:
     """Record the top-from-below events ``sel``: exits (sampled) or cells (operator).
 
     ``rays`` = (directions, frames' x axes, facet normals); ``how`` = (sampled exit,
-    alpha of the top, scalar mode); ``into`` = (keys, rows, raw list or None).
+    the top's distribution, scalar mode); ``into`` = (keys, rows, raw list or None).
     """
     k, s_loc, m = rays
-    sampled, alpha, scalar = how
+    sampled, face, scalar = how
     keys, rows, raw = into
     if not sampled:
         # near the pole the operator's centroid rule moves a lobe centred on the pole off
@@ -199,4 +200,4 @@ def record_up(
         sel = near
         if not sel.any():
             return
-    deposit_exit(grid, batches, k, s_loc, m, M, transmission, alpha, scalar, sel, rid, keys, rows)
+    deposit_exit(grid, batches, k, s_loc, m, M, transmission, face, scalar, sel, rid, keys, rows)

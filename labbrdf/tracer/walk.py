@@ -21,15 +21,23 @@ One step, for every live ray:
    has no microsurface: a ray reaching it is re-emitted at once (``albedo * diag(1, 0, 0,
    0)``, cosine-distributed direction) and crosses back up in the same step; a bare base
    sends every ray straight out.
-3. *Scatter* a hitting ray: a visible GGX normal (Heitz 2018 / Dupuy & Benyoub 2023), the
-   frame rotated to the facet's s axis, Fresnel reflection (conductor; ideal mirror; or
-   coherent film) or, at the dielectric top interface, reflection or refraction chosen with
-   the probability equal to the reflected fraction of the ray's current Stokes vector for
-   unpolarized input (the paper's step 3 uses ``(Rs + Rp)/2``, which is the same for an
-   unpolarized ray), the Mueller weight divided by that probability. A refracted ray
-   changes side and its height changes sign (Heitz 2016, dielectric walk).
+3. *Scatter* a hitting ray: a visible normal of its interface's distribution (GGX in
+   closed form, Heitz 2018 / Dupuy & Benyoub 2023; a slope table, measured or Beckmann,
+   by exact rejection), the frame rotated to the facet's s axis, Fresnel reflection
+   (conductor; ideal mirror; or coherent film) or, at the dielectric top interface,
+   reflection or refraction chosen with the probability equal to the reflected fraction
+   of the ray's current Stokes vector for unpolarized input (the paper's step 3 uses
+   ``(Rs + Rp)/2``, which is the same for an unpolarized ray), the Mueller weight divided
+   by that probability. A refracted ray changes side and its height changes sign (Heitz
+   2016, dielectric walk).
 4. *Terminate*: after ``max_bounces`` events, or below the weight threshold ``tau``
    (``termination="threshold"``, Dong 2022 sec. 2.3) or by Russian roulette.
+
+Each interface carries one distribution object (:mod:`labbrdf.microfacet.interface`, built
+in :class:`~labbrdf.tracer.setup.WalkSetup`): the walk asks the interface a ray is on for
+the Smith Lambda and G1 of its travel direction and for its visible normals, and never
+needs to know which distribution it is. The block's sums are kept in
+:class:`~labbrdf.tracer.tally.Ledger` and tallied by :mod:`labbrdf.tracer.tally`.
 
 Energy ledger (unpolarized input, per ray exact): every change of ``M00`` is booked:
 exit -> exited; Fresnel loss at the substrate and Beer-Lambert loss -> absorbed (the
@@ -51,190 +59,22 @@ intensity of the unpolarized-input Stokes vector (M00).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from ..microfacet import ggx
 from ..microfacet.height import sample_height
-from .binning import Grid, bin_exits
+from .binning import Grid
 from .config import TraceConfig
-from .exit_sampled import exit_is_sampled, record_up
-from .interfaces import apply_fresnel, fresnel_abcs, rotate_frame, s_axis
+from .exit_sampled import record_up
+from .interfaces import apply_fresnel, rotate_frame, s_axis
+from .setup import WalkSetup, grid_of
+from .tally import BlockTally, Ledger, block_tally
 
 __all__ = ["BlockTally", "GroupTally", "run_unit", "trace_block", "trace_group"]
 
 TOP, SUB = 0, 1
-
-
-@dataclass
-class BlockTally:
-    """What one block contributes (folded by the driver in block order)."""
-
-    block: int
-    rays: int
-    sums: NDArray[np.float64]  # (n_bins, 16) summed exit Mueller elements
-    sumsq: NDArray[np.float64]  # (n_bins, 16) summed squares (per-ray variance)
-    counts: NDArray[np.int64]  # (n_bins,) exiting rays
-    exited: float
-    absorbed: float
-    terminated: float
-    hemi: NDArray[np.float64]  # (16,) summed exit Mueller over the hemisphere
-    events: int
-    # estimator="evaluated": Mueller sums of the rays reaching the top interface from
-    # below, per (batch, internal cell), flat key batch * n_bins + cell; rays per batch
-    cell_keys: NDArray[np.int64] | None = None
-    cell_sums: NDArray[np.float64] | None = None  # (len(cell_keys), 16)
-    batch_rays: NDArray[np.int64] | None = None  # (batches,)
-
-
-def _grid(cfg: TraceConfig) -> Grid:
-    return Grid(cfg.theta_step_deg, cfg.phi_step_deg)
-
-
-class _Setup:
-    """Per-run constants derived from the config."""
-
-    def __init__(self, cfg: TraceConfig) -> None:
-        sub, coat = cfg.substrate, cfg.coating
-        self.single = cfg.scattering == "single"
-        self.layered = coat is not None and not cfg.coherent
-        self.coherent = bool(cfg.coherent)
-        self.mirror = sub.mirror
-        self.n_sub = complex(sub.n, sub.k)
-        self.alpha_sub = coat.alpha if (coat is not None and cfg.coherent) else sub.alpha
-        self.alpha_top = coat.alpha if coat is not None else 0.0
-        self.n_coat = coat.n if coat is not None else 1.0
-        self.k_coat = coat.k if coat is not None else 0.0
-        self.d = coat.thickness_nm if coat is not None else 0.0
-        self.lam = cfg.wavelength_nm
-        self.coat = coat
-        self.n_above_sub = self.n_coat if self.layered else 1.0
-        # tabulated substrate distribution (None: GGX everywhere, the original path)
-        self.ndf_sub = None if cfg.coherent else sub.ndf
-        # tabulated top interface (seen from above; from below: its point reflection)
-        self.ndf_top = coat.ndf if (coat is not None and self.layered) else None
-        self.evaluated = cfg.resolved_estimator == "evaluated"
-        # evaluated, nearly smooth top: the exit is the walk's own facet (exit_sampled)
-        self.sampled_exit = (
-            self.evaluated
-            and self.layered
-            and exit_is_sampled(_grid(cfg), self.n_coat, self.alpha_top)
-        )
-        self.scalar = bool(cfg.scalar)
-        # Lambertian base instead of the conductor's microsurface (None: the conductor)
-        self.albedo = sub.albedo
-
-    def lambda_of(
-        self,
-        k: NDArray[np.float64],
-        kz_loc: NDArray[np.float64],
-        on_sub: NDArray[np.bool_],
-        alpha: NDArray[np.float64],
-        below: NDArray[np.bool_] | None = None,
-    ) -> NDArray[np.float64]:
-        """Smith Lambda of the travel directions (GGX, or the interfaces' tables)."""
-        lam = ggx.smith_lambda(kz_loc, alpha)
-        if self.ndf_sub is not None and on_sub.any():
-            # the substrate is always seen from above: its local frame is the global one
-            lam[on_sub] = self.ndf_sub.smith_lambda(k[:, on_sub])
-        if self.ndf_top is not None and not on_sub.all():
-            top = ~on_sub
-            lam[top] = self.ndf_top.smith_lambda(self._top_dirs(k, top, below))
-        return lam
-
-    @staticmethod
-    def _top_dirs(
-        k: NDArray[np.float64], top: NDArray[np.bool_], below: NDArray[np.bool_] | None
-    ) -> NDArray[np.float64]:
-        """Directions of top-interface rays in the frame of the table seen from above.
-
-        The lower side of a height field, seen through the point reflection r -> -r, has
-        the same slope distribution as the upper side: a direction k below is -k above.
-        """
-        d = k[:, top]
-        if below is None:
-            return d
-        return np.where(below[top], -d, d)
-
-    def g1_of(
-        self,
-        k: NDArray[np.float64],
-        kz_loc: NDArray[np.float64],
-        on_sub: NDArray[np.bool_],
-        alpha: NDArray[np.float64],
-        below: NDArray[np.bool_] | None = None,
-    ) -> NDArray[np.float64]:
-        """Smith G1 of the travel directions (GGX, or the interfaces' tables)."""
-        g = ggx.smith_g1(kz_loc, alpha)
-        if self.ndf_sub is not None and on_sub.any():
-            g[on_sub] = self.ndf_sub.smith_g1(k[:, on_sub])
-        if self.ndf_top is not None and not on_sub.all():
-            top = ~on_sub
-            g[top] = self.ndf_top.smith_g1(self._top_dirs(k, top, below))
-        return g
-
-    def beer_lambert(self, kz: NDArray[np.float64]) -> NDArray[np.float64] | None:
-        if self.k_coat == 0 or self.d == 0:
-            return None
-        return np.exp(-4 * np.pi * self.k_coat * self.d / (self.lam * np.abs(kz)))
-
-    def substrate_abcs(
-        self, cos_i: NDArray[np.float64]
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray]:
-        out = self._substrate_abcs(cos_i)
-        return _scalar(out) if self.scalar else out
-
-    def _substrate_abcs(
-        self, cos_i: NDArray[np.float64]
-    ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray]:
-        if self.coherent:
-            from ..films.onefilm import film_amplitudes
-
-            theta = np.degrees(np.arccos(np.clip(cos_i, 0.0, 1.0)))
-            coat = self.coat
-            assert coat is not None  # TraceConfig refuses coherent=True without a coating
-            rs, rp = film_amplitudes(
-                1.0, complex(coat.n, coat.k), self.n_sub, coat.thickness_nm, self.lam, theta
-            )
-            rs2 = np.abs(rs) ** 2
-            rp2 = np.abs(rp) ** 2
-            x = rs * np.conj(rp)
-            return 0.5 * (rs2 + rp2), 0.5 * (rs2 - rp2), x.real, x.imag
-        refl, _, _ = fresnel_abcs(self.n_above_sub, self.n_sub, cos_i, mirror=self.mirror)
-        return refl
-
-    def layered_abcs(
-        self, cos_i: NDArray[np.float64], on_top: NDArray[np.bool_], below: NDArray[np.bool_]
-    ) -> tuple[tuple, tuple, NDArray[np.float64], NDArray[np.float64]]:
-        """Reflection/transmission numbers for a mix of top-interface and substrate rays."""
-        refl, tr, cos_t, eta = self._layered_abcs(cos_i, on_top, below)
-        if self.scalar:
-            refl, tr = _scalar(refl), _scalar(tr)
-        return refl, tr, cos_t, eta
-
-    def _layered_abcs(
-        self, cos_i: NDArray[np.float64], on_top: NDArray[np.bool_], below: NDArray[np.bool_]
-    ) -> tuple[tuple, tuple, NDArray[np.float64], NDArray[np.float64]]:
-        nc = self.n_coat
-        n1 = np.where(on_top & below, nc, np.where(on_top, 1.0, nc)).astype(np.complex128)
-        n2 = np.where(on_top, np.where(below, 1.0, nc), 0.0).astype(np.complex128)
-        if not self.mirror:
-            n2 = np.where(on_top, n2, self.n_sub)
-        else:
-            n2 = np.where(on_top, n2, 1.0 + 0.0j)  # placeholder, overridden below
-        refl, tr, cos_t = fresnel_abcs(n1, n2, cos_i, opaque=~on_top)
-        if self.mirror:
-            sub = ~on_top
-            refl = (
-                np.where(sub, 1.0, refl[0]),
-                np.where(sub, 0.0, refl[1]),
-                np.where(sub, -1.0, refl[2]),
-                np.where(sub, 0.0, refl[3]),
-            )
-        eta = np.where(on_top, n1.real / np.where(on_top, n2.real, 1.0), 1.0)
-        return refl, tr, cos_t, eta
 
 
 @dataclass
@@ -252,7 +92,7 @@ class _Rays:
     rid: NDArray[np.int64]  # global ray index
 
     @classmethod
-    def launch(cls, cfg: TraceConfig, su: _Setup, block: int, n: int) -> _Rays:
+    def launch(cls, cfg: TraceConfig, su: WalkSetup, block: int, n: int) -> _Rays:
         """The ``n`` incident rays of block ``block``, on the first interface."""
         k, s, M = _launch(cfg.theta_i_deg, n)
         return cls(
@@ -277,27 +117,6 @@ class _Rays:
 
 
 @dataclass
-class _Ledger:
-    """A block's running sums: the energy ledger, the exiting rays and the deposits."""
-
-    booked: float = 0.0  # evaluated: the sampled weight of the branches not followed
-    absorbed: float = 0.0
-    terminated: float = 0.0
-    events: int = 0
-    ex_k: list[NDArray] = field(default_factory=list)
-    ex_s: list[NDArray] = field(default_factory=list)
-    ex_M: list[NDArray] = field(default_factory=list)
-    dep_key: list[NDArray] = field(default_factory=list)
-    dep_rows: list[NDArray] = field(default_factory=list)
-
-    def exit(self, k: NDArray, s: NDArray, M: NDArray) -> None:
-        """Keep exiting rays for the binning."""
-        self.ex_k.append(k)
-        self.ex_s.append(s)
-        self.ex_M.append(M)
-
-
-@dataclass
 class _Hit:
     """Step 3's facet event of every live ray, before the Fresnel weights."""
 
@@ -306,7 +125,6 @@ class _Hit:
     kr: NDArray[np.float64]  # (3, n) mirror direction
     s_loc: NDArray[np.float64]  # (3, n) the facet's s axis, the ray's new frame
     on_top: NDArray[np.bool_]
-    alpha: NDArray[np.float64]  # GGX alpha of the interface hit
     u: NDArray[np.float64]  # the uniform draw of the reflect/refract choice
 
 
@@ -335,12 +153,12 @@ def trace_block(
     """
     if not 0 <= block < cfg.n_blocks:
         raise ValueError(f"block must be in [0, {cfg.n_blocks}), got {block!r}")
-    su = _Setup(cfg)
-    grid = _grid(cfg)
+    su = WalkSetup(cfg)
+    grid = grid_of(cfg)
     n = cfg.block_size(block)
     rng = np.random.default_rng(np.random.SeedSequence([cfg.seed, block]))
     rays = _Rays.launch(cfg, su, block, n)
-    led = _Ledger()
+    led = Ledger()
     if su.albedo is not None and not su.layered:
         _bare_base(su.albedo, su.evaluated, rng, rays, led)
     while rays.k.shape[1]:
@@ -358,11 +176,11 @@ def trace_block(
             break
         alive, led.terminated = _weight_cut(cfg, rng, rays.M, led.terminated)
         rays.keep(alive)
-    return _block_tally(cfg, grid, block, n, led, su.evaluated)
+    return block_tally(cfg, grid, block, n, led, su.evaluated)
 
 
 def _bare_base(
-    albedo: float, evaluated: bool, rng: np.random.Generator, rays: _Rays, led: _Ledger
+    albedo: float, evaluated: bool, rng: np.random.Generator, rays: _Rays, led: Ledger
 ) -> None:
     """A bare Lambertian base: one base event, then every ray leaves."""
     k, s, M = rays.k, rays.s, rays.M
@@ -376,14 +194,13 @@ def _bare_base(
 
 
 def _leave_or_hit(
-    su: _Setup, rng: np.random.Generator, rays: _Rays, led: _Ledger
+    su: WalkSetup, rng: np.random.Generator, rays: _Rays, led: Ledger
 ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
     """Step 1: which rays leave their microsurface; returns (leave, alive)."""
     k, M, iface, below = rays.k, rays.M, rays.iface, rays.below
     m_ = int(k.shape[1])
     alive = np.ones(m_, dtype=bool)
     kz_loc = np.where(below, -k[2], k[2])
-    alpha = np.where(iface == TOP, su.alpha_top, su.alpha_sub)
     if su.single:
         leave = ~rays.fresh
         if leave.any():
@@ -391,22 +208,22 @@ def _leave_or_hit(
             led.terminated += float(M[0, 0, back].sum())
             alive &= ~back
             go = leave & ~back
-            g = np.where(go, su.g1_of(k, kz_loc, iface == SUB, alpha, below), 1.0)
+            g = np.where(go, su.g1_of(k, iface == SUB, below), 1.0)
             led.terminated += float((M[0, 0] * (1.0 - g))[go].sum())
             M *= g
             leave = go
     else:
-        lam = su.lambda_of(k, kz_loc, iface == SUB, alpha, below)
+        lam = su.lambda_of(k, iface == SUB, below)
         leave, h_new = sample_height(kz_loc, lam, rays.h, rng.random(m_))
         rays.h = np.where(leave, rays.h, h_new)
     return leave, alive
 
 
 def _route(
-    su: _Setup,
+    su: WalkSetup,
     rng: np.random.Generator,
     rays: _Rays,
-    led: _Ledger,
+    led: Ledger,
     leave: NDArray[np.bool_],
     alive: NDArray[np.bool_],
 ) -> None:
@@ -430,37 +247,26 @@ def _route(
             rays.fresh[cross_] = True
 
 
-def _facet_hit(su: _Setup, rng: np.random.Generator, rays: _Rays) -> _Hit:
+def _facet_hit(su: WalkSetup, rng: np.random.Generator, rays: _Rays) -> _Hit:
     """Step 3, first half: a visible facet normal for every ray, its frame rotated to it."""
     k, s, M, below = rays.k, rays.s, rays.M, rays.below
     u = rng.random((3, k.shape[1]))
     on_top = rays.iface == TOP
-    a = np.where(on_top, su.alpha_top, su.alpha_sub)
-    wi = -k
-    wi[2] = np.where(below, k[2], wi[2])
-    m = ggx.sample_visible(wi, a, u[0], u[1])
-    if su.ndf_sub is not None and not on_top.all():
-        on_sub = ~on_top
-        m[:, on_sub] = su.ndf_sub.sample_visible(wi[:, on_sub], rng)
-    m[2] = np.where(below, -m[2], m[2])
-    if su.ndf_top is not None and on_top.any():
-        # from below: the point reflection of the table's visible normals for k
-        sign = np.where(below[on_top], -1.0, 1.0)
-        m[:, on_top] = sign * su.ndf_top.sample_visible(-k[:, on_top] * sign, rng)
+    m = su.sample(k, ~on_top, below, u[:2], rng)
     cos_i = np.clip(-(k[0] * m[0] + k[1] * m[1] + k[2] * m[2]), 0.0, 1.0)
     s_loc = s_axis(k, m, s)
     rotate_frame(M, k, s, s_loc)
     kr = k + 2.0 * cos_i * m
-    return _Hit(m=m, cos_i=cos_i, kr=kr, s_loc=s_loc, on_top=on_top, alpha=a, u=u[2])
+    return _Hit(m=m, cos_i=cos_i, kr=kr, s_loc=s_loc, on_top=on_top, u=u[2])
 
 
 def _scatter(
-    su: _Setup,
+    su: WalkSetup,
     cfg: TraceConfig,
     grid: Grid,
     rng: np.random.Generator,
     rays: _Rays,
-    led: _Ledger,
+    led: Ledger,
     raw: list[tuple[NDArray, NDArray, NDArray]] | None,
 ) -> bool:
     """Step 3: scatter every live ray at its facet (in place); True ends the walk."""
@@ -488,7 +294,7 @@ def _scatter(
     return False
 
 
-def _substrate_event(su: _Setup, M: NDArray[np.float64], hit: _Hit, led: _Ledger) -> bool:
+def _substrate_event(su: WalkSetup, M: NDArray[np.float64], hit: _Hit, led: Ledger) -> bool:
     """Step 3 on a bare substrate: Fresnel reflection (in place); True ends the walk."""
     A, B, C, S = su.substrate_abcs(hit.cos_i)
     apply_fresnel(M, A, B, C, S)
@@ -499,18 +305,18 @@ def _substrate_event(su: _Setup, M: NDArray[np.float64], hit: _Hit, led: _Ledger
     # the first (and only followed) event: its reflection is evaluated in closed form;
     # the sampled weight only closes the energy ledger
     krn = hit.kr / np.sqrt((hit.kr * hit.kr).sum(axis=0))
-    g = su.g1_of(krn, krn[2], ~hit.on_top, hit.alpha)
+    g = su.g1_of(krn, ~hit.on_top)
     led.booked += float((M[0, 0] * g).sum())
     led.terminated += float((M[0, 0] * (1.0 - g)).sum())
     return True
 
 
 def _layered_event(
-    su: _Setup,
+    su: WalkSetup,
     cfg: TraceConfig,
     grid: Grid,
     rays: _Rays,
-    led: _Ledger,
+    led: Ledger,
     raw: list[tuple[NDArray, NDArray, NDArray]] | None,
     hit: _Hit,
     m00: NDArray[np.float64],
@@ -535,6 +341,7 @@ def _layered_event(
             wt = np.where(trans, 1.0, 0.0)
             up_ = on_top & below
             if up_.any():
+                assert su.top is not None  # rays below a top interface: a layered run
                 record_up(
                     grid,
                     cfg.batches,
@@ -543,7 +350,7 @@ def _layered_event(
                     M,
                     (tr, cos_t, eta),
                     up_,
-                    (su.sampled_exit, su.alpha_top, su.scalar),
+                    (su.sampled_exit, su.top, su.scalar),
                     (led.dep_key, led.dep_rows, raw),
                 )
         else:
@@ -572,33 +379,6 @@ def _layered_event(
     return np.where(trans, kt, hit.kr), trans, m00
 
 
-def _block_tally(
-    cfg: TraceConfig, grid: Grid, block: int, n: int, led: _Ledger, evaluated: bool
-) -> BlockTally:
-    """Bin the exits (and fold the deposits of the evaluated walk) into the block's tally."""
-    cell_keys = cell_sums = batch_rays = None
-    if evaluated:
-        cell_keys, cell_sums, batch_rays = _cell_tally(
-            cfg, grid, block, n, led.dep_key, led.dep_rows
-        )
-    sums, sumsq, counts, hemi = _bin_exit_rays(grid, led.ex_k, led.ex_s, led.ex_M)
-    return BlockTally(
-        block=block,
-        rays=n,
-        sums=sums,
-        sumsq=sumsq,
-        counts=counts,
-        exited=float(hemi[0]) + led.booked,
-        absorbed=led.absorbed,
-        terminated=led.terminated,
-        hemi=hemi,
-        events=led.events,
-        cell_keys=cell_keys,
-        cell_sums=cell_sums,
-        batch_rays=batch_rays,
-    )
-
-
 def _launch(
     theta_i_deg: float, n: int
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
@@ -616,7 +396,7 @@ def _launch(
 
 
 def _other_branch(
-    su: _Setup,
+    su: WalkSetup,
     k: NDArray[np.float64],
     m: NDArray[np.float64],
     kr: NDArray[np.float64],
@@ -644,7 +424,7 @@ def _other_branch(
     k_o = k_o / np.sqrt((k_o * k_o).sum(axis=0))
     g = np.where(
         entry | up_,
-        su.g1_of(k_o, k_o[2], np.zeros_like(on_top), np.full(k.shape[1], su.alpha_top)),
+        su.g1_of(k_o, np.zeros_like(on_top)),
         0.0,
     )
     return w_o, g
@@ -684,58 +464,8 @@ def _weight_cut(
     return alive, terminated
 
 
-def _cell_tally(
-    cfg: TraceConfig,
-    grid: Grid,
-    block: int,
-    n: int,
-    dep_key: list[NDArray],
-    dep_rows: list[NDArray],
-) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]]:
-    """Evaluated estimator: the recorded up-going rays summed per (batch, cell).
-
-    Returns the occupied keys, their (n_keys, 16) Mueller sums and the rays per batch.
-    """
-    batch_rays = np.bincount(
-        (cfg.block_rays * block + np.arange(n)) % cfg.batches, minlength=cfg.batches
-    ).astype(np.int64)
-    if not dep_key:
-        return np.zeros(0, dtype=np.int64), np.zeros((0, 16)), batch_rays
-    key = np.concatenate(dep_key)
-    rows_d = np.concatenate(dep_rows, axis=1)
-    nkeys = 2 * cfg.batches * grid.n_bins  # cells for the operator, then sampled exits
-    cnt = np.bincount(key, minlength=nkeys)
-    cell_keys = np.flatnonzero(cnt)
-    dense = np.empty((16, nkeys))
-    for e in range(16):
-        dense[e] = np.bincount(key, weights=rows_d[e], minlength=nkeys)
-    return cell_keys, dense[:, cell_keys].T.copy(), batch_rays
-
-
-def _bin_exit_rays(
-    grid: Grid, ex_k: list[NDArray], ex_s: list[NDArray], ex_M: list[NDArray]
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.int64], NDArray[np.float64]]:
-    """Bin the exited rays in the LB exit frames ``phi_hat(phi)``.
-
-    Returns the per-bin sums and sums of squares (n_bins, 16), the counts and the
-    hemispherical sum (16,).
-    """
-    if not ex_k:
-        nb = grid.n_bins
-        return np.zeros((nb, 16)), np.zeros((nb, 16)), np.zeros(nb, dtype=np.int64), np.zeros(16)
-    ke = np.concatenate(ex_k, axis=1)
-    se = np.concatenate(ex_s, axis=1)
-    Me = np.concatenate(ex_M, axis=2)
-    idx, phi = grid.index(ke)
-    s_det = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
-    rotate_frame(Me, ke, se, s_det)
-    rows = Me.reshape(16, -1)
-    sums, sumsq, counts = bin_exits(grid, idx, rows)
-    return sums, sumsq, counts, rows.sum(axis=1)
-
-
 def _cross(
-    su: _Setup,
+    su: WalkSetup,
     rng: np.random.Generator,
     ci: NDArray[np.int64],
     k: NDArray[np.float64],
@@ -779,8 +509,7 @@ def _cross(
     below[ci] = up
     if not su.single:
         kz_new = np.where(up, -k[2, ci], k[2, ci])
-        a_new = np.where(up, su.alpha_top, su.alpha_sub)
-        lam_new = su.lambda_of(k[:, ci], kz_new, ~up, a_new, up)
+        lam_new = su.lambda_of(k[:, ci], ~up, up)
         _, h[ci] = sample_height(kz_new, lam_new, np.full(ci.size, np.inf), rng.random(ci.size))
     return absorbed, base
 
@@ -812,17 +541,6 @@ def _base_event(
     k[:, idx] = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1.0 - u[0])])
     s[:, idx] = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
     return absorbed
-
-
-def _scalar(abcs: tuple) -> tuple:
-    """Scalar mode: the unpolarized reflectance A alone, B = C = S = 0.
-
-    With the rows 1-3 of M zeroed after each vertex the ray then carries only S0, weighted
-    by ``(|r_s|^2 + |r_p|^2) / 2`` (or the transmittance) at every vertex, which is what
-    a scalar (unpolarized) code computes.
-    """
-    z = np.zeros_like(abcs[0])
-    return abcs[0], z, z, z
 
 
 @dataclass
@@ -859,7 +577,7 @@ def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
     if not 0 <= group < cfg.n_groups:
         raise ValueError(f"group must be in [0, {cfg.n_groups}), got {group!r}")
     blocks = tuple(cfg.group_blocks(group))
-    nb = _grid(cfg).n_bins
+    nb = grid_of(cfg).n_bins
     sums, sumsq = np.zeros((nb, 16)), np.zeros((nb, 16))
     counts = np.zeros(nb, dtype=np.int64)
     hemi = np.zeros(16)

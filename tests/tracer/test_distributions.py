@@ -2,7 +2,7 @@
 
 The coating's top takes a slope table like the substrate (seen from below as its point
 reflection); the evaluated estimator covers tables on a bare substrate (no isotropy
-assumed there) and leaves a tabulated coating top to counting.
+assumed there) and on the coating's top (exits through the sampled facets).
 """
 
 from __future__ import annotations
@@ -88,11 +88,14 @@ def test_coating_table_round_trips_through_json():
     assert back.coating is not None and back.coating.ndf == cfg.coating.ndf
 
 
-def test_tabulated_coating_top_is_counted_and_refuses_the_evaluated_estimator():
+def test_tabulated_coating_top_is_evaluated_through_its_sampled_facets():
     coat = Coating(alpha=0.3, ndf=TabulatedNDF.ggx(0.3, n=32))
-    assert TraceConfig(scattering="single", coating=coat).resolved_estimator == "counting"
-    with pytest.raises(ValueError, match="GGX coating top"):
-        TraceConfig(scattering="single", coating=coat, estimator="evaluated")
+    cfg = TraceConfig(scattering="single", coating=coat, rays=200, theta_step_deg=10.0)
+    assert cfg.resolved_estimator == "evaluated"
+    # the GGX exit operator does not describe a table: the exit is always sampled
+    assert trace(cfg).info["exit_sampled"] == 1.0
+    with pytest.raises(ValueError, match="'evaluated' needs scattering='single'"):
+        TraceConfig(coating=coat, estimator="evaluated")
     with pytest.raises(ValueError, match="tabulated coating NDF"):
         TraceConfig(coating=coat, coherent=True)
     with pytest.raises(ValueError, match="coating.ndf must be a TabulatedNDF"):

@@ -1,0 +1,134 @@
+"""What multiple scattering costs today: the counting walk on the paper's case.
+
+The paper's case (varnish n = 1.5 over Al 1.55+7.71i, alpha 0.2 both, 60 deg, 650 nm,
+1-degree grid), one process:
+
+1. multiple scattering, counting (the only estimator that covers it): the RMS relative
+   error of S0 per 1-degree lobe bin (S0 > 10 % of its maximum) from two seeds, seconds
+   per run, and the rays and seconds it would need for 1 % (the error falls like
+   ``1 / sqrt(rays)``);
+2. single scattering, evaluated, in the same run (the estimator a converged
+   multiple-scattering estimator has to match);
+3. what single scattering leaves out: the albedo of both models, and the lobe's RMS
+   relative difference;
+4. the white furnace (a lossless coating over a white Lambertian base, 45 deg) at coating
+   alpha 0.05 / 0.1 / 0.2: multiple scattering (counting) against single (evaluated).
+
+Seconds are CPU seconds of this process (``time.process_time``): on a shared machine the
+wall clock mostly measures the other processes.
+
+Usage: ``python benchmarks/bench_multiple.py [--rays N]`` (default 2e5 rays per
+counting run).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from bench_tracer import _relerr  # noqa: E402
+
+from labbrdf.tracer import Coating, Substrate, TraceConfig, trace  # noqa: E402
+
+PAPER = TraceConfig(
+    wavelength_nm=650.0,
+    theta_i_deg=60.0,
+    substrate=Substrate(n=1.55, k=7.71, alpha=0.2),
+    coating=Coating(n=1.5, alpha=0.2),
+)
+
+
+def _pair(cfg: TraceConfig) -> tuple:
+    """Two seeds of ``cfg``: (run 1, run 2, mean seconds per run)."""
+    t0 = time.process_time()
+    a = trace(cfg.replace(seed=1))
+    t1 = time.process_time()
+    b = trace(cfg.replace(seed=2))
+    t2 = time.process_time()
+    return a, b, (t2 - t0) / 2, (t1 - t0, t2 - t1)
+
+
+def costs(rays: int) -> tuple:
+    """Items 1 and 2."""
+    print("1. multiple scattering, counting, the paper's case, 1-degree grid")
+    a, b, sec, _ = _pair(PAPER.replace(rays=rays, scattering="multiple", estimator="counting"))
+    rc = _relerr(a, b)
+    need = rays * (rc / 0.01) ** 2
+    print(
+        f"   {rays:.1e} rays: relerr per lobe bin {rc:.2%}, {sec:.1f} s/run; "
+        f"1 % needs {need:.2e} rays, {sec * need / rays:.0f} s"
+    )
+    print("2. single scattering, evaluated, same case")
+    ev_rays = max(rays // 2, 1000)
+    c, d, _, (t_first, t_second) = _pair(
+        PAPER.replace(rays=ev_rays, scattering="single", estimator="evaluated")
+    )
+    re = _relerr(c, d)
+    need_e = ev_rays * (re / 0.01) ** 2
+    print(
+        f"   {ev_rays:.1e} rays: relerr per lobe bin {re:.2%}; runs {t_first:.1f} s "
+        f"(operator {c.info.get('operator_seconds', 0):.1f} s) and {t_second:.1f} s "
+        f"(operator {d.info.get('operator_seconds', 0):.1f} s); 1 % needs {need_e:.2e} rays, "
+        f"{t_second * need_e / ev_rays:.1f} s with the operator at hand"
+    )
+    ratio = (sec * need / rays) / (t_second * need_e / ev_rays)
+    print(f"   seconds to 1 %: multiple (counting) / single (evaluated) = {ratio:.0f}")
+    return a, b, c, d
+
+
+def missing(a, b, c, d) -> None:  # noqa: ANN001
+    """Item 3."""
+    ms = (a.s0() + b.s0()) / 2
+    ss = (c.s0() + d.s0()) / 2
+    lobe = ms > 0.1 * ms.max()
+    rel = float(np.sqrt(np.mean(((ss - ms)[lobe] / ms[lobe]) ** 2)))
+    print("3. what single scattering leaves out (same case)")
+    print(
+        f"   albedo multiple {(a.albedo() + b.albedo()) / 2:.4f} +- {a.albedo_stderr():.4f}, "
+        f"single {(c.albedo() + d.albedo()) / 2:.4f}; lobe RMS relative difference {rel:.1%}"
+    )
+
+
+def furnace(rays: int) -> None:
+    """Item 4."""
+    print("4. white furnace (lossless coating n 1.5 over a white Lambertian base, 45 deg)")
+    for alpha in (0.05, 0.1, 0.2):
+        cfg = TraceConfig(
+            theta_i_deg=45.0,
+            substrate=Substrate.lambertian(1.0),
+            coating=Coating(n=1.5, alpha=alpha),
+            theta_step_deg=3.0,
+            phi_step_deg=6.0,
+            tau=0.0,
+            max_bounces=1000,
+        )
+        t0 = time.process_time()
+        m = trace(cfg.replace(rays=rays // 4, scattering="multiple", estimator="counting"))
+        t1 = time.process_time()
+        s = trace(cfg.replace(rays=rays // 20, scattering="single", estimator="evaluated"))
+        t2 = time.process_time()
+        print(
+            f"   alpha {alpha:4.2f}: multiple {m.albedo():.4f} +- {m.albedo_stderr():.4f} "
+            f"({t1 - t0:.1f} s), single {s.albedo():.4f} +- {s.albedo_stderr():.4f} "
+            f"({t2 - t1:.1f} s)"
+        )
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rays", type=int, default=200_000)
+    args = ap.parse_args(argv)
+    runs = costs(args.rays)
+    missing(*runs)
+    furnace(args.rays)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
