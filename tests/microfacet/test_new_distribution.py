@@ -24,7 +24,6 @@ from scipy import integrate
 
 from labbrdf import models
 from labbrdf.cli import main
-from labbrdf.dataset import make_frame
 from labbrdf.fitting import fit
 from labbrdf.integrate import hemispherical_reflectance
 from labbrdf.microfacet import DISTRIBUTIONS, TabulatedNDF, registry
@@ -149,30 +148,10 @@ def test_the_module_is_complete_and_its_closed_forms_are_right(student3):
             assert lam == pytest.approx(tail / mu, rel=1e-7, abs=1e-12)
 
 
-def _brdf_rows(alpha: float, seed: int):
-    ti = np.repeat([20.0, 45.0, 65.0], 3 * 17)
-    tr = np.tile(np.linspace(0.0, 80.0, 17), 9)
-    pr = np.tile(np.repeat([180.0, 150.0, 120.0], 17), 3)
-    truth = models.get("microfacet", n=1.5, k=0.0, distribution="student3")
-    y = truth.evaluate(*np.radians([ti, tr, pr]), params={"alpha": alpha})
-    y = y * (1 + 0.02 * np.random.default_rng(seed).standard_normal(y.size))
-    return make_frame(
-        sample="s",
-        instrument="synthetic",
-        source="test",
-        quantity="brdf",
-        value=y,
-        unit="sr-1",
-        wavelength_nm=633.0,
-        sigma=0.02 * y,
-        theta_i_deg=ti,
-        theta_r_deg=tr,
-        phi_r_deg=pr,
-    )
-
-
-def test_the_microfacet_model_fits_it_from_python_and_the_command_line(student3, tmp_path, capsys):
-    data = _brdf_rows(0.3, seed=7)
+def test_the_microfacet_model_fits_it_from_python_and_the_command_line(
+    student3, tmp_path, capsys, microfacet_rows
+):
+    data = microfacet_rows("student3", 0.3, seed=7)
     res = fit(models.get("microfacet", n=1.5, k=0.0, distribution="student3"), data)
     p = res.params["alpha"]
     assert p.stderr is not None and abs(p.value - 0.3) < 3 * p.stderr, (p.value, p.stderr)

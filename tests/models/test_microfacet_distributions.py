@@ -14,7 +14,6 @@ from scipy import special
 
 from labbrdf import models
 from labbrdf.cli import main
-from labbrdf.dataset import make_frame
 from labbrdf.fitting import fit
 from labbrdf.integrate import hemispherical_reflectance
 from labbrdf.microfacet import DISTRIBUTIONS
@@ -96,30 +95,8 @@ def test_smith_albedo_is_at_most_one(name):
     assert np.all((rho > 0.5) & (rho <= 1.0))
 
 
-def _synthetic(alpha: float, seed: int):
-    ti = np.repeat([20.0, 45.0, 65.0], 3 * 17)
-    tr = np.tile(np.linspace(0.0, 80.0, 17), 9)
-    pr = np.tile(np.repeat([180.0, 150.0, 120.0], 17), 3)
-    truth = models.get("microfacet", n=1.5, k=0.0, distribution="beckmann")
-    y = truth.evaluate(*np.radians([ti, tr, pr]), params={"alpha": alpha})
-    y = y * (1 + 0.02 * np.random.default_rng(seed).standard_normal(y.size))
-    return make_frame(
-        sample="s",
-        instrument="synthetic",
-        source="test",
-        quantity="brdf",
-        value=y,
-        unit="sr-1",
-        wavelength_nm=633.0,
-        sigma=0.02 * np.abs(y),
-        theta_i_deg=ti,
-        theta_r_deg=tr,
-        phi_r_deg=pr,
-    )
-
-
-def test_a_noisy_beckmann_brdf_is_fitted_back_within_3_standard_errors():
-    data = _synthetic(0.25, seed=3)
+def test_a_noisy_beckmann_brdf_is_fitted_back_within_3_standard_errors(microfacet_rows):
+    data = microfacet_rows("beckmann", 0.25, seed=3)
     res = fit(models.get("microfacet", n=1.5, k=0.0, distribution="beckmann"), data)
     p = res.params["alpha"]
     assert p.stderr is not None and abs(p.value - 0.25) < 3 * p.stderr, (p.value, p.stderr)
@@ -146,9 +123,11 @@ def test_an_unknown_distribution_is_refused_with_the_registered_ones(bad):
         models.get("microfacet", n=1.5, distribution=bad)
 
 
-def test_fit_command_takes_the_distribution_and_refuses_an_unknown_one(tmp_path, capsys):
+def test_fit_command_takes_the_distribution_and_refuses_an_unknown_one(
+    tmp_path, capsys, microfacet_rows
+):
     path = tmp_path / "b.csv"
-    _synthetic(0.25, seed=4).to_csv(path, index=False)
+    microfacet_rows("beckmann", 0.25, seed=4).to_csv(path, index=False)
     base = ["fit", str(path), "--model", "microfacet", "--param", "n=1.5", "--param", "k=0"]
     assert main([*base, "--param", "distribution=beckmann", "--json"]) == 0
     out = capsys.readouterr().out
