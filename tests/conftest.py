@@ -134,3 +134,39 @@ def sample_set(prediction_sets, tmp_path_factory: pytest.TempPathFactory) -> dic
         "psi_delta_wrong": ps.write_wvase(d / "sample_b_psi.dat", ps.WRONG_NK, "SYNTHETIC B"),
         "bsdf": ps.write_bsdf(d / "sample_a.bsdf", ps.brdf_config(fit.alpha)),
     }
+
+
+@pytest.fixture(scope="session")
+def microfacet_rows():
+    """``rows(distribution, alpha, seed)``: a synthetic microfacet BRDF with 2 % noise.
+
+    n = 1.5, k = 0 at 633 nm; incidences 20, 45, 65 deg, detectors 0-80 deg in three
+    azimuth planes (180, 150, 120 deg); sigma = the 2 % of each value.
+    """
+    import numpy as np
+
+    from labbrdf import models
+    from labbrdf.dataset import make_frame
+
+    def rows(distribution: str, alpha: float, seed: int):
+        ti = np.repeat([20.0, 45.0, 65.0], 3 * 17)
+        tr = np.tile(np.linspace(0.0, 80.0, 17), 9)
+        pr = np.tile(np.repeat([180.0, 150.0, 120.0], 17), 3)
+        truth = models.get("microfacet", n=1.5, k=0.0, distribution=distribution)
+        y = truth.evaluate(*np.radians([ti, tr, pr]), params={"alpha": alpha})
+        y = y * (1 + 0.02 * np.random.default_rng(seed).standard_normal(y.size))
+        return make_frame(
+            sample="s",
+            instrument="synthetic",
+            source="test",
+            quantity="brdf",
+            value=y,
+            unit="sr-1",
+            wavelength_nm=633.0,
+            sigma=0.02 * np.abs(y),
+            theta_i_deg=ti,
+            theta_r_deg=tr,
+            phi_r_deg=pr,
+        )
+
+    return rows

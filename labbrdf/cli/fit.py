@@ -313,7 +313,8 @@ def add_parser(sub: Any) -> None:
         "--param",
         action="append",
         metavar="NAME=VALUE",
-        help="a model option (microfacet n=, k=, diffuse=true; five_param shadowing=mb; "
+        help="a model option (microfacet n=, k=, diffuse=true, distribution=beckmann; "
+        "five_param shadowing=mb; "
         "layered base=diffuse, rays=, floor=true) or a parameter's starting value",
     )
     s.add_argument(

@@ -22,6 +22,8 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import parts
+
 __all__ = [
     "LABEL",
     "NAME",
@@ -78,21 +80,18 @@ def smith_lambda(wz: ArrayLike, alpha: float | NDArray[np.float64]) -> NDArray[n
     """
     from scipy import special  # imported here: the command line starts without scipy
 
-    z = np.asarray(wz, dtype=float)
-    z2 = np.maximum(z * z, 1e-300)
-    tan = np.sqrt(np.maximum(1.0 - z2, 0.0) / z2)
+    z, t2 = parts.tan2(wz)
+    tan = np.sqrt(t2)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         a = 1.0 / (alpha * tan)
         lam = 0.5 * (special.erf(a) - 1.0) + np.exp(-a * a) / (2.0 * a * math.sqrt(math.pi))
     lam = np.where(np.isfinite(a), lam, 0.0)
-    return np.where(z >= 0, lam, -1.0 - lam)
+    return parts.both_ways(z, lam)
 
 
 def smith_g1(wz: ArrayLike, alpha: float | NDArray[np.float64]) -> NDArray[np.float64]:
     """Smith masking ``G1 = 1 / (1 + Lambda)`` for wz > 0, else 0."""
-    z = np.asarray(wz, dtype=float)
-    lam = smith_lambda(np.abs(z), alpha)
-    return np.where(z > 0, 1.0 / (1.0 + lam), 0.0)
+    return parts.smith_g1(smith_lambda, wz, alpha)
 
 
 def p22(x: NDArray, y: NDArray, alpha: float) -> NDArray[np.float64]:

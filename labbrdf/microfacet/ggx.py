@@ -33,6 +33,8 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import parts
+
 __all__ = [
     "LABEL",
     "NAME",
@@ -94,18 +96,14 @@ def smith_lambda(wz: ArrayLike, alpha: float | NDArray[np.float64]) -> NDArray[n
     for downward ones ``Lambda(w) = -1 - Lambda(-w)`` ([5]_), so that the height sampling of
     the multiple-scattering walk works in both directions.
     """
-    z = np.asarray(wz, dtype=float)
-    z2 = np.maximum(z * z, 1e-300)
-    t2 = np.maximum(1.0 - z2, 0.0) / z2
+    z, t2 = parts.tan2(wz)
     lam = 0.5 * (-1.0 + np.sqrt(1.0 + alpha * alpha * t2))
-    return np.where(z >= 0, lam, -1.0 - lam)
+    return parts.both_ways(z, lam)
 
 
 def smith_g1(wz: ArrayLike, alpha: float | NDArray[np.float64]) -> NDArray[np.float64]:
     """Smith masking ``G1 = 1 / (1 + Lambda)`` for wz > 0, else 0 (the tracer's form)."""
-    z = np.asarray(wz, dtype=float)
-    lam = smith_lambda(np.abs(z), alpha)
-    return np.where(z > 0, 1.0 / (1.0 + lam), 0.0)
+    return parts.smith_g1(smith_lambda, wz, alpha)
 
 
 def smith_g1_closed(cos_v: ArrayLike, alpha: float) -> NDArray[np.float64]:
@@ -214,11 +212,9 @@ def ml_s(q: NDArray, areal: bool) -> float:
     The root of the score equation ``mean(s / (s + q)) = 1/2`` (``q = x^2 + y^2``, 2-D) or
     ``= 2/3`` (``q = x^2``, the 1-D marginal). The left side increases with s; the root is
     bracketed by stepping a factor 4 from the mean of q (one temporary of q's size per
-    evaluation), then polished by Brent's method to a relative 1e-13 inside the bracket.
-    0 when every q is 0.
+    evaluation), then polished by Brent's method to a relative 1e-13 inside the bracket
+    (:func:`labbrdf.microfacet.parts.score_root`). 0 when every q is 0.
     """
-    from scipy import optimize  # imported here: the command line starts without scipy
-
     frac = 0.5 if areal else 2.0 / 3.0
     qpos = q[q > 0]
     if qpos.size == 0:
@@ -235,24 +231,9 @@ def ml_s(q: NDArray, areal: bool) -> float:
         np.divide(s, t, out=t)
         return float(np.mean(t)) - frac
 
-    s0 = min(max(float(np.mean(q)), lo_lim), hi_lim)
-    lo = hi = s0
-    if g(s0) < 0:
-        while g(hi) < 0 and hi < hi_lim:
-            lo, hi = hi, min(hi * 4.0, hi_lim)
-    else:
-        while g(lo) > 0 and lo > lo_lim:
-            lo, hi = max(lo / 4.0, lo_lim), lo
-    root = float(optimize.brentq(g, lo, hi, xtol=1e-300, rtol=1e-13))
+    root = parts.score_root(g, float(np.mean(q)), lo_lim, hi_lim)
     arrays.clear()
     return root
-
-
-def _sum_log(q: NDArray, s: float) -> float:
-    """``sum(ln(s + q))`` with one temporary."""
-    t = q + s
-    np.log(t, out=t)
-    return float(np.sum(t))
 
 
 def log_likelihood(q: NDArray, s: float, n: int, areal: bool) -> float:
@@ -262,8 +243,8 @@ def log_likelihood(q: NDArray, s: float, n: int, areal: bool) -> float:
     ``log P2 = ln s - 3/2 ln(s + q) - ln 2``.
     """
     if areal:
-        return float(n * math.log(s) - 2 * _sum_log(q, s) - n * math.log(math.pi))
-    return float(n * math.log(s) - 1.5 * _sum_log(q, s) - n * math.log(2.0))
+        return float(n * math.log(s) - 2 * parts.sum_log(q, s) - n * math.log(math.pi))
+    return float(n * math.log(s) - 1.5 * parts.sum_log(q, s) - n * math.log(2.0))
 
 
 def ks_cdf(s: float, areal: bool) -> Callable[[NDArray], NDArray]:

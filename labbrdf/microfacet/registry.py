@@ -8,7 +8,9 @@ Every distribution module defines the same names (:data:`REQUIRED`): ``NAME``, `
 in closed form (``TRACED_IN_CLOSED_FORM``) also defines ``sample_visible``; the others are
 traced through their slope table (:meth:`labbrdf.microfacet.TabulatedNDF.of`).
 
-A new distribution is its module plus one line in :data:`DISTRIBUTIONS`.
+A new distribution is its module plus one line in :data:`DISTRIBUTIONS`; what does not
+depend on its formulas (G1 from Lambda, Lambda below the horizon, the root of a score
+equation) it takes from :mod:`labbrdf.microfacet.parts`.
 """
 
 from __future__ import annotations

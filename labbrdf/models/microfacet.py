@@ -1,19 +1,22 @@
-"""GGX microfacet BRDF with separable Smith shadowing and the exact complex Fresnel factor.
+"""Microfacet BRDF with separable Smith shadowing and the exact complex Fresnel factor.
 
 Physics layer: numpy only (the Fresnel amplitudes and the ellipsometric inversion come from
-:mod:`labbrdf.optics`, D and G1 from :mod:`labbrdf.microfacet.ggx`).
+:mod:`labbrdf.optics`, D and G1 from the distribution's module in
+:data:`labbrdf.microfacet.registry.DISTRIBUTIONS`).
 
 ``f = scale * F(theta_d) D(h) G1(w_i) G1(w_o) / (4 cos theta_i cos theta_r)`` [sr^-1], where
 h is the half vector, theta_d the local incidence angle on the facet (cos = w_i.h), D the
-GGX (Trowbridge-Reitz) distribution and G1 the Smith masking function of GGX. This is the
-single-scattering model of Mitsuba's ``roughconductor`` (distribution ``ggx``) and of
-NIST SCATMECH's ``Shadowed_Facet_BRDF_Model`` with the ellipsoid (GGX) slope distribution
-(oracles README section 4).
+distribution of normals and G1 its Smith masking function (eqs. (20), (25)-(27), (33), (34)
+of [1]_). The distribution is any registered one: GGX (Trowbridge-Reitz, the default) or
+Beckmann, or one added to the registry. With GGX this is the single-scattering model of
+Mitsuba's ``roughconductor`` (distribution ``ggx``) and of NIST SCATMECH's
+``Shadowed_Facet_BRDF_Model`` with the ellipsoid (GGX) slope distribution (oracles README
+section 4).
 
 References
 ----------
 .. [1] Walter B., Marschner S. R., Li H., Torrance K. E., "Microfacet models for refraction
-   through rough surfaces", Proc. EGSR 2007, eqs. (20), (33), (34).
+   through rough surfaces", Proc. EGSR 2007, eqs. (20), (25)-(27), (33), (34).
    doi:10.2312/EGWR/EGSR07/195-206
 .. [2] Trowbridge T. S., Reitz K. P., "Average irregularity representation of a rough surface
    for ray reflection", J. Opt. Soc. Am. 65(5), 531-536 (1975). doi:10.1364/JOSA.65.000531
@@ -28,13 +31,23 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..ellipsometry import nk_from_psi_delta
-from ..microfacet import ggx
+from ..microfacet import registry
 from ..optics import fresnel_cos
 from .base import Model, ModelError, Parameters, lambert
 
 __all__ = ["Microfacet", "stokes_from_jones"]
 
 _SHADOWING = ("smith", "none")
+_OPTIONS = ["n", "k", "psi_delta", "ideal_mirror", "shadowing", "diffuse", "distribution"]
+_REFERENCE = (
+    "Walter B. et al., Microfacet models for refraction through rough surfaces, "
+    "EGSR 2007 ({label} D, Smith G1); Fresnel amplitudes of the substrate"
+)
+_RECIPROCITY = (
+    "microfacet is reciprocal by construction (the {label} term "
+    "F D G1 G1 / (4 cos\u03b8i cos\u03b8r) and the Lambertian kd / pi are symmetric in the "
+    "two directions)."
+)
 
 # coherency vector (Es Es*, Es Ep*, Ep Es*, Ep Ep*) -> Stokes (S0, S1, S2, S3), LB convention
 _A = np.array([[1, 0, 0, 1], [1, 0, 0, -1], [0, 1, 1, 0], [0, 1j, -1j, 0]], dtype=complex)
@@ -66,7 +79,7 @@ def stokes_from_jones(jones: NDArray) -> NDArray[np.float64]:
 
 
 class Microfacet(Model):
-    """GGX microfacet BRDF with Smith G1 G1 and the exact Fresnel factor of a substrate.
+    """Microfacet BRDF with Smith G1 G1 and the exact Fresnel factor of a substrate.
 
     Other Parameters
     ----------------
@@ -84,10 +97,16 @@ class Microfacet(Model):
         Add a Lambertian floor ``kd / pi`` [sr^-1] (unpolarized: Mueller ``kd / pi`` times
         diag(1, 0, 0, 0)), for painted, polymer or other surfaces whose subsurface scatter
         the facets do not describe.
+    distribution : str, default "ggx"
+        A name of :data:`labbrdf.microfacet.registry.DISTRIBUTIONS` (``"ggx"``,
+        ``"beckmann"``, or one added there): its ``d`` and ``smith_g1`` give D and G1.
+        Stored in :attr:`options` when it is not the default.
 
-    Parameters: ``alpha`` [1] in [1e-3, 1.5] (log), ``scale`` [1] in [0, 10], fixed at 1
-    (free it for relative data; it enters linearly); with ``diffuse``, ``kd`` [1] in
-    [0, 1], the directional-hemispherical albedo of the floor (linear).
+    Parameters: ``alpha`` [1] in [1e-3, 1.5] (log), the distribution's roughness (GGX:
+    eq. (33) of Walter et al. 2007; Beckmann: eq. (25), the RMS slope of ``|grad z|``),
+    ``scale`` [1] in [0, 10], fixed at 1 (free it for relative data; it enters linearly);
+    with ``diffuse``, ``kd`` [1] in [0, 1], the directional-hemispherical albedo of the
+    floor (linear).
 
     Notes
     -----
@@ -95,19 +114,16 @@ class Microfacet(Model):
     conserved with Smith shadowing (single scattering loses energy, up to 21 % for
     alpha = 0.4); with G = 1 the albedo exceeds 1 at grazing incidence.
     The index is taken wavelength-independent: fit one model per wavelength.
+    GGX's G1 is evaluated in the form of eq. (34) of Walter et al. 2007
+    (:func:`labbrdf.microfacet.ggx.smith_g1_closed`), which the oracles were checked
+    against; a distribution that defines ``smith_g1_closed`` has it used the same way,
+    the others their ``smith_g1 = 1 / (1 + Lambda)``.
     """
 
     name = "microfacet"
-    reference = (
-        "Walter B. et al., Microfacet models for refraction through rough surfaces, "
-        "EGSR 2007 (GGX D, Smith G1); Fresnel amplitudes of the substrate"
-    )
+    reference = _REFERENCE.format(label="GGX")
     doi = "10.2312/EGWR/EGSR07/195-206"
-    reciprocity_note = (
-        "microfacet is reciprocal by construction (the GGX term "
-        "F D G1 G1 / (4 cos\u03b8i cos\u03b8r) and the Lambertian kd / pi are symmetric in the "
-        "two directions)."
-    )
+    reciprocity_note = _RECIPROCITY.format(label="GGX")
     linear: tuple[str, ...] = ("scale",)
 
     def __init__(
@@ -118,13 +134,14 @@ class Microfacet(Model):
         ideal_mirror: bool = False,
         shadowing: str = "smith",
         diffuse: bool = False,
+        distribution: str = "ggx",
         **options: Any,
     ) -> None:
         if options:
             raise ModelError(
-                f"model 'microfacet' got unknown options {sorted(options)}; options are "
-                "['n', 'k', 'psi_delta', 'ideal_mirror', 'shadowing', 'diffuse']"
+                f"model 'microfacet' got unknown options {sorted(options)}; options are {_OPTIONS}"
             )
+        self._set_distribution(distribution)
         self._diffuse = bool(diffuse)
         if self._diffuse:
             self.linear = ("scale", "kd")
@@ -171,12 +188,44 @@ class Microfacet(Model):
         self._shadowing = shadowing
         if self._diffuse:
             opts["diffuse"] = True
+        if self.distribution != "ggx":
+            opts["distribution"] = self.distribution
         super().__init__(**opts)
+
+    def _set_distribution(self, name: Any) -> None:
+        """Take D and G1 from the registered distribution ``name``; state it in the texts."""
+        try:
+            dist = registry.get(name)
+        except (KeyError, TypeError):
+            raise ModelError(
+                f"microfacet option 'distribution' must be one of {list(registry.names())}; "
+                f"got {name!r}"
+            ) from None
+        #: the registry name (the module is looked up when used: a model is pickled by
+        #: the process pools, a module cannot be)
+        self.distribution: str = dist.NAME
+        if dist.NAME != "ggx":
+            self.reference = _REFERENCE.format(label=dist.LABEL)
+            self.reciprocity_note = _RECIPROCITY.format(label=dist.LABEL)
+
+    @property
+    def _dist(self) -> Any:
+        return registry.get(self.distribution)
+
+    def _g1(self, cos_v: NDArray, alpha: float) -> NDArray:
+        dist = self._dist
+        return getattr(dist, "smith_g1_closed", dist.smith_g1)(cos_v, alpha)
+
+    @property
+    def label(self) -> str:
+        """The model and its distribution for a reader, e.g. ``"microfacet (Beckmann)"``."""
+        return f"{self.name} ({self._dist.LABEL})"
 
     def default_params(self) -> Parameters:
         """alpha 0.2 in [1e-3, 1.5] (log); scale 1, fixed."""
         p = Parameters()
-        p.add("alpha", 0.2, 1e-3, 1.5, units="1", log=True, description="GGX roughness")
+        what = f"{self._dist.LABEL} roughness"
+        p.add("alpha", 0.2, 1e-3, 1.5, units="1", log=True, description=what)
         p.add(
             "scale",
             1.0,
@@ -225,9 +274,9 @@ class Microfacet(Model):
             raise ModelError(f"microfacet parameter 'alpha' must be > 0; got {alpha!r}")
         ci, co = np.cos(ti), np.cos(tr)
         up = (ci > 0) & (co > 0)
-        d = ggx.d(cos_h, alpha)
+        d = self._dist.d(cos_h, alpha)
         g = (
-            ggx.smith_g1_closed(ci, alpha) * ggx.smith_g1_closed(co, alpha)
+            self._g1(ci, alpha) * self._g1(co, alpha)
             if self._shadowing == "smith"
             else np.ones_like(d)
         )

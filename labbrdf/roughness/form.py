@@ -3,7 +3,7 @@
 A map of a curved part (a cylinder, a lens) levelled by a plane keeps the curvature in its
 "roughness": sigma, slopes and correlation length then describe the form, not the finish.
 :func:`check_form` measures the share of the height variance left by the levelling that a
-least-squares quadric (the levelling of degree 2, :func:`labbrdf.roughness.topography.level`) also
+least-squares quadric (the levelling of degree 2, :func:`labbrdf.roughness.levelling.level`) also
 removes, and names the quadric's shape from its principal curvatures: a cylinder (one
 curvature much the larger), a sphere or bowl (two alike, same sign), a saddle.
 
@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .topography import level
+from .levelling import level
 
 __all__ = ["FORMS", "FORM_DOMINATES", "CYLINDER_RATIO", "FormCheck", "check_form"]
 

@@ -1,6 +1,6 @@
 """Partial sums of a polynomial levelling: what a jackknife replicate's levelling needs.
 
-The least-squares polynomial of :func:`labbrdf.roughness.topography.level` is fixed by a
+The least-squares polynomial of :func:`labbrdf.roughness.levelling.level` is fixed by a
 few sums over the valid points (their count, the sum of heights, and the monomials' normal
 equations).
 Sums over disjoint regions add, so the sums of a map less one tile are the whole map's less
@@ -85,7 +85,7 @@ def region_design(
     """The levelling's monomials at the valid points ``v`` of the region ``reg`` of the grid.
 
     Coordinates scaled to [-1, 1) over the whole grid per axis, as the levelling of
-    :func:`labbrdf.roughness.topography.level` scales them; ``exps`` the monomials' exponents.
+    :func:`labbrdf.roughness.levelling.level` scales them; ``exps`` the monomials' exponents.
     """
     coords = [2.0 * np.arange(*sl.indices(m)) / m - 1.0 for sl, m in zip(reg, shape, strict=True)]
     grids = np.meshgrid(*coords, indexing="ij") if len(coords) > 1 else coords

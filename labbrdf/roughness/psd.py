@@ -13,7 +13,7 @@ variance, the 1-D PSD [m^3] is two-sided and integrates over ``-inf < fx < inf``
 Pipeline
 --------
 1. *Detrending*: the least-squares polynomial of total degree ``degree`` is subtracted
-   (default 1, the mean plane), by :func:`labbrdf.roughness.topography.level`, the levelling of
+   (default 1, the mean plane), by :func:`labbrdf.roughness.levelling.level`, the levelling of
    ``labbrdf surface``.
 2. *Window*: SurfaceTopography's (default ``"hann"``, normalised so that the mean of its
    square is one: the expected variance is kept); for a map's 2-D PSD its rotationally
@@ -69,7 +69,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .topography import level
+from .levelling import level
 
 __all__ = [
     "AGREEMENT_CHI2",

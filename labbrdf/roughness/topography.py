@@ -3,7 +3,11 @@
 Pure NumPy/SciPy: the arrays come in already read (see :mod:`labbrdf.adapters.topography`
 for instrument files). Lengths are in metres throughout; slopes are dimensionless.
 
-Pipeline (derivations in ``docs/topography.md``):
+Pipeline (derivations in ``docs/topography.md``). This module runs it and holds the result
+(:class:`RoughnessStats`) and the jackknife; the steps live in one module each, whose public
+names it also exports: :mod:`~labbrdf.roughness.levelling` (levelling, S-filter, dropout
+rims), :mod:`~labbrdf.roughness.slope_fits` (slopes and the fits of their distribution),
+:mod:`~labbrdf.roughness.acf` (autocorrelation, correlation lengths).
 
 1. *Levelling* (form removal, ISO 25178-2 F-operator): the least-squares polynomial of total
    degree ``degree`` in (x, y) over the valid points is subtracted (default 1, the mean
@@ -51,12 +55,36 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import fft as sfft
-from scipy import ndimage, optimize, special
+from scipy import ndimage
 
 from ..jsonsafe import jsonable
 from ..microfacet import DISTRIBUTIONS
+from .acf import _crossing, _fit_acf, _principal, autocorrelation
+from .levelling import (
+    GAUSS_ALPHA,
+    _as_heights,
+    _eroded,
+    _exponents,
+    _level,
+    _pixel,
+    _row_blocks,
+    _s_filter,
+    erode_mask,
+    level,
+    s_filter,
+)
 from .levelling_sums import NormalSums
+from .slope_fits import (
+    KS_WARN,
+    SlopeFit,
+    SlopeFits,
+    _fisher_u,
+    _fit_core,
+    _make_fits,
+    _shape_stats,
+    fit_slope_distribution,
+    slopes,
+)
 
 __all__ = [
     "C_MIN_PIXELS",
@@ -76,521 +104,13 @@ __all__ = [
     "slopes",
 ]
 
-#: KS distance above which neither GGX nor Beckmann is said to describe the slopes.
-KS_WARN = 0.05
 #: Correlation length [pixels] below which the ACF is said to be pixel-scale noise.
 C_MIN_PIXELS = 2.0
 #: Share of the height variance the 1 % largest squared heights may carry before a note
 #: (a Gaussian surface: 8.5 %).
 TOP_VARIANCE_WARN = 0.5
-#: ISO 16610-61 Gaussian weighting constant, sqrt(ln 2 / pi): 50 % transmission at lambda_s.
-GAUSS_ALPHA = math.sqrt(math.log(2.0) / math.pi)
 
 _NAN_DEFAULT = float("nan")
-
-_INV_E = math.exp(-1.0)
-
-
-# --------------------------------------------------------------------------- helpers
-def _as_heights(heights: ArrayLike, mask: ArrayLike | None) -> tuple[NDArray, NDArray]:
-    """Float heights and the valid-point indicator (finite and not masked)."""
-    z = np.ma.getdata(heights)
-    z = np.array(z, dtype=float)
-    valid = np.isfinite(z)
-    m = np.ma.getmaskarray(heights) if np.ma.isMaskedArray(heights) else None
-    if m is not None:
-        valid &= ~m
-    if mask is not None:
-        mk = np.asarray(mask, dtype=bool)
-        if mk.shape != z.shape:
-            raise ValueError(f"mask shape {mk.shape} differs from heights shape {z.shape}")
-        valid &= ~mk
-    if z.ndim not in (1, 2):
-        raise ValueError(f"heights must be a profile (1-D) or a map (2-D), got {z.ndim}-D")
-    if min(z.shape) < 8:
-        raise ValueError(f"heights need at least 8 points per axis, got shape {z.shape}")
-    return z, valid
-
-
-def _pixel(pixel_size: float | ArrayLike, ndim: int) -> tuple[float, ...]:
-    p = np.broadcast_to(np.asarray(pixel_size, dtype=float), (ndim,))
-    if not np.all(np.isfinite(p)) or np.any(p <= 0):
-        raise ValueError(f"pixel_size must be positive and finite [m], got {pixel_size!r}")
-    return tuple(float(v) for v in p)
-
-
-#: Elements per block of the passes that walk a map in row blocks (bounded temporaries).
-_CHUNK = 1 << 18
-
-
-def _exponents(ndim: int, degree: int) -> list[tuple[int, ...]]:
-    """Monomial exponents of total degree <= degree (x first, then mixed, then y)."""
-    if ndim == 1:
-        return [(p,) for p in range(degree + 1)]
-    return [(tot - py, py) for tot in range(degree + 1) for py in range(tot + 1)]
-
-
-def _row_blocks(shape: tuple[int, ...]) -> list[tuple[int, int]]:
-    """Row ranges of about :data:`_CHUNK` elements (whole rows of a map)."""
-    row = int(np.prod(shape[1:])) if len(shape) > 1 else 1
-    step = max(1, _CHUNK // max(row, 1))
-    return [(a, min(a + step, shape[0])) for a in range(0, shape[0], step)]
-
-
-def _block_design(
-    shape: tuple[int, ...], r0: int, r1: int, exps: list[tuple[int, ...]], v: NDArray
-) -> NDArray:
-    """Monomials in coordinates scaled to [-1, 1) at the valid points of rows r0:r1."""
-    x = 2.0 * np.arange(r0, r1) / shape[0] - 1.0
-    if len(shape) == 1:
-        xs = x[v]
-        return np.column_stack([xs ** e[0] for e in exps])
-    y = 2.0 * np.arange(shape[1]) / shape[1] - 1.0
-    xs = np.broadcast_to(x[:, None], v.shape)[v]
-    ys = np.broadcast_to(y[None, :], v.shape)[v]
-    return np.column_stack([xs ** e[0] * ys ** e[1] for e in exps])
-
-
-def level(heights: ArrayLike, degree: int = 1, mask: ArrayLike | None = None) -> NDArray:
-    """Subtract the least-squares polynomial of total degree ``degree`` (form removal).
-
-    Parameters
-    ----------
-    heights : array_like, 1-D or 2-D
-        Heights [m]; NaN (or masked) points are invalid.
-    degree : int
-        0 = mean, 1 = mean plane (default, ISO 25178 F-operator; SurfaceTopography
-        ``detrend("height")``), 2 = full quadric (``detrend("curvature")``), higher on request.
-    mask : array_like of bool, optional
-        True where a point is invalid.
-
-    Returns
-    -------
-    ndarray
-        Levelled heights [m], NaN at invalid points.
-    """
-    z, valid = _as_heights(heights, mask)
-    return _level(z, valid, degree)
-
-
-def _level(z: NDArray, valid: NDArray, degree: int) -> NDArray:
-    """Levelled copy of z (NaN at invalid points); normal equations summed over row blocks.
-
-    The polynomial is fitted in coordinates scaled to [-1, 1) after removing the mean
-    height, which keeps the normal equations well conditioned for the low degrees of form
-    removal; no design matrix of the whole map is ever built.
-    """
-    if not (isinstance(degree, int | np.integer) and degree >= 0):
-        raise ValueError(f"degree must be an integer >= 0, got {degree!r}")
-    exps = _exponents(z.ndim, int(degree))
-    k = len(exps)
-    nvalid = int(np.count_nonzero(valid))
-    if nvalid <= k:
-        raise ValueError(f"{nvalid} valid points cannot fix a polynomial of degree {degree}")
-    zmean = float(np.mean(z, where=valid))
-    ata = np.zeros((k, k))
-    atz = np.zeros(k)
-    blocks = _row_blocks(z.shape)
-    for r0, r1 in blocks:
-        v = valid[r0:r1]
-        a = _block_design(z.shape, r0, r1, exps, v)
-        zz = z[r0:r1][v] - zmean
-        ata += a.T @ a
-        atz += a.T @ zz
-    coef = np.linalg.lstsq(ata, atz, rcond=None)[0]
-    out = np.full(z.shape, np.nan)
-    for r0, r1 in blocks:
-        v = valid[r0:r1]
-        a = _block_design(z.shape, r0, r1, exps, v)
-        out[r0:r1][v] = z[r0:r1][v] - zmean - a @ coef
-    return out
-
-
-def slopes(
-    z: NDArray, pixel_size: tuple[float, ...], valid: NDArray | None = None
-) -> tuple[NDArray, NDArray | None]:
-    """Forward-difference slopes at the valid corner points.
-
-    Parameters
-    ----------
-    z : ndarray
-        Heights [m], 1-D or 2-D.
-    pixel_size : tuple of float
-        Grid spacing [m] per axis.
-    valid : ndarray of bool, optional
-        Valid points (default: finite ones).
-
-    Returns
-    -------
-    sx, sy : ndarray
-        1-D arrays of dz/dx and dz/dy [1] at the points (i, j), i < M-1, j < N-1, where
-        h[i, j], h[i+1, j] and h[i, j+1] are all valid (``sy`` is None for a profile).
-    """
-    if valid is None:
-        valid = np.isfinite(z)
-    if z.ndim == 1:
-        ok = valid[1:] & valid[:-1]
-        return ((z[1:] - z[:-1]) / pixel_size[0])[ok], None
-    ok = valid[:-1, :-1] & valid[1:, :-1] & valid[:-1, 1:]
-    sx = (z[1:, :-1] - z[:-1, :-1]) / pixel_size[0]
-    sy = (z[:-1, 1:] - z[:-1, :-1]) / pixel_size[1]
-    return sx[ok], sy[ok]
-
-
-def autocorrelation(
-    z: NDArray,
-    valid: NDArray | None = None,
-    max_lag: tuple[int, ...] | None = None,
-    *,
-    hole: tuple[slice, ...] | None = None,
-) -> NDArray:
-    """Normalised autocorrelation by a mask-normalised, zero-padded FFT.
-
-    Parameters
-    ----------
-    z : ndarray
-        Levelled heights, 1-D or 2-D (invalid points anything; they get weight 0).
-    valid : ndarray of bool, optional
-        Valid points (default: finite).
-    max_lag : tuple of int, optional
-        Largest lag per axis in pixels (default: half the extent).
-    hole : tuple of slice, optional
-        Declares that ``valid`` is the whole grid except this rectangle (a jackknife
-        replicate of a map without dropouts): the pair counts are then exact products of
-        interval overlaps instead of a second FFT.
-
-    Returns
-    -------
-    ndarray
-        rho(tau) for lags ``-max_lag..max_lag`` per axis (zero lag at the centre);
-        NaN where no pair of valid points exists.
-    """
-    if valid is None:
-        valid = np.isfinite(z)
-    if max_lag is None:
-        max_lag = tuple(n // 2 for n in z.shape)
-    shape = [
-        sfft.next_fast_len(n + lag, real=True) for n, lag in zip(z.shape, max_lag, strict=True)
-    ]
-    zc = np.zeros(z.shape)
-    np.subtract(z, np.mean(z, where=valid), out=zc, where=valid)
-    num = _correlate_window(zc, shape, max_lag)
-    del zc
-    if valid.all():
-        den = _rect_pair_counts(z.shape, max_lag, None)
-    elif hole is not None:
-        den = _rect_pair_counts(z.shape, max_lag, hole)
-    else:
-        den = _correlate_window(valid.astype(float), shape, max_lag)
-    good = den > 0.5
-    cov = np.full(num.shape, np.nan)
-    cov[good] = num[good] / np.round(den[good])
-    centre = tuple(max_lag)
-    return cov / cov[centre]
-
-
-def _rect_pair_counts(
-    shape: tuple[int, ...], max_lag: tuple[int, ...], hole: tuple[slice, ...] | None
-) -> NDArray:
-    """Valid pairs at lags ``-max_lag..max_lag`` of a full grid F minus a rectangle T.
-
-    With ``1_V = 1_F - 1_T`` the count ``sum_p 1_V(p) 1_V(p + l)`` is
-    ``c_FF - c_FT - c_TF + c_TT``, where ``c_PQ(l) = #{p in P : p + l in Q}`` of two
-    rectangles is the product over the axes of the interval overlaps
-    ``|P_k ∩ (Q_k - l_k)|``: exactly what the FFT of the indicator gives, without it.
-    """
-
-    def overlap(i: tuple[int, int], j: tuple[int, int], lags: NDArray) -> NDArray:
-        return np.maximum(0, np.minimum(i[1], j[1] - lags) - np.maximum(i[0], j[0] - lags))
-
-    lags = [np.arange(-lag, lag + 1) for lag in max_lag]
-    full = [(0, n) for n in shape]
-    if hole is None:
-        sets = [(1.0, full, full)]
-    else:
-        tile = [sl.indices(n)[:2] for sl, n in zip(hole, shape, strict=True)]
-        sets = [(1.0, full, full), (-1.0, full, tile), (-1.0, tile, full), (1.0, tile, tile)]
-    den = np.zeros(tuple(lg.size for lg in lags))
-    for sign, a, b in sets:
-        term = overlap(a[0], b[0], lags[0]).astype(float)
-        for k in range(1, len(shape)):
-            term = np.multiply.outer(term, overlap(a[k], b[k], lags[k]))
-        den += sign * term
-    return den
-
-
-def _correlate_window(a: NDArray, shape: list[int], max_lag: tuple[int, ...]) -> NDArray:
-    """Zero-padded circular autocorrelation of ``a`` at lags ``-max_lag..max_lag``.
-
-    ``IFFT |FFT a|^2`` with the power formed in place in the spectrum, so that the padded
-    transform is held once (plus its inverse), not in several temporary copies.
-    """
-    axes = tuple(range(a.ndim))
-    f = sfft.rfftn(a, shape, axes=axes)
-    re, im = f.real, f.imag
-    np.square(re, out=re)
-    np.square(im, out=im)
-    re += im
-    im[...] = 0.0
-    r = sfft.irfftn(f, shape, axes=axes, overwrite_x=True)
-    del f, re, im
-    idx = np.ix_(*[np.r_[s - lag : s, 0 : lag + 1] for s, lag in zip(shape, max_lag, strict=True)])
-    return r[idx]
-
-
-def _crossing(r: NDArray, step: float) -> float:
-    """First 1/e crossing of a 1-D ACF starting at lag 0 (linear interpolation) [m]."""
-    below = np.nonzero(~(r > _INV_E))[0]
-    if below.size == 0 or below[0] == 0:
-        return float("nan")
-    i = below[0]
-    r0, r1 = r[i - 1], r[i]
-    if not np.isfinite(r1):
-        return float("nan")
-    return float((i - 1 + (r0 - _INV_E) / (r0 - r1)) * step)
-
-
-def _fit_acf(r: NDArray, step: float, c0: float) -> dict[str, float]:
-    """Least-squares Gaussian and exponential ACF models on lags where rho > 0.05."""
-    out = {}
-    if not np.isfinite(c0):
-        return {"gaussian": float("nan"), "exponential": float("nan")} | {
-            "rms_gaussian": float("nan"),
-            "rms_exponential": float("nan"),
-        }
-    stop = np.nonzero(~(r > 0.05))[0]
-    n = int(stop[0]) if stop.size else r.size
-    n = max(n, 3)
-    tau = np.arange(n) * step
-    rr = r[:n]
-    models = {
-        "gaussian": lambda c: np.exp(-((tau / c) ** 2)),
-        "exponential": lambda c: np.exp(-tau / c),
-    }
-    for name, f in models.items():
-        res = optimize.minimize_scalar(
-            lambda lc, f=f: float(np.sum((f(np.exp(lc)) - rr) ** 2)),
-            bounds=(math.log(c0) - 3, math.log(c0) + 3),
-            method="bounded",
-            options={"xatol": 1e-10},
-        )
-        out[name] = float(np.exp(res.x))
-        out["rms_" + name] = float(np.sqrt(res.fun / n))
-    return out
-
-
-def _ks_sorted(xs: NDArray, cdf: Any) -> float:
-    """Two-sided KS distance sup|F_n - F| of sorted samples to the CDF ``cdf``.
-
-    Walked in blocks of :data:`_CHUNK` samples, so that no array of the sample's size
-    beyond ``xs`` itself is made.
-    """
-    n = xs.size
-    d = -np.inf
-    for a in range(0, n, _CHUNK):
-        f = cdf(xs[a : a + _CHUNK])
-        i = np.arange(a, a + f.size, dtype=float)
-        d = max(d, float(np.max((i + 1) / n - f)), float(np.max(f - i / n)))
-    return float(d)
-
-
-def _shape_stats(x: NDArray) -> tuple[float, float, float]:
-    """Skewness, kurtosis (3 for a Gaussian) and KS distance to the Gaussian.
-
-    The moment estimators of :func:`scipy.stats.skew` and :func:`scipy.stats.kurtosis`
-    (biased, ``m3 / m2^1.5`` and ``m4 / m2^2``), formed with two temporaries.
-    """
-    s = x.std() if x.size >= 3 else 0.0
-    if s == 0:
-        return float("nan"), float("nan"), float("nan")
-    d = x - x.mean()
-    d2 = d * d
-    m2 = float(np.mean(d2))
-    m3 = float(np.dot(d2, d)) / x.size
-    m4 = float(np.dot(d2, d2)) / x.size
-    del d2
-    d /= s  # standardised: the KS distance to N(0, 1)
-    d.sort()
-    return m3 / m2**1.5, m4 / m2**2, _ks_sorted(d, special.ndtr)
-
-
-# ------------------------------------------------------------------ slope-space fits
-@dataclass(frozen=True)
-class SlopeFit:
-    """Maximum-likelihood fit of one slope distribution.
-
-    Attributes
-    ----------
-    model : str
-        ``"ggx"`` or ``"beckmann"``.
-    alpha : float
-        Roughness [1].
-    alpha_u : float
-        Standard uncertainty [1] (observed Fisher information for independent slopes; the
-        block jackknife when fitted inside :func:`roughness_statistics`).
-    loglik : float
-        Log-likelihood at the optimum (densities in slope space).
-    aic : float
-        ``2 k - 2 loglik`` with k = 1.
-    ks : float
-        KS distance of the radial slope |s| (2-D) or of the slope (profile) [1].
-    n : int
-        Number of slopes.
-    """
-
-    model: str
-    alpha: float
-    alpha_u: float
-    loglik: float
-    aic: float
-    ks: float
-    n: int
-
-
-@dataclass(frozen=True)
-class SlopeFits:
-    """The fits of every registered distribution to one slope sample.
-
-    Attributes
-    ----------
-    fits : dict of str to SlopeFit
-        One fit per name of :data:`labbrdf.microfacet.registry.DISTRIBUTIONS`, in registry order;
-        also readable as attributes (``fits.ggx``, ``fits.beckmann``).
-    best : str
-        The name with the smallest AIC (the first of equal ones).
-    warning : str or None
-        Set when no distribution describes the slopes (every KS distance above
-        ``ks_threshold``).
-    ks_threshold : float
-        :data:`KS_WARN`.
-    """
-
-    fits: dict[str, SlopeFit]
-    best: str
-    warning: str | None
-    ks_threshold: float = KS_WARN
-
-    def __getattr__(self, name: str) -> SlopeFit:
-        fits = self.__dict__.get("fits", {})
-        if name in fits:
-            return fits[name]
-        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-safe dict: one entry per distribution, then best, warning, ks_threshold."""
-        d: dict[str, Any] = {name: asdict(fit) for name, fit in self.fits.items()}
-        d.update(best=self.best, warning=self.warning, ks_threshold=self.ks_threshold)
-        return jsonable(d)
-
-
-def _fit_core(x: NDArray, y: NDArray | None) -> dict[str, float]:
-    """ML alphas, log-likelihoods and KS distances (no uncertainties) of every distribution.
-
-    Keys ``"<name>_alpha"``, ``"<name>_loglik"``, ``"<name>_ks"`` and ``"<name>_s"``
-    (``s = alpha^2``) for each name of :data:`labbrdf.microfacet.registry.DISTRIBUTIONS`.
-
-    Raises
-    ------
-    ValueError
-        All slopes are zero (a map without roughness at the pixel scale).
-    """
-    n = x.size
-    areal = y is not None
-    q = x * x
-    if y is not None:
-        q += y * y
-    s = {name: dist.ml_s(q, areal) for name, dist in DISTRIBUTIONS.items()}
-    _check_slopes(s)
-    ll = {name: dist.log_likelihood(q, s[name], n, areal) for name, dist in DISTRIBUTIONS.items()}
-    if areal:  # KS of the squared radial slope
-        q.sort()
-        sample = q
-    else:  # KS of the slope itself
-        del q
-        sample = np.sort(x)
-    out: dict[str, float] = {}
-    for name, dist in DISTRIBUTIONS.items():
-        out[name + "_alpha"] = math.sqrt(s[name])
-        out[name + "_loglik"] = ll[name]
-        out[name + "_ks"] = _ks_sorted(sample, dist.ks_cdf(s[name], areal))
-        out[name + "_s"] = s[name]
-    return out
-
-
-def _check_slopes(s: dict[str, float]) -> None:
-    if not all(v > 0 for v in s.values()):
-        raise ValueError("all slopes are zero: the heights do not change between pixels")
-
-
-def _fisher_u(x: NDArray, y: NDArray | None, core: dict[str, float]) -> dict[str, float]:
-    """Observed-information standard uncertainties of the ML alphas (independent slopes)."""
-    n = x.size
-    q = x * x + (y * y if y is not None else 0.0)
-    out = {}
-    for name, dist in DISTRIBUTIONS.items():
-        s = core[name + "_s"]
-        j = dist.fisher_information(q, s, n, y is not None)
-        # alpha = sqrt(s): u(alpha) = u(s) / (2 alpha)
-        out[name] = (1.0 / math.sqrt(j)) / (2 * math.sqrt(s)) if j > 0 else float("nan")
-    return out
-
-
-def _make_fits(core: dict[str, float], u: dict[str, float], n: int) -> SlopeFits:
-    fits = {}
-    for m in DISTRIBUTIONS:
-        ll = core[m + "_loglik"]
-        fits[m] = SlopeFit(m, core[m + "_alpha"], u[m], ll, 2.0 - 2.0 * ll, core[m + "_ks"], n)
-    best = next(iter(fits))
-    for m in fits:  # the first of the smallest AIC
-        if not fits[best].aic <= fits[m].aic:
-            best = m
-    warning = None
-    if min(f.ks for f in fits.values()) > KS_WARN:
-        each = " nor ".join(f"{DISTRIBUTIONS[m].LABEL} (KS {f.ks:.3f})" for m, f in fits.items())
-        warning = (
-            f"neither {each} describes the slope distribution: "
-            f"{'both' if len(fits) == 2 else 'all'} KS distances exceed {KS_WARN}"
-        )
-    return SlopeFits(fits, best, warning)
-
-
-def fit_slope_distribution(x: ArrayLike, y: ArrayLike | None = None) -> SlopeFits:
-    """Fit GGX and Beckmann alphas to slopes by maximum likelihood.
-
-    Parameters
-    ----------
-    x : array_like
-        Slopes dz/dx [1].
-    y : array_like, optional
-        Slopes dz/dy [1] at the same points; without them the 1-D marginal densities are
-        fitted (a profile; the alpha then assumes an isotropic surface).
-
-    Returns
-    -------
-    SlopeFits
-        Both fits with observed-Fisher uncertainties (valid for independent slopes),
-        log-likelihood, AIC, KS distance; ``warning`` when both KS distances exceed
-        :data:`KS_WARN`.
-
-    Notes
-    -----
-    Slope-space densities (Walter et al. 2007; Heitz 2014, sec. 5.2):
-    GGX ``P22 = 1 / (pi a^2 (1 + r^2/a^2)^2)``, Beckmann ``P22 = exp(-r^2/a^2)/(pi a^2)``,
-    r^2 = x^2 + y^2. Their x marginals are ``1 / (2 a (1 + x^2/a^2)^(3/2))`` and
-    ``exp(-x^2/a^2) / (sqrt(pi) a)``. With s = a^2 the score equations are
-    ``mean(s/(s + r^2)) = 1/2`` (GGX 2-D), ``= 2/3`` (GGX 1-D), ``s = mean(r^2)``
-    (Beckmann 2-D), ``s = 2 mean(x^2)`` (Beckmann 1-D). GGX has infinite slope variance,
-    so its alpha is not a moment; the ML fit is what defines it.
-    """
-    xa = np.asarray(x, dtype=float).ravel()
-    ya = None if y is None else np.asarray(y, dtype=float).ravel()
-    ok = np.isfinite(xa) if ya is None else np.isfinite(xa) & np.isfinite(ya)
-    xa = xa[ok]
-    ya = None if ya is None else ya[ok]
-    if xa.size < 2 or not np.any(xa != 0) and (ya is None or not np.any(ya != 0)):
-        raise ValueError("need at least 2 finite, not all zero slopes")
-    core = _fit_core(xa, ya)
-    return _make_fits(core, _fisher_u(xa, ya, core), xa.size)
 
 
 # ------------------------------------------------------------------------ statistics
@@ -653,41 +173,6 @@ class RoughnessStats:
 
 
 _NAN = float("nan")
-
-
-def _principal(rho: NDArray, px: tuple[float, float]) -> tuple[float, float, float, float]:
-    """c_major, c_minor, ratio and angle [deg] from the inertia tensor of rho > 1/e."""
-    centre = tuple(n // 2 for n in rho.shape)
-    inside = np.nan_to_num(rho, nan=0.0) > _INV_E
-    lab, _ = ndimage.label(inside)
-    region = lab == lab[centre]
-    ii, jj = np.nonzero(region)
-    tx = (ii - centre[0]) * px[0]
-    ty = (jj - centre[1]) * px[1]
-    wgt = rho[ii, jj]
-    inertia = np.array(
-        [
-            [np.sum(wgt * tx * tx), np.sum(wgt * tx * ty)],
-            [np.sum(wgt * tx * ty), np.sum(wgt * ty * ty)],
-        ]
-    )
-    evals, evecs = np.linalg.eigh(inertia)
-    lengths = []
-    for k in (1, 0):  # major first
-        e = evecs[:, k]
-        step = min(px)
-        nmax = int(min(rho.shape[0] // 2 * px[0], rho.shape[1] // 2 * px[1]) / step)
-        t = np.arange(nmax) * step
-        coords = np.stack([centre[0] + t * e[0] / px[0], centre[1] + t * e[1] / px[1]])
-        prof = ndimage.map_coordinates(np.nan_to_num(rho, nan=0.0), coords, order=1)
-        lengths.append(_crossing(prof, step))
-    cmaj, cmin = lengths
-    ev = evecs[:, 1]
-    ang = math.degrees(math.atan2(ev[1], ev[0]))
-    ang = (ang + 90.0) % 180.0 - 90.0
-    if ang == -90.0:
-        ang = 90.0
-    return cmaj, cmin, cmaj / cmin if cmin > 0 else _NAN, ang
 
 
 def _core(
@@ -802,105 +287,11 @@ def _tiles(valid: NDArray, blocks: int) -> list[tuple[slice, ...]]:
     return [t for t in cand if valid[t].any()]
 
 
-def s_filter(
-    heights: ArrayLike,
-    pixel_size: float | ArrayLike,
-    cutoff: float,
-    mask: ArrayLike | None = None,
-) -> NDArray:
-    """Gaussian S-filter (ISO 16610-61): remove wavelengths shorter than ``cutoff``.
-
-    Parameters
-    ----------
-    heights : array_like, 1-D or 2-D
-        Heights [m]; NaN (or masked) points are invalid.
-    pixel_size : float or (float, float)
-        Grid spacing [m].
-    cutoff : float
-        Short-wavelength cut-off lambda_s [m]: a sinusoid of this wavelength keeps 50 % of
-        its amplitude.
-    mask : array_like of bool, optional
-        True where a point is invalid.
-
-    Returns
-    -------
-    ndarray
-        Filtered heights [m], NaN at invalid points.
-
-    Notes
-    -----
-    ISO 16610-61 (areal; ISO 16610-21 for profiles) weights with
-    ``s(x) = exp(-pi (x / (a lambda_s))^2) / (a lambda_s)``, a = sqrt(ln 2 / pi), whose
-    transmission is ``exp(-pi (a lambda_s / lambda)^2)`` (0.5 at lambda = lambda_s). That
-    is a normal kernel of standard deviation ``a lambda_s / sqrt(2 pi)``, applied here per
-    axis by :func:`scipy.ndimage.gaussian_filter` to ``w z`` and to the valid-point
-    indicator ``w`` and divided (normalised convolution): dropouts and the map border get
-    no weight instead of the standard's end-effect corrections.
-    """
-    z, valid = _as_heights(heights, mask)
-    return _s_filter(z, valid, _pixel(pixel_size, z.ndim), cutoff)
-
-
-def _s_filter(z: NDArray, valid: NDArray, px: tuple[float, ...], cutoff: float) -> NDArray:
-    if not (math.isfinite(cutoff) and cutoff > 0):
-        raise ValueError(
-            f"short-wavelength cut-off must be positive and finite [m], got {cutoff!r}"
-        )
-    sig = [GAUSS_ALPHA * cutoff / (math.sqrt(2.0 * math.pi) * p) for p in px]
-    num = np.zeros(z.shape)
-    np.copyto(num, z, where=valid)
-    ndimage.gaussian_filter(num, sig, output=num, mode="constant", truncate=4.0)
-    den = ndimage.gaussian_filter(valid.astype(float), sig, mode="constant", truncate=4.0)
-    np.divide(num, den, out=num, where=valid)
-    num[~valid] = np.nan
-    return num
-
-
-def erode_mask(valid: ArrayLike, pixels: int) -> NDArray:
-    """Valid points farther than ``pixels`` (chessboard distance) from any invalid point.
-
-    Parameters
-    ----------
-    valid : array_like of bool
-        True at valid points.
-    pixels : int
-        Width of the band around each dropout to drop [pixels], >= 0.
-
-    Returns
-    -------
-    ndarray of bool
-        The eroded valid set (the map border is not a dropout).
-    """
-    v = np.asarray(valid, dtype=bool)
-    if not (isinstance(pixels, int | np.integer) and pixels >= 0):
-        raise ValueError(f"erode pixels must be an integer >= 0, got {pixels!r}")
-    if pixels == 0 or v.all():
-        return v.copy()
-    bad = ndimage.binary_dilation(
-        ~v, structure=np.ones((3,) * v.ndim, dtype=bool), iterations=int(pixels)
-    )
-    return v & ~bad
-
-
 def _fmt_len(v: float) -> str:
     for unit, f in (("mm", 1e-3), ("um", 1e-6), ("nm", 1e-9)):
         if abs(v) >= f:
             return f"{v / f:.4g} {unit}"
     return f"{v / 1e-12:.4g} pm"
-
-
-def _eroded(valid: NDArray, erode: int) -> tuple[NDArray, int]:
-    """The valid points after :func:`erode_mask` by ``erode`` pixels, and how many it dropped."""
-    if not valid.any():
-        raise ValueError("heights hold no valid (finite, unmasked) point")
-    if not erode:
-        return valid, 0
-    n_before = int(np.count_nonzero(valid))
-    valid = erode_mask(valid, erode)
-    n_eroded = n_before - int(np.count_nonzero(valid))
-    if not valid.any():
-        raise ValueError(f"eroding the mask by {erode} pixels leaves no valid point")
-    return valid, n_eroded
 
 
 def _jackknife(

@@ -26,7 +26,8 @@ from numpy.typing import NDArray
 from ..adapters.topography import HeightMap, read_height_map
 from ..errors import SampleError, SetupError, escaped
 from ..microfacet import DISTRIBUTIONS, TabulatedNDF
-from ..roughness.topography import SlopeFit, fit_slope_distribution, level, slopes
+from ..roughness.levelling import level
+from ..roughness.slope_fits import SlopeFit, fit_slope_distribution, slopes
 from ..tracer.config import Substrate
 
 __all__ = [
@@ -135,13 +136,13 @@ def roughness_alpha(
     pixel_size : float or (float, float)
         Grid spacing [m] (not needed for a HeightMap).
     degree : int
-        Levelling polynomial (1 = mean plane), :func:`labbrdf.roughness.topography.level`.
+        Levelling polynomial (1 = mean plane), :func:`labbrdf.roughness.levelling.level`.
 
     Returns
     -------
     SlopeFit
         ``alpha`` and its uncertainty ``alpha_u`` [1] (the GGX fit of
-        :func:`labbrdf.roughness.topography.fit_slope_distribution`, the alpha that
+        :func:`labbrdf.roughness.slope_fits.fit_slope_distribution`, the alpha that
         :meth:`labbrdf.Substrate.from_surface` gives the tracer).
 
     Raises

@@ -390,13 +390,14 @@ def test_gaussian_map_gets_no_dropout_or_pixel_notes():
 
 
 def test_progress_reports_every_pass_and_chunking_leaves_results_unchanged(monkeypatch):
-    import labbrdf.roughness.topography as T
+    from labbrdf.roughness import levelling, slope_fits
 
     z = gaussian_surface(96, 96e-6, 1e-7, 5e-6, rng=3).z
     calls = []
     a = roughness_statistics(z, 1e-6, blocks=3, progress=lambda i, n: calls.append((i, n)))
     assert calls == [(i, 10) for i in range(1, 11)]
-    monkeypatch.setattr(T, "_CHUNK", 1000)  # many row blocks in levelling and KS
+    monkeypatch.setattr(levelling, "_CHUNK", 1000)  # many row blocks in levelling
+    monkeypatch.setattr(slope_fits, "_CHUNK", 1000)  # and in the KS distances
     b = roughness_statistics(z, 1e-6, blocks=3)
     for k in ("sigma", "c", "slope_rms", "alpha_ggx_ml", "alpha_gaussian_acf", "height_ks"):
         assert getattr(b, k) == pytest.approx(getattr(a, k), rel=1e-9)
@@ -451,7 +452,7 @@ def test_pair_counts_of_a_grid_minus_a_tile_equal_the_fft_counts(shape, hole):
     those the FFT of the indicator gives, so rho is the same to round-off."""
     from scipy import fft as sfft
 
-    from labbrdf.roughness.topography import _correlate_window, _rect_pair_counts
+    from labbrdf.roughness.acf import _correlate_window, _rect_pair_counts
 
     v = np.ones(shape, bool)
     v[hole] = False

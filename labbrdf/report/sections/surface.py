@@ -4,7 +4,7 @@ User report (:func:`surface_section`): one part per height map read at ingest
 (:func:`ingest_height_maps`: the profilometer, AFM or interferometer files among the inputs,
 which :func:`labbrdf.adapters.read_inputs` tells from optical exports and reads through
 SurfaceTopography, :mod:`labbrdf.adapters.topography`): the levelled map, its
-autocorrelation and slope histogram with the GGX and Beckmann fits; the roughness
+autocorrelation and slope histogram with the fit of each distribution; the roughness
 statistics of :func:`labbrdf.roughness.topography.roughness_statistics` with their block-jackknife
 uncertainties; and, for an areal map, tracer S0 and DOP hemisphere maps of a substrate whose
 facets follow the *measured* slope distribution (:func:`labbrdf.sample.measured_substrate`)
@@ -287,8 +287,8 @@ def _statistics_parts(b: Builder, name: str, sid: str, hm: HeightMap, st: Any) -
         "scale: 0.5 to 99.5 percentiles, arrows = beyond). Middle: "
         "normalised ACF along the axes, with the 1/e level that defines the "
         "correlation lengths. Right: the measured slope magnitude |grad z| (areal "
-        "map) or dz/dx (profile) with the densities of the maximum-likelihood GGX "
-        "(solid) and Beckmann (dashed) fits; KS = Kolmogorov-Smirnov distance.",
+        "map) or dz/dx (profile) with the densities of the maximum-likelihood fit of "
+        "each distribution (the legend names them); KS = Kolmogorov-Smirnov distance.",
         figures.surface_figure(z, hm.pixel_size, st, title=f"{name} ({hm.channel})"),
     )
     b.table(
@@ -309,7 +309,7 @@ def _statistics_parts(b: Builder, name: str, sid: str, hm: HeightMap, st: Any) -
     )
     b.table(
         f"surface_fits_{sid}",
-        f"{name}: GGX and Beckmann fits to the slopes",
+        f"{name}: fits of the microfacet distributions to the slopes",
         [
             ("model", "model", ""),
             ("alpha", "alpha (ML) [1]", ".4g"),
