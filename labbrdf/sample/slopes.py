@@ -25,7 +25,8 @@ from numpy.typing import NDArray
 
 from ..adapters.topography import HeightMap, read_height_map
 from ..errors import SampleError, SetupError, escaped
-from ..microfacet import DISTRIBUTIONS, TabulatedNDF
+from ..microfacet import DISTRIBUTIONS, TabulatedNDF, ggx
+from ..microfacet.interface import table_for
 from ..roughness.levelling import level
 from ..roughness.slope_fits import SlopeFit, fit_slope_distribution, slopes
 from ..tracer.config import Substrate
@@ -82,7 +83,9 @@ def pitch(hm: HeightMap) -> float | tuple[float, float]:
 def analytic_table(distribution: str, alpha: float) -> TabulatedNDF | None:
     """The slope table of an analytic distribution at ``alpha`` [1].
 
-    None for a distribution the tracer samples in closed form (GGX).
+    None for GGX, which the tracer samples in closed form; any other registered
+    distribution is traced through its slope table
+    (``labbrdf.microfacet.interface.table_for``).
 
     Raises
     ------
@@ -93,11 +96,11 @@ def analytic_table(distribution: str, alpha: float) -> TabulatedNDF | None:
         expected = " or ".join(repr(name) for name in DISTRIBUTIONS)
         raise SetupError(f"{{distribution}} {escaped(repr(distribution))}: expected {expected}")
     dist = DISTRIBUTIONS[distribution]
-    if dist.TRACED_IN_CLOSED_FORM:
-        return None
-    if not alpha > 0:
+    if dist is not ggx and not alpha > 0:
         raise SetupError(f"{{distribution}} {dist.NAME} needs a roughness alpha > 0")
-    return TabulatedNDF.of(dist, alpha)
+    # the walk's one closed form is GGX: any other distribution, closed-form or not, is
+    # traced through its slope table, never silently as GGX
+    return table_for(distribution, alpha)
 
 
 def areal(
