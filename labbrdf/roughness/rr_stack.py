@@ -56,7 +56,11 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ..films.graded import Graded
+from ..films.stack import Stack
 from .rayleigh_rice import (
+    POLARIZATIONS,
+    Polarization,
     PsdFunction,
     _angles,
     _mueller_from_jones,
@@ -66,10 +70,22 @@ from .rayleigh_rice import (
     bragg_frequencies,
 )
 
-__all__ = ["CORRELATIONS", "interface_factors", "mueller_brdf_stack", "stack_fields"]
+__all__ = [
+    "CORRELATIONS",
+    "INTERFACES",
+    "interface_factors",
+    "mueller_brdf_stack",
+    "stack_brdf",
+    "stack_fields",
+    "stack_layers",
+]
 
 #: how the interfaces' heights relate: the same heights (amplitudes add) or independent
 CORRELATIONS = ("uncorrelated", "correlated")
+
+#: which interfaces of a stack are rough (:func:`stack_brdf`): all, the same heights; all,
+#: independent heights of the same PSD; only the substrate's; only the top (ambient's)
+INTERFACES = ("correlated", "uncorrelated", "substrate", "top")
 
 Correlation = Literal["uncorrelated", "correlated"]
 
@@ -252,3 +268,76 @@ def mueller_brdf_stack(
             w = scale * _psd_at(psd, fx, fy)
             out += w[..., None, None] * _mueller_from_jones(q[..., j, :, :])
     return out
+
+
+def stack_layers(
+    stack: Stack, wavelength_nm: float
+) -> tuple[NDArray[np.complex128], NDArray[np.float64]]:
+    """A film stack's ``[1, N_1, ..., N_substrate]`` [1] and thicknesses [m] at one wavelength.
+
+    Parameters
+    ----------
+    stack : labbrdf.films.Stack
+        Coherent layers (no incoherent layer, finite substrate, thickness spread or graded
+        layer: their interfaces are not single sharp surfaces), ambient of index 1.
+    wavelength_nm : float
+        Vacuum wavelength [nm].
+
+    Raises
+    ------
+    ValueError
+        A stack this theory does not describe, naming what is wrong.
+    """
+    if not stack.coherent:
+        raise ValueError(
+            "the stack has an incoherent layer, a finite substrate or a thickness spread; "
+            "Rayleigh-Rice of rough interfaces needs coherent layers on a semi-infinite substrate"
+        )
+    graded = [lay.name for lay in stack.layers if isinstance(lay.material, Graded)]
+    if graded:
+        raise ValueError(f"graded layers {graded} have no sharp interface to be rough")
+    idx = [complex(np.asarray(n).reshape(-1)[0]) for n in stack.indices(float(wavelength_nm))]
+    if idx[0] != 1.0:
+        raise ValueError(f"the stack's ambient index is {idx[0]:.6g}; expected 1 (vacuum/air)")
+    d = np.array([lay.thickness_nm for lay in stack.layers], dtype=float) * 1e-9
+    return np.array(idx, dtype=complex), d
+
+
+def stack_brdf(
+    theta_i: ArrayLike,
+    theta_r: ArrayLike,
+    phi_r: ArrayLike,
+    wavelength: float,
+    indices: ArrayLike,
+    thicknesses: ArrayLike,
+    psd2d: PsdFunction,
+    interfaces: str = "correlated",
+    polarization: Polarization = "unpolarized",
+) -> NDArray[np.float64]:
+    """The BRDF [sr^-1] of a stack for one incident polarization, all scattered light.
+
+    Parameters
+    ----------
+    theta_i, theta_r, phi_r, wavelength, indices, thicknesses
+        As :func:`mueller_brdf_stack`.
+    psd2d : callable
+        The 2-D PSD [m^4] of every rough interface.
+    interfaces : {"correlated", "uncorrelated", "substrate", "top"}
+        :data:`INTERFACES`: every interface rough with the same heights, every interface
+        rough with independent heights, or only the substrate's or the top interface rough.
+    polarization : {"unpolarized", "s", "p"}
+        ``M00``, ``M00 + M01`` or ``M00 - M01`` of the Mueller BRDF (``S1 = +1`` for s).
+    """
+    if interfaces not in INTERFACES:
+        raise ValueError(f"interfaces must be one of {INTERFACES}, got {interfaces!r}")
+    if polarization not in POLARIZATIONS:
+        raise ValueError(f"polarization must be one of {POLARIZATIONS}, got {polarization!r}")
+    m_if = np.asarray(indices).size - 1
+    psds: PsdFunction | list[PsdFunction | None] = psd2d
+    corr: Correlation = "correlated" if interfaces == "correlated" else "uncorrelated"
+    if interfaces in ("substrate", "top"):
+        psds = [None] * m_if
+        psds[-1 if interfaces == "substrate" else 0] = psd2d
+    m = mueller_brdf_stack(theta_i, theta_r, phi_r, wavelength, indices, thicknesses, psds, corr)
+    sign = {"unpolarized": 0.0, "s": 1.0, "p": -1.0}[polarization]
+    return np.asarray(m[..., 0, 0] + sign * m[..., 0, 1])
