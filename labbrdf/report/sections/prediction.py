@@ -22,8 +22,9 @@ check of GGX itself: where the two predictions differ, the slope distribution ma
 
 Each measured ``.bsdf`` is first judged by the Rayleigh criterion
 (:mod:`labbrdf.report.smooth_prediction`): smooth at all its angles, it is predicted by
-Rayleigh-Rice from the height map's PSD (with the PSD recovered from the BRDF beside the
-map's) and the tracer is not run; rough, by the tracer; in between, by both.
+Rayleigh-Rice from the composite PSD of the sample's height maps (the spectrum of section
+``psd``; with the PSD recovered from the BRDF beside it), for a coated sample through its
+film fit's stack, and the tracer is not run; rough, by the tracer; in between, by both.
 
 For the tracer, the section draws
 
@@ -127,6 +128,7 @@ def sample_inputs(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, An
                 "name": g.name,
                 "reason": g.reason,
                 "height_map": hms[0],
+                "height_maps": hms,
                 "psi_delta": psi[0],
                 "film": ctx.film_fits.get(psi[0][0].name),
                 "bsdf": bs,
@@ -216,7 +218,8 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
         f"from the height map: {fit.alpha:.4g} +- {fit.alpha_u:.2g}"
         + ("; traced: the map's measured slope table." if ndf is not None else ".")
         + (
-            f" Not used (the first height map and psi/Delta file are): {', '.join(s['unused'])}."
+            f" Not used by the tracer (the first height map and psi/Delta file are): "
+            f"{', '.join(s['unused'])}; Rayleigh-Rice takes the composite PSD of all the maps."
             if s["unused"]
             else ""
         )
@@ -232,7 +235,8 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
             "|cos 2psi| is the coherent film's, while the tracer's coating is incoherent "
             "(intensities add, which depolarizes), so the two DOPs differ by construction.",
         )
-    theories = [choose_theory(ctx, hm, p, coated=film is not None) for p in s["bsdf"]]
+    stack = None if film is None else getattr(film, "stack", None)
+    theories = [choose_theory(ctx, hm, p, coated=film is not None, stack=stack) for p in s["bsdf"]]
     if film is None and all(t.choice == "rayleigh-rice" for t in theories):
         b.text(
             "The sample is smooth (below): its specular reflection is the Fresnel reflection "
@@ -253,7 +257,8 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
         if theory.choice in ("tracer", "both"):
             _tracer_brdf(ctx, sid, path, frame, fit, film, ndf)
         if theory.choice in ("rayleigh-rice", "both"):
-            rr_part(ctx, f"{sid}_{slug(path.name)}", hm, path, frame)
+            maps = s.get("height_maps") or [hm]
+            rr_part(ctx, f"{sid}_{slug(path.name)}", maps, path, frame, film)
 
 
 def _tracer_brdf(
