@@ -321,12 +321,14 @@ def _film(
             "rayleigh_rice: the film's stack gives the substrate's index; leave out n, k, "
             "free_index (and --nk-from)"
         )
+    rng: tuple[float, float] | None
     if isinstance(film, (Stack, Mapping)):  # a Stack, or its dict (the model's options)
         try:
             stack = film if isinstance(film, Stack) else Stack.from_dict(film)
         except (FilmError, ValueError) as exc:
             raise ModelError(f"rayleigh_rice option 'film': {exc}") from None
-        rng, shown = None, stack.to_dict()
+        rng = None
+        shown: Any = stack.to_dict()
     elif isinstance(film, (str, os.PathLike)):
         try:
             stack, rng = read_fit_json(film)

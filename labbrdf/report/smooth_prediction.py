@@ -44,7 +44,15 @@ from . import figures
 from .context import Context
 from .roughness import judge, map_roughness
 
-__all__ = ["FIT_FLOOR", "THEORIES", "Theory", "choose", "choose_theory", "rr_part"]
+__all__ = [
+    "FIT_FLOOR",
+    "THEORIES",
+    "Theory",
+    "choose",
+    "choose_theory",
+    "given_wavelength",
+    "rr_part",
+]
 
 #: the section's choices: Rayleigh-Rice, the microfacet tracer, or both
 THEORIES = ("rayleigh-rice", "tracer", "both")
@@ -104,6 +112,17 @@ def _why(choice: str, rows: Sequence[dict[str, Any]]) -> str:
     )
 
 
+def given_wavelength(ctx: Context, path: Path) -> float | None:
+    """The wavelength [nm] ``report --wavelength`` gave a ``.bsdf`` that states none."""
+    given = [
+        float(r["meta"]["wavelength_nm"])
+        for r in ctx.files
+        if (r.get("meta") or {}).get("wavelength_given")
+        and Path(str(r["path"])).name == Path(path).name
+    ]
+    return given[0] if given else None
+
+
 def choose_theory(
     ctx: Context, hm: Any, path: Path, *, coated: bool = False, stack: Any = None
 ) -> Theory:
@@ -118,14 +137,15 @@ def choose_theory(
     except (LabbrdfError, ValueError, OSError):
         return Theory("tracer", f"{name}: not read, so not judged by the Rayleigh criterion.")
     m = map_roughness(ctx).get(str(hm.path))
-    if t.wavelength_nm is None or m is None:
-        why = "states no wavelength" if t.wavelength_nm is None else "has no usable height map"
+    wl_file = t.wavelength_nm if t.wavelength_nm is not None else given_wavelength(ctx, path)
+    if wl_file is None or m is None:
+        why = "states no wavelength" if wl_file is None else "has no usable height map"
         return Theory(
             "tracer",
             f"{name} {why}: the Rayleigh criterion cannot be applied; the microfacet tracer's "
             "prediction is tried.",
         )
-    wl = float(t.wavelength_nm)
+    wl = float(wl_file)
     rows = tuple(judge(m, wl, float(ti)) for ti in t.theta_i_deg)
     choice = choose([r["rayleigh"] for r in rows])
     sig = [r["sigma_nm"] for r in rows if "sigma_nm" in r]
@@ -307,7 +327,9 @@ def rr_part(ctx: Context, sid: str, maps: Any, path: Path, frame: Any, film: Any
     stack = None if film is None else film.stack
     try:
         psd = group_psd(maps)
-        p = predict_rr_brdf(path, frame, psd, stack=stack)
+        p = predict_rr_brdf(
+            path, frame, psd, wavelength_nm=given_wavelength(ctx, path), stack=stack
+        )
     except (PredictionError, LabbrdfError, ValueError) as exc:
         b.note(f"{name}: no Rayleigh-Rice prediction", str(exc))
         return
