@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -172,3 +173,17 @@ def test_a_sample_in_between_gets_both_and_the_page_says_where(prediction_sets, 
     texts = [it["text"] for it in sec["items"] if it["kind"] == "text"]
     assert any("the film fit's stack (top first: coat 100 nm, 1.46" in t for t in texts)
     assert any("the stack fixed as above" in t for t in texts)
+
+
+def test_the_wavelength_given_to_the_report_is_taken_for_a_bsdf_that_states_none():
+    from types import SimpleNamespace
+
+    from labbrdf.report.smooth_prediction import given_wavelength
+
+    files = [
+        {"path": "/d/x.bsdf", "meta": {"wavelength_given": True, "wavelength_nm": 633.0}},
+        {"path": "/d/y.bsdf", "meta": {"wavelength_nm": 555.0}},
+    ]
+    ctx: Any = SimpleNamespace(files=files)
+    assert given_wavelength(ctx, Path("/e/x.bsdf")) == 633.0
+    assert given_wavelength(ctx, Path("/d/y.bsdf")) is None
