@@ -374,7 +374,7 @@ class PsdAgreement:
     form : str
         The fitted PSD form.
     source : str
-        The height map's file.
+        The height maps' files (comma separated).
     """
 
     f: NDArray[np.float64]
@@ -420,7 +420,8 @@ class PsdAgreement:
 
         fig = Figure(figsize=(5.5, 3.8)) if ax is None else ax.figure
         ax = fig.add_subplot(1, 1, 1) if ax is None else ax
-        ax.loglog(self.f, self.psd_map, "o", ms=3, label=f"height map ({Path(self.source).name})")
+        names = ", ".join(Path(x.strip()).name for x in self.source.split(","))
+        ax.loglog(self.f, self.psd_map, "o", ms=3, label=f"height maps ({names})")
         ax.loglog(self.f, self.psd_brdf, "-", label=f"from the BRDF ({self.form} fit)")
         ax.set_xlabel("spatial frequency f [cycles/m]")
         ax.set_ylabel("isotropic 2-D PSD [m$^4$]")

@@ -185,7 +185,8 @@ def prediction_section(ctx: Context, *, slopes: str = "ggx") -> None:
         "single scattering is closed form and has none). Which theory predicts each measured "
         "BRDF is chosen by the Rayleigh criterion of section smoothness at the file's "
         "wavelength and angles: a smooth sample is predicted by Rayleigh-Rice (first-order "
-        "perturbation theory) from its height map's PSD instead of the tracer, a sample in "
+        "perturbation theory) from the composite PSD of its height maps (section psd's), "
+        "through its film fit's stack where it has one, instead of the tracer, a sample in "
         "between by both (docs/rayleigh-rice.md)."
     )
     if lacking:
