@@ -259,6 +259,7 @@ def predict_rr_brdf(
     wavelength_nm: float | None = None,
     substrate_index: complex | None = None,
     stack: Stack | None = None,
+    stack_range: tuple[float, float] | None = None,
 ) -> RrPrediction:
     """The Rayleigh-Rice BRDF (unpolarized) at every point of a measured ``.bsdf``.
 
@@ -279,6 +280,9 @@ def predict_rr_brdf(
         A coated sample's film stack (a film fit's): its layers and substrate replace the
         psi/Delta's n, k, and every interface carries the map's roughness, correlated (a
         conformal coating: :func:`labbrdf.roughness.rr_stack.stack_brdf`).
+    stack_range : (float, float), optional
+        The wavelengths [nm] the film fit was made over; a ``.bsdf`` outside them is
+        refused (a dispersion model is not extrapolated beyond the data that fixed it).
 
     Raises
     ------
@@ -287,6 +291,13 @@ def predict_rr_brdf(
         with several rotations or channels).
     """
     t, path, wl = _checked_table(bsdf, wavelength_nm)
+    if stack is not None and stack_range is not None:
+        lo, hi = stack_range
+        if not lo <= wl <= hi:
+            raise PredictionError(
+                f"{path}: {wl:g} nm lies outside the film fit's wavelengths {lo:g}-{hi:g} nm; "
+                "expected a film fit that covers the BRDF's wavelength"
+            )
     layers, coating = _layers(stack, wl, path)
     if layers is not None:
         index = complex(layers[0][-1])

@@ -157,3 +157,5 @@ def test_a_coated_sample_is_predicted_through_its_stack(tmp_path):
     slab = films.Stack(stack.layers, sub, substrate_thickness_nm=1e6)
     with pytest.raises(PredictionError, match="coated.bsdf: the film stack: .*coherent"):
         predict_rr_brdf(bsdf, None, psd, stack=slab)
+    with pytest.raises(PredictionError, match="633 nm lies outside the film fit's wavelengths"):
+        predict_rr_brdf(bsdf, None, psd, stack=stack, stack_range=(700.0, 900.0))

@@ -325,10 +325,20 @@ def rr_part(ctx: Context, sid: str, maps: Any, path: Path, frame: Any, film: Any
     name = Path(path).name
     maps = list(maps) if isinstance(maps, (list, tuple)) else [maps]
     stack = None if film is None else film.stack
+    data = getattr(film, "data", None)
+    span = None
+    if data is not None and "wavelength_nm" in data and len(data):
+        w = np.asarray(data["wavelength_nm"], float)
+        span = (float(np.nanmin(w)), float(np.nanmax(w)))
     try:
         psd = group_psd(maps)
         p = predict_rr_brdf(
-            path, frame, psd, wavelength_nm=given_wavelength(ctx, path), stack=stack
+            path,
+            frame,
+            psd,
+            wavelength_nm=given_wavelength(ctx, path),
+            stack=stack,
+            stack_range=span,
         )
     except (PredictionError, LabbrdfError, ValueError) as exc:
         b.note(f"{name}: no Rayleigh-Rice prediction", str(exc))
