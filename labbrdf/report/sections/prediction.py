@@ -219,9 +219,14 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
         f"from the height map: {fit.alpha:.4g} +- {fit.alpha_u:.2g}"
         + ("; traced: the map's measured slope table." if ndf is not None else ".")
         + (
-            f" Not used by the tracer (the first height map and psi/Delta file are): "
-            f"{', '.join(s['unused'])}; Rayleigh-Rice takes the composite PSD of all the maps."
+            f" Not used (the first height map and psi/Delta file are): {', '.join(s['unused'])}."
             if s["unused"]
+            else ""
+        )
+        + (
+            " Rayleigh-Rice, where it applies, takes the composite PSD of all "
+            f"{len(s['height_maps'])} height maps."
+            if len(s.get("height_maps", ())) > 1
             else ""
         )
     )
