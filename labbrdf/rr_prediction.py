@@ -5,11 +5,15 @@ sample that is smooth by the Rayleigh criterion (:mod:`labbrdf.roughness.smoothn
 first-order perturbation theory says (:mod:`labbrdf.roughness.rayleigh_rice`): its BRDF at
 every point of a measured ``.bsdf`` follows, with **no fitted parameter**, from
 
-* the isotropic 2-D PSD of its height map (:func:`map_psd`: SurfaceTopography's
-  ``power_spectrum_from_area`` of the plane-levelled map, Hann window; the PSD is taken as
-  0 outside the map's band, from ``1 / size`` to the Nyquist frequency ``1 / (2 pixel)``,
-  and the points whose Bragg frequency lies outside it are counted, not guessed);
-* the substrate's n, k from the sample's psi/Delta (:func:`labbrdf.prediction.substrate_nk`).
+* the isotropic 2-D PSD of its height maps (:func:`group_psd`: the composite that
+  :func:`labbrdf.psd` and the report's PSD section compute, SurfaceTopography's periodogram
+  of each plane-levelled map with a Hann window, joined over the union of the maps' bands;
+  the PSD is taken as 0 outside the band, from ``1 / size`` of the largest map to the
+  Nyquist frequency ``1 / (2 pixel)`` of the finest, and in any gap between maps, and the
+  points whose Bragg frequency lies there are counted, not guessed);
+* the substrate's n, k from the sample's psi/Delta (:func:`labbrdf.prediction.substrate_nk`),
+  or, for a coated sample, the film fit's stack, whose interfaces all carry the map's
+  roughness (correlated: a conformal coating, :mod:`labbrdf.roughness.rr_stack`).
 
 Prediction and measurement are integrated by the same grid rule
 (:func:`labbrdf.integrate.grid_integral`), so their TIS compare like with like.
@@ -19,7 +23,8 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -30,15 +35,20 @@ from numpy.typing import ArrayLike, NDArray
 from .adapters import zemax_bsdf
 from .adapters.topography import HeightMap
 from .bsdf_geometry import scatter_to_angles
+from .errors import LabbrdfError
+from .films.stack import Stack
 from .integrate import grid_integral
 from .prediction import PredictionError, _checked_table, substrate_nk
+from .roughness.psd import Spectrum
 from .roughness.rayleigh_rice import bragg_frequencies, brdf
+from .roughness.rr_stack import stack_brdf, stack_layers
 
 __all__ = [
     "MapPsd",
     "PsdAgreement",
     "RrPrediction",
     "bragg_band",
+    "group_psd",
     "map_psd",
     "predict_rr_brdf",
     "psd_agreement",
@@ -47,7 +57,7 @@ __all__ = [
 
 @dataclass(frozen=True)
 class MapPsd:
-    """The isotropic 2-D PSD of a height map.
+    """The isotropic 2-D PSD of a sample's height maps (one map, or their composite).
 
     Attributes
     ----------
@@ -56,9 +66,16 @@ class MapPsd:
     psd : ndarray
         Azimuthally averaged 2-D PSD [m^4] (``sigma^2 = integral PSD 2 pi f df``).
     f_min, f_max : float
-        The map's band [cycles/m]: ``1 / size`` to ``1 / (2 pixel)``.
+        The band [cycles/m]: ``1 / size`` of the largest map to ``1 / (2 pixel)`` of the
+        finest.
     source : str
-        The height map's file.
+        The height maps' files (comma separated).
+    gaps : tuple of (float, float)
+        Frequency ranges [cycles/m] inside the band that no map covers (PSD 0 there).
+    spectrum : Spectrum, optional
+        The :func:`labbrdf.psd` composite it was made from (its band sigma is used).
+    notes : tuple of str
+        The composite's members and overlaps (:func:`labbrdf.roughness.psd.composite`).
     """
 
     f: NDArray[np.float64]
@@ -66,64 +83,105 @@ class MapPsd:
     f_min: float
     f_max: float
     source: str
+    gaps: tuple[tuple[float, float], ...] = ()
+    spectrum: Spectrum | None = field(default=None, repr=False)
+    notes: tuple[str, ...] = ()
 
     def sigma(self, f_lo: float | None = None, f_hi: float | None = None) -> float:
-        """RMS height [m] of the PSD over ``[f_lo, f_hi]`` (default the band), trapezoid in f."""
+        """RMS height [m] of the PSD over ``[f_lo, f_hi]`` (default the band).
+
+        The composite's :meth:`~labbrdf.roughness.psd.Spectrum.band_sigma` (a single map's
+        unbinned periodogram; bins by the trapezoid rule for several, gaps left out), the
+        number the PSD section states; else the trapezoid rule over the bins.
+        """
         lo = self.f_min if f_lo is None else max(f_lo, self.f_min)
         hi = self.f_max if f_hi is None else min(f_hi, self.f_max)
         if not lo < hi:
             return 0.0
+        if self.spectrum is not None:
+            return self.spectrum.band_sigma(lo, hi)
         f = np.concatenate([[lo], self.f[(self.f > lo) & (self.f < hi)], [hi]])
         y = self._interp(f) * 2.0 * math.pi * f
         return float(math.sqrt(max(np.trapezoid(y, f), 0.0)))
 
+    def covers(self, f: ArrayLike) -> NDArray[np.bool_]:
+        """Whether a map resolves each frequency [cycles/m]: in the band, in no gap."""
+        f = np.asarray(f, float)
+        inside = (f >= self.f_min) & (f <= self.f_max)
+        for lo, hi in self.gaps:
+            inside &= ~((f > lo) & (f < hi))
+        return np.asarray(inside)
+
     def _interp(self, f: NDArray) -> NDArray[np.float64]:
         """Log-log interpolation inside the band (end values held to its edges), 0 outside."""
         f = np.asarray(f, float)
-        inside = (f >= self.f_min) & (f <= self.f_max)
         lf = np.log(np.clip(f, self.f[0], self.f[-1]))
         v = np.exp(np.interp(lf, np.log(self.f), np.log(self.psd)))
-        return np.where(inside, v, 0.0)
+        return np.where(self.covers(f), v, 0.0)
 
     def psd2d(self, fx: NDArray, fy: NDArray) -> NDArray[np.float64]:
         """``PSD2(fx, fy)`` [m^4] of the isotropic PSD, 0 outside the map's band."""
         return self._interp(np.hypot(fx, fy))
 
 
-def map_psd(hm: HeightMap) -> MapPsd:
-    """The isotropic PSD of an areal height map (module docstring).
+def group_psd(maps: Sequence[HeightMap]) -> MapPsd:
+    """The composite isotropic PSD of one sample's areal height maps (module docstring).
+
+    The same spectrum as ``labbrdf psd MAP...`` and the report's PSD section
+    (:func:`labbrdf.roughness.psd_result.psd`, 2-D, its default levelling, window and bins).
 
     Raises
     ------
     PredictionError
-        A profile, or a map with undefined points (SurfaceTopography's area PSD needs them
-        all), or one with no positive PSD value.
+        No map, a profile, a map with undefined points (the area PSD needs them all), or
+        no positive PSD value.
     """
-    from SurfaceTopography import Topography
+    from .roughness.psd_result import psd
 
-    z = np.asarray(hm.heights, float)
-    if z.ndim != 2:
-        raise PredictionError(f"{hm.path}: a profile; the PSD prediction needs an areal map")
-    if not np.isfinite(z).all():
-        raise PredictionError(
-            f"{hm.path}: {int((~np.isfinite(z)).sum())} undefined points; the area PSD needs "
-            "a complete map"
-        )
-    sizes = tuple(n * p for n, p in zip(z.shape, hm.pixel_size, strict=True))
-    topo = Topography(z, physical_sizes=sizes).detrend(detrend_mode="height")
-    q, c = topo.power_spectrum_from_area(window="hann", nb_points_per_decade=10)
-    q, c = np.ma.filled(q, np.nan), np.ma.filled(c, np.nan)
-    ok = np.isfinite(q) & np.isfinite(c) & (c > 0) & (q > 0)
+    if not maps:
+        raise PredictionError("no height map for the PSD")
+    for hm in maps:
+        z = np.asarray(hm.heights, float)
+        if z.ndim != 2:
+            raise PredictionError(f"{hm.path}: a profile; the PSD prediction needs an areal map")
+        if not np.isfinite(z).all():
+            raise PredictionError(
+                f"{hm.path}: {int((~np.isfinite(z)).sum())} undefined points; the area PSD "
+                "needs a complete map"
+            )
+    try:
+        res = psd(list(maps), kind="2d")
+    except (LabbrdfError, ValueError) as exc:
+        raise PredictionError(str(exc)) from None
+    comp = res.composite
+    ok = np.isfinite(comp.f) & np.isfinite(comp.psd) & (comp.psd > 0) & (comp.f > 0)
     if not ok.any():
-        raise PredictionError(f"{hm.path}: no positive PSD value")
-    f = q[ok] / (2.0 * math.pi)
+        raise PredictionError(f"{', '.join(str(hm.path) for hm in maps)}: no positive PSD value")
     return MapPsd(
-        f=f,
-        psd=c[ok],
-        f_min=1.0 / max(sizes),
-        f_max=1.0 / (2.0 * max(hm.pixel_size)),
-        source=str(hm.path),
+        f=comp.f[ok],
+        psd=comp.psd[ok],
+        f_min=float(comp.band[0]),
+        f_max=float(comp.band[1]),
+        source=", ".join(str(hm.path) for hm in maps),
+        gaps=_gaps([s.band for s in res.spectra]),
+        spectrum=comp,
+        notes=tuple(comp.notes),
     )
+
+
+def _gaps(bands: Sequence[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
+    """The ranges inside the union of the bands that no band covers."""
+    out, reach = [], 0.0
+    for lo, hi in sorted(bands):
+        if reach and lo > reach:
+            out.append((reach, lo))
+        reach = max(reach, hi)
+    return tuple(out)
+
+
+def map_psd(hm: HeightMap) -> MapPsd:
+    """The isotropic PSD of one areal height map: :func:`group_psd` of ``[hm]``."""
+    return group_psd([hm])
 
 
 @dataclass
@@ -149,6 +207,8 @@ class RrPrediction:
     tis_predicted: NDArray[np.float64]
     band_measured: NDArray[np.float64]
     band_predicted: NDArray[np.float64]
+    #: the film stack's layers (``name d nm, n + ik``, top first) of a coated sample, or ""
+    coating: str = ""
 
     def table(self) -> pd.DataFrame:
         """Per incidence: both grid TIS, their ratio, how many points the map's band sees."""
@@ -198,6 +258,8 @@ def predict_rr_brdf(
     *,
     wavelength_nm: float | None = None,
     substrate_index: complex | None = None,
+    stack: Stack | None = None,
+    stack_range: tuple[float, float] | None = None,
 ) -> RrPrediction:
     """The Rayleigh-Rice BRDF (unpolarized) at every point of a measured ``.bsdf``.
 
@@ -214,6 +276,13 @@ def predict_rr_brdf(
         Default: the one the file states.
     substrate_index : complex, optional
         ``n + ik`` instead of the psi/Delta's.
+    stack : labbrdf.films.Stack, optional
+        A coated sample's film stack (a film fit's): its layers and substrate replace the
+        psi/Delta's n, k, and every interface carries the map's roughness, correlated (a
+        conformal coating: :func:`labbrdf.roughness.rr_stack.stack_brdf`).
+    stack_range : (float, float), optional
+        The wavelengths [nm] the film fit was made over; a ``.bsdf`` outside them is
+        refused (a dispersion model is not extrapolated beyond the data that fixed it).
 
     Raises
     ------
@@ -222,7 +291,17 @@ def predict_rr_brdf(
         with several rotations or channels).
     """
     t, path, wl = _checked_table(bsdf, wavelength_nm)
-    if substrate_index is None:
+    if stack is not None and stack_range is not None:
+        lo, hi = stack_range
+        if not lo <= wl <= hi:
+            raise PredictionError(
+                f"{path}: {wl:g} nm lies outside the film fit's wavelengths {lo:g}-{hi:g} nm; "
+                "expected a film fit that covers the BRDF's wavelength"
+            )
+    layers, coating = _layers(stack, wl, path)
+    if layers is not None:
+        index = complex(layers[0][-1])
+    elif substrate_index is None:
         if data is None:
             raise PredictionError(f"{path}: give the psi/Delta rows or the substrate index")
         nk: dict[str, Any] = substrate_nk(data, [wl])
@@ -238,8 +317,12 @@ def predict_rr_brdf(
     args = (np.radians(tib), np.radians(trs), np.radians(pr))
     fx, fy = bragg_frequencies(*args, lam)
     fr = np.hypot(fx, fy)
-    in_band = above & (fr >= psd.f_min) & (fr <= psd.f_max)
-    pred = np.where(above, brdf(*args, lam, index, psd.psd2d), 0.0)
+    in_band = above & psd.covers(fr)
+    if layers is None:
+        f = brdf(*args, lam, index, psd.psd2d)
+    else:
+        f = stack_brdf(*args, lam, *layers, psd.psd2d, "correlated")
+    pred = np.where(above, f, 0.0)
     meas = np.where(above, t.values[0, 0], 0.0)
     geo: dict[str, Any] = {"theta_i_deg": ti, "azimuth_deg": az, "radial_deg": rad}
     geo["symmetry"] = t.symmetry
@@ -260,7 +343,25 @@ def predict_rr_brdf(
         tis_predicted=_tis(pred, geo),
         band_measured=_tis(np.where(in_band, meas, 0.0), geo),
         band_predicted=_tis(np.where(in_band, pred, 0.0), geo),
+        coating=coating,
     )
+
+
+def _layers(
+    stack: Stack | None, wavelength_nm: float, path: str
+) -> tuple[tuple[NDArray, NDArray] | None, str]:
+    """The stack's indices and thicknesses [m] at the wavelength, and the layers in words."""
+    if stack is None:
+        return None, ""
+    try:
+        n, d = stack_layers(stack, wavelength_nm)
+    except (ValueError, LabbrdfError) as exc:
+        raise PredictionError(f"{path}: the film stack: {exc}") from None
+    words = [
+        f"{lay.name} {dd * 1e9:.4g} nm, {nn.real:.4g} + {nn.imag:.3g}i"
+        for lay, nn, dd in zip(stack.layers, n[1:-1], d, strict=True)
+    ]
+    return (n, d), "; ".join(words)
 
 
 def _tis(values: NDArray, geo: dict[str, Any]) -> NDArray[np.float64]:
@@ -284,7 +385,7 @@ class PsdAgreement:
     form : str
         The fitted PSD form.
     source : str
-        The height map's file.
+        The height maps' files (comma separated).
     """
 
     f: NDArray[np.float64]
@@ -330,7 +431,8 @@ class PsdAgreement:
 
         fig = Figure(figsize=(5.5, 3.8)) if ax is None else ax.figure
         ax = fig.add_subplot(1, 1, 1) if ax is None else ax
-        ax.loglog(self.f, self.psd_map, "o", ms=3, label=f"height map ({Path(self.source).name})")
+        names = ", ".join(Path(x.strip()).name for x in self.source.split(","))
+        ax.loglog(self.f, self.psd_map, "o", ms=3, label=f"height maps ({names})")
         ax.loglog(self.f, self.psd_brdf, "-", label=f"from the BRDF ({self.form} fit)")
         ax.set_xlabel("spatial frequency f [cycles/m]")
         ax.set_ylabel("isotropic 2-D PSD [m$^4$]")

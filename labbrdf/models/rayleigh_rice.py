@@ -17,14 +17,17 @@ References
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from ..films import FilmError, Stack, read_fit_json
 from ..roughness import psd_models
 from ..roughness.rayleigh_rice import POLARIZATIONS, brdf, mueller_brdf
+from ..roughness.rr_stack import INTERFACES, mueller_brdf_stack, stack_brdf, stack_layers
 from .base import Model, ModelError, Parameters
 
 __all__ = ["PSD_FORMS", "RayleighRice", "psd_function"]
@@ -91,6 +94,16 @@ class RayleighRice(Model):
         [0, 50], started at the options ``n``, ``k``. The index and the PSD's amplitude are
         strongly correlated (both scale the BRDF): expect wide intervals unless the data
         span angles where the polarization factors differ.
+    film : path-like or labbrdf.films.Stack, optional
+        A coated sample: a film fit's JSON (``labbrdf film --fit-json``, read by
+        :func:`labbrdf.films.read_fit_json`) or a :class:`~labbrdf.films.Stack`. Its layers
+        and substrate replace ``n``, ``k`` (leave them out); the scatter is that of the
+        stack's rough interfaces (:mod:`labbrdf.roughness.rr_stack`), each with the fitted
+        PSD.
+    interfaces : {"correlated", "uncorrelated", "substrate", "top"}, default "correlated"
+        With ``film``: every interface rough with the same heights (a conformal coating on a
+        polished substrate), every one rough with independent heights, or only the
+        substrate's or the top interface rough.
 
     Parameters: k-correlation ``A`` [um^4] in [1e-12, 1e4] (log), ``B`` [um] in
     [1e-2, 1e4] (log), ``C`` [1] in [0.05, 8]; gaussian and exponential ``sigma`` [um] in
@@ -125,13 +138,19 @@ class RayleighRice(Model):
         wavelength_nm: float | None = None,
         polarization: str = "unpolarized",
         free_index: bool = False,
+        film: Any = None,
+        interfaces: str = "correlated",
         **options: Any,
     ) -> None:
         if options:
             raise ModelError(
                 f"model 'rayleigh_rice' got unknown options {sorted(options)}; options are "
-                "['n', 'k', 'psd', 'wavelength_nm', 'polarization', 'free_index']"
+                "['n', 'k', 'psd', 'wavelength_nm', 'polarization', 'free_index', 'film', "
+                "'interfaces']"
             )
+        self._stack, self._range, film_opts = _film(film, interfaces, n, k, free_index)
+        if self._stack is not None:
+            n, k = 1.0, 0.0  # a stand-in: the stack's substrate is the index
         if psd not in PSD_FORMS:
             raise ModelError(
                 f"rayleigh_rice option 'psd' must be one of {list(PSD_FORMS)}; got {psd!r}"
@@ -160,11 +179,15 @@ class RayleighRice(Model):
         self._wl = None if wavelength_nm is None else float(wavelength_nm)
         self._pol = polarization
         self._free = bool(free_index)
+        self._interfaces = interfaces
         opts: dict[str, Any] = {"n": float(n), "k": kk, "psd": psd, "polarization": polarization}
         if self._wl is not None:
             opts["wavelength_nm"] = self._wl
         if self._free:
             opts["free_index"] = True
+        if film_opts:
+            del opts["n"], opts["k"]
+            opts.update(film_opts)
         super().__init__(**opts)
 
     def default_params(self) -> Parameters:
@@ -180,8 +203,15 @@ class RayleighRice(Model):
             p.add("k_sub", k0, 0.0, max(50.0, k0), description="substrate k (start: option k)")
         return p
 
+    @property
+    def stack(self) -> Stack | None:
+        """The film stack of the ``film`` option (None for a bare surface)."""
+        return self._stack
+
     def index(self, params: Mapping[str, float] | None = None) -> complex:
         """The substrate's ``n + ik``: the option's, or the fitted ``n_sub``, ``k_sub``."""
+        if self._stack is not None:
+            raise ModelError("rayleigh_rice with a film: the stack gives the indices")
         if not self._free:
             return self.N
         v = self.values(params)
@@ -221,18 +251,31 @@ class RayleighRice(Model):
         index = complex(p["n_sub"], p["k_sub"]) if self._free else self.N
         up = (theta_i >= 0) & (theta_i <= math.pi / 2) & (theta_r >= 0) & (theta_r <= math.pi / 2)
         out = np.zeros(np.shape(theta_r))
+        pol: Any = self._pol
         for w in np.unique(lam):
             sel = up & (lam == w)
-            out[sel] = brdf(
-                theta_i[sel],
-                theta_r[sel],
-                phi_r[sel],
-                float(w),
-                index,
-                psd,
-                self._pol,  # type: ignore[arg-type]
-            )
+            geometry = (theta_i[sel], theta_r[sel], phi_r[sel], float(w))
+            if self._stack is None:
+                out[sel] = brdf(*geometry, index, psd, pol)
+            else:
+                layers = self._layers(float(w))
+                out[sel] = stack_brdf(*geometry, *layers, psd, self._interfaces, pol)
         return out
+
+    def _layers(self, wavelength_m: float) -> tuple[NDArray, NDArray]:
+        """The film stack's indices and thicknesses [m] at one wavelength [m]."""
+        assert self._stack is not None
+        wl_nm = wavelength_m * 1e9
+        if self._range is not None and not self._range[0] <= wl_nm <= self._range[1]:
+            lo, hi = self._range
+            raise ModelError(
+                f"rayleigh_rice: {wl_nm:g} nm lies outside the film fit's range "
+                f"{lo:g}-{hi:g} nm; expected a film fit that covers the BRDF's wavelength"
+            )
+        try:
+            return stack_layers(self._stack, wl_nm)
+        except (ValueError, FilmError) as exc:
+            raise ModelError(f"rayleigh_rice option 'film': {exc}") from None
 
     def mueller(
         self,
@@ -246,4 +289,58 @@ class RayleighRice(Model):
         lam = float(
             self._wavelength_m(None if wavelength_nm is None else np.asarray(wavelength_nm))
         )
-        return mueller_brdf(theta_i, theta_r, phi_r, lam, self.index(params), self.psd2d(params))
+        if self._stack is None:
+            return mueller_brdf(
+                theta_i, theta_r, phi_r, lam, self.index(params), self.psd2d(params)
+            )
+        psd = self.psd2d(params)
+        layers = self._layers(lam)
+        if self._interfaces == "correlated":
+            return mueller_brdf_stack(theta_i, theta_r, phi_r, lam, *layers, psd, "correlated")
+        m_if = layers[0].size - 1
+        one = {"substrate": m_if - 1, "top": 0}.get(self._interfaces)
+        psds = [psd if one is None or j == one else None for j in range(m_if)]
+        return mueller_brdf_stack(theta_i, theta_r, phi_r, lam, *layers, psds)
+
+
+def _film(
+    film: Any, interfaces: str, n: float | None, k: float | None, free_index: bool
+) -> tuple[Stack | None, tuple[float, float] | None, dict[str, Any]]:
+    """The ``film`` option: its stack, the fit's wavelength range and the options to keep."""
+    if interfaces not in INTERFACES:
+        raise ModelError(
+            f"rayleigh_rice option 'interfaces' must be one of {list(INTERFACES)}; "
+            f"got {interfaces!r}"
+        )
+    if film is None:
+        if interfaces != "correlated":
+            raise ModelError("rayleigh_rice option 'interfaces' needs the option 'film'")
+        return None, None, {}
+    if n is not None or k is not None or free_index:
+        raise ModelError(
+            "rayleigh_rice: the film's stack gives the substrate's index; leave out n, k, "
+            "free_index (and --nk-from)"
+        )
+    rng: tuple[float, float] | None
+    if isinstance(film, (Stack, Mapping)):  # a Stack, or its dict (the model's options)
+        try:
+            stack = film if isinstance(film, Stack) else Stack.from_dict(film)
+        except (FilmError, ValueError) as exc:
+            raise ModelError(f"rayleigh_rice option 'film': {exc}") from None
+        rng = None
+        shown: Any = stack.to_dict()
+    elif isinstance(film, (str, os.PathLike)):
+        try:
+            stack, rng = read_fit_json(film)
+        except FilmError as exc:
+            raise ModelError(f"rayleigh_rice option 'film': {exc}") from None
+        shown = os.fspath(film)
+    else:
+        raise ModelError(
+            f"rayleigh_rice option 'film' must be a film fit JSON path or a Stack; got {film!r}"
+        )
+    try:
+        stack_layers(stack, 0.5 * (rng[0] + rng[1]) if rng else 633.0)
+    except (ValueError, FilmError) as exc:
+        raise ModelError(f"rayleigh_rice option 'film': {exc}") from None
+    return stack, rng, {"film": shown, "interfaces": interfaces}

@@ -5,15 +5,17 @@ A sample smooth by the Rayleigh criterion (the verdict section ``smoothness`` ta
 ``lambda / (8 cos theta_i)``) scatters as first-order perturbation theory says; the
 microfacet tracer's facets need ``k sigma > 1``. Per measured ``.bsdf``:
 
-* smooth at every angle of incidence: Rayleigh-Rice from the height map's PSD
-  (:mod:`labbrdf.rr_prediction`), no tracer;
+* smooth at every angle of incidence: Rayleigh-Rice from the composite PSD of the sample's
+  height maps, the spectrum the PSD section shows (:mod:`labbrdf.rr_prediction`), no
+  tracer; for a coated sample with a film fit, Rayleigh-Rice of the fitted stack with every
+  interface carrying the map's roughness (correlated: a conformal coating);
 * rough at every angle: the tracer (as before), no Rayleigh-Rice;
 * anything else (undecided within sigma's uncertainty, or smooth at some angles and rough at
   others, or outside the map's band): both, and the page says which applies where.
 
 The Rayleigh-Rice part also solves the inverse problem: the ``rayleigh_rice`` model
-(K-correlation PSD, the psi/Delta's n, k fixed) fitted to the measured BRDF, its PSD drawn
-beside the height map's over their common frequencies.
+(K-correlation PSD, the psi/Delta's n, k or the film fit's stack fixed) fitted to the
+measured BRDF, its PSD drawn beside the height maps' over their common frequencies.
 """
 
 from __future__ import annotations
@@ -29,11 +31,12 @@ import numpy as np
 from ..adapters import zemax_bsdf
 from ..errors import LabbrdfError
 from ..prediction import PredictionError
+from ..roughness.rr_stack import stack_layers
 from ..rr_prediction import (
     MapPsd,
     RrPrediction,
     bragg_band,
-    map_psd,
+    group_psd,
     predict_rr_brdf,
     psd_agreement,
 )
@@ -41,7 +44,15 @@ from . import figures
 from .context import Context
 from .roughness import judge, map_roughness
 
-__all__ = ["FIT_FLOOR", "THEORIES", "Theory", "choose", "choose_theory", "rr_part"]
+__all__ = [
+    "FIT_FLOOR",
+    "THEORIES",
+    "Theory",
+    "choose",
+    "choose_theory",
+    "given_wavelength",
+    "rr_part",
+]
 
 #: the section's choices: Rayleigh-Rice, the microfacet tracer, or both
 THEORIES = ("rayleigh-rice", "tracer", "both")
@@ -101,22 +112,40 @@ def _why(choice: str, rows: Sequence[dict[str, Any]]) -> str:
     )
 
 
-def choose_theory(ctx: Context, hm: Any, path: Path, *, coated: bool = False) -> Theory:
-    """The theory for one measured ``.bsdf`` of the sample whose height map is ``hm``."""
+def given_wavelength(ctx: Context, path: Path) -> float | None:
+    """The wavelength [nm] ``report --wavelength`` gave a ``.bsdf`` that states none."""
+    given = [
+        float(r["meta"]["wavelength_nm"])
+        for r in ctx.files
+        if (r.get("meta") or {}).get("wavelength_given")
+        and Path(str(r["path"])).name == Path(path).name
+    ]
+    return given[0] if given else None
+
+
+def choose_theory(
+    ctx: Context, hm: Any, path: Path, *, coated: bool = False, stack: Any = None
+) -> Theory:
+    """The theory for one measured ``.bsdf`` of the sample whose height map is ``hm``.
+
+    ``coated``: the sample has a film fit, whose ``stack`` (a :class:`labbrdf.films.Stack`)
+    Rayleigh-Rice takes if it can (coherent layers); else only the tracer predicts it.
+    """
     name = Path(path).name
     try:
         t = zemax_bsdf.read_table(path)
     except (LabbrdfError, ValueError, OSError):
         return Theory("tracer", f"{name}: not read, so not judged by the Rayleigh criterion.")
     m = map_roughness(ctx).get(str(hm.path))
-    if t.wavelength_nm is None or m is None:
-        why = "states no wavelength" if t.wavelength_nm is None else "has no usable height map"
+    wl_file = t.wavelength_nm if t.wavelength_nm is not None else given_wavelength(ctx, path)
+    if wl_file is None or m is None:
+        why = "states no wavelength" if wl_file is None else "has no usable height map"
         return Theory(
             "tracer",
             f"{name} {why}: the Rayleigh criterion cannot be applied; the microfacet tracer's "
             "prediction is tried.",
         )
-    wl = float(t.wavelength_nm)
+    wl = float(wl_file)
     rows = tuple(judge(m, wl, float(ti)) for ti in t.theta_i_deg)
     choice = choose([r["rayleigh"] for r in rows])
     sig = [r["sigma_nm"] for r in rows if "sigma_nm" in r]
@@ -132,12 +161,31 @@ def choose_theory(ctx: Context, hm: Any, path: Path, *, coated: bool = False) ->
         f"{max(thr):.3g} nm over the file's {len(rows)} angles of incidence. " + _why(choice, rows)
     )
     if coated and choice != "tracer":
-        text += (
-            " The sample is coated (a film fit): Rayleigh-Rice of a film stack with rough "
-            "interfaces is not computed here, so only the tracer's prediction is shown."
-        )
-        choice = "tracer"
+        why = _stack_refused(stack, wl)
+        if why:
+            text += (
+                f" The sample is coated (a film fit) and {why}: only the tracer's prediction "
+                "is shown."
+            )
+            choice = "tracer"
+        else:
+            text += (
+                " The sample is coated (a film fit): Rayleigh-Rice is that of the fitted "
+                "stack, every interface carrying the height map's roughness with the same "
+                "heights (correlated: a conformal coating; docs: rayleigh-rice)."
+            )
     return Theory(choice, text, rows)
+
+
+def _stack_refused(stack: Any, wavelength_nm: float) -> str:
+    """Why Rayleigh-Rice cannot take the film fit's stack ("" when it can)."""
+    if stack is None:
+        return "its stack is not at hand"
+    try:
+        stack_layers(stack, wavelength_nm)
+    except (LabbrdfError, ValueError) as exc:
+        return f"Rayleigh-Rice of rough interfaces cannot take its stack ({exc})"
+    return ""
 
 
 # --------------------------------------------------------------------------- drawing
@@ -176,9 +224,10 @@ def _cuts(ctx: Context, sid: str, p: RrPrediction) -> None:
         f"prediction_rr_cuts_{sid}",
         f"In-plane cuts, measured and Rayleigh-Rice, {Path(p.path).name}",
         "The plane of incidence at the file's points: measured (phi_r = 180 deg positive, "
-        "0 deg negative) and the Rayleigh-Rice BRDF from the height map's PSD and the "
-        "psi/Delta's n, k (line; absent where the point's spatial frequency lies outside the "
-        "map's band, where the PSD is taken as 0).",
+        "0 deg negative) and the Rayleigh-Rice BRDF from the height maps' PSD and "
+        + ("the film fit's stack" if p.coating else "the psi/Delta's n, k")
+        + " (line; absent where the point's spatial frequency lies outside the maps' band, "
+        "where the PSD is taken as 0).",
         figures.panels_figure(panels, ncols=min(4, len(panels)), panel_size=(4.0, 3.0)),
     )
 
@@ -204,8 +253,8 @@ def _table(ctx: Context, sid: str, p: RrPrediction) -> None:
     )
 
 
-def _inverse(ctx: Context, sid: str, p: RrPrediction, psd: MapPsd) -> None:
-    """The ``rayleigh_rice`` model fitted to the .bsdf; its PSD beside the map's."""
+def _inverse(ctx: Context, sid: str, p: RrPrediction, psd: MapPsd, stack: Any = None) -> None:
+    """The ``rayleigh_rice`` model fitted to the .bsdf; its PSD beside the maps'."""
     from .. import adapters
     from ..fitting import fit
     from ..models.rayleigh_rice import RayleighRice
@@ -221,7 +270,10 @@ def _inverse(ctx: Context, sid: str, p: RrPrediction, psd: MapPsd) -> None:
         )
         # points below 1e-6 of the peak carry only the file's rounding
         rows = rows[off & (rows["value"] >= FIT_FLOOR * rows["value"].max())]
-        model = RayleighRice(n=p.n, k=p.k, wavelength_nm=p.wavelength_nm)
+        if stack is None:
+            model = RayleighRice(n=p.n, k=p.k, wavelength_nm=p.wavelength_nm)
+        else:
+            model = RayleighRice(film=stack, wavelength_nm=p.wavelength_nm)
         res = fit(model, rows, weighting="relative")
         band = bragg_band(
             rows["theta_i_deg"], rows["theta_r_deg"], rows["phi_r_deg"], p.wavelength_nm
@@ -231,7 +283,8 @@ def _inverse(ctx: Context, sid: str, p: RrPrediction, psd: MapPsd) -> None:
         return
     agree = psd_agreement(model.psd2d(res.values), "k-correlation", psd, band)
     b.text(
-        f"The inverse problem: the rayleigh_rice model (K-correlation PSD, n, k fixed as above) "
+        "The inverse problem: the rayleigh_rice model (K-correlation PSD, "
+        f"{'the stack' if stack is not None else 'n, k'} fixed as above) "
         f"fitted to the {len(rows)} measured points of {name} off the specular direction and "
         f"above {FIT_FLOOR:g} of the peak (relative weighting). " + agree.sentence()
     )
@@ -255,31 +308,76 @@ def _inverse(ctx: Context, sid: str, p: RrPrediction, psd: MapPsd) -> None:
         b.figure(
             f"prediction_rr_psd_{sid}",
             f"PSD from the BRDF and from the height map, {name}",
-            "Isotropic 2-D PSD over the frequencies both see: the height map's (points, "
-            "SurfaceTopography's area PSD of the plane-levelled map) and the K-correlation "
+            "Isotropic 2-D PSD over the frequencies both see: the height maps' (points, the "
+            "composite of section psd) and the K-correlation "
             "PSD fitted to the measured BRDF (line). " + agree.sentence(),
             figures.to_uri(agree.plot()),
         )
 
 
-def rr_part(ctx: Context, sid: str, hm: Any, path: Path, frame: Any) -> None:
-    """Rayleigh-Rice prediction of one ``.bsdf`` from the height map's PSD, and the inverse."""
+def rr_part(ctx: Context, sid: str, maps: Any, path: Path, frame: Any, film: Any = None) -> None:
+    """Rayleigh-Rice prediction of one ``.bsdf`` from the maps' composite PSD, and the inverse.
+
+    ``maps``: the sample's areal height maps (or one); ``film``: its film fit, whose stack
+    replaces the psi/Delta's n, k (:func:`labbrdf.rr_prediction.predict_rr_brdf`).
+    """
     b = ctx.b
     name = Path(path).name
+    maps = list(maps) if isinstance(maps, (list, tuple)) else [maps]
+    stack = None if film is None else film.stack
+    data = getattr(film, "data", None)
+    span = None
+    if data is not None and "wavelength_nm" in data and len(data):
+        w = np.asarray(data["wavelength_nm"], float)
+        span = (float(np.nanmin(w)), float(np.nanmax(w)))
     try:
-        psd = map_psd(hm)
-        p = predict_rr_brdf(path, frame, psd)
+        psd = group_psd(maps)
+        p = predict_rr_brdf(
+            path,
+            frame,
+            psd,
+            wavelength_nm=given_wavelength(ctx, path),
+            stack=stack,
+            stack_range=span,
+        )
     except (PredictionError, LabbrdfError, ValueError) as exc:
         b.note(f"{name}: no Rayleigh-Rice prediction", str(exc))
         return
     b.text(
         f"Rayleigh-Rice prediction of {name} at {p.wavelength_nm:g} nm, no parameter fitted: "
-        f"substrate n + ik = {p.n:.4g} + {p.k:.4g}i from the psi/Delta; the PSD of "
-        f"{Path(psd.source).name} (SurfaceTopography's area PSD of the plane-levelled map) "
-        f"over its band {psd.f_min:.3g} to {psd.f_max:.3g} cycles/m (periods "
-        f"{1e6 / psd.f_max:.3g} to {1e6 / psd.f_min:.3g} um; sigma over the band "
-        f"{psd.sigma() * 1e9:.3g} nm), 0 outside it. " + p.verdict()
+        + _optics_text(p)
+        + "; "
+        + _psd_text(psd)
+        + " "
+        + p.verdict()
     )
     _cuts(ctx, sid, p)
     _table(ctx, sid, p)
-    _inverse(ctx, sid, p, psd)
+    _inverse(ctx, sid, p, psd, stack)
+
+
+def _optics_text(p: RrPrediction) -> str:
+    if not p.coating:
+        return f"substrate n + ik = {p.n:.4g} + {p.k:.4g}i from the psi/Delta"
+    return (
+        f"the film fit's stack (top first: {p.coating}; substrate n + ik = {p.n:.4g} + "
+        f"{p.k:.4g}i), every interface with the maps' roughness, correlated"
+    )
+
+
+def _psd_text(psd: MapPsd) -> str:
+    names = [Path(s.strip()).name for s in psd.source.split(",")]
+    what = (
+        f"the PSD of {names[0]}"
+        if len(names) == 1
+        else f"the composite PSD of {len(names)} maps ({', '.join(names)})"
+    )
+    gaps = "".join(
+        f" and in the gap {lo:.3g} to {hi:.3g} cycles/m that no map covers" for lo, hi in psd.gaps
+    )
+    return (
+        f"{what}, the spectrum of section psd (SurfaceTopography's periodogram of each "
+        f"plane-levelled map, Hann window), over the band {psd.f_min:.3g} to "
+        f"{psd.f_max:.3g} cycles/m (periods {1e6 / psd.f_max:.3g} to {1e6 / psd.f_min:.3g} um; "
+        f"sigma over the band {psd.sigma() * 1e9:.3g} nm), 0 outside it{gaps}."
+    )

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -152,3 +153,37 @@ def test_a_sample_in_between_gets_both_and_the_page_says_where(prediction_sets, 
     assert theory.choice == "both"
     assert "smooth at 75 deg" in theory.text and "rough at 30 deg" in theory.text
     assert choose_theory(ctx, ctx.height_maps[0], Path(bsdf), coated=True).choice == "tracer"
+    # a coated sample whose film fit gives a coherent stack keeps Rayleigh-Rice, via the stack
+    from types import SimpleNamespace
+
+    from labbrdf import films
+    from labbrdf.nk.dispersion import Constant
+    from labbrdf.report.smooth_prediction import rr_part
+
+    stack = films.Stack([films.Layer(Constant(1.46), 100.0, "coat")], Constant(nk.real, nk.imag))
+    coated = choose_theory(ctx, ctx.height_maps[0], Path(bsdf), coated=True, stack=stack)
+    assert coated.choice == "both" and "the fitted stack" in coated.text
+    slab = films.Stack(stack.layers, stack.substrate, substrate_thickness_nm=1e6)
+    refused = choose_theory(ctx, ctx.height_maps[0], Path(bsdf), coated=True, stack=slab)
+    assert refused.choice == "tracer" and "cannot take its stack" in refused.text
+    with b.section("prediction", "Predict, then measure"):
+        rr_part(ctx, "c", ctx.height_maps, Path(bsdf), None, SimpleNamespace(stack=stack))
+    b.finish()
+    sec = {s["id"]: s for s in b.results["sections"]}["prediction"]
+    texts = [it["text"] for it in sec["items"] if it["kind"] == "text"]
+    assert any("the film fit's stack (top first: coat 100 nm, 1.46" in t for t in texts)
+    assert any("the stack fixed as above" in t for t in texts)
+
+
+def test_the_wavelength_given_to_the_report_is_taken_for_a_bsdf_that_states_none():
+    from types import SimpleNamespace
+
+    from labbrdf.report.smooth_prediction import given_wavelength
+
+    files = [
+        {"path": "/d/x.bsdf", "meta": {"wavelength_given": True, "wavelength_nm": 633.0}},
+        {"path": "/d/y.bsdf", "meta": {"wavelength_nm": 555.0}},
+    ]
+    ctx: Any = SimpleNamespace(files=files)
+    assert given_wavelength(ctx, Path("/e/x.bsdf")) == 633.0
+    assert given_wavelength(ctx, Path("/d/y.bsdf")) is None

@@ -22,8 +22,9 @@ check of GGX itself: where the two predictions differ, the slope distribution ma
 
 Each measured ``.bsdf`` is first judged by the Rayleigh criterion
 (:mod:`labbrdf.report.smooth_prediction`): smooth at all its angles, it is predicted by
-Rayleigh-Rice from the height map's PSD (with the PSD recovered from the BRDF beside the
-map's) and the tracer is not run; rough, by the tracer; in between, by both.
+Rayleigh-Rice from the composite PSD of the sample's height maps (the spectrum of section
+``psd``; with the PSD recovered from the BRDF beside it), for a coated sample through its
+film fit's stack, and the tracer is not run; rough, by the tracer; in between, by both.
 
 For the tracer, the section draws
 
@@ -127,6 +128,7 @@ def sample_inputs(ctx: Context) -> tuple[list[dict[str, Any]], list[dict[str, An
                 "name": g.name,
                 "reason": g.reason,
                 "height_map": hms[0],
+                "height_maps": hms,
                 "psi_delta": psi[0],
                 "film": ctx.film_fits.get(psi[0][0].name),
                 "bsdf": bs,
@@ -183,7 +185,8 @@ def prediction_section(ctx: Context, *, slopes: str = "ggx") -> None:
         "single scattering is closed form and has none). Which theory predicts each measured "
         "BRDF is chosen by the Rayleigh criterion of section smoothness at the file's "
         "wavelength and angles: a smooth sample is predicted by Rayleigh-Rice (first-order "
-        "perturbation theory) from its height map's PSD instead of the tracer, a sample in "
+        "perturbation theory) from the composite PSD of its height maps (section psd's), "
+        "through its film fit's stack where it has one, instead of the tracer, a sample in "
         "between by both (docs/rayleigh-rice.md)."
     )
     if lacking:
@@ -220,6 +223,12 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
             if s["unused"]
             else ""
         )
+        + (
+            " Rayleigh-Rice, where it applies, takes the composite PSD of all "
+            f"{len(s['height_maps'])} height maps."
+            if len(s.get("height_maps", ())) > 1
+            else ""
+        )
     )
     if film is not None:
         b.text(
@@ -232,7 +241,8 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
             "|cos 2psi| is the coherent film's, while the tracer's coating is incoherent "
             "(intensities add, which depolarizes), so the two DOPs differ by construction.",
         )
-    theories = [choose_theory(ctx, hm, p, coated=film is not None) for p in s["bsdf"]]
+    stack = None if film is None else getattr(film, "stack", None)
+    theories = [choose_theory(ctx, hm, p, coated=film is not None, stack=stack) for p in s["bsdf"]]
     if film is None and all(t.choice == "rayleigh-rice" for t in theories):
         b.text(
             "The sample is smooth (below): its specular reflection is the Fresnel reflection "
@@ -253,7 +263,8 @@ def _one_sample(ctx: Context, s: dict[str, Any], slopes: str = "ggx") -> None:
         if theory.choice in ("tracer", "both"):
             _tracer_brdf(ctx, sid, path, frame, fit, film, ndf)
         if theory.choice in ("rayleigh-rice", "both"):
-            rr_part(ctx, f"{sid}_{slug(path.name)}", hm, path, frame)
+            maps = s.get("height_maps") or [hm]
+            rr_part(ctx, f"{sid}_{slug(path.name)}", maps, path, frame, film)
 
 
 def _tracer_brdf(
