@@ -88,21 +88,23 @@ def run(label: str, make: Any, df: Any, repeat: int, replicates: int | None = No
     ``replicates``: seed replicates of a stochastic model (None: the model's default);
     their traces run in fresh model instances and are not counted.
     """
-    walls, nfevs, traces = [], [], []
+    walls, cpus, nfevs, traces = [], [], [], []
     res = None
     for _ in range(repeat):
         model = make()
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         R = replicates if model.stochastic else None
         res = fit(model, df, weighting="relative", replicates=R)
         walls.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)
         nfevs.append(res.nfev)
         traces.append(getattr(model, "traces", 0))
     assert res is not None
     wall = statistics.median(walls)
     nfev = statistics.median(nfevs)
     print(
-        f"{label:<34} {wall:8.1f} s  nfev {nfev:5.0f}  traces {statistics.median(traces):5.0f}"
+        f"{label:<34} {wall:8.1f} s (CPU {statistics.median(cpus):6.1f} s)  nfev {nfev:5.0f}"
+        f"  traces {statistics.median(traces):5.0f}"
         f"  {1e3 * wall / nfev:7.1f} ms/eval  chi2/nu {res.redchi:.4g}  AIC {res.aic:.5g}"
         f"  BIC {res.bic:.5g}  success {res.success}"
     )

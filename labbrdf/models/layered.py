@@ -176,6 +176,13 @@ class Layered(Model):
             self.default_replicates = 1
         self._floor = _flag(floor, "floor")
         self._nk = (1.0, 0.0)
+        # a Lambertian base is a renewal process: its single-scattering walk has a
+        # closed-form expectation (labbrdf.tracer.coated_lambert), no rays needed
+        self._closed = base == "diffuse"
+        if self._closed:
+            self.fd_rel_step = None
+            self.stochastic = False
+            self.default_replicates = 1
         if base == "diffuse":
             if n is not None or k is not None:
                 raise ModelError(
@@ -411,6 +418,9 @@ class Layered(Model):
             cfg = self._config(p, float(theta_i_deg), float(wavelength_nm))
         except ValueError as exc:
             raise ModelError(f"layered: {exc}") from None
+        if self._closed:
+            f = self._closed_map(cfg)
+            return self._remember(key, (f, np.zeros((1, *f.shape))))
         with memory_cache(self._operators):
             res = trace(cfg)
         self.traces += 1
@@ -425,11 +435,37 @@ class Layered(Model):
             # no Monte Carlo part (a bare or coherent first surface): the batch maps are
             # the same map, and only their float32 storage differs from f
             dev = np.zeros_like(dev)
-        out = (f, dev)
+        return self._remember(key, (f, dev))
+
+    def _remember(
+        self, key: tuple, out: tuple[NDArray[np.float64], NDArray[np.float64]]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         self._cache[key] = out
         if len(self._cache) > _CACHE_SIZE:
             self._cache.popitem(last=False)
         return out
+
+    def _closed_map(self, cfg: Any) -> NDArray[np.float64]:
+        """S0 map of a coated Lambertian base in closed form (n_theta, n_phi) [sr^-1].
+
+        The first surface's bin averages (:func:`labbrdf.tracer.estimator.first_surface_map`)
+        plus the light through the coating (:mod:`labbrdf.tracer.coated_lambert`): the
+        expectation of the traced map, on the same grid, without its Monte Carlo error.
+        """
+        from ..tracer import Grid
+        from ..tracer.coated_lambert import coated_lambert
+        from ..tracer.estimator import first_surface_map
+
+        coat = cfg.coating
+        body = coated_lambert(
+            coat.n, coat.alpha, coat.k, coat.thickness_nm, cfg.wavelength_nm
+        ).bin_map(
+            float(cfg.substrate.albedo),
+            cfg.theta_i_deg,
+            Grid(cfg.theta_step_deg, cfg.phi_step_deg),
+        )
+        self.traces += 1
+        return np.asarray(first_surface_map(cfg)[..., 0, 0] + body, float)
 
     @property
     def grid_deg(self) -> tuple[float, float] | None:
@@ -538,6 +574,8 @@ class Layered(Model):
         interpolated values, with the correlations between points that share bins or
         rays (the exit operator spreads each ray over the top interface's lobe).
         """
+        if self._closed:
+            return np.zeros((1, *np.broadcast(theta_i, theta_r, phi_r).shape))
         q = self.values(p)  # missing names take the current values
         ti, tr, pr = np.broadcast_arrays(
             np.asarray(theta_i, float), np.asarray(theta_r, float), np.asarray(phi_r, float)
@@ -564,7 +602,7 @@ class Layered(Model):
         self, theta_i_deg: ArrayLike, params: Mapping[str, float] | None = None
     ) -> NDArray[np.float64] | None:
         """The traced albedo [1] (S0 map integrated over the hemisphere) plus ``kd``."""
-        from ..tracer import trace
+        from ..tracer import Grid, trace
         from ..tracer.operator import memory_cache
 
         p = self.values(params)
@@ -573,9 +611,14 @@ class Layered(Model):
             self.options["grid"] = "2x4"
         out = []
         for t in np.atleast_1d(np.asarray(theta_i_deg, float)):
-            with memory_cache(self._operators):
-                res = trace(self._config(p, float(t), self._wl_default))
-            out.append(res.albedo() + (p["kd"] if self._floor else 0.0))
+            cfg = self._config(p, float(t), self._wl_default)
+            if self._closed:
+                omega = Grid(*self._grid).cos_solid_angle_sr
+                albedo = float((self._closed_map(cfg) * omega).sum())
+            else:
+                with memory_cache(self._operators):
+                    albedo = trace(cfg).albedo()
+            out.append(albedo + (p["kd"] if self._floor else 0.0))
         return np.asarray(out, float).reshape(np.shape(theta_i_deg))
 
 
