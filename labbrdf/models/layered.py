@@ -7,7 +7,9 @@ grid, interpolated to the points. Every trace uses the same seed whatever the pa
 (common random numbers), so the BRDF is a deterministic and nearly smooth function of the
 parameters and a fit can use it like a closed-form model; its Monte Carlo error enters the
 fit through :meth:`Layered.point_noise` and :meth:`Layered.point_variance`
-(``docs/models.md`` 7).
+(``docs/models.md`` 7). Over a Lambertian base (``base="diffuse"``) the walk's expectation
+is a closed form (:mod:`labbrdf.tracer.coated_lambert`), evaluated on the same grid without
+rays: deterministic, no Monte Carlo error.
 
 References
 ----------
@@ -79,11 +81,12 @@ class Layered(Model):
     floor : bool, default False
         Add a Lambertian floor ``kd / pi`` [sr^-1] (linear; profiled by the fit).
     rays : int, default 20000
-        Rays per trace. On a 3 x 6 degree grid 2e4 rays give a per-bin relative standard
-        error of about 3 % over the lobe of a coating on Al and 1-5 % over a diffuse base
-        (``docs/models.md`` 7).
+        Rays per trace (conductor base; a diffuse base is evaluated without rays). On a
+        3 x 6 degree grid 2e4 rays give a per-bin relative standard error of about 3 %
+        over the lobe of a coating on Al (``docs/models.md`` 7).
     seed : int, default 0
-        Seed of every trace (common random numbers: the same for all parameter values).
+        Seed of every trace (common random numbers: the same for all parameter values;
+        conductor base only).
     grid : "auto", "THETAxPHI" or (float, float), default "auto"
         Tracer bin steps (theta, phi) [deg], e.g. "3x6"; "auto" derives them from the
         number of points per incidence of the first evaluation (:meth:`_set_grid`; at
@@ -105,6 +108,13 @@ class Layered(Model):
     bin centres. Against the point value of the BRDF this has a bias of order
     ``h^2 f'' / 8``, which is why "auto" keeps the bins at most half the data's spacing
     and at most 3 x 6 degrees.
+    A diffuse base: every ray that reaches it is re-emitted with the cosine law whatever
+    way it came, so the walk is a renewal process and its expectation is the series
+    ``a T(theta_i) T(theta_o) / (pi n^2 (1 - a R))`` plus the first surface
+    (:mod:`labbrdf.tracer.coated_lambert`; agrees with the counting walk over every bin,
+    ``docs/tracer.md``). The model evaluates that, on the tracer's grid and interpolated
+    like a traced map, so it is the traced model without its noise (and without the exit
+    operator's bias near the pole).
     Single scattering (the separable Smith G1 G1 per interface) loses energy for rough
     interfaces; the multiple-scattering walk would count rays, whose noise no fit can
     use (``docs/tracer.md``).
