@@ -25,6 +25,7 @@ References
 from __future__ import annotations
 
 import math
+import warnings
 from collections import OrderedDict
 from collections.abc import Mapping
 from typing import Any
@@ -34,7 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .base import Model, ModelError, Parameters, lambert
 
-__all__ = ["Layered"]
+__all__ = ["Layered", "PoleBiasWarning"]
 
 _BASES = ("conductor", "diffuse")
 #: traces kept per model instance (two small maps each): a fit's Jacobian and polish come
@@ -48,6 +49,16 @@ _PHI_STEPS = (2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0)
 #: a fitted alpha 2.4 % low); the cost of a trace barely depends on the grid
 _AUTO_THETA_STEPS = (1.0, 2.0, 3.0)
 _AUTO_PHI_STEPS = (2.0, 3.0, 4.0, 5.0, 6.0)
+#: the traced exit operator is biased low within this many degrees of the normal [deg]
+#: (its polar cells put every ray at the cell's centroid: -8.6 / -4.4 / -2.2 % in the rows
+#: at 0 / 3 / 6 deg at normal incidence on coated Al, alpha 0.2; docs/tracer.md)
+POLE_BIAS_DEG = 9.0
+POLE_WARNING = (
+    "layered: {n} point(s) lie within {deg:g} deg of the surface normal, where the traced "
+    "exit operator is biased low (-9 to -2 % in the rows at 0-6 deg, measured on coated "
+    "Al at alpha 0.2; more for narrower lobes; docs/tracer.md); leave them out "
+    "(--theta-r 9:) or read their residuals with that in mind"
+)
 
 
 def _auto_step(spacing: float, steps: tuple[float, ...]) -> float:
@@ -180,19 +191,9 @@ class Layered(Model):
             raise ModelError(f"layered option 'base' must be one of {list(_BASES)}; got {base!r}")
         self._base = base
         self._coherent = _flag(coherent, "coherent")
-        if self._coherent:
-            self.fd_rel_step = None
-            self.stochastic = False
-            self.default_replicates = 1
         self._floor = _flag(floor, "floor")
         self._nk = (1.0, 0.0)
-        # a Lambertian base is a renewal process: its single-scattering walk has a
-        # closed-form expectation (labbrdf.tracer.coated_lambert), no rays needed
-        self._closed = base == "diffuse"
-        if self._closed:
-            self.fd_rel_step = None
-            self.stochastic = False
-            self.default_replicates = 1
+        self._closed = self._closed_form(base)
         if base == "diffuse":
             if n is not None or k is not None:
                 raise ModelError(
@@ -271,6 +272,21 @@ class Layered(Model):
             self.linear = ("scale", "kd")
         opts["grid"] = "auto" if self._grid is None else f"{self._grid[0]:g}x{self._grid[1]:g}"
         super().__init__(**opts)
+
+    def _closed_form(self, base: str) -> bool:
+        """Whether a diffuse base is evaluated in closed form; marks a deterministic model.
+
+        A Lambertian base makes the single-scattering walk a renewal process, whose
+        expectation is a closed form (:mod:`labbrdf.tracer.coated_lambert`): no rays. The
+        coherent mode's map is evaluated in closed form too. Both are deterministic.
+        """
+        self._pole_warned = False  # the traced operator's pole warning, given once
+        closed = base == "diffuse"
+        if closed or self._coherent:
+            self.fd_rel_step = None
+            self.stochastic = False
+            self.default_replicates = 1
+        return closed
 
     def reseeded(self, seed: int) -> Layered:
         """The same model (options, grid) with the tracer seed ``seed`` and a fresh cache."""
@@ -524,6 +540,7 @@ class Layered(Model):
         val = np.zeros(ti_deg.shape)
         dev: NDArray | None = None
         up = (tr_deg >= 0) & (tr_deg <= 90)
+        self._warn_pole(p, tr_deg[up])
         dt, dp = self._grid
         pairs = np.unique(np.stack([np.round(ti_deg, 9).ravel(), wl.ravel()], axis=1), axis=0)
         for t, w in pairs:
@@ -537,6 +554,25 @@ class Layered(Model):
             val[sel] = _bilinear(f, u, v)
             dev[:, sel] = _bilinear(d, u, v)
         return val, np.zeros((1, *ti_deg.shape)) if dev is None else dev
+
+    def _warn_pole(self, p: Mapping[str, float], tr_deg: NDArray) -> None:
+        """Warn once if points near the normal go through the traced exit operator.
+
+        Not for the closed-form diffuse base, the coherent mode (no operator) or a top
+        smooth enough for the sampled exit (:func:`labbrdf.tracer.exit_sampled.exit_is_sampled`).
+        """
+        from ..tracer import Grid
+        from ..tracer.exit_sampled import exit_is_sampled
+
+        if self._closed or self._coherent or self._pole_warned or self._grid is None:
+            return
+        near = int(np.count_nonzero(tr_deg < POLE_BIAS_DEG))
+        grid = Grid(*self._grid)
+        if near and not exit_is_sampled(grid, float(p["n_coat"]), float(p["alpha_top"])):
+            warnings.warn(
+                POLE_WARNING.format(n=near, deg=POLE_BIAS_DEG), PoleBiasWarning, stacklevel=4
+            )
+            self._pole_warned = True
 
     # ------------------------------------------------------------------ model API
     def _evaluate(
@@ -630,6 +666,10 @@ class Layered(Model):
                     albedo = trace(cfg).albedo()
             out.append(albedo + (p["kd"] if self._floor else 0.0))
         return np.asarray(out, float).reshape(np.shape(theta_i_deg))
+
+
+class PoleBiasWarning(UserWarning):
+    """Points near the normal go through the traced exit operator, biased low there."""
 
 
 def _flag(v: Any, name: str) -> bool:

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
 from labbrdf import models
 from labbrdf.models import ModelError
+from labbrdf.models.layered import PoleBiasWarning
 
 AL = {"n": 1.55, "k": 7.71}
 
@@ -174,3 +177,19 @@ def test_a_nearly_smooth_coating_keeps_its_energy():
     assert abs(got[0] - ct.albedo()) < 4 * ct.albedo_stderr()
     se = np.hypot(ev.albedo_stderr(), ct.albedo_stderr())
     assert abs(ev.albedo() - ct.albedo()) < 4 * se
+
+
+def test_points_near_the_normal_through_the_exit_operator_warn_once():
+    """The traced operator's pole bias is never silent; the closed forms have none."""
+    ti, tr, pr = _points(0.0, 10)  # theta_r from 2 deg
+    lay = models.get("layered", grid="3x6", rays=1000, **AL)
+    with pytest.warns(PoleBiasWarning, match=r"within 9 deg of the surface normal"):
+        lay.evaluate(ti, tr, pr, params={"alpha_top": 0.2, "alpha_sub": 0.2})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lay.evaluate(ti, tr, pr, params={"alpha_top": 0.2, "alpha_sub": 0.2})  # once
+        far = models.get("layered", grid="3x6", rays=1000, **AL)
+        far.evaluate(ti[:1], tr[-1:], pr[:1], params={"alpha_top": 0.2, "alpha_sub": 0.2})
+        dif = models.get("layered", base="diffuse", grid="3x6")
+        dif.evaluate(ti, tr, pr, params={"alpha_top": 0.2, "albedo": 0.5})
+        assert not dif.stochastic
