@@ -20,7 +20,7 @@ vinyl 1113 s wall, ~170 s CPU, 354 evaluations over the three seeds, alpha_top 0
 0.0092, albedo 0.2443 +- 0.0068, chi2/nu 0.1345; one evaluation 0.48 s of CPU (cProfile:
 the walks 53 %, one exit-operator build per new alpha_top 37 %, the first-surface maps the
 rest). Now a diffuse base is evaluated in closed form (``labbrdf.tracer.coated_lambert``,
-``docs/tracer.md``): one deterministic fit, 13.5 s CPU (71 s wall at load 15), 133
+``docs/tracer.md``): one deterministic fit, 12.8-13.7 s CPU (40-100 s wall at load 10-15), 133
 evaluations, alpha_top 0.3442, albedo 0.2411, chi2/nu 0.1336. ``--check`` compares the
 closed form at the fitted parameters with the counting walk at each incidence (every bin
 pooled into groups of 400 counted rays; z RMS ~1 and the albedo within its error when they

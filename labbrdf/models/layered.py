@@ -281,6 +281,7 @@ class Layered(Model):
         coherent mode's map is evaluated in closed form too. Both are deterministic.
         """
         self._pole_warned = False  # the traced operator's pole warning, given once
+        self._first_maps: OrderedDict[tuple, NDArray] = OrderedDict()  # closed form's
         closed = base == "diffuse"
         if closed or self._coherent:
             self.fd_rel_step = None
@@ -491,7 +492,14 @@ class Layered(Model):
             Grid(cfg.theta_step_deg, cfg.phi_step_deg),
         )
         self.traces += 1
-        return np.asarray(first_surface_map(cfg)[..., 0, 0] + body, float)
+        # the first surface does not depend on the albedo: kept per (coating, incidence)
+        key = (coat.n, coat.alpha, cfg.theta_i_deg, cfg.theta_step_deg, cfg.phi_step_deg)
+        first = self._first_maps.get(key)
+        if first is None:
+            first = self._first_maps[key] = first_surface_map(cfg)[..., 0, 0]
+            if len(self._first_maps) > _CACHE_SIZE:
+                self._first_maps.popitem(last=False)
+        return np.asarray(first + body, float)
 
     @property
     def grid_deg(self) -> tuple[float, float] | None:
