@@ -14,25 +14,19 @@ BIC, and with seed replicates each seed's estimate, their spread and the reporte
 parts of one layered evaluation: one trace, the exit operator's build, and an evaluation at
 all incidences with a fresh operator.
 
-Aim: 2-3 layered parameters at three incidences in under 10 minutes on 2 cores. Measured
-(load average 3.5-8, ``OPENBLAS_NUM_THREADS=1``): the vinyl 137 s (124 evaluations, 378
-traces), the synthetic file 194 s (115 evaluations, 351 traces); microfacet + Lambertian
-0.1-0.3 s on either. Seed replicates cost R fits: the synthetic file at 45 degrees only
-(166 points), 4000 rays, Al + floor (``--file /none --incidences 45 --rays 4000``): one
-seed 32 s (112 evaluations, alpha_top 0.267), three seeds (the default) 91 s (331
-evaluations): alpha_top 0.267, 0.172, 0.134, s_between 0.069, reported 0.191 +- 0.040
-against the truth 0.15 (load average 1.4-1.6). Where the
-time goes (cProfile of three evaluations of the vinyl at 15, 45 and 75 deg, diffuse base,
-2e4 rays, 3 x 6 grid, load average ~11): 2.6 s per evaluation, of which the three walks
-1.4 s (53 %), one exit-operator build per new alpha_top 1.0 s (37 %; the memory cache
-keeps two, so every new alpha_top value builds one), the first-surface maps and the
-operator's application the rest. A fit of ~124 evaluations is therefore ~2/3 walks and
-~1/3 operator builds: reusing operators across alpha_top (interpolating their spectra) and
-reusing the walks across the base albedo (the diffuse base multiplies a ray's weight by
-the albedo at each base event, so cells kept per number of base events make the map a
-polynomial in the albedo) are the two largest savings; neither is done yet. Not a
-timed test: numbers depend on the machine and its load (report ``uptime`` with them), and
-on OpenBLAS's thread count (``OPENBLAS_NUM_THREADS=1`` is 2.5x faster on a loaded machine).
+Aim: 2-3 layered parameters at three incidences in seconds on 2 cores. Before (traced
+diffuse base, three seed replicates, ``OPENBLAS_NUM_THREADS=1``, load average 10-16): the
+vinyl 1113 s wall, ~170 s CPU, 354 evaluations over the three seeds, alpha_top 0.3453 +-
+0.0092, albedo 0.2443 +- 0.0068, chi2/nu 0.1345; one evaluation 0.48 s of CPU (cProfile:
+the walks 53 %, one exit-operator build per new alpha_top 37 %, the first-surface maps the
+rest). Now a diffuse base is evaluated in closed form (``labbrdf.tracer.coated_lambert``,
+``docs/tracer.md``): one deterministic fit, 12.8-13.7 s CPU (40-100 s wall at load 10-15), 133
+evaluations, alpha_top 0.3442, albedo 0.2411, chi2/nu 0.1336. ``--check`` compares the
+closed form at the fitted parameters with the counting walk at each incidence (every bin
+pooled into groups of 400 counted rays; z RMS ~1 and the albedo within its error when they
+agree). The synthetic file's conductor base is still traced. Not a timed test: numbers
+depend on the machine and its load (report ``uptime`` with them), and on OpenBLAS's
+thread count (``OPENBLAS_NUM_THREADS=1`` is 2.5x faster on a loaded machine).
 """
 
 from __future__ import annotations
@@ -88,21 +82,23 @@ def run(label: str, make: Any, df: Any, repeat: int, replicates: int | None = No
     ``replicates``: seed replicates of a stochastic model (None: the model's default);
     their traces run in fresh model instances and are not counted.
     """
-    walls, nfevs, traces = [], [], []
+    walls, cpus, nfevs, traces = [], [], [], []
     res = None
     for _ in range(repeat):
         model = make()
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         R = replicates if model.stochastic else None
         res = fit(model, df, weighting="relative", replicates=R)
         walls.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)
         nfevs.append(res.nfev)
         traces.append(getattr(model, "traces", 0))
     assert res is not None
     wall = statistics.median(walls)
     nfev = statistics.median(nfevs)
     print(
-        f"{label:<34} {wall:8.1f} s  nfev {nfev:5.0f}  traces {statistics.median(traces):5.0f}"
+        f"{label:<34} {wall:8.1f} s (CPU {statistics.median(cpus):6.1f} s)  nfev {nfev:5.0f}"
+        f"  traces {statistics.median(traces):5.0f}"
         f"  {1e3 * wall / nfev:7.1f} ms/eval  chi2/nu {res.redchi:.4g}  AIC {res.aic:.5g}"
         f"  BIC {res.bic:.5g}  success {res.success}"
     )
@@ -152,6 +148,46 @@ def parts(df: Any, rays: int) -> None:
     print(f"one evaluation at {n_inc} incidences: {statistics.median(ev):.2f} s")
 
 
+def check(res: Any, incidences: list[float], rays: int) -> None:
+    """The closed-form diffuse base at the fitted parameters against the counting walk."""
+    from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
+    from labbrdf.tracer.agreement import pool_bins
+    from labbrdf.tracer.coated_lambert import coated_lambert
+    from labbrdf.tracer.estimator import first_surface_map
+
+    a, alb = res.params["alpha_top"].value, res.params["albedo"].value
+    for t in incidences:
+        cfg = TraceConfig(
+            rays=rays,
+            theta_i_deg=t,
+            substrate=Substrate.lambertian(alb),
+            coating=Coating(n=1.5, alpha=a, thickness_nm=1000.0),
+            scattering="single",
+            estimator="counting",
+            scalar=True,
+            theta_step_deg=3.0,
+            phi_step_deg=6.0,
+            seed=99,
+        )
+        ct = trace(cfg)
+        f = first_surface_map(cfg)[..., 0, 0]
+        f = f + coated_lambert(1.5, a, 0.0, 1000.0, cfg.wavelength_nm).bin_map(alb, t, ct.grid)
+        om = ct.grid.cos_solid_angle_sr.ravel()
+        g = pool_bins(ct.counts, 400)
+        ng = int(g.max()) + 1
+        omg = np.bincount(g, weights=om, minlength=ng)
+        s = np.bincount(g, weights=ct.sums[..., 0, 0].ravel(), minlength=ng)
+        ss = np.bincount(g, weights=ct.sumsq[..., 0, 0].ravel(), minlength=ng)
+        se = np.sqrt(np.maximum(ss / rays - (s / rays) ** 2, 0.0) / rays) / omg
+        z = (np.bincount(g, weights=f.ravel() * om, minlength=ng) / omg - s / (rays * omg)) / se
+        alb_c = float((f.ravel() * om).sum())
+        print(
+            f"  {t:g} deg: closed form vs counting ({rays} rays), {ng} groups: z RMS "
+            f"{np.sqrt(np.mean(z**2)):.2f}, max |z| {np.abs(z).max():.1f}; albedo "
+            f"{alb_c:.5f} vs {ct.albedo():.5f} +- {ct.albedo_stderr():.5f}"
+        )
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=1)
@@ -161,6 +197,7 @@ def main() -> None:
     ap.add_argument(
         "--replicates", type=int, default=None, help="seed replicates (default: the model's)"
     )
+    ap.add_argument("--check", type=int, default=0, help="rays of the counting check (0: none)")
     args = ap.parse_args()
     inc = [float(x) for x in args.incidences.split(",")]
     with tempfile.TemporaryDirectory() as tmp:
@@ -176,13 +213,15 @@ def main() -> None:
             args.repeat,
         )
         if path == args.file:  # the vinyl: a clear layer over a diffuse body
-            run(
+            out = run(
                 f"layered, diffuse base ({args.rays} rays)",
                 lambda: models.get("layered", rays=args.rays, base="diffuse"),
                 df,
                 args.repeat,
                 args.replicates,
             )
+            if args.check:
+                check(out["result"], inc, args.check)
         else:
             run(
                 f"layered over Al + floor ({args.rays} rays)",

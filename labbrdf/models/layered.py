@@ -7,7 +7,9 @@ grid, interpolated to the points. Every trace uses the same seed whatever the pa
 (common random numbers), so the BRDF is a deterministic and nearly smooth function of the
 parameters and a fit can use it like a closed-form model; its Monte Carlo error enters the
 fit through :meth:`Layered.point_noise` and :meth:`Layered.point_variance`
-(``docs/models.md`` 7).
+(``docs/models.md`` 7). Over a Lambertian base (``base="diffuse"``) the walk's expectation
+is a closed form (:mod:`labbrdf.tracer.coated_lambert`), evaluated on the same grid without
+rays: deterministic, no Monte Carlo error.
 
 References
 ----------
@@ -23,6 +25,7 @@ References
 from __future__ import annotations
 
 import math
+import warnings
 from collections import OrderedDict
 from collections.abc import Mapping
 from typing import Any
@@ -32,7 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .base import Model, ModelError, Parameters, lambert
 
-__all__ = ["Layered"]
+__all__ = ["Layered", "PoleBiasWarning"]
 
 _BASES = ("conductor", "diffuse")
 #: traces kept per model instance (two small maps each): a fit's Jacobian and polish come
@@ -46,6 +49,16 @@ _PHI_STEPS = (2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0)
 #: a fitted alpha 2.4 % low); the cost of a trace barely depends on the grid
 _AUTO_THETA_STEPS = (1.0, 2.0, 3.0)
 _AUTO_PHI_STEPS = (2.0, 3.0, 4.0, 5.0, 6.0)
+#: the traced exit operator is biased low within this many degrees of the normal [deg]
+#: (its polar cells put every ray at the cell's centroid: -8.6 / -4.4 / -2.2 % in the rows
+#: at 0 / 3 / 6 deg at normal incidence on coated Al, alpha 0.2; docs/tracer.md)
+POLE_BIAS_DEG = 9.0
+POLE_WARNING = (
+    "layered: {n} point(s) lie within {deg:g} deg of the surface normal, where the traced "
+    "exit operator is biased low (-9 to -2 % in the rows at 0-6 deg, measured on coated "
+    "Al at alpha 0.2; more for narrower lobes; docs/tracer.md); leave them out "
+    "(--theta-r 9:) or read their residuals with that in mind"
+)
 
 
 def _auto_step(spacing: float, steps: tuple[float, ...]) -> float:
@@ -79,11 +92,12 @@ class Layered(Model):
     floor : bool, default False
         Add a Lambertian floor ``kd / pi`` [sr^-1] (linear; profiled by the fit).
     rays : int, default 20000
-        Rays per trace. On a 3 x 6 degree grid 2e4 rays give a per-bin relative standard
-        error of about 3 % over the lobe of a coating on Al and 1-5 % over a diffuse base
-        (``docs/models.md`` 7).
+        Rays per trace (conductor base; a diffuse base is evaluated without rays). On a
+        3 x 6 degree grid 2e4 rays give a per-bin relative standard error of about 3 %
+        over the lobe of a coating on Al (``docs/models.md`` 7).
     seed : int, default 0
-        Seed of every trace (common random numbers: the same for all parameter values).
+        Seed of every trace (common random numbers: the same for all parameter values;
+        conductor base only).
     grid : "auto", "THETAxPHI" or (float, float), default "auto"
         Tracer bin steps (theta, phi) [deg], e.g. "3x6"; "auto" derives them from the
         number of points per incidence of the first evaluation (:meth:`_set_grid`; at
@@ -105,6 +119,13 @@ class Layered(Model):
     bin centres. Against the point value of the BRDF this has a bias of order
     ``h^2 f'' / 8``, which is why "auto" keeps the bins at most half the data's spacing
     and at most 3 x 6 degrees.
+    A diffuse base: every ray that reaches it is re-emitted with the cosine law whatever
+    way it came, so the walk is a renewal process and its expectation is the series
+    ``a T(theta_i) T(theta_o) / (pi n^2 (1 - a R))`` plus the first surface
+    (:mod:`labbrdf.tracer.coated_lambert`; agrees with the counting walk over every bin,
+    ``docs/tracer.md``). The model evaluates that, on the tracer's grid and interpolated
+    like a traced map, so it is the traced model without its noise (and without the exit
+    operator's bias near the pole).
     Single scattering (the separable Smith G1 G1 per interface) loses energy for rough
     interfaces; the multiple-scattering walk would count rays, whose noise no fit can
     use (``docs/tracer.md``).
@@ -170,12 +191,9 @@ class Layered(Model):
             raise ModelError(f"layered option 'base' must be one of {list(_BASES)}; got {base!r}")
         self._base = base
         self._coherent = _flag(coherent, "coherent")
-        if self._coherent:
-            self.fd_rel_step = None
-            self.stochastic = False
-            self.default_replicates = 1
         self._floor = _flag(floor, "floor")
         self._nk = (1.0, 0.0)
+        self._closed = self._closed_form(base)
         if base == "diffuse":
             if n is not None or k is not None:
                 raise ModelError(
@@ -254,6 +272,22 @@ class Layered(Model):
             self.linear = ("scale", "kd")
         opts["grid"] = "auto" if self._grid is None else f"{self._grid[0]:g}x{self._grid[1]:g}"
         super().__init__(**opts)
+
+    def _closed_form(self, base: str) -> bool:
+        """Whether a diffuse base is evaluated in closed form; marks a deterministic model.
+
+        A Lambertian base makes the single-scattering walk a renewal process, whose
+        expectation is a closed form (:mod:`labbrdf.tracer.coated_lambert`): no rays. The
+        coherent mode's map is evaluated in closed form too. Both are deterministic.
+        """
+        self._pole_warned = False  # the traced operator's pole warning, given once
+        self._first_maps: OrderedDict[tuple, NDArray] = OrderedDict()  # closed form's
+        closed = base == "diffuse"
+        if closed or self._coherent:
+            self.fd_rel_step = None
+            self.stochastic = False
+            self.default_replicates = 1
+        return closed
 
     def reseeded(self, seed: int) -> Layered:
         """The same model (options, grid) with the tracer seed ``seed`` and a fresh cache."""
@@ -411,6 +445,9 @@ class Layered(Model):
             cfg = self._config(p, float(theta_i_deg), float(wavelength_nm))
         except ValueError as exc:
             raise ModelError(f"layered: {exc}") from None
+        if self._closed:
+            f = self._closed_map(cfg)
+            return self._remember(key, (f, np.zeros((1, *f.shape))))
         with memory_cache(self._operators):
             res = trace(cfg)
         self.traces += 1
@@ -425,11 +462,44 @@ class Layered(Model):
             # no Monte Carlo part (a bare or coherent first surface): the batch maps are
             # the same map, and only their float32 storage differs from f
             dev = np.zeros_like(dev)
-        out = (f, dev)
+        return self._remember(key, (f, dev))
+
+    def _remember(
+        self, key: tuple, out: tuple[NDArray[np.float64], NDArray[np.float64]]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         self._cache[key] = out
         if len(self._cache) > _CACHE_SIZE:
             self._cache.popitem(last=False)
         return out
+
+    def _closed_map(self, cfg: Any) -> NDArray[np.float64]:
+        """S0 map of a coated Lambertian base in closed form (n_theta, n_phi) [sr^-1].
+
+        The first surface's bin averages (:func:`labbrdf.tracer.estimator.first_surface_map`)
+        plus the light through the coating (:mod:`labbrdf.tracer.coated_lambert`): the
+        expectation of the traced map, on the same grid, without its Monte Carlo error.
+        """
+        from ..tracer import Grid
+        from ..tracer.coated_lambert import coated_lambert
+        from ..tracer.estimator import first_surface_map
+
+        coat = cfg.coating
+        body = coated_lambert(
+            coat.n, coat.alpha, coat.k, coat.thickness_nm, cfg.wavelength_nm
+        ).bin_map(
+            float(cfg.substrate.albedo),
+            cfg.theta_i_deg,
+            Grid(cfg.theta_step_deg, cfg.phi_step_deg),
+        )
+        self.traces += 1
+        # the first surface does not depend on the albedo: kept per (coating, incidence)
+        key = (coat.n, coat.alpha, cfg.theta_i_deg, cfg.theta_step_deg, cfg.phi_step_deg)
+        first = self._first_maps.get(key)
+        if first is None:
+            first = self._first_maps[key] = first_surface_map(cfg)[..., 0, 0]
+            if len(self._first_maps) > _CACHE_SIZE:
+                self._first_maps.popitem(last=False)
+        return np.asarray(first + body, float)
 
     @property
     def grid_deg(self) -> tuple[float, float] | None:
@@ -478,6 +548,7 @@ class Layered(Model):
         val = np.zeros(ti_deg.shape)
         dev: NDArray | None = None
         up = (tr_deg >= 0) & (tr_deg <= 90)
+        self._warn_pole(p, tr_deg[up])
         dt, dp = self._grid
         pairs = np.unique(np.stack([np.round(ti_deg, 9).ravel(), wl.ravel()], axis=1), axis=0)
         for t, w in pairs:
@@ -491,6 +562,25 @@ class Layered(Model):
             val[sel] = _bilinear(f, u, v)
             dev[:, sel] = _bilinear(d, u, v)
         return val, np.zeros((1, *ti_deg.shape)) if dev is None else dev
+
+    def _warn_pole(self, p: Mapping[str, float], tr_deg: NDArray) -> None:
+        """Warn once if points near the normal go through the traced exit operator.
+
+        Not for the closed-form diffuse base, the coherent mode (no operator) or a top
+        smooth enough for the sampled exit (:func:`labbrdf.tracer.exit_sampled.exit_is_sampled`).
+        """
+        from ..tracer import Grid
+        from ..tracer.exit_sampled import exit_is_sampled
+
+        if self._closed or self._coherent or self._pole_warned or self._grid is None:
+            return
+        near = int(np.count_nonzero(tr_deg < POLE_BIAS_DEG))
+        grid = Grid(*self._grid)
+        if near and not exit_is_sampled(grid, float(p["n_coat"]), float(p["alpha_top"])):
+            warnings.warn(
+                POLE_WARNING.format(n=near, deg=POLE_BIAS_DEG), PoleBiasWarning, stacklevel=4
+            )
+            self._pole_warned = True
 
     # ------------------------------------------------------------------ model API
     def _evaluate(
@@ -538,6 +628,8 @@ class Layered(Model):
         interpolated values, with the correlations between points that share bins or
         rays (the exit operator spreads each ray over the top interface's lobe).
         """
+        if self._closed:
+            return np.zeros((1, *np.broadcast(theta_i, theta_r, phi_r).shape))
         q = self.values(p)  # missing names take the current values
         ti, tr, pr = np.broadcast_arrays(
             np.asarray(theta_i, float), np.asarray(theta_r, float), np.asarray(phi_r, float)
@@ -564,7 +656,7 @@ class Layered(Model):
         self, theta_i_deg: ArrayLike, params: Mapping[str, float] | None = None
     ) -> NDArray[np.float64] | None:
         """The traced albedo [1] (S0 map integrated over the hemisphere) plus ``kd``."""
-        from ..tracer import trace
+        from ..tracer import Grid, trace
         from ..tracer.operator import memory_cache
 
         p = self.values(params)
@@ -573,10 +665,19 @@ class Layered(Model):
             self.options["grid"] = "2x4"
         out = []
         for t in np.atleast_1d(np.asarray(theta_i_deg, float)):
-            with memory_cache(self._operators):
-                res = trace(self._config(p, float(t), self._wl_default))
-            out.append(res.albedo() + (p["kd"] if self._floor else 0.0))
+            cfg = self._config(p, float(t), self._wl_default)
+            if self._closed:
+                omega = Grid(*self._grid).cos_solid_angle_sr
+                albedo = float((self._closed_map(cfg) * omega).sum())
+            else:
+                with memory_cache(self._operators):
+                    albedo = trace(cfg).albedo()
+            out.append(albedo + (p["kd"] if self._floor else 0.0))
         return np.asarray(out, float).reshape(np.shape(theta_i_deg))
+
+
+class PoleBiasWarning(UserWarning):
+    """Points near the normal go through the traced exit operator, biased low there."""
 
 
 def _flag(v: Any, name: str) -> bool:
