@@ -61,6 +61,27 @@ POLE_WARNING = (
 )
 
 
+def _distribution(name: Any, base: str, coherent: bool) -> str:
+    """The checked ``distribution`` option: a registered name, GGX where only GGX is written."""
+    from ..microfacet import DISTRIBUTIONS
+
+    if name not in DISTRIBUTIONS:
+        raise ModelError(
+            f"layered option 'distribution' must be one of {list(DISTRIBUTIONS)}; got {name!r}"
+        )
+    if name != "ggx" and (base == "diffuse" or coherent):
+        reason = (
+            "the closed form of a coated Lambertian base is written for GGX"
+            if base == "diffuse"
+            else "the coherent mode's facets are GGX"
+        )
+        raise ModelError(
+            f"layered option distribution={name!r} needs base='conductor' without "
+            f"coherent: {reason}"
+        )
+    return str(name)
+
+
 def _auto_step(spacing: float, steps: tuple[float, ...]) -> float:
     """The largest allowed step not above half the data's angular spacing [deg]."""
     ok = [s for s in steps if s <= spacing / 2.0]
@@ -104,6 +125,12 @@ class Layered(Model):
         most 3 x 6 degrees).
     wavelength_nm : float, default 550
         Wavelength [nm] for points that carry none.
+    distribution : str, default "ggx"
+        Microfacet distribution of both rough interfaces, a name of
+        :data:`labbrdf.microfacet.DISTRIBUTIONS` (e.g. "beckmann"). Other than GGX it is
+        traced through its slope table and its exit is sampled through the walk's facets
+        (``docs/tracer.md``); conductor base and incoherent mode only (the closed form of a
+        diffuse base and the coherent facets are written for GGX).
 
     Parameters: ``n_coat`` [1] in [1.2, 2.2], fixed at 1.5 by default (``--free n_coat``);
     ``alpha_top`` [1] in [0.02, 1] (log), GGX roughness of the coating's top;
@@ -179,18 +206,20 @@ class Layered(Model):
         seed: int = 0,
         grid: str | tuple[float, float] = "auto",
         wavelength_nm: float = 550.0,
+        distribution: str = "ggx",
         **options: Any,
     ) -> None:
         if options:
             raise ModelError(
                 f"model 'layered' got unknown options {sorted(options)}; options are "
                 "['n', 'k', 'base', 'coherent', 'coating_k', 'thickness_nm', 'floor', "
-                "'rays', 'seed', 'grid', 'wavelength_nm']"
+                "'rays', 'seed', 'grid', 'wavelength_nm', 'distribution']"
             )
         if base not in _BASES:
             raise ModelError(f"layered option 'base' must be one of {list(_BASES)}; got {base!r}")
         self._base = base
         self._coherent = _flag(coherent, "coherent")
+        self._distribution = _distribution(distribution, base, self._coherent)
         self._floor = _flag(floor, "floor")
         self._nk = (1.0, 0.0)
         self._closed = self._closed_form(base)
@@ -260,6 +289,8 @@ class Layered(Model):
             opts["wavelength_nm"] = self._wl_default
         if base == "conductor":
             opts.update(n=self._nk[0], k=self._nk[1])
+        if self._distribution != "ggx":
+            opts["distribution"] = self._distribution
         if self._coherent:
             opts["coherent"] = True
         else:
@@ -393,6 +424,7 @@ class Layered(Model):
 
     # ------------------------------------------------------------------ tracing
     def _config(self, p: Mapping[str, float], theta_i_deg: float, wl: float) -> Any:
+        from ..microfacet.interface import table_for
         from ..tracer import Coating, Substrate, TraceConfig
 
         n_coat, a_top = float(p["n_coat"]), float(p["alpha_top"])
@@ -400,12 +432,19 @@ class Layered(Model):
             if not (math.isfinite(v) and v > lo):
                 raise ModelError(f"layered parameter {name!r} must be > {lo:g}; got {v!r}")
         thick = float(p["thickness_nm"]) if self._coherent else self._thickness
-        coat = Coating(n=n_coat, k=self._coating_k, thickness_nm=thick, alpha=a_top)
+        dist = self._distribution
+        coat = Coating(
+            n=n_coat,
+            k=self._coating_k,
+            thickness_nm=thick,
+            alpha=a_top,
+            ndf=table_for(dist, a_top),
+        )
         if self._base == "diffuse":
             sub = Substrate.lambertian(float(p["albedo"]))
         else:
             a_sub = a_top if self._coherent else float(p["alpha_sub"])
-            sub = Substrate(n=self._nk[0], k=self._nk[1], alpha=a_sub)
+            sub = Substrate(n=self._nk[0], k=self._nk[1], alpha=a_sub, ndf=table_for(dist, a_sub))
         assert self._grid is not None
         return TraceConfig(
             wavelength_nm=wl,

@@ -45,6 +45,9 @@ def test_layered_is_registered_and_names_its_parameters():
         ({"colour": 1, **AL}, "unknown options ['colour']"),
         ({"base": "diffuse", **AL}, "takes no substrate index n, k"),
         ({"base": "diffuse", "coherent": True}, "coherent=True needs base='conductor'"),
+        ({"distribution": "gauss", **AL}, "'distribution' must be one of ['ggx', 'beckmann'"),
+        ({"distribution": "beckmann", "base": "diffuse"}, "coated Lambertian base is written"),
+        ({"distribution": "beckmann", "coherent": True, **AL}, "coherent mode's facets are GGX"),
     ],
 )
 def test_bad_options_are_refused_by_name(options, words):
@@ -193,3 +196,37 @@ def test_points_near_the_normal_through_the_exit_operator_warn_once():
         dif = models.get("layered", base="diffuse", grid="3x6")
         dif.evaluate(ti, tr, pr, params={"alpha_top": 0.2, "albedo": 0.5})
         assert not dif.stochastic
+
+
+def test_a_beckmann_coating_traces_both_interfaces_through_their_slope_tables():
+    """``distribution='beckmann'`` puts the Beckmann table on the top and on the conductor.
+
+    The model's map is the tracer's own run of the configuration that ``labbrdf trace
+    --distribution beckmann`` builds (same seed, same arithmetic: equal arrays); a model that
+    left either interface GGX traces another surface and differs by far more than the noise.
+    """
+    from labbrdf.microfacet import TabulatedNDF, beckmann
+    from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
+
+    kw = {"grid": "3x6", "rays": 2000, **AL}
+    m = models.get("layered", distribution="beckmann", **kw)
+    assert m.options["distribution"] == "beckmann"
+    assert "distribution" not in models.get("layered", **kw).options
+    p = {"n_coat": 1.5, "alpha_top": 0.2, "alpha_sub": 0.3, "scale": 1.0}
+    got, _ = m.trace_maps(p, 45.0, 550.0)
+    cfg = TraceConfig(
+        wavelength_nm=550.0,
+        theta_i_deg=45.0,
+        substrate=Substrate(n=1.55, k=7.71, alpha=0.3, ndf=TabulatedNDF.of(beckmann, 0.3)),
+        coating=Coating(n=1.5, thickness_nm=1000.0, alpha=0.2, ndf=TabulatedNDF.of(beckmann, 0.2)),
+        rays=2000,
+        seed=0,
+        scattering="single",
+        estimator="evaluated",
+        theta_step_deg=3.0,
+        phi_step_deg=6.0,
+    )
+    want = np.asarray(trace(cfg).mueller[..., 0, 0], float)
+    assert np.array_equal(got, want)
+    ggx, _ = models.get("layered", **kw).trace_maps(p, 45.0, 550.0)
+    assert np.max(np.abs(ggx - got)) > 0.05 * np.max(got)
