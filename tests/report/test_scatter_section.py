@@ -1,0 +1,174 @@
+"""The report's ``scatter`` section: ABg and Harvey-Shack beside the physical models, the
+TIS, and the designer's files written beside the page.
+
+A synthetic ``.bsdf`` written from known ABg parameters with 2 % noise (recovered within 3
+standard errors), its BTDF twin (only the transmission forms are fitted), and inputs
+without a tabulated BSDF (the section is not available).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from labbrdf import models
+from labbrdf.adapters import read
+from labbrdf.adapters.zemax_bsdf import read_table
+from labbrdf.bsdf_geometry import scatter_to_angles
+from labbrdf.report.builder import Builder, write_report
+from labbrdf.report.context import Context
+from labbrdf.report.sections import run
+from labbrdf.report.sections.scatter import scatter_section
+from labbrdf.writers.zemax import write_bsdf
+
+TRUTH = {"A": 0.004, "B": 2e-4, "g": 1.6}
+TI = np.array([10.0, 30.0, 50.0])
+RAD = np.array([0.0, 0.5, 1, 2, 4, 8, 15, 25, 40, 60, 80])
+AZ = np.arange(0, 181, 30.0)
+
+
+def _abg_file(path: Path, scatter_type: str = "BRDF") -> Path:
+    tr, pr, above = scatter_to_angles(TI[:, None, None], RAD[None, None, :], AZ[None, :, None])
+    st = np.sin(np.radians(tr))
+    d = np.hypot(
+        st * np.cos(np.radians(pr)) + np.sin(np.radians(TI))[:, None, None],
+        st * np.sin(np.radians(pr)),
+    )
+    f = TRUTH["A"] / (TRUTH["B"] + d ** TRUTH["g"])
+    f = f * (1 + 0.02 * np.random.default_rng(3).standard_normal(f.shape))
+    return write_bsdf(
+        path,
+        theta_i_deg=TI,
+        radial_deg=RAD,
+        azimuth_deg=AZ,
+        values=np.where(above, f, 0.0)[None, None],
+        symmetry="PlaneSymmetrical",
+        scatter_type=scatter_type,
+        digits=12,
+    )
+
+
+def _section(paths: list[Path], out: Path, model: str = "microfacet") -> tuple[dict, Builder]:
+    b = Builder("scatter test")
+    ctx = Context(b=b, executor="serial")  # type: ignore[arg-type]
+    from labbrdf.parallel import as_executor
+
+    ctx.executor = as_executor("serial")
+    for p in paths:
+        m = read(p)
+        ctx.files.append({"path": str(p), "meta": m.meta})
+        ctx.frames.append(m.data)
+    run(ctx, [("scatter", "Scatter", lambda c: scatter_section(c, model, {}))])
+    b.finish()
+    write_report(out, b.results, "<html></html>", files=b.files)
+    return b.results, b
+
+
+@pytest.fixture(scope="module")
+def brdf(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    """The section run once on the synthetic BRDF file; (results, report folder)."""
+    tmp = tmp_path_factory.mktemp("scatter")
+    res, _ = _section([_abg_file(tmp / "s.bsdf")], tmp / "out")
+    return res, tmp / "out"
+
+
+def test_abg_recovered_tis_and_designer_files(brdf: tuple[dict, Path]) -> None:
+    res, out = brdf
+    (sec,) = res["sections"]
+    assert sec["status"] == "ok", sec["reason"]
+    fits = res["tables"]["scatter_fits_s_555_0"]["rows"]
+    assert [r["model"] for r in fits] == [
+        "ABg",
+        "ABg + Lambertian floor",
+        "Harvey-Shack",
+        "microfacet + Lambertian floor",
+    ]
+    abg = {
+        r["param"]: r
+        for r in res["tables"]["scatter_params_s_555_0"]["rows"]
+        if r["model"] == "ABg"
+    }
+    for k, v in TRUTH.items():  # 2 % noise: within 3 standard errors
+        assert abs(abg[k]["value"] - v) < 3 * abg[k]["stderr"], k
+    # the file's own TIS line is the grid integral of what was written: ABg on the grid
+    tis = [r for r in res["tables"]["scatter_tis_s_555_0"]["rows"] if r["model"] == "ABg"]
+    assert len(tis) == 3
+    assert all(r["ratio"] == pytest.approx(1.0, abs=0.02) for r in tis)
+    names = sorted(p.name for p in (out / "designer").iterdir())
+    assert names == sorted(
+        ["s_555_0_abg.frs", "s_555_0_harvey_shack.frs"]
+        + [f"s_555_0_{_best(fits)}.{e}" for e in ("bsdf", "anisotropicbsdf", "astm")]
+    )
+    linked = [it["name"] for it in sec["items"] if it["kind"] == "file"]
+    assert sorted(linked) == names
+
+
+def _best(fits: list[dict]) -> str:
+    best = min(
+        (r for r in fits if not r["model"].startswith("microfacet")), key=lambda r: r["aic"]
+    )
+    return "harvey_shack" if best["model"].startswith("Harvey") else "abg"
+
+
+def test_fred_script_evaluates_to_the_fitted_abg(brdf: tuple[dict, Path]) -> None:
+    """The script's Acoef, Bcoef, G in FRED's ABg formula, written here independently:
+    BSDF = A / (B + |beta - beta0|^g), beta the projected direction cosines."""
+    res, out = brdf
+    text = (out / "designer" / "s_555_0_abg.frs").read_text()
+    coef = {
+        k: float(re.search(rf"scat\.{k} = (\S+)", text).group(1))  # type: ignore[union-attr]
+        for k in ("Acoef", "Bcoef", "G")
+    }
+    fitted = {
+        r["param"]: r["value"]
+        for r in res["tables"]["scatter_params_s_555_0"]["rows"]
+        if r["model"] == "ABg"
+    }
+    ti, ts, ps = math.radians(30.0), math.radians(41.0), math.radians(150.0)
+    d = math.hypot(math.sin(ts) * math.cos(ps) + math.sin(ti), math.sin(ts) * math.sin(ps))
+    fred = coef["Acoef"] / (coef["Bcoef"] + d ** coef["G"])
+    ours = float(models.get("abg").evaluate(ti, ts, ps, params=fitted))
+    assert fred == pytest.approx(ours, rel=1e-6)  # the table rounds the values to 6 digits
+
+
+def test_best_fit_table_reads_back(brdf: tuple[dict, Path]) -> None:
+    res, out = brdf
+    fits = res["tables"]["scatter_fits_s_555_0"]["rows"]
+    t = read_table(out / "designer" / f"s_555_0_{_best(fits)}.bsdf")
+    assert list(t.theta_i_deg) == list(TI)
+    assert np.all(np.asarray(t.values) >= 0) and np.asarray(t.values).max() > 1.0
+
+
+def test_btdf_file_gets_the_transmission_forms_only(tmp_path: Path) -> None:
+    res, _ = _section([_abg_file(tmp_path / "t.bsdf", "BTDF")], tmp_path / "out")
+    (sec,) = res["sections"]
+    assert sec["status"] == "ok", sec["reason"]
+    fits = res["tables"]["scatter_fits_t_555_0"]["rows"]
+    assert [r["model"] for r in fits] == [
+        "ABg (BTDF)",
+        "ABg + Lambertian floor (BTDF)",
+        "Harvey-Shack (BTDF)",
+    ]
+    g = {
+        r["param"]: r
+        for r in res["tables"]["scatter_params_t_555_0"]["rows"]
+        if r["model"] == "ABg (BTDF)"
+    }
+    assert abs(g["g"]["value"] - TRUTH["g"]) < 3 * g["g"]["stderr"]
+    names = sorted(p.name for p in (tmp_path / "out" / "designer").iterdir())
+    assert names == ["t_555_0_abg.frs", "t_555_0_harvey_shack.frs"]
+    assert "scat.ApplyTrans = True" in (tmp_path / "out" / "designer" / names[0]).read_text()
+
+
+def test_no_tabulated_file_not_available(tmp_path: Path) -> None:
+    import labbrdf
+
+    scan = Path(labbrdf.__file__).parent / "data" / "fixtures" / "specular" / "osr_specular.csv"
+    res, _ = _section([scan], tmp_path / "out")
+    (sec,) = res["sections"]
+    assert sec["status"] == "not available"
+    assert "no tabulated BSDF file among the inputs" in sec["reason"]
