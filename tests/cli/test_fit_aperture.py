@@ -146,3 +146,16 @@ def test_export_from_an_apertured_fit_writes_the_samples_model(tmp_path: Path, c
     at_specular = float(np.asarray(table.values).ravel()[0])  # radial 0: the specular peak
     want = models.get("abg").evaluate(np.radians(10.0), np.radians(10.0), np.pi, params=values)
     assert at_specular == pytest.approx(float(want), rel=1e-5)
+
+
+def test_nk_from_model_that_cannot_be_apertured_exits_2_before_reading(
+    tmp_path: Path, capsys
+) -> None:
+    """With --nk-from the model is built per wavelength; it is checked on a stand-in index
+    before the index file is read (this one is not an n, k file at all)."""
+    nk = tmp_path / "nk.csv"
+    nk.write_text("not read\n")
+    argv = ["fit", str(_scan(tmp_path / "s.csv")), "--model", "layered", "--nk-from", str(nk)]
+    assert main([*argv, "--wavelength", "633"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("labbrdf fit: --aperture: model 'layered' is a Monte Carlo estimate")
