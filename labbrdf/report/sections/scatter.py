@@ -14,6 +14,7 @@ Harvey fit tabulated as Zemax ``.bsdf``, Speos and ASTM tables).
 
 from __future__ import annotations
 
+import functools
 import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -32,7 +33,7 @@ __all__ = ["TABULATED_FORMATS", "scatter_section"]
 #: reader formats of tabulated BSDF files (``meta["format"]``)
 TABULATED_FORMATS = ("zemax-bsdf", "speos-bsdf", "pab-pgii", "astm-brdf")
 #: the Harvey-family fits: (label, registry name, options)
-HARVEY = (
+HARVEY: tuple[tuple[str, str, dict[str, Any]], ...] = (
     ("ABg", "abg", {}),
     ("ABg + Lambertian floor", "abg", {"diffuse": True}),
     ("Harvey-Shack", "harvey_shack", {}),
@@ -329,7 +330,7 @@ def _designer_files(
     best: dict[str, Any] | None,
 ) -> None:
     """FRED scripts of the Harvey fits; the best one as .bsdf, Speos and ASTM tables."""
-    from ...writers.fred import FRED_MODELS, write_fred_script
+    from ...writers.fred import FRED_MODELS
 
     stated = (f.get("meta") or {}).get("wavelength_stated", True) is not False
     for g in group:
@@ -339,11 +340,17 @@ def _designer_files(
                 f"{stem}_{g['name']}.frs",
                 f"FRED script defining the fitted {label} scatter model (with its wavelength, "
                 "domain, chi2/nu and standard errors as comments)",
-                lambda p, res=res: write_fred_script(res, p, wavelength_stated=stated),
+                functools.partial(_fred, res, stated),
             )
     if best is None or best["options"].get("transmission"):
         return
     _tables(ctx, stem, best)
+
+
+def _fred(res: Any, stated: bool, path: Path) -> Path:
+    from ...writers.fred import write_fred_script
+
+    return write_fred_script(res, path, wavelength_stated=stated)
 
 
 def _tables(ctx: Context, stem: str, best: dict[str, Any]) -> None:
