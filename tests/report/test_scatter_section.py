@@ -105,6 +105,8 @@ def test_abg_recovered_tis_and_designer_files(brdf: tuple[dict, Path]) -> None:
     )
     linked = [it["name"] for it in sec["items"] if it["kind"] == "file"]
     assert sorted(linked) == names
+    (check,) = [c for c in res["checks"] if c["id"] == "scatter.fits.success"]
+    assert check["status"] == "pass" and check["value"] == 4
 
 
 def _best(fits: list[dict]) -> str:

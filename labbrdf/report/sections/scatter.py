@@ -60,8 +60,18 @@ def scatter_section(ctx: Context, model: str, options: Mapping[str, Any]) -> Non
         "and AIC compare like with like (lower AIC: better, after the count of free "
         "parameters). The files for the designer are written beside this page."
     )
-    for f, rows in files:
-        _one_file(ctx, f, rows, model, dict(options))
+    fits = [g for f, rows in files for g in _one_file(ctx, f, rows, model, dict(options))]
+    bad = [f"{g['label']} ({g['key']}): {g['res'].message}" for g in fits if not g["res"].success]
+    ctx.b.check(
+        "scatter.fits.success",
+        "every Harvey-family and physical fit to the tabulated BSDF files converged",
+        not bad,
+        against="the optimiser's success flag",
+        value=len(fits) - len(bad),
+        tolerance=len(fits),
+        justification="value = converged fits, tolerance = fits run",
+        reason="; ".join(bad)[:1000],
+    )
 
 
 def _tabulated(ctx: Context) -> list[tuple[dict[str, Any], pd.DataFrame]]:
@@ -127,7 +137,8 @@ def _fits(
 
 def _one_file(
     ctx: Context, f: dict[str, Any], rows: pd.DataFrame, model: str, options: dict[str, Any]
-) -> None:
+) -> list[dict[str, Any]]:
+    """Fit, tabulate, map and export one file's BSDF; its fits."""
     name = Path(f["path"]).name
     quantity = "btdf" if (rows["quantity"] == "btdf").any() else "brdf"
     ctx.b.heading(f"{name} ({quantity.upper()})", anchor=f"scatter-{_slug(name)}")
@@ -151,6 +162,7 @@ def _one_file(
         _maps(ctx, tag, ids, shown)
         _tis(ctx, f, tag, ids, shown)
         _designer_files(ctx, f, ids, group, best)
+    return fits
 
 
 def _best_harvey(group: Sequence[dict[str, Any]]) -> dict[str, Any] | None:
