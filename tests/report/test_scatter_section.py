@@ -174,3 +174,30 @@ def test_no_tabulated_file_not_available(tmp_path: Path) -> None:
     (sec,) = res["sections"]
     assert sec["status"] == "not available"
     assert "no tabulated BSDF file among the inputs" in sec["reason"]
+
+
+def test_tristimulus_file_fits_the_y_channel(tmp_path: Path) -> None:
+    """X and Z at other scales than Y: fitting them together would mix three BSDFs."""
+    mono = _abg_file(tmp_path / "y.bsdf")
+    base = read_table(mono)
+    values = np.asarray(base.values)[:, :1] * np.array([0.5, 1.0, 2.0])[None, :, None, None, None]
+    path = write_bsdf(
+        tmp_path / "xyz.bsdf",
+        theta_i_deg=TI,
+        radial_deg=RAD,
+        azimuth_deg=AZ,
+        values=values,
+        symmetry="PlaneSymmetrical",
+        spectral="XYZ",
+        digits=12,
+    )
+    res, _ = _section([path], tmp_path / "out")
+    (sec,) = res["sections"]
+    assert any(it.get("label") == "tristimulus" for it in sec["items"])
+    (abg, *_) = res["tables"]["scatter_fits_xyz_555_0"]["rows"]
+    y = read(mono).data
+    assert abg["ndata"] == int((y["value"] != 0).sum())  # one channel's points
+    assert abg["redchi"] < 2 * 0.02**2  # relative weights: the 2 % noise, no channel mix
+    rows = res["tables"]["scatter_params_xyz_555_0"]["rows"]
+    a = next(r for r in rows if r["model"] == "ABg" and r["param"] == "A")
+    assert abs(a["value"] - TRUTH["A"]) < 3 * a["stderr"]  # Y: the written scale

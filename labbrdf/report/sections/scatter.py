@@ -142,6 +142,12 @@ def _one_file(
     name = Path(f["path"]).name
     quantity = "btdf" if (rows["quantity"] == "btdf").any() else "brdf"
     ctx.b.heading(f"{name} ({quantity.upper()})", anchor=f"scatter-{_slug(name)}")
+    if "channel" in rows.columns and rows["channel"].notna().any():
+        rows = rows[(rows["channel"] == "Y").to_numpy()]
+        ctx.b.note(
+            "tristimulus",
+            f"{name} holds CIE X, Y, Z channels: the Y (luminance) channel is fitted and exported",
+        )
     fits = _fits(ctx, rows[rows["quantity"] == quantity], _candidates(quantity, model, options))
     keys = []
     for fit in fits:
