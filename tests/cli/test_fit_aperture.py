@@ -4,6 +4,8 @@ files that disagree)."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 from pathlib import Path
 
@@ -46,8 +48,21 @@ def _fit_json(capsys, *argv: str) -> dict:
     return rec
 
 
-def test_the_files_aperture_is_used_and_the_moves_reported(tmp_path: Path, capsys) -> None:
-    rec = _fit_json(capsys, str(_scan(tmp_path / "s.csv")))
+@pytest.fixture(scope="module")
+def stated(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
+    """The JSON record of ``fit s.csv --model abg`` (the file states a 1 deg detector)."""
+    tmp = tmp_path_factory.mktemp("aperture")
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        argv = ["fit", str(_scan(tmp / "s.csv")), "--model", "abg", "--scheduler", "serial"]
+        code = main([*argv, "--json"])
+    assert code == 0
+    (rec,) = json.loads(out.getvalue())
+    return rec, tmp
+
+
+def test_the_files_aperture_is_used_and_the_moves_reported(stated: tuple[dict, Path]) -> None:
+    rec, _ = stated
     ap = rec["aperture"]
     assert (ap["detector_deg"], ap["beam_deg"]) == (1.0, 0.0)
     assert ap["source"] == "stated by s.csv"
@@ -130,10 +145,12 @@ def test_bad_stated_half_angle_names_the_file(tmp_path: Path, capsys) -> None:
     assert "'# beam_half_angle_deg: 30': expected a half-angle in [0, 20]" in err
 
 
-def test_export_from_an_apertured_fit_writes_the_samples_model(tmp_path: Path, capsys) -> None:
+def test_export_from_an_apertured_fit_writes_the_samples_model(
+    stated: tuple[dict, Path], tmp_path: Path, capsys
+) -> None:
     from labbrdf.adapters.zemax_bsdf import read_table
 
-    rec = _fit_json(capsys, str(_scan(tmp_path / "s.csv")))
+    rec, _ = stated
     fit_json = tmp_path / "fit.json"
     fit_json.write_text(json.dumps([rec]))
     out = tmp_path / "sample.bsdf"
