@@ -201,3 +201,14 @@ def test_tristimulus_file_fits_the_y_channel(tmp_path: Path) -> None:
     rows = res["tables"]["scatter_params_xyz_555_0"]["rows"]
     a = next(r for r in rows if r["model"] == "ABg" and r["param"] == "A")
     assert abs(a["value"] - TRUTH["A"]) < 3 * a["stderr"]  # Y: the written scale
+
+
+@pytest.mark.parametrize("name", ["../x.frs", "designer/x.frs", "", ".hidden", "a" * 130])
+def test_a_linked_file_is_a_plain_new_name(name: str) -> None:
+    b = Builder("t")
+    with b.section("s", "S"):
+        b.file("ok.frs", "fine", lambda p: None)
+        with pytest.raises(ValueError, match="expected a new plain file name"):
+            b.file(name, "bad", lambda p: None)
+        with pytest.raises(ValueError, match="expected a new plain file name"):
+            b.file("ok.frs", "twice", lambda p: None)
