@@ -212,3 +212,24 @@ def test_a_linked_file_is_a_plain_new_name(name: str) -> None:
             b.file(name, "bad", lambda p: None)
         with pytest.raises(ValueError, match="expected a new plain file name"):
             b.file("ok.frs", "twice", lambda p: None)
+
+
+def test_speos_file_gets_its_tis_table(tmp_path: Path) -> None:
+    from labbrdf.writers.speos import model_to_speos
+
+    path = model_to_speos(
+        models.get("abg"),
+        {"A": 0.01, "B": 0.01, "g": 1.8},
+        tmp_path / "sp.anisotropicbsdf",
+        theta_i_deg=[10.0, 40.0],
+        theta_deg=np.arange(0, 91, 5.0),
+        phi_deg=np.arange(0, 361, 30.0),
+        wavelength_nm=633.0,
+    )
+    res, _ = _section([path], tmp_path / "out")
+    (sec,) = res["sections"]
+    assert sec["status"] == "ok", sec["reason"]
+    tis = res["tables"]["scatter_tis_sp_633_0"]["rows"]
+    abg = [r for r in tis if r["model"].startswith("ABg")]
+    assert [r["theta_i_deg"] for r in abg] == [10.0, 40.0]
+    assert all(r["ratio"] == pytest.approx(1.0, abs=1e-3) for r in abg)  # noiseless ABg

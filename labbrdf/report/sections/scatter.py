@@ -303,22 +303,18 @@ def _tis(
     ctx: Context, f: dict[str, Any], tag: str, ids: str, shown: Sequence[dict[str, Any]]
 ) -> None:
     """The file's TIS, the grid integrals of measurement and fit, the fit's hemisphere TIS."""
-    from ...adapters.zemax_bsdf import read_table
-    from ...fitting.scatter_tis import tis_comparison
-
-    if (f.get("meta") or {}).get("format") != "zemax-bsdf":
+    fmt = (f.get("meta") or {}).get("format")
+    if fmt not in ("zemax-bsdf", "speos-bsdf"):
         ctx.b.note(
             "TIS",
-            f"{tag}: the grid-integral comparison needs the .bsdf file's own scatter grid; "
-            "this format's TIS is not compared",
+            f"{tag}: the grid-integral comparison needs the file's own regular grid (a .bsdf "
+            "or Speos table); this format's scattered points are not integrated",
         )
         return
-    table = read_table(f["path"])
     rows = []
     for g in shown:
         m = models.get(g["name"], **g["options"])
-        cmp = tis_comparison(m, g["res"].values, table)
-        for r in cmp.to_dict("records"):
+        for r in _tis_rows(f, m, g).to_dict("records"):
             rows.append({"model": g["label"], **r})
     ctx.b.table(
         f"scatter_tis_{ids}",
@@ -335,9 +331,24 @@ def _tis(
         rows,
         caption="The grid integrals use the file's own nodes and cells for the measurement "
         "and the fit alike (the like-for-like comparison); the last column integrates the "
-        "fit over the whole hemisphere (closed form for ABg and Harvey-Shack).",
+        "fit over the whole hemisphere (closed form for ABg and Harvey-Shack). A Speos file "
+        "states its TIS (the spectrum's coefficient) at one incidence only.",
         details=True,
     )
+
+
+def _tis_rows(f: dict[str, Any], m: models.Model, g: dict[str, Any]) -> pd.DataFrame:
+    """:func:`tis_comparison` (``.bsdf``) or :func:`speos_tis_comparison` of one fit."""
+    from ...fitting.scatter_tis import speos_tis_comparison, tis_comparison
+
+    if f["meta"]["format"] == "zemax-bsdf":
+        from ...adapters.zemax_bsdf import read_table
+
+        return tis_comparison(m, g["res"].values, read_table(f["path"]))
+    from ...adapters.speos_bsdf import read_speos_table
+
+    wl = float(g["key"].get("wavelength_nm", np.nan))
+    return speos_tis_comparison(m, g["res"].values, read_speos_table(f["path"]), wl)
 
 
 def _designer_files(
