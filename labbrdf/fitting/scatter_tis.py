@@ -11,6 +11,7 @@ where it has one, :meth:`labbrdf.models.Model.hemispherical`, else quadrature).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from typing import Any
 
@@ -139,8 +140,6 @@ def speos_tis_comparison(
         spectrum's incidence, else NaN), ``grid_measured``, ``grid_model``, ``ratio`` and
         ``tis_model`` (the model over the whole hemisphere) [1].
     """
-    from types import SimpleNamespace
-
     from ..adapters.speos_bsdf import hemispherical_integral
 
     ti = np.asarray(table.theta_i_deg, float)
@@ -159,7 +158,7 @@ def speos_tis_comparison(
             for t in ti
         ]
     )  # fmt: skip
-    mod = hemispherical_integral(SimpleNamespace(theta_deg=th, phi_deg=ph, values=f))
+    mod = hemispherical_integral(dataclasses.replace(table, values=f[None]))[0]
     hemi = hemispherical_reflectance(model, vals, ti)
     return pd.DataFrame(
         {
