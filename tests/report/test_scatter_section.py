@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -52,12 +53,13 @@ def _abg_file(path: Path, scatter_type: str = "BRDF") -> Path:
     )
 
 
-def _section(paths: list[Path], out: Path, model: str = "microfacet") -> tuple[dict, Builder]:
-    b = Builder("scatter test")
-    ctx = Context(b=b, executor="serial")  # type: ignore[arg-type]
+def _section(
+    paths: list[Path], out: Path, model: str = "microfacet", **fit_options: Any
+) -> tuple[dict, Builder]:
     from labbrdf.parallel import as_executor
 
-    ctx.executor = as_executor("serial")
+    b = Builder("scatter test")
+    ctx = Context(b=b, executor=as_executor("serial"), fit_options=fit_options)
     for p in paths:
         m = read(p)
         ctx.files.append({"path": str(p), "meta": m.meta})
@@ -70,9 +72,13 @@ def _section(paths: list[Path], out: Path, model: str = "microfacet") -> tuple[d
 
 @pytest.fixture(scope="module")
 def brdf(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict, Path]:
-    """The section run once on the synthetic BRDF file; (results, report folder)."""
+    """The section run once on the synthetic BRDF file; (results, report folder).
+
+    With the report's own starting value for its microfacet (``--param alpha=0.3``): the
+    Harvey fits (no alpha) and the section's microfacet (its own start) leave it alone.
+    """
     tmp = tmp_path_factory.mktemp("scatter")
-    res, _ = _section([_abg_file(tmp / "s.bsdf")], tmp / "out")
+    res, _ = _section([_abg_file(tmp / "s.bsdf")], tmp / "out", params={"alpha": 0.3})
     return res, tmp / "out"
 
 
@@ -149,7 +155,7 @@ def test_btdf_file_gets_the_transmission_forms_only(tmp_path: Path) -> None:
     res, _ = _section([_abg_file(tmp_path / "t.bsdf", "BTDF")], tmp_path / "out")
     (sec,) = res["sections"]
     assert sec["status"] == "ok", sec["reason"]
-    fits = res["tables"]["scatter_fits_t_555_0"]["rows"]
+    fits = res["tables"]["scatter_fits_t_555_0_btdf"]["rows"]
     assert [r["model"] for r in fits] == [
         "ABg (BTDF)",
         "ABg + Lambertian floor (BTDF)",
@@ -157,12 +163,12 @@ def test_btdf_file_gets_the_transmission_forms_only(tmp_path: Path) -> None:
     ]
     g = {
         r["param"]: r
-        for r in res["tables"]["scatter_params_t_555_0"]["rows"]
+        for r in res["tables"]["scatter_params_t_555_0_btdf"]["rows"]
         if r["model"] == "ABg (BTDF)"
     }
     assert abs(g["g"]["value"] - TRUTH["g"]) < 3 * g["g"]["stderr"]
     names = sorted(p.name for p in (tmp_path / "out" / "designer").iterdir())
-    assert names == ["t_555_0_abg.frs", "t_555_0_harvey_shack.frs"]
+    assert names == ["t_555_0_btdf_abg.frs", "t_555_0_btdf_harvey_shack.frs"]
     assert "scat.ApplyTrans = True" in (tmp_path / "out" / "designer" / names[0]).read_text()
 
 

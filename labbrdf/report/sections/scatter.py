@@ -93,31 +93,38 @@ def _tabulated(ctx: Context) -> list[tuple[dict[str, Any], pd.DataFrame]]:
 
 
 def _candidates(
-    quantity: str, model: str, options: dict[str, Any]
-) -> list[tuple[str, str, dict[str, Any]]]:
-    """(label, name, options) of every model fitted to rows of ``quantity``."""
+    ctx: Context, quantity: str, model: str, options: dict[str, Any]
+) -> list[tuple[str, str, dict[str, Any], Any]]:
+    """(label, name, options, starting params) of every model fitted to ``quantity`` rows.
+
+    The report's ``--param`` starting values (``ctx.fit_options["params"]``) are its own
+    model's: only that model's fit takes them.
+    """
     if quantity == "btdf":  # only the transmission forms describe a BTDF
-        return [(f"{lab} (BTDF)", n, {**o, "transmission": True}) for lab, n, o in HARVEY]
-    out = [(lab, n, dict(o)) for lab, n, o in HARVEY]
-    out.append((PHYSICAL[0], PHYSICAL[1], dict(PHYSICAL[2])))
+        return [(f"{lab} (BTDF)", n, {**o, "transmission": True}, None) for lab, n, o in HARVEY]
+    out: list[tuple[str, str, dict[str, Any], Any]] = [
+        (lab, n, dict(o), None) for lab, n, o in HARVEY
+    ]
+    out.append((PHYSICAL[0], PHYSICAL[1], dict(PHYSICAL[2]), PHYSICAL_PARAMS))
     if model in HEMISPHERE_MODELS and model != PHYSICAL[1]:  # layered: only when asked
-        out.append((f"{model} (the report's model)", model, options))
+        start = ctx.fit_options.get("params")
+        out.append((f"{model} (the report's model)", model, options, start))
     return out
 
 
 def _fits(
-    ctx: Context, rows: pd.DataFrame, cands: Sequence[tuple[str, str, dict[str, Any]]]
+    ctx: Context, rows: pd.DataFrame, cands: Sequence[tuple[str, str, dict[str, Any], Any]]
 ) -> list[dict[str, Any]]:
     """Each candidate fitted per (sample, wavelength); one entry per fitted group."""
-    kw = {"mask_zeros": True, "weighting": "auto", **ctx.fit_options}
+    extra = {k: v for k, v in ctx.fit_options.items() if k != "params"}
+    kw = {"mask_zeros": True, "weighting": "auto", **extra}
     out = []
-    for label, name, opts in cands:
+    for label, name, opts, params in cands:
         try:
             m = models.get(name, **opts)
         except models.ModelError as exc:
             ctx.b.note(label, f"not fitted: {exc}")
             continue
-        params = PHYSICAL_PARAMS if (name, opts) == (PHYSICAL[1], PHYSICAL[2]) else None
         _, results = fit_many(
             rows,
             m,
@@ -138,29 +145,47 @@ def _fits(
 def _one_file(
     ctx: Context, f: dict[str, Any], rows: pd.DataFrame, model: str, options: dict[str, Any]
 ) -> list[dict[str, Any]]:
-    """Fit, tabulate, map and export one file's BSDF; its fits."""
+    """Fit, tabulate, map and export one file's BRDF and BTDF; its fits."""
     name = Path(f["path"]).name
-    quantity = "btdf" if (rows["quantity"] == "btdf").any() else "brdf"
-    ctx.b.heading(f"{name} ({quantity.upper()})", anchor=f"scatter-{_slug(name)}")
     if "channel" in rows.columns and rows["channel"].notna().any():
         rows = rows[(rows["channel"] == "Y").to_numpy()]
         ctx.b.note(
             "tristimulus",
             f"{name} holds CIE X, Y, Z channels: the Y (luminance) channel is fitted and exported",
         )
-    fits = _fits(ctx, rows[rows["quantity"] == quantity], _candidates(quantity, model, options))
-    keys = []
+    fits = []
+    for quantity in ("brdf", "btdf"):
+        part = rows[(rows["quantity"] == quantity).to_numpy()]
+        if len(part):
+            fits += _one_quantity(ctx, f, part, quantity, model, options)
+    return fits
+
+
+def _one_quantity(
+    ctx: Context,
+    f: dict[str, Any],
+    rows: pd.DataFrame,
+    quantity: str,
+    model: str,
+    options: dict[str, Any],
+) -> list[dict[str, Any]]:
+    """The fits of one quantity of one file, per (sample, wavelength), with their page."""
+    name = Path(f["path"]).name
+    ctx.b.heading(f"{name} ({quantity.upper()})", anchor=f"scatter-{_slug(name)}-{quantity}")
+    fits = _fits(ctx, rows, _candidates(ctx, quantity, model, options))
+    keys: list[dict[str, Any]] = []
     for fit in fits:
         if fit["key"] not in keys:
             keys.append(fit["key"])
+    stated = (f.get("meta") or {}).get("wavelength_stated", True) is not False
     for key in keys:
         group = [g for g in fits if g["key"] == key]
-        stated = (f.get("meta") or {}).get("wavelength_stated", True) is not False
         wl = wl_label(float(key.get("wavelength_nm", 0.0)), stated=stated)
         own = key.get("sample") == Path(name).stem
         tag = f"{name}, {wl}" if own else f"{name}, sample {key.get('sample')}, {wl}"
-        sample = "" if key.get("sample") == Path(name).stem else f"_{key.get('sample', '')}"
-        ids = _slug(f"{Path(name).stem}{sample}_{key.get('wavelength_nm', '')}")
+        sample = "" if own else f"_{key.get('sample', '')}"
+        suffix = "_btdf" if quantity == "btdf" else ""
+        ids = _slug(f"{Path(name).stem}{sample}_{key.get('wavelength_nm', '')}{suffix}")
         _table(ctx, tag, ids, group)
         best = _best_harvey(group)
         physical = [g for g in group if g["name"] not in ("abg", "harvey_shack")]
