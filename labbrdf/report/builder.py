@@ -165,8 +165,8 @@ class Builder:
         }
         self.images: dict[str, str] = {}
         self.swatches: dict[str, str] = {}
-        #: files written beside the page (``designer/<name>``): name -> writer of a path
-        self.files: dict[str, Callable[[Path], Any]] = {}
+        #: files written beside the page (``designer/<name>``): name -> content
+        self.files: dict[str, bytes] = {}
         self.progress = progress
         self._t0 = time.perf_counter()
         self._current: dict[str, Any] | None = None
@@ -294,15 +294,15 @@ class Builder:
         self.images[fid] = uri
         self._sec()["items"].append({"kind": "figure", "id": fid, "details": details})
 
-    def file(self, name: str, label: str, write: Callable[[Path], Any]) -> None:
+    def file(self, name: str, label: str, content: bytes) -> None:
         """A file written beside the page as ``designer/<name>`` and linked from it.
 
-        ``write(path)`` writes it when the report is written (:func:`write_report`, inside
-        the report's atomic folder, through :mod:`labbrdf.outputs`).
+        ``content`` is written with the page (:func:`write_report`, inside the report's
+        atomic folder).
         """
         if not _FILE_NAME.fullmatch(name) or name in self.files:
             raise ValueError(f"file name {name!r}: expected a new plain file name")
-        self.files[name] = write
+        self.files[name] = bytes(content)
         self._sec()["items"].append({"kind": "file", "name": name, "text": label})
 
     def swatch(self, sid: str, hex_colour: str) -> None:
@@ -530,7 +530,7 @@ def write_report(
     html_text: str,
     *,
     inputs: Sequence[str | os.PathLike[str]] = (),
-    files: Mapping[str, Callable[[Path], Any]] | None = None,
+    files: Mapping[str, bytes] | None = None,
 ) -> Path:
     """Write ``index.html``, ``results.json`` and ``tables/*.csv`` atomically into ``out``.
 
@@ -548,7 +548,7 @@ def write_report(
             (d / "tables" / f"{tid}.csv").write_text(text, encoding="utf-8")
         if files:
             (d / "designer").mkdir()
-            for name, write in files.items():
-                write(d / "designer" / name)
+            for name, content in files.items():
+                (d / "designer" / name).write_bytes(content)
 
     return atomic_dir(out, _write, inputs=inputs)

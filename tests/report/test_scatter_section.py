@@ -24,7 +24,7 @@ from labbrdf.report.builder import Builder, write_report
 from labbrdf.report.context import Context
 from labbrdf.report.sections import run
 from labbrdf.report.sections.scatter import scatter_section
-from labbrdf.writers.zemax import write_bsdf
+from labbrdf.writers.zemax import model_to_bsdf, write_bsdf
 
 TRUTH = {"A": 0.004, "B": 2e-4, "g": 1.6}
 TI = np.array([10.0, 30.0, 50.0])
@@ -213,11 +213,11 @@ def test_tristimulus_file_fits_the_y_channel(tmp_path: Path) -> None:
 def test_a_linked_file_is_a_plain_new_name(name: str) -> None:
     b = Builder("t")
     with b.section("s", "S"):
-        b.file("ok.frs", "fine", lambda p: None)
+        b.file("ok.frs", "fine", b"x")
         with pytest.raises(ValueError, match="expected a new plain file name"):
-            b.file(name, "bad", lambda p: None)
+            b.file(name, "bad", b"x")
         with pytest.raises(ValueError, match="expected a new plain file name"):
-            b.file("ok.frs", "twice", lambda p: None)
+            b.file("ok.frs", "twice", b"x")
 
 
 def test_speos_file_gets_its_tis_table(tmp_path: Path) -> None:
@@ -239,3 +239,27 @@ def test_speos_file_gets_its_tis_table(tmp_path: Path) -> None:
     abg = [r for r in tis if r["model"].startswith("ABg")]
     assert [r["theta_i_deg"] for r in abg] == [10.0, 40.0]
     assert all(r["ratio"] == pytest.approx(1.0, abs=1e-3) for r in abg)  # noiseless ABg
+
+
+def test_a_designer_file_the_writer_refuses_is_a_note(tmp_path: Path) -> None:
+    """Scatter above the incident power (TIS > 1): Speos refuses such a spectrum; the page
+    says so and the other files are written."""
+    m = models.get("abg")
+    p = {"A": 0.5, "B": 1e-3, "g": 2.0}
+    assert float(m.hemispherical(30.0, p)) > 1.0
+    path = model_to_bsdf(
+        m,
+        p,
+        tmp_path / "bright.bsdf",
+        theta_i_deg=[30.0],
+        radial_deg=RAD,
+        azimuth_deg=AZ,
+    )
+    res, _ = _section([path], tmp_path / "out")
+    (sec,) = res["sections"]
+    assert sec["status"] == "ok", sec["reason"]
+    notes = [it for it in sec["items"] if it["kind"] == "note" and "not written" in it["text"]]
+    assert [n["label"].rsplit(".", 1)[1] for n in notes] == ["anisotropicbsdf"]
+    assert "a Speos spectrum needs a reflectance in (0, 1]" in notes[0]["text"]
+    names = sorted(q.suffix for q in (tmp_path / "out" / "designer").iterdir())
+    assert ".bsdf" in names and ".astm" in names and ".anisotropicbsdf" not in names

@@ -16,7 +16,8 @@ from __future__ import annotations
 
 import functools
 import re
-from collections.abc import Mapping, Sequence
+import tempfile
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -390,7 +391,8 @@ def _designer_files(
     for g in group:
         if g["name"] in FRED_MODELS and not g["options"].get("diffuse"):
             res, label = g["res"], g["label"]
-            ctx.b.file(
+            _attach(
+                ctx,
                 f"{stem}_{g['name']}.frs",
                 f"FRED script defining the fitted {label} scatter model (with its wavelength, "
                 "domain, chi2/nu and standard errors as comments)",
@@ -399,6 +401,23 @@ def _designer_files(
     if best is None or best["options"].get("transmission"):
         return
     _tables(ctx, stem, best)
+
+
+def _attach(ctx: Context, name: str, label: str, write: Callable[[Path], Any]) -> None:
+    """Write a designer's file now (into a scratch folder) and attach it to the page.
+
+    A writer that refuses the fit (a Speos spectrum above 1, a model FRED cannot hold) is
+    a note on the page, not a failed report.
+    """
+    with tempfile.TemporaryDirectory(prefix="labbrdf-designer-") as tmp:
+        path = Path(tmp) / name
+        try:
+            write(path)
+        except (ValueError, OSError) as exc:
+            ctx.b.note(name, f"not written: {exc}")
+            return
+        content = path.read_bytes()
+    ctx.b.file(name, label, content)
 
 
 def _fred(res: Any, stated: bool, path: Path) -> Path:
@@ -420,7 +439,8 @@ def _tables(ctx: Context, stem: str, best: dict[str, Any]) -> None:
     wl = 555.0 if wls is None else float(np.asarray(wls, float).ravel()[0])
     what = f"the fitted {best['label']} (lowest AIC of the Harvey family)"
     radial = np.array([0, 0.5, 1, 2, 3, 5, 7.5, 10, 15, 20, 30, 40, 50, 60, 70, 80, 90.0])
-    ctx.b.file(
+    _attach(
+        ctx,
         f"{stem}_{best['name']}.bsdf",
         f"Zemax/Radiant tabulated BSDF of {what}",
         lambda p: model_to_bsdf(
@@ -433,12 +453,14 @@ def _tables(ctx: Context, stem: str, best: dict[str, Any]) -> None:
             wavelength_nm=wl,
         ),  # fmt: skip
     )
-    ctx.b.file(
+    _attach(
+        ctx,
         f"{stem}_{best['name']}.anisotropicbsdf",
         f"Speos anisotropic BSDF text of {what}",
         lambda p: model_to_speos(m, vals, p, theta_i_deg=tis, wavelength_nm=wl),
     )
-    ctx.b.file(
+    _attach(
+        ctx,
         f"{stem}_{best['name']}.astm",
         f"ASTM E1392-style table of {what} (plane of incidence)",
         lambda p: model_to_astm(m, vals, p, theta_i_deg=tis, wavelength_nm=wl),
