@@ -34,7 +34,10 @@ Common rules
 -------------------------------------------------
 Header keys: ``quantity`` (required): ``brdf`` or ``specular_intensity``; ``unit``:
 ``sr-1`` for ``brdf`` (the default and only choice), ``1`` (default), ``sr-1`` or ``%``
-(converted to ``1``) for ``specular_intensity``.
+(converted to ``1``) for ``specular_intensity``. ``detector_half_angle_deg`` and
+``beam_half_angle_deg`` (optional, each in [0, 20]): the instrument's aperture, the
+half-angles of the detector's cone and of the beam's divergence [deg], kept in
+``meta["aperture"]`` (a fit uses it: ``labbrdf fit --aperture``; a key left out is 0).
 
 Columns: ``wavelength_nm``, ``theta_i_deg``, ``theta_r_deg``, ``value`` (required);
 ``sigma`` (1-sigma uncertainty, same unit as value), ``phi_r_deg`` (optional).
@@ -251,6 +254,32 @@ def _range(
         raise AdapterError(path, f"{name} {v:g} is outside [{lo:g}, {hi:g}{bracket}", n)
 
 
+#: header key -> the aperture's half-angle it states [deg]
+_APERTURE = {"detector_half_angle_deg": "detector_deg", "beam_half_angle_deg": "beam_deg"}
+#: largest half-angle a header may state [deg] (as ``models.aperture.MAX_APERTURE_DEG``)
+_MAX_HALF_ANGLE_DEG = 20.0
+
+
+def _aperture(path: str | os.PathLike[str], keys: dict[str, str]) -> dict[str, float]:
+    """``{"detector_deg", "beam_deg"}`` from the header's half-angle keys; {} if none."""
+    if not any(k in keys for k in _APERTURE):
+        return {}
+    out = {}
+    for key, name in _APERTURE.items():
+        text = keys.get(key, "0")
+        try:
+            v = float(text)
+        except ValueError:
+            v = math.nan
+        if not 0.0 <= v <= _MAX_HALF_ANGLE_DEG:
+            raise AdapterError(
+                path,
+                f"'# {key}: {text}': expected a half-angle in [0, {_MAX_HALF_ANGLE_DEG:g}] deg",
+            )
+        out[name] = v
+    return out
+
+
 def read_specular_scan(path: str | os.PathLike[str]) -> Measurement:
     """Read a ``# labbrdf specular-scan v1`` CSV (layout (a) of this module's docstring).
 
@@ -326,7 +355,10 @@ def read_specular_scan(path: str | os.PathLike[str]) -> Measurement:
         theta_r_deg=out["tr"],
         phi_r_deg=out["pr"],
     )
-    meta = _meta(keys, _SPECULAR, ("sample", "instrument", "quantity", "unit"))
+    aperture = _aperture(path, keys)
+    meta = _meta(keys, _SPECULAR, ("sample", "instrument", "quantity", "unit", *_APERTURE))
+    if aperture:
+        meta["aperture"] = aperture
     meta.update(
         quantity=quantity,
         unit_in_file=unit_in,

@@ -96,6 +96,9 @@ def _from_fit(args: argparse.Namespace) -> tuple[Any, dict[str, float], float | 
     if args.param or args.nk_from:
         raise UsageError("--from-fit takes the model and its values from the fit; drop --param")
     rec = fit_record(args.from_fit, args.wavelength)
+    # a fit through the instrument's aperture estimates the sample: the file describes the
+    # sample's model, without the instrument's average
+    aperture = {k: rec["options"].pop(k) for k in models.APERTURE_OPTIONS if k in rec["options"]}
     try:
         model = models.get(rec["model"], **rec["options"])
         for k, v in rec["values"].items():
@@ -103,6 +106,12 @@ def _from_fit(args: argparse.Namespace) -> tuple[Any, dict[str, float], float | 
     except ValueError as exc:
         raise UsageError(f"--from-fit {args.from_fit}: {exc}") from None
     note = f"labbrdf fit of {rec['model']} from {Path(args.from_fit).name}"
+    if any(aperture.values()):
+        note += (
+            f", fitted through a {aperture.get('detector_deg', 0):g} deg detector and "
+            f"{aperture.get('beam_deg', 0):g} deg beam aperture (half-angles); the sample's "
+            "model, without it"
+        )
     return model, rec["values"], rec["wavelength_nm"], (note,)
 
 

@@ -7,6 +7,14 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
+from ._aperture import (
+    aperture_columns,
+    aperture_records,
+    aperture_value,
+    apertured_options,
+    chosen_aperture,
+    print_comparisons,
+)
 from ._executor import _add_scheduler, _executor, _executor_errors
 from ._options import (
     UsageError,
@@ -175,12 +183,16 @@ def _residual_groups(args: argparse.Namespace, data: Any, by: list[str]) -> None
 def cmd_fit(args: argparse.Namespace) -> int:
     """Fit ``--model`` to each group of the files; exit 3 if a group fails."""
     from .. import adapters
-    from ..fitting import fit_many, fit_many_nk, fit_records
+    from ..fitting import fit_records
 
     model, options, settings = _fit_settings(args)
     by = [c.strip() for c in args.by.split(",") if c.strip()]
     data = _selected(args, adapters.read_many(args.files))
     _residual_groups(args, data, by)
+    aperture = chosen_aperture(args, data)
+    plain_model, plain_options = model, options
+    if aperture is not None and aperture.active:
+        model, options = apertured_options(args, model, options, aperture)
     executor = _executor(args, progress=not args.json)
     kw: dict[str, Any] = {
         **settings,
@@ -191,20 +203,17 @@ def cmd_fit(args: argparse.Namespace) -> int:
         "return_results": True,
         "mask_zeros": not args.keep_zeros,
         "relative_floor": args.relative_floor,
+        "weighting": args.weighting,
     }
-    kw["weighting"] = args.weighting
-    if args.nk_from:
-        with _option_errors():
-            table, results = fit_many_nk(
-                data,
-                args.model,
-                args.nk_from,
-                options=options,
-                wavelength_nm=args.wavelength,
-                **kw,
-            )
-    else:
-        table, results = fit_many(data, model, **kw)
+    table, results = _fits(args, data, model, options, kw)
+    comparisons: list = []
+    if aperture is not None and aperture.active:
+        from ..fitting.aperture import compare_groups
+
+        _, plain = _fits(args, data, plain_model, plain_options, kw)
+        comparisons = compare_groups(plain, results, aperture)
+    if aperture is not None:
+        table = aperture_columns(table, aperture)
     if args.output:
         from ..outputs import atomic_output, csv_safe_frame
 
@@ -214,16 +223,40 @@ def cmd_fit(args: argparse.Namespace) -> int:
         _residual_maps(args, data, results)
     failed = [r for r in table.to_dict("records") if not r["success"]]
     if args.json:
-        _emit_json(_with_stated(fit_records(table, results, by), data))
+        records = _with_stated(fit_records(table, results, by), data)
+        if aperture is not None:
+            records = aperture_records(records, aperture, comparisons)
+        _emit_json(records)
     else:
         import pandas as pd
 
         with pd.option_context("display.width", 200, "display.max_columns", 50):
             print(table.to_string(index=False))
+        if aperture is not None:
+            print_comparisons(aperture, comparisons)
     for r in failed:
         group = ", ".join(f"{b}={r[b]}" for b in by)
         print(f"labbrdf fit: group {group} FAILED: {r['message']}", file=sys.stderr)
     return 3 if failed else 0
+
+
+def _fits(
+    args: argparse.Namespace, data: Any, model: Any, options: dict[str, Any], kw: dict[str, Any]
+) -> tuple[Any, list]:
+    """The table and results of one model fitted to every group (``--nk-from``: per index)."""
+    from ..fitting import fit_many, fit_many_nk
+
+    if args.nk_from:
+        with _option_errors():
+            return fit_many_nk(
+                data,
+                args.model,
+                args.nk_from,
+                options=options,
+                wavelength_nm=args.wavelength,
+                **kw,
+            )
+    return fit_many(data, model, **kw)
 
 
 def _with_stated(records: list[dict[str, Any]], data: Any) -> list[dict[str, Any]]:
@@ -350,6 +383,15 @@ def add_parser(sub: Any) -> None:
         help="floor of --weighting relative, a fraction of the largest absolute value",
     )
     s.add_argument("--keep-zeros", action="store_true", help="fit points with value 0 too")
+    s.add_argument(
+        "--aperture",
+        type=aperture_value,
+        default=None,
+        metavar="DETECTOR_DEG[,BEAM_DEG]",
+        help="fit the model averaged over the detector's cone and the beam's divergence "
+        "(half-angles [deg]; default: the aperture the files state, else none; 0: none), and "
+        "report how far each parameter moves against the fit without it",
+    )
     s.add_argument(
         "-o",
         "--output",

@@ -11,6 +11,7 @@ where it has one, :meth:`labbrdf.models.Model.hemispherical`, else quadrature).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from typing import Any
 
@@ -22,7 +23,7 @@ from ..bsdf_geometry import scatter_to_angles
 from ..integrate import grid_integral, hemispherical_reflectance
 from ..models import Model
 
-__all__ = ["model_on_grid", "tis_comparison"]
+__all__ = ["model_on_grid", "speos_tis_comparison", "tis_comparison"]
 
 
 def model_on_grid(
@@ -104,3 +105,68 @@ def tis_comparison(
                     }
                 )
     return pd.DataFrame(rows)
+
+
+def speos_tis_comparison(
+    model: Model,
+    params: Mapping[str, float] | Any | None,
+    table: Any,
+    wavelength_nm: float,
+) -> pd.DataFrame:
+    """TIS of the measurement and of the fitted model, per incidence of a Speos table.
+
+    The like-for-like comparison of :func:`tis_comparison` on a Speos
+    ``.anisotropicbsdf`` grid: the measurement's integral ``int f cos(theta) d omega`` by
+    the reader's trapezoid rule (:func:`labbrdf.adapters.speos_bsdf.hemispherical_integral`)
+    with the reader's scaling (the table at the spectrum's incidence integrates to the
+    stated coefficient), and the model's on the same nodes.
+
+    Parameters
+    ----------
+    model : Model
+        The fitted model.
+    params : mapping or Parameters or None
+        Its fitted values.
+    table : SpeosTable
+        The file's numbers (:func:`labbrdf.adapters.speos_bsdf.read_speos_table`),
+        reflection tables of the first sample rotation.
+    wavelength_nm : float
+        The spectrum's wavelength [nm] whose coefficient scales the tables.
+
+    Returns
+    -------
+    DataFrame
+        One row per incidence: ``theta_i_deg``, ``tis_file`` (the stated coefficient at the
+        spectrum's incidence, else NaN), ``grid_measured``, ``grid_model``, ``ratio`` and
+        ``tis_model`` (the model over the whole hemisphere) [1].
+    """
+    from ..adapters.speos_bsdf import hemispherical_integral
+
+    ti = np.asarray(table.theta_i_deg, float)
+    th, ph = np.asarray(table.theta_deg, float), np.asarray(table.phi_deg, float)
+    k = int(np.argmin(np.abs(np.asarray(table.wavelength_nm, float) - wavelength_nm)))
+    coef = float(table.coefficient_pct[k]) / 100.0
+    ref = float(table.spectrum_direction_deg[0])
+    raw = hemispherical_integral(table)[0]
+    meas = raw * coef / float(raw[int(np.argmin(np.abs(ti - ref)))])
+    vals = model.values(params)
+    tt, pp = np.meshgrid(np.radians(th), np.radians(ph + 180.0), indexing="ij")
+    f = np.stack(
+        [
+            np.asarray(model.evaluate(np.radians(t), tt, pp, wavelength=wavelength_nm,
+                                      params=vals), float)
+            for t in ti
+        ]
+    )  # fmt: skip
+    mod = hemispherical_integral(dataclasses.replace(table, values=f[None]))[0]
+    hemi = hemispherical_reflectance(model, vals, ti)
+    return pd.DataFrame(
+        {
+            "theta_i_deg": ti,
+            "tis_file": np.where(np.isclose(ti, ref), coef, np.nan),
+            "grid_measured": meas,
+            "grid_model": mod,
+            "ratio": mod / np.where(meas > 0, meas, np.nan),
+            "tis_model": np.asarray(hemi, float),
+        }
+    )

@@ -11,6 +11,7 @@ import inspect
 from typing import Any
 
 from .abg import ABg
+from .aperture import Apertured
 from .base import Model, ModelError, Parameter, Parameters
 from .five_param import FiveParam
 from .harvey_shack import HarveyShack
@@ -20,6 +21,7 @@ from .rayleigh_rice import RayleighRice
 from .smooth3 import Smooth3
 
 __all__ = [
+    "APERTURE_OPTIONS",
     "MODELS",
     "Model",
     "ModelError",
@@ -42,13 +44,25 @@ MODELS: dict[str, type[Model]] = {
 }
 
 
+#: options any registry model takes: the instrument's aperture half-angles [deg]; with
+#: either, :func:`get` returns the model seen through it (:class:`~.aperture.Apertured`)
+APERTURE_OPTIONS = ("detector_deg", "beam_deg")
+
+
 def get(name: str, **options: Any) -> Model:
-    """A new model instance by registry name, with model-specific options."""
+    """A new model instance by registry name, with model-specific options.
+
+    ``detector_deg`` / ``beam_deg`` (:data:`APERTURE_OPTIONS`) wrap the model in
+    :class:`~labbrdf.models.aperture.Apertured`, so that a fit's recorded options rebuild
+    the model it fitted.
+    """
     try:
         cls = MODELS[name]
     except KeyError:
         raise ModelError(f"unknown model {name!r}; models are {sorted(MODELS)}") from None
-    return cls(**options)
+    aperture = {k: options.pop(k) for k in APERTURE_OPTIONS if k in options}
+    model = cls(**options)
+    return Apertured(model, **aperture) if aperture else model
 
 
 def names() -> list[str]:

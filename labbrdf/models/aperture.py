@@ -112,6 +112,7 @@ class Apertured(Model):
     ) -> None:
         if not isinstance(model, Model):
             raise ModelError(f"Apertured: expected a Model, got {type(model).__name__}")
+        _check_can_average(model)
         for name, v in (("detector_deg", detector_deg), ("beam_deg", beam_deg)):
             if not (isinstance(v, int | float) and 0.0 <= v <= MAX_APERTURE_DEG):
                 raise ModelError(
@@ -126,7 +127,8 @@ class Apertured(Model):
         self.reference = model.reference
         self.doi = model.doi
         self.linear = model.linear
-        self.quantities = model.quantities
+        # a cone average of a BSDF; a specular intensity is not a BSDF value
+        self.quantities = tuple(q for q in model.quantities if q in ("brdf", "btdf"))
         self.reciprocity_note = model.reciprocity_note
         self.detector_deg, self.beam_deg = float(detector_deg), float(beam_deg)
         self._det = cap_nodes(self.detector_deg, n_t, n_psi) if detector_deg > 0 else None
@@ -200,6 +202,28 @@ class Apertured(Model):
     def is_reciprocal(self, params: Mapping[str, float] | None = None) -> bool:
         """False: an instrument's average is not symmetric in the two directions in general."""
         return False
+
+
+def _check_can_average(model: Model) -> None:
+    """Refuse a model whose value cannot be averaged over the aperture's cones.
+
+    A Monte Carlo model (its cost times the nodes, its noise fixed by a seed per point)
+    and a specular-plane model (its value off the plane of incidence is not a prediction,
+    and the cones leave the plane) are refused, with why.
+    """
+    if getattr(model, "stochastic", False):
+        raise ModelError(
+            f"model {model.name!r} is a Monte Carlo estimate: averaging it over the "
+            "aperture's cones multiplies its rays by the number of nodes; fit it without "
+            "the aperture (its bins are wider than a small aperture) or use a closed-form "
+            "model"
+        )
+    if getattr(model, "domain", "hemisphere") != "hemisphere":
+        raise ModelError(
+            f"model {model.name!r} describes the plane of incidence only: the aperture's "
+            "cones leave that plane; use a hemispherical model (microfacet, abg, "
+            "harvey_shack, five_param)"
+        )
 
 
 def _weighted(val: Any, w_det: NDArray, w_beam: float) -> Any:

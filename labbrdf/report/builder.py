@@ -18,6 +18,7 @@ import io
 import json
 import math
 import os
+import re
 import sys
 import time
 import traceback
@@ -52,6 +53,8 @@ __all__ = [
 
 #: the three check outcomes
 STATUSES = ("pass", "fail", "skipped")
+#: a file the page links (``Builder.file``): a plain name, no folder
+_FILE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,120}")
 
 
 class Unavailable(Exception):
@@ -162,6 +165,8 @@ class Builder:
         }
         self.images: dict[str, str] = {}
         self.swatches: dict[str, str] = {}
+        #: files written beside the page (``designer/<name>``): name -> content
+        self.files: dict[str, bytes] = {}
         self.progress = progress
         self._t0 = time.perf_counter()
         self._current: dict[str, Any] | None = None
@@ -288,6 +293,17 @@ class Builder:
         self.results["figures"][fid] = {"title": title, "caption": caption}
         self.images[fid] = uri
         self._sec()["items"].append({"kind": "figure", "id": fid, "details": details})
+
+    def file(self, name: str, label: str, content: bytes) -> None:
+        """A file written beside the page as ``designer/<name>`` and linked from it.
+
+        ``content`` is written with the page (:func:`write_report`, inside the report's
+        atomic folder).
+        """
+        if not _FILE_NAME.fullmatch(name) or name in self.files:
+            raise ValueError(f"file name {name!r}: expected a new plain file name")
+        self.files[name] = bytes(content)
+        self._sec()["items"].append({"kind": "file", "name": name, "text": label})
 
     def swatch(self, sid: str, hex_colour: str) -> None:
         """A colour swatch (hex ``#rrggbb`` computed by the report, never from a file)."""
@@ -514,10 +530,12 @@ def write_report(
     html_text: str,
     *,
     inputs: Sequence[str | os.PathLike[str]] = (),
+    files: Mapping[str, bytes] | None = None,
 ) -> Path:
     """Write ``index.html``, ``results.json`` and ``tables/*.csv`` atomically into ``out``.
 
-    Refused when ``out`` holds anything but an earlier report, or one of ``inputs``.
+    ``files`` (:attr:`Builder.files`) are written into ``designer/``. Refused when ``out``
+    holds anything but an earlier report, or one of ``inputs``.
     """
     payload = json.dumps(jsonable(results), indent=1, allow_nan=False)
     csvs = tables_csv(results)
@@ -528,5 +546,9 @@ def write_report(
         (d / "tables").mkdir()
         for tid, text in csvs.items():
             (d / "tables" / f"{tid}.csv").write_text(text, encoding="utf-8")
+        if files:
+            (d / "designer").mkdir()
+            for name, content in files.items():
+                (d / "designer" / name).write_bytes(content)
 
     return atomic_dir(out, _write, inputs=inputs)

@@ -38,6 +38,7 @@ from .sections.physics import physics_section
 from .sections.prediction import SLOPES, prediction_section
 from .sections.psd import psd_section
 from .sections.scans import scans_section
+from .sections.scatter import scatter_section
 from .sections.smoothness import smoothness_section
 from .sections.spectra import spectra_section
 from .sections.surface import TRACE_WAVELENGTH_NM, surface_section
@@ -205,7 +206,7 @@ def user_report(
     code = b.finish()
     page = html.render(b.results, b.images, b.swatches)
     nk_file = [] if nk_from is None else [Path(nk_from)]
-    write_report(out, b.results, page, inputs=[*paths, *model_file, *nk_file])
+    write_report(out, b.results, page, inputs=[*paths, *model_file, *nk_file], files=b.files)
     b.log(f"wrote {Path(out).resolve() / 'index.html'}: {b.results['summary']}")
     return code
 
@@ -376,6 +377,11 @@ def _sections(
             "brdf",
             f"Measured BRDF: {model} per angle of incidence, maps, energy, reciprocity",
             lambda ctx: brdf_section(ctx, model, opts),
+        ),
+        (
+            "scatter",
+            "Measured BSDF for the designer: ABg and Harvey-Shack beside the physical models",
+            lambda ctx: scatter_section(ctx, model, opts),
         ),
         ("colour", "Sample colour from spectrophotometer reflectance", colour_section),
         (

@@ -28,6 +28,7 @@ module                     section id(s)
 :mod:`.smoothness`         ``smoothness`` (user: a height map against one sample's reflectance)
 :mod:`.prediction`         ``prediction`` (user: tracer prediction beside a measured BRDF)
 :mod:`.model_measurement`  ``model_measurement`` (validation: the two above on a bundled set)
+:mod:`.scatter`            ``scatter`` (user: ABg beside physical models, files for the designer)
 =========================  ====================================================================
 """
 
