@@ -111,6 +111,8 @@ def test_synthetic_alpha_recovered(synthetic: tuple[dict, Path]) -> None:
     res, _ = synthetic
     rows = res["tables"]["brdf_fits"]["rows"]
     assert len(rows) == 3 and all(r["status"] == "ok" for r in rows)
+    # the table names the fitted distribution, the default GGX included
+    assert res["tables"]["brdf_fits"]["title"].startswith("microfacet (GGX)")
     for r in rows:
         # alpha: the 95 % interval holds the generating value (2 % log-normal noise, seed 1)
         assert r["alpha_lo"] <= TRUTH["alpha"] <= r["alpha_hi"], r

@@ -288,9 +288,11 @@ def _fits_table(
         row["status"] = r.summary.get("status") or ("ok" if row["success"] else "failed")
         out.append(row)
     opts = ", ".join(f"{k}={v}" for k, v in options.items()) or "defaults"
+    # the model's own label where it has one (microfacet names its distribution, GGX too)
+    label = getattr(models.get(model, **options), "label", model)
     b.table(
         "brdf_fits",
-        f"{model} ({opts}) fitted per angle of incidence and jointly{_one_group(ctx, fits)}",
+        f"{label} ({opts}) fitted per angle of incidence and jointly{_one_group(ctx, fits)}",
         cols,
         out,
         caption=f"Measured: the BRDF rows of each incidence angle \u03b8i ('joint': all angles "
