@@ -17,6 +17,9 @@ from ._options import (
 )
 from ._paths import InputPath, OutputPath, _add_overwrite
 
+#: --dpol's words -> fit_film's depolarization
+_DPOL: dict[str, bool | str] = {"auto": "auto", "on": True, "off": False}
+
 
 def _film_model(args: argparse.Namespace) -> Any:
     """The FilmModel of --model FILE, or of --substrate and --layer, or the default."""
@@ -196,7 +199,7 @@ def cmd_film(args: argparse.Namespace) -> int:
         ci=args.ci,
         one_sample=_one_sample(args, parts, data),
         on_wald=_wald_first(args, at_nm),
-        depolarization={"auto": "auto", "on": True, "off": False}[args.dpol],
+        depolarization=_DPOL[args.dpol],
     )
     try:
         summary = res.summary(at_nm)

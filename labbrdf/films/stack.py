@@ -166,15 +166,27 @@ class Stack:
         out.append(n_amb)
         return out[::-1]
 
-    def _layer_index(self, m: Any, lam: NDArray, below: NDArray, n_amb: NDArray) -> NDArray:
-        """The index of one homogeneous layer material (a mixture from its constituents)."""
+    def _layer_index(
+        self,
+        m: Any,
+        lam: NDArray,
+        below: NDArray,
+        n_amb: NDArray,
+        memo: dict[int, tuple[Any, NDArray]] | None = None,
+    ) -> NDArray:
+        """The index of one homogeneous layer material (a mixture from its constituents).
+
+        ``memo`` keeps each plain material's index by identity for one evaluation: an
+        ``@NAME`` constituent is then the index its layer has, computed once.
+        """
+        memo = {} if memo is None else memo
         if isinstance(m, Roughness):
             n = np.sqrt(stk.bruggeman(below * below, n_amb * n_amb + 0j, m.fraction))
         elif isinstance(m, Ema):
-            eps = [self._constituent(c, lam, n_amb) ** 2 for c in m.components]
+            eps = [self._constituent(c, lam, n_amb, memo) ** 2 for c in m.components]
             n = np.sqrt(m.mix(eps))
         else:
-            return np.asarray(m.nk(lam))
+            return _memo_nk(m, lam, memo)
         return np.asarray(np.where(n.imag < 0, -n, n))
 
     def _optical(self, lam: NDArray) -> tuple[list[NDArray], list[float], list[bool]]:
@@ -182,18 +194,21 @@ class Stack:
         n_amb = self._ambient_nk(lam)
         below = np.asarray(self.substrate.nk(lam))
         n_out, d_out, c_out = [below], [], []
+        memo: dict[int, tuple[Any, NDArray]] = {}
         for lay in reversed(self.layers):
             m = lay.material
             parts = m.slices()[::-1] if isinstance(m, Graded) else [m]
             for part in parts:
-                below = self._layer_index(part, lam, below, n_amb)
+                below = self._layer_index(part, lam, below, n_amb, memo)
                 n_out.append(below)
                 d_out.append(lay.thickness_nm / len(parts))
                 c_out.append(lay.coherent)
         n_out.append(n_amb)
         return n_out[::-1], d_out[::-1], c_out[::-1]
 
-    def _constituent(self, c: Any, lam: NDArray, n_amb: NDArray) -> NDArray:
+    def _constituent(
+        self, c: Any, lam: NDArray, n_amb: NDArray, memo: dict[int, tuple[Any, NDArray]]
+    ) -> NDArray:
         """The index of an EMA constituent: a material, or ``@NAME`` of the stack."""
         if not isinstance(c, str):
             return np.asarray(c.nk(lam), complex)
@@ -203,7 +218,7 @@ class Stack:
         if ref == "substrate":
             return np.asarray(self.substrate.nk(lam), complex)
         (lay,) = (x for x in self.layers if x.name == ref)
-        return np.asarray(lay.material.nk(lam), complex)
+        return np.asarray(_memo_nk(lay.material, lam, memo), complex)
 
     def _thicknesses(self) -> list[float]:
         return [lay.thickness_nm for lay in self.layers]
@@ -411,6 +426,13 @@ class Stack:
         for k, v in self._beam().items():
             thick += f", {k}={v:.4g}"
         return f"Stack([{inner}], substrate={self.substrate.name}{thick})"
+
+
+def _memo_nk(m: Any, lam: NDArray, memo: dict[int, tuple[Any, NDArray]]) -> NDArray:
+    """``m.nk(lam)``, computed once per evaluation (``memo`` holds ``m``: its id stays its)."""
+    if id(m) not in memo:
+        memo[id(m)] = (m, np.asarray(m.nk(lam)))
+    return memo[id(m)][1]
 
 
 def _check_references(layers: Sequence[Layer]) -> None:
