@@ -146,7 +146,7 @@ def _frame(stack: Stack, seed: int) -> pd.DataFrame:
     return pd.concat(parts, ignore_index=True)
 
 
-def test_the_depolarization_channel_is_fitted_when_the_model_can_depolarize():
+def test_the_depolarization_channel_is_fitted_when_the_model_can_depolarize(tmp_path):
     """A 6 nm band on a 300 nm film, recovered from psi, Delta and dpol within its interval.
 
     Local fit from 3 nm and 295 nm (the global stage finds the same point). z = (fit -
@@ -168,6 +168,8 @@ def test_the_depolarization_channel_is_fitted_when_the_model_can_depolarize():
     ]
     np.testing.assert_allclose(r, fit.data.value[fit.channels == 8] - model, atol=1e-12)
     assert stats["depolarization"]["chi2"] == pytest.approx(np.sum((r / 0.002) ** 2))
+    back = Stack.from_fit_json(fit.save_json(tmp_path / "fit.json"))  # the schema takes it
+    assert back.bandwidth_nm == p.value
     # the same model without the band cannot depolarize: auto leaves the channel out
     plain = Stack([Layer(Cauchy(A=2.1, B=0.02), 300.0, "film")], "si")
     box = {"film.thickness_nm": (280.0, 320.0)}
