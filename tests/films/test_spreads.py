@@ -168,6 +168,14 @@ def test_the_depolarization_channel_is_fitted_when_the_model_can_depolarize(tmp_
     ]
     np.testing.assert_allclose(r, fit.data.value[fit.channels == 8] - model, atol=1e-12)
     assert stats["depolarization"]["chi2"] == pytest.approx(np.sum((r / 0.002) ** 2))
+    text = fit.fit_report()
+    assert (
+        "depolarization channel: 22 rows, chi2 " in text and "MSE of psi and Delta alone" in text
+    )
+    off = fit_film(
+        FilmModel(start, box), data, method="LN_BOBYQA", ci="wald", depolarization=False
+    )
+    assert "depolarization channel" not in off.fit_report()
     back = Stack.from_fit_json(fit.save_json(tmp_path / "fit.json"))  # the schema takes it
     assert back.bandwidth_nm == p.value
     # the same model without the band cannot depolarize: auto leaves the channel out
