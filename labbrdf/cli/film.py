@@ -17,20 +17,38 @@ from ._options import (
 )
 from ._paths import InputPath, OutputPath, _add_overwrite
 
+#: --dpol's words -> fit_film's depolarization
+_DPOL: dict[str, bool | str] = {"auto": "auto", "on": True, "off": False}
+
 
 def _film_model(args: argparse.Namespace) -> Any:
     """The FilmModel of --model FILE, or of --substrate and --layer, or the default."""
     from .. import films
     from ..nk import tabulated_from_file
 
+    written = {opt: getattr(args, opt[2:].replace("-", "_")) for opt in films.layers.STACK_OPTIONS}
     if args.model is not None:
         if args.layer or args.substrate:
             raise UsageError("give --model FILE or --substrate/--layer, not both")
+        given = [opt for opt, v in written.items() if v is not None]
+        if given:
+            raise UsageError(
+                f"{given[0]} with --model: give it in the model file (thickness_spread, "
+                "bandwidth_nm, angle_spread_deg, [substrate] thickness_nm)"
+            )
         return films.load_model(args.model)
+    try:
+        beam, beam_free = films.layers.parse_stack_values(written)
+    except films.FilmError as exc:
+        raise UsageError(str(exc)) from None
     if not args.layer:
         if args.substrate not in (None, "si"):
             raise UsageError("--substrate without --layer: give the layers with --layer")
-        return films.FilmModel.cauchy_on_silicon()
+        fm = films.FilmModel.cauchy_on_silicon()
+        if not beam:
+            return fm
+        stack = films.Stack(fm.stack.layers, fm.stack.substrate, **beam)
+        return films.FilmModel(stack, {**fm.free, **beam_free}, fm.wavelength_range_nm, fm.source)
     sub_text = args.substrate or "si"
     try:
         sub = (
@@ -53,10 +71,10 @@ def _film_model(args: argparse.Namespace) -> Any:
         layers.append(layer)
         free.update(layer_free)
     try:
-        stack = films.Stack(layers, sub)
+        stack = films.Stack(layers, sub, **beam)
     except ValueError as exc:
         raise UsageError(f"--layer: {exc}") from None
-    return films.FilmModel(stack, free, None, "--layer")
+    return films.FilmModel(stack, {**free, **beam_free}, None, "--layer")
 
 
 def _at_wavelengths(text: str | None) -> list[float]:
@@ -181,6 +199,7 @@ def cmd_film(args: argparse.Namespace) -> int:
         ci=args.ci,
         one_sample=_one_sample(args, parts, data),
         on_wald=_wald_first(args, at_nm),
+        depolarization=_DPOL[args.dpol],
     )
     try:
         summary = res.summary(at_nm)
@@ -232,11 +251,51 @@ def add_parser(sub: Any) -> None:
         "--layer",
         action="append",
         default=[],
-        metavar="NAME:MATERIAL:THICKNESS[:P=V|LO..HI]",
+        metavar="NAME:MATERIAL:THICKNESS[:P=V|LO..HI][:KEYWORD]",
         help="a layer, top first (repeat): V is fixed, LO..HI fitted (started mid-box), and a "
         "material parameter not written is fitted in its default box (Cauchy: A, B, C; its "
         "absorption k_amp stays 0), the rule of --model TOML; e.g. oxide:cauchy:0..20:A=1.3..1.7:"
-        "B=0.004 (no --model/--layer: one Cauchy layer on Si)",
+        "B=0.004 (no --model/--layer: one Cauchy layer on Si). Keywords: incoherent (a thick "
+        "layer added in intensity, e.g. sheet:sio2:2e5:incoherent), graded=P (P varies from "
+        "P_top to P_bottom in sublayers=N slices, default 20, e.g. "
+        "f:cauchy:100..300:graded=A:A_top=1.9..2.3:A_bottom=1.9..2.3)",
+    )
+    s.add_argument(
+        "--substrate-thickness",
+        default=None,
+        metavar="NM|LO..HI",
+        help="a substrate of this thickness [nm] with the ambient behind it: incoherent, its "
+        "backside reflection added in intensity (a film on a glass slide); default "
+        "semi-infinite",
+    )
+    s.add_argument(
+        "--thickness-spread",
+        default=None,
+        metavar="S|LO..HI",
+        help="relative 1-sigma spread of every coherent layer's thickness over the spot, in "
+        "[0, 0.1] (stack.thickness_spread)",
+    )
+    s.add_argument(
+        "--bandwidth",
+        default=None,
+        metavar="NM|LO..HI",
+        help="spectral bandwidth of the instrument, FWHM of a Gaussian, in [0, 20] nm "
+        "(stack.bandwidth_nm)",
+    )
+    s.add_argument(
+        "--angle-spread",
+        default=None,
+        metavar="DEG|LO..HI",
+        help="1-sigma spread of the angle of incidence, in [0, 2] deg (stack.angle_spread_deg)",
+    )
+    s.add_argument(
+        "--dpol",
+        choices=("auto", "on", "off"),
+        default="auto",
+        help="fit the files' depolarization channel (WVASE dpolE), each row weighted by its "
+        "own sigma, its chi2 reported apart: auto (default) when the model can depolarize "
+        "(a spread, bandwidth or angle spread, an incoherent layer or a finite substrate), "
+        "as a model that cannot only adds a constant to chi2; on; off",
     )
     s.add_argument(
         "--sigma",

@@ -16,7 +16,9 @@ Thick layers and a finite substrate add in intensity (:mod:`~labbrdf.films.incoh
 ``Layer(..., coherent=False)``, ``Stack(..., substrate_thickness_nm=...)``); interface layers
 are Bruggeman mixtures of two or three materials (:class:`Ema`), a graded layer varies a
 parameter through its thickness (:class:`Graded`), and a thickness spread over the spot
-depolarizes (:mod:`~labbrdf.films.nonuniform`, ``Stack(..., thickness_spread=...)``).
+depolarizes (:mod:`~labbrdf.films.nonuniform`, ``Stack(..., thickness_spread=...)``), as
+the instrument's bandwidth and angle spread do (:mod:`~labbrdf.films.spreads`,
+``Stack(..., bandwidth_nm=..., angle_spread_deg=...)``).
 
 Parameter names are ``"<layer>.<parameter>"``: ``"oxide.thickness_nm"``, ``"oxide.A"``,
 ``"substrate.omega_p"``, ``"rough.fraction"``, ``"stack.thickness_spread"``.

@@ -117,6 +117,8 @@ def _fit_json_schema() -> dict[str, Any]:
                     "substrate": material,
                     "layers": {"type": "array", "items": layer, "max_items": MAX_LAYERS},
                     "thickness_spread": {"type": "number", "min": 0.0, "max": 0.1},
+                    "bandwidth_nm": {"type": "number", "min": 0.0, "max": 20.0},
+                    "angle_spread_deg": {"type": "number", "min": 0.0, "max": 2.0},
                     "substrate_thickness_nm": {
                         "type": "number",
                         "min": 0.0,

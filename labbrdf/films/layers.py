@@ -8,7 +8,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..nk import dispersion as disp
-from .limits import FilmError
+from .graded import Graded
+from .limits import MAX_THICKNESS_NM, FilmError
 from .materials import _with_params, as_material
 
 
@@ -133,15 +134,70 @@ def parse_value(text: str, where: str) -> tuple[float, tuple[float, float] | Non
     return (lo + hi) / 2, (lo, hi)
 
 
+LAYER_KEYWORDS = "incoherent, graded=PARAM, sublayers=N"
+"""The keyword fields of a ``--layer`` beside its parameters (the TOML keys ``coherent =
+false``, ``graded = "PARAM"``, ``sublayers = N``)."""
+
+
+def _keywords(fields: list[str], name: str) -> tuple[dict[str, Any], list[str]]:
+    """The keyword fields of a layer (``incoherent``, ``graded=P``, ``sublayers=N``), the rest."""
+    kw: dict[str, Any] = {}
+    rest = []
+    for item in fields:
+        key, sep, val = item.partition("=")
+        if key == "incoherent":
+            if sep:
+                raise FilmError(f"{name}: {item!r}: expected 'incoherent' alone (no value)")
+            kw["coherent"] = False
+        elif key == "graded":
+            if not val:
+                raise FilmError(
+                    f"{name}: {item!r}: expected graded=PARAM (the parameter that varies)"
+                )
+            kw["graded"] = val
+        elif key == "sublayers":
+            try:
+                kw["sublayers"] = int(val)
+            except ValueError:
+                raise FilmError(f"{name}: {item!r}: expected sublayers=N, an integer") from None
+        else:
+            rest.append(item)
+    if "sublayers" in kw and "graded" not in kw:
+        raise FilmError(f"{name}: sublayers=N needs graded=PARAM (the parameter that varies)")
+    return kw, rest
+
+
+def _graded(m: Any, kw: Mapping[str, Any], name: str) -> Any:
+    """The material graded in ``kw["graded"]`` (top = bottom = its value, linear), or ``m``."""
+    p = kw.get("graded")
+    if p is None:
+        return m
+    if isinstance(m, Graded) or p not in getattr(m, "params", {}):
+        raise FilmError(
+            f"{name}: graded={p}: expected one of the parameters of {m.name}: "
+            f"{sorted(getattr(m, 'params', {})) or 'none (a table)'}"
+        )
+    try:
+        return Graded(m, p, m.params[p], m.params[p], 1.0, kw.get("sublayers", 20))
+    except FilmError as exc:
+        raise FilmError(f"{name}: {exc}") from None
+
+
 def parse_layer(
     spec: str, j: int, material_of: Callable[[str], Any]
 ) -> tuple[Layer, dict[str, tuple[float, float]]]:
-    """A layer and its fitted parameters from ``NAME:MATERIAL:THICKNESS[:PARAM=V|LO..HI ...]``.
+    """A layer and its fitted parameters from ``NAME:MATERIAL:THICKNESS[:FIELD ...]``.
+
+    Each FIELD is ``PARAM=V`` (fixed), ``PARAM=LO..HI`` (fitted) or a keyword: ``incoherent``
+    (a thick layer added in intensity, TOML ``coherent = false``), ``graded=PARAM`` (that
+    parameter varies through the layer from ``PARAM_top`` to ``PARAM_bottom``, TOML
+    ``graded = "PARAM"``) and ``sublayers=N`` (its slices, default 20).
 
     Parameters
     ----------
     spec : str
-        The layer, e.g. ``"oxide:cauchy:0..20:A=1.3..1.7"`` (an empty name is ``layer<j>``).
+        The layer, e.g. ``"oxide:cauchy:0..20:A=1.3..1.7"`` (an empty name is ``layer<j>``),
+        ``"glass:sio2:1e6:incoherent"``, ``"f:cauchy:100..300:graded=A:A_top=1.9..2.3"``.
     j : int
         Its place from the top, from 1.
     material_of : callable
@@ -168,22 +224,76 @@ def parse_layer(
         )
     name, mat, thick = fields[0] or f"layer{j}", fields[1], fields[2]
     d, dbox = parse_value(thick, f"{name}: thickness")
+    kw, items = _keywords(fields[3:], name)
     try:
         m = material_of(mat)
     except ValueError as exc:
         raise FilmError(f"{name}: {exc}") from None
+    m = _graded(m, kw, name)
     values: dict[str, float] = {}
     written: dict[str, tuple[float, float] | None] = {}
-    for item in fields[3:]:
+    for item in items:
         key, sep, val = item.partition("=")
         if not sep or key not in m.params:
             raise FilmError(
                 f"{name}: {item!r}: expected PARAM=V or PARAM=LO..HI with PARAM "
-                f"one of {sorted(m.params) or 'none (a table)'}"
+                f"one of {sorted(m.params) or 'none (a table)'}, or a keyword "
+                f"({LAYER_KEYWORDS})"
             )
         values[key], written[key] = parse_value(val, f"{name}: {key}")
     try:
-        layer = Layer(_with_params(m, values), d, name)
+        layer = Layer(_with_params(m, values), d, name, kw.get("coherent", True))
     except ValueError as exc:
         raise FilmError(f"{name}: {exc}") from None
     return layer, free_parameters(layer, {**written, "thickness_nm": dbox})
+
+
+#: the stack-wide values of the command line: option -> (Stack keyword, largest value)
+STACK_OPTIONS = {
+    "--thickness-spread": ("thickness_spread", 0.1),
+    "--bandwidth": ("bandwidth_nm", 20.0),
+    "--angle-spread": ("angle_spread_deg", 2.0),
+    "--substrate-thickness": ("substrate_thickness_nm", MAX_THICKNESS_NM),
+}
+
+
+def parse_stack_values(
+    written: Mapping[str, str | None],
+) -> tuple[dict[str, float], dict[str, tuple[float, float]]]:
+    """The stack-wide values of the command line (``--bandwidth 0..5`` ...).
+
+    The grammar of :func:`parse_value`, the ranges of :class:`~labbrdf.films.Stack`.
+
+    Parameters
+    ----------
+    written : mapping
+        Option (a key of :data:`STACK_OPTIONS`) -> its text, or None where not given.
+
+    Returns
+    -------
+    (dict, dict)
+        The :class:`Stack` keywords and the fitted parameters (``"stack.bandwidth_nm"``,
+        ``"substrate.thickness_nm"`` -> box).
+
+    Raises
+    ------
+    FilmError
+        A value that is not a number or a box, or outside its range (naming the option).
+    """
+    kw: dict[str, float] = {}
+    free: dict[str, tuple[float, float]] = {}
+    for opt, text in written.items():
+        if text is None:
+            continue
+        key, top = STACK_OPTIONS[opt]
+        v, box = parse_value(text, opt)
+        lo, hi = box or (v, v)
+        low_ok = lo > 0 if key == "substrate_thickness_nm" else lo >= 0
+        if not (low_ok and hi <= top):
+            kind = "(0" if key == "substrate_thickness_nm" else "[0"
+            raise FilmError(f"{opt} {text}: expected a value or LO..HI in {kind}, {top:g}]")
+        kw[key] = v
+        if box is not None:
+            owner = "substrate.thickness_nm" if key == "substrate_thickness_nm" else f"stack.{key}"
+            free[owner] = box
+    return kw, free

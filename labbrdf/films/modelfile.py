@@ -32,6 +32,7 @@ from .materials import Material, Roughness, _table_file, _with_params, as_materi
 from .model import FilmModel
 from .modelsamples import ModelSamples, parse_samples, sample_files
 from .nonuniform import MAX_SPREAD
+from .spreads import MAX_ANGLE_SPREAD_DEG, MAX_BANDWIDTH_NM
 from .stack import Stack
 
 _LAYER_KEYS = {
@@ -49,7 +50,12 @@ _LAYER_KEYS = {
 }
 
 
-_TOP_KEYS = ("ambient", "wavelength_nm", "thickness_spread", "substrate", "layer", "samples")
+_BEAM_KEYS = {  # top-level spreads: name -> (largest value, what it is)
+    "thickness_spread": (MAX_SPREAD, "a relative spread"),
+    "bandwidth_nm": (MAX_BANDWIDTH_NM, "a bandwidth (FWHM) [nm]"),
+    "angle_spread_deg": (MAX_ANGLE_SPREAD_DEG, "an angle spread (1 sigma) [deg]"),
+}
+_TOP_KEYS = ("ambient", "wavelength_nm", *_BEAM_KEYS, "substrate", "layer", "samples")
 
 
 class _KeyLines:
@@ -269,7 +275,8 @@ def _check_top(doc: Mapping[str, Any], where: str, text: str, lines: _KeyLines) 
         line = next((i for i, raw in enumerate(text.splitlines(), 1) if re.match(pattern, raw)), 1)
         raise FilmError(
             f"{where}, line {line}: unknown key or table {key!r}; expected ambient, "
-            "wavelength_nm, thickness_spread, [substrate], [[layer]], [samples]"
+            "wavelength_nm, thickness_spread, bandwidth_nm, angle_spread_deg, [substrate], "
+            "[[layer]], [samples]"
         )
     layers = doc.get("layer", [])
     if not isinstance(layers, list) or not all(isinstance(t, dict) for t in layers):
@@ -369,6 +376,8 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
         ambient = 1.0                  # optional, a number (lossless)
         wavelength_nm = [250, 1000]    # optional fit window [nm]
         thickness_spread = [0, 0.05]   # optional: relative 1-sigma thickness spread
+        bandwidth_nm = [0, 5]          # optional: spectral bandwidth (Gaussian FWHM) [nm]
+        angle_spread_deg = 0.2         # optional: 1-sigma angle-of-incidence spread [deg]
 
         [substrate]
         material = "si"                # si, sio2 (shipped tables), a model name, or
@@ -429,17 +438,19 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
         seen.add(layer.name)
         layers.append(layer)
         free.update(layer_free)
-    spread = None
-    if "thickness_spread" in doc:
-        at = f"{where}, line {lines('', 0, 'thickness_spread')}: thickness_spread"
-        spread, box = _spec(doc["thickness_spread"], at)
+    beam: dict[str, float] = {}
+    for key, (top, what) in _BEAM_KEYS.items():
+        if key not in doc:
+            continue
+        at = f"{where}, line {lines('', 0, key)}: {key}"
+        beam[key], box = _spec(doc[key], at)
         if box is not None:
-            free["stack.thickness_spread"] = box
-        lo, hi = box or (spread, spread)
-        if not 0.0 <= lo <= hi <= MAX_SPREAD:
-            raise FilmError(f"{at}: expected a relative spread in [0, {MAX_SPREAD:g}]")
+            free[f"stack.{key}"] = box
+        lo, hi = box or (beam[key], beam[key])
+        if not 0.0 <= lo <= hi <= top:
+            raise FilmError(f"{at}: expected {what} in [0, {top:g}]")
     try:
-        st = Stack(layers, sub, ambient, sub_d, spread)
+        st = Stack(layers, sub, ambient, sub_d, **beam)
     except FilmError as exc:
         raise FilmError(f"{where}: {exc}") from None
     return FilmModel(st, free, wl_range, where)

@@ -23,30 +23,23 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .incoherent import IntensitySums, intensity_sums
+from .spreads import MAX_POINTS, gaussian_nodes
 
 __all__ = ["MAX_POINTS", "MAX_SPREAD", "spread_sums"]
 
 MAX_SPREAD = 0.1
 """Largest relative 1-sigma thickness spread: every node stays at positive thickness."""
-MAX_POINTS = 121
-"""Most quadrature nodes (stack evaluations) of one average."""
-_REACH = 7.0  # nodes over +-7 sigma: the Gaussian tail beyond holds 3e-12
 
 
 def _nodes(spread, indices, thicknesses_nm, coherent, wavelength_nm, points):
-    """Trapezoid nodes over +-7 sigma and their normalised Gaussian weights."""
-    if points is None:
-        lam = np.min(np.asarray(wavelength_nm, float))
-        phase = sum(
-            4.0 * np.pi * float(np.max(np.abs(np.real(n)))) * d * spread / lam
-            for n, d, c in zip(indices[1:-1], thicknesses_nm, coherent, strict=True)
-            if c
-        )  # 1-sigma spread of the round-trip phase through the coherent layers [rad]
-        h = 1.0 / (1.0 + 1.1 * phase)
-        points = int(min(2 * np.ceil(_REACH / h) + 1, MAX_POINTS))
-    x = np.linspace(-_REACH, _REACH, points)
-    w = np.exp(-0.5 * x * x)
-    return x, w / w.sum()
+    """Trapezoid nodes over +-7 sigma and their weights (:func:`.spreads.gaussian_nodes`)."""
+    lam = np.min(np.asarray(wavelength_nm, float))
+    phase = sum(
+        4.0 * np.pi * float(np.max(np.abs(np.real(n)))) * d * spread / lam
+        for n, d, c in zip(indices[1:-1], thicknesses_nm, coherent, strict=True)
+        if c
+    )  # 1-sigma spread of the round-trip phase through the coherent layers [rad]
+    return gaussian_nodes(phase, points)
 
 
 def spread_sums(

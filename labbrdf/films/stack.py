@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..nk import dispersion as disp
 from . import incoherent as inc
 from . import matrices as stk
-from . import nonuniform
+from . import nonuniform, spreads
 from .ema import Ema
 from .fitjson import _check_indices, _fit_doc, _tabulated
 from .graded import Graded
@@ -58,6 +58,12 @@ class Stack:
         Relative 1-sigma spread of every coherent layer's thickness over the measured spot,
         in [0, 0.1] [1] (:func:`labbrdf.films.nonuniform.spread_sums`): the parameter
         ``stack.thickness_spread``. Default: none (not a parameter).
+    bandwidth_nm : float, optional
+        Full width at half maximum of the instrument's Gaussian spectral band [nm], in [0,
+        20] (:func:`labbrdf.films.spreads.beam_sums`): the parameter ``stack.bandwidth_nm``.
+    angle_spread_deg : float, optional
+        1-sigma Gaussian spread of the angle of incidence [deg], in [0, 2]: the parameter
+        ``stack.angle_spread_deg``.
 
     Notes
     -----
@@ -73,6 +79,8 @@ class Stack:
         ambient: Any = 1.0,
         substrate_thickness_nm: float | None = None,
         thickness_spread: float | None = None,
+        bandwidth_nm: float | None = None,
+        angle_spread_deg: float | None = None,
     ) -> None:
         layers = list(layers)
         if len(layers) > MAX_LAYERS:
@@ -102,13 +110,31 @@ class Stack:
         self.ambient: disp.Dispersion = amb
         self.substrate_thickness_nm = _substrate_thickness(substrate_thickness_nm)
         self.thickness_spread = _spread(thickness_spread)
+        self.bandwidth_nm = _beam_value(bandwidth_nm, spreads.MAX_BANDWIDTH_NM, "bandwidth_nm")
+        self.angle_spread_deg = _beam_value(
+            angle_spread_deg, spreads.MAX_ANGLE_SPREAD_DEG, "angle_spread_deg"
+        )
 
     @property
     def coherent(self) -> bool:
         """True when every layer is coherent, the substrate semi-infinite and no spread."""
-        flat = not self.thickness_spread
+        flat = not (self.thickness_spread or self.bandwidth_nm or self.angle_spread_deg)
         return (
             flat and self.substrate_thickness_nm is None and all(x.coherent for x in self.layers)
+        )
+
+    @property
+    def depolarizing(self) -> bool:
+        """True when the model can depolarize: a spread parameter, a thick layer or backside.
+
+        Any of ``stack.thickness_spread``, ``stack.bandwidth_nm``, ``stack.angle_spread_deg``
+        present (even at 0: a fit may move it), an incoherent layer or a finite substrate.
+        """
+        beam = (self.thickness_spread, self.bandwidth_nm, self.angle_spread_deg)
+        return (
+            any(v is not None for v in beam)
+            or self.substrate_thickness_nm is not None
+            or not all(x.coherent for x in self.layers)
         )
 
     # ---- optics
@@ -140,15 +166,27 @@ class Stack:
         out.append(n_amb)
         return out[::-1]
 
-    def _layer_index(self, m: Any, lam: NDArray, below: NDArray, n_amb: NDArray) -> NDArray:
-        """The index of one homogeneous layer material (a mixture from its constituents)."""
+    def _layer_index(
+        self,
+        m: Any,
+        lam: NDArray,
+        below: NDArray,
+        n_amb: NDArray,
+        memo: dict[int, tuple[Any, NDArray]] | None = None,
+    ) -> NDArray:
+        """The index of one homogeneous layer material (a mixture from its constituents).
+
+        ``memo`` keeps each plain material's index by identity for one evaluation: an
+        ``@NAME`` constituent is then the index its layer has, computed once.
+        """
+        memo = {} if memo is None else memo
         if isinstance(m, Roughness):
             n = np.sqrt(stk.bruggeman(below * below, n_amb * n_amb + 0j, m.fraction))
         elif isinstance(m, Ema):
-            eps = [self._constituent(c, lam, n_amb) ** 2 for c in m.components]
+            eps = [self._constituent(c, lam, n_amb, memo) ** 2 for c in m.components]
             n = np.sqrt(m.mix(eps))
         else:
-            return np.asarray(m.nk(lam))
+            return _memo_nk(m, lam, memo)
         return np.asarray(np.where(n.imag < 0, -n, n))
 
     def _optical(self, lam: NDArray) -> tuple[list[NDArray], list[float], list[bool]]:
@@ -156,18 +194,21 @@ class Stack:
         n_amb = self._ambient_nk(lam)
         below = np.asarray(self.substrate.nk(lam))
         n_out, d_out, c_out = [below], [], []
+        memo: dict[int, tuple[Any, NDArray]] = {}
         for lay in reversed(self.layers):
             m = lay.material
             parts = m.slices()[::-1] if isinstance(m, Graded) else [m]
             for part in parts:
-                below = self._layer_index(part, lam, below, n_amb)
+                below = self._layer_index(part, lam, below, n_amb, memo)
                 n_out.append(below)
                 d_out.append(lay.thickness_nm / len(parts))
                 c_out.append(lay.coherent)
         n_out.append(n_amb)
         return n_out[::-1], d_out[::-1], c_out[::-1]
 
-    def _constituent(self, c: Any, lam: NDArray, n_amb: NDArray) -> NDArray:
+    def _constituent(
+        self, c: Any, lam: NDArray, n_amb: NDArray, memo: dict[int, tuple[Any, NDArray]]
+    ) -> NDArray:
         """The index of an EMA constituent: a material, or ``@NAME`` of the stack."""
         if not isinstance(c, str):
             return np.asarray(c.nk(lam), complex)
@@ -177,7 +218,7 @@ class Stack:
         if ref == "substrate":
             return np.asarray(self.substrate.nk(lam), complex)
         (lay,) = (x for x in self.layers if x.name == ref)
-        return np.asarray(lay.material.nk(lam), complex)
+        return np.asarray(_memo_nk(lay.material, lam, memo), complex)
 
     def _thicknesses(self) -> list[float]:
         return [lay.thickness_nm for lay in self.layers]
@@ -198,9 +239,23 @@ class Stack:
         if self.substrate_thickness_nm is not None:
             n, d, flags = [*n, n[0]], [*d, self.substrate_thickness_nm], [*flags, False]
         th = np.asarray(theta_deg, float)
-        if self.thickness_spread:
-            return nonuniform.spread_sums(n, d, flags, lam, th, self.thickness_spread)
-        return inc.intensity_sums(n, d, flags, lam, th)
+        spread = self.thickness_spread
+
+        def sums(lam_k: NDArray, th_k: NDArray) -> inc.IntensitySums:
+            if spread:  # indices held at the centre wavelengths (spreads.beam_sums, Notes)
+                return nonuniform.spread_sums(n, d, flags, lam_k, th_k, spread)
+            return inc.intensity_sums(n, d, flags, lam_k, th_k)
+
+        if not (self.bandwidth_nm or self.angle_spread_deg):
+            return sums(lam, th)
+        path = sum(
+            float(np.max(np.abs(np.real(nj)))) * dj
+            for nj, dj, c in zip(n[1:-1], d, flags, strict=True)
+            if c
+        )
+        return spreads.beam_sums(
+            sums, lam, th, self.bandwidth_nm or 0.0, self.angle_spread_deg or 0.0, path
+        )
 
     def psi_delta(
         self, wavelength_nm: ArrayLike, theta_deg: ArrayLike
@@ -275,9 +330,18 @@ class Stack:
         out.update({f"substrate.{k}": v for k, v in self.substrate.params.items()})
         if self.substrate_thickness_nm is not None:
             out["substrate.thickness_nm"] = self.substrate_thickness_nm
-        if self.thickness_spread is not None:
-            out["stack.thickness_spread"] = self.thickness_spread
+        for k, v in self._beam().items():
+            out[f"stack.{k}"] = v
         return out
+
+    def _beam(self) -> dict[str, float]:
+        """The spread parameters that are present, by name."""
+        beam = {
+            "thickness_spread": self.thickness_spread,
+            "bandwidth_nm": self.bandwidth_nm,
+            "angle_spread_deg": self.angle_spread_deg,
+        }
+        return {k: v for k, v in beam.items() if v is not None}
 
     def units(self) -> dict[str, str]:
         """Units of every parameter of :meth:`values`."""
@@ -288,8 +352,9 @@ class Stack:
         out.update({f"substrate.{k}": u for k, u in self.substrate.units().items()})
         if self.substrate_thickness_nm is not None:
             out["substrate.thickness_nm"] = "nm"
-        if self.thickness_spread is not None:
-            out["stack.thickness_spread"] = "1"
+        beam_units = {"thickness_spread": "1", "bandwidth_nm": "nm", "angle_spread_deg": "deg"}
+        for k in self._beam():
+            out[f"stack.{k}"] = beam_units[k]
         return out
 
     def with_values(self, values: Mapping[str, float]) -> Stack:
@@ -308,8 +373,8 @@ class Stack:
             layers.append(replace(lay, material=_with_params(lay.material, p), thickness_nm=d))
         p = dict(per.get("substrate", {}))
         d_sub = p.pop("thickness_nm", self.substrate_thickness_nm)
-        spread = per.get("stack", {}).get("thickness_spread", self.thickness_spread)
-        return Stack(layers, _with_params(self.substrate, p), self.ambient, d_sub, spread)
+        beam = {**self._beam(), **per.get("stack", {})}
+        return Stack(layers, _with_params(self.substrate, p), self.ambient, d_sub, **beam)
 
     # ---- serialisation
     def to_dict(self) -> dict[str, Any]:
@@ -321,8 +386,7 @@ class Stack:
         }
         if self.substrate_thickness_nm is not None:
             out["substrate_thickness_nm"] = self.substrate_thickness_nm
-        if self.thickness_spread is not None:
-            out["thickness_spread"] = self.thickness_spread
+        out.update(self._beam())
         return out
 
     @classmethod
@@ -339,8 +403,10 @@ class Stack:
                 for x in d.get("layers", [])
             ]
             sub, amb = as_material(d["substrate"]), as_material(d.get("ambient", 1.0))
-            d_sub, spread = d.get("substrate_thickness_nm"), d.get("thickness_spread")
-            return cls(layers, sub, amb, d_sub, spread)
+            beam = {
+                k: d[k] for k in ("thickness_spread", "bandwidth_nm", "angle_spread_deg") if k in d
+            }
+            return cls(layers, sub, amb, d.get("substrate_thickness_nm"), **beam)
         except KeyError as exc:
             raise FilmError(f"stack: missing key {exc}") from None
 
@@ -357,9 +423,16 @@ class Stack:
         )
         d = self.substrate_thickness_nm
         thick = "" if d is None else f", substrate_thickness_nm={d:.6g}"
-        if self.thickness_spread is not None:
-            thick += f", thickness_spread={self.thickness_spread:.4g}"
+        for k, v in self._beam().items():
+            thick += f", {k}={v:.4g}"
         return f"Stack([{inner}], substrate={self.substrate.name}{thick})"
+
+
+def _memo_nk(m: Any, lam: NDArray, memo: dict[int, tuple[Any, NDArray]]) -> NDArray:
+    """``m.nk(lam)``, computed once per evaluation (``memo`` holds ``m``: its id stays its)."""
+    if id(m) not in memo:
+        memo[id(m)] = (m, np.asarray(m.nk(lam)))
+    return memo[id(m)][1]
 
 
 def _check_references(layers: Sequence[Layer]) -> None:
@@ -399,6 +472,19 @@ def _spread(s: Any) -> float | None:
             f"got {s!r}"
         )
     return v
+
+
+def _beam_value(v: Any, top: float, what: str) -> float | None:
+    """None (no parameter) or a bandwidth / angle spread in [0, top]."""
+    if v is None:
+        return None
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise FilmError(f"{what}: expected a number, got {v!r}") from None
+    if not 0.0 <= x <= top:
+        raise FilmError(f"{what}: expected a value in [0, {top:g}], got {v!r}")
+    return x
 
 
 def _substrate_thickness(d: Any) -> float | None:

@@ -26,6 +26,7 @@ from scipy import special
 
 from ..dataset import Measurement
 from ..films import FILM_QUANTITIES, NK_REPORT_NM, FilmError, FilmModel, Stack, load_model
+from ..films import incoherent as inc
 from ..jsonsafe import jsonable
 from ..models import Model, Parameters
 from ..nk import dispersion as disp
@@ -54,7 +55,7 @@ class _FilmFitModel(Model):
         "coherent transfer matrices (labbrdf.films.matrices) with labbrdf.nk.dispersion materials"
     )
 
-    _CH = {"psi": 0, "delta": 1, "rs": 2, "rp": 3, "r": 4, "ts": 5, "tp": 6, "t": 7}
+    _CH = {"psi": 0, "delta": 1, "rs": 2, "rp": 3, "r": 4, "ts": 5, "tp": 6, "t": 7, "dpol": 8}
 
     def __init__(self, fm: FilmModel, channels: NDArray, y: NDArray) -> None:
         self.fm = fm
@@ -101,6 +102,8 @@ class _FilmFitModel(Model):
             out = np.where(ch == 5, Ts, out)
             out = np.where(ch == 6, Tp, out)
             out = np.where(ch == 7, 0.5 * (Ts + Tp), out)
+        if np.any(ch == 8):  # depolarization, 1 - sqrt(N^2 + C^2 + S^2) (films.incoherent)
+            out = np.where(ch == 8, inc.ellipsometry(sums)[2][inv], out)
         return out
 
     def _evaluate(self, p, theta_i, theta_r, phi_r, wavelength):
@@ -133,10 +136,12 @@ def _film_rows(
     data: Any,
     wl_range: tuple[float, float] | None,
     default_sigma: Mapping[str, float] | None,
+    depolarization: bool = False,
 ) -> tuple[pd.DataFrame, NDArray]:
-    """The rows a film fit uses and their channel codes."""
+    """The rows a film fit uses and their channel codes (with the depolarization rows)."""
     df = _frame(data)
-    df = df[df["quantity"].astype(str).isin(FILM_QUANTITIES)].copy()
+    wanted = FILM_QUANTITIES + (("depolarization",) if depolarization else ())
+    df = df[df["quantity"].astype(str).isin(wanted)].copy()
     if "channel" in df.columns:
         ch = df["channel"].astype(object).where(df["channel"].notna(), "").astype(str)
     else:
@@ -156,6 +161,8 @@ def _film_rows(
     code = np.full(len(df), -1)
     code[(q == "psi").to_numpy()] = 0
     code[(q == "delta").to_numpy()] = 1
+    code[(q == "depolarization").to_numpy()] = 8
+    ell = ell | (q == "depolarization")  # needs an angle as psi and Delta do
     for qty, base in (("reflectance", 2), ("transmittance", 5)):
         m = (q == qty).to_numpy()
         c = ch.to_numpy()
@@ -170,7 +177,7 @@ def _film_rows(
     theta = df["theta_i_deg"].to_numpy(float).copy()
     no_angle = ~np.isfinite(theta)
     if np.any(no_angle & ell.to_numpy()):
-        raise FilmError("data: psi/delta rows without an angle of incidence")
+        raise FilmError("data: psi/delta or depolarization rows without an angle of incidence")
     theta[no_angle] = 0.0  # spectrophotometer R, T without an angle: normal incidence
     df["theta_i_deg"] = theta
     sig = df["sigma"].to_numpy(float).copy()
@@ -347,6 +354,7 @@ class FilmFit:
     def channel_stats(self) -> dict[str, dict[str, float]]:
         """chi2 and count per data channel (psi, delta, R_s, ...)."""
         names = {0: "psi", 1: "delta", 2: "R_s", 3: "R_p", 4: "R", 5: "T_s", 6: "T_p", 7: "T"}
+        names[8] = "depolarization"
         r = np.asarray(self.result.residual, float) / self.data["sigma"].to_numpy(float)
         out = {}
         for code, nm in names.items():
@@ -633,6 +641,19 @@ class FilmFit:
         return film_fit_plot(self, ax)
 
 
+def _fits_depolarization(choice: bool | str, stack: Stack, data: Any) -> bool:
+    """Whether the depolarization rows enter the fit (:func:`fit_film`'s rule)."""
+    if choice not in ("auto", True, False):
+        raise FilmError(f"depolarization: expected 'auto', True or False, got {choice!r}")
+    has = bool((_frame(data)["quantity"].astype(str) == "depolarization").any())
+    if choice is True and not has:
+        raise FilmError(
+            "depolarization: the data have no depolarization rows to fit (a WVASE file "
+            "carries them as dpolE); expected data with them, or depolarization='auto'"
+        )
+    return has and (choice is True or (choice == "auto" and stack.depolarizing))
+
+
 def fit_film(
     stack_or_model: Stack | FilmModel | str | os.PathLike[str],
     data: Any,
@@ -646,6 +667,7 @@ def fit_film(
     maxeval: int | Sequence[int | None] | None = None,
     one_sample: bool = False,
     on_wald: Callable[[FilmFit], None] | None = None,
+    depolarization: bool | str = "auto",
 ) -> FilmFit:
     """Fit a film stack's thicknesses and dispersion parameters to measured data.
 
@@ -681,6 +703,15 @@ def fit_film(
     on_wald : callable, optional
         Called with the fit carrying Wald intervals before any profile is computed (a
         command line prints this fast answer first); not called when nothing is profiled.
+    depolarization : {"auto", True, False}
+        Whether the files' depolarization rows (WVASE ``dpolE``) enter the residual, each
+        divided by its own sigma. ``"auto"`` (default): when the model can depolarize
+        (:attr:`Stack.depolarizing`: a thickness spread, bandwidth or angle spread
+        parameter, an incoherent layer or a finite substrate) and the data have such rows;
+        a model that cannot depolarize predicts 0 whatever its parameters, and the channel
+        would only add a constant to chi-square. ``True`` requires such rows. Their chi2
+        is the ``depolarization`` entry of :meth:`FilmFit.channel_stats`, and they count in
+        the MSE as every fitted value does.
 
     Returns
     -------
@@ -713,7 +744,8 @@ def fit_film(
         fm = FilmModel(fm.stack, {k: (float(a), float(b)) for k, (a, b) in free.items()},
                        fm.wavelength_range_nm, fm.source)  # fmt: skip
     wl_range = wavelength_range_nm or fm.wavelength_range_nm
-    rows, codes = _film_rows(data, wl_range, default_sigma)
+    with_dpol = _fits_depolarization(depolarization, fm.stack, data)
+    rows, codes = _film_rows(data, wl_range, default_sigma, with_dpol)
     if not one_sample:
         _check_one_sample(rows)
     wl = rows["wavelength_nm"].to_numpy(float)

@@ -7,6 +7,7 @@ residuals (figure); :class:`labbrdf.FilmFit` delegates its ``fit_report``, ``__s
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
@@ -36,6 +37,7 @@ CHANNELS = {
     5: ("T_s", "T_s"),
     6: ("T_p", "T_p"),
     7: ("T", "T"),
+    8: ("depolarization", "depolarization [1]"),
 }
 
 
@@ -94,6 +96,22 @@ def _fit_line(summary: Mapping[str, Any]) -> str:
     )
 
 
+def _dpol_lines(summary: Mapping[str, Any]) -> list[str]:
+    """The depolarization channel's own chi2, and the MSE of psi and Delta alone, if fitted."""
+    ch = summary.get("channels", {})
+    dp = ch.get("depolarization")
+    if dp is None:
+        return []
+    per = dp["chi2"] / dp["n"]
+    line = f"depolarization channel: {dp['n']} rows, chi2 {dp['chi2']:.4g} (chi2/n {per:.3g})"
+    if "psi" in ch and "delta" in ch:
+        n = ch["psi"]["n"] + ch["delta"]["n"] - summary["nvarys"]
+        if n > 0:
+            mse = math.sqrt((ch["psi"]["chi2"] + ch["delta"]["chi2"]) / n)
+            line += f"; MSE of psi and Delta alone {mse:.4g}"
+    return [line]
+
+
 def intervals_text(summary: Mapping[str, Any]) -> str:
     """Which 95 % intervals a film fit's summary carries, in words.
 
@@ -144,6 +162,7 @@ def film_fit_report(summary: Mapping[str, Any]) -> str:
     for k, p in summary.get("stack_parameters", {}).items():  # e.g. thickness_spread
         lines.append(f"stack {k:<14s} {_param_text(p)}")
     lines.append(_fit_line(summary))
+    lines.extend(_dpol_lines(summary))
     if not summary["success"]:
         lines.append(f"fit did not converge: {summary['message']}")
     lines.extend(f"note: {n}" for n in summary["notes"])

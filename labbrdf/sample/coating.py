@@ -11,17 +11,23 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from typing import Any
 
 import numpy as np
 
 from ..errors import SampleError
+from ..films.graded import Graded
 from ..films.materials import Roughness
 from ..films.stack import read_fit_json
 from ..roughness.topography import SlopeFit
 from ..tracer.config import Coating
 
-__all__ = ["coating_from_fit", "coating_of_stack", "film_coating"]
+__all__ = ["CoatingWarning", "coating_from_fit", "coating_of_stack", "film_coating"]
+
+
+class CoatingWarning(UserWarning):
+    """A part of a fitted stack that the tracer's coating leaves out (a substrate's backside)."""
 
 
 def coating_from_fit(path: str | os.PathLike[str], wavelength_nm: float) -> tuple[complex, float]:
@@ -99,14 +105,44 @@ def coating_of_stack(
     Raises
     ------
     ValueError
-        No layer, several layers or a roughness layer, or a wavelength outside the fitted
-        range.
+        No layer, several layers or a roughness layer, a layer graded through its
+        thickness, or a wavelength outside the fitted range.
+
+    Warns
+    -----
+    CoatingWarning
+        The stack's substrate has a finite thickness: the tracer's substrate is
+        semi-infinite, and the light of its backside is left out.
+
+    Notes
+    -----
+    The tracer's coating is one homogeneous layer added in intensity (Beer-Lambert). A
+    graded layer whose parameter is the same at its top and bottom is homogeneous and
+    taken; one that varies is refused, naming it: its two interfaces see different
+    indices, which no single index represents. An incoherent layer is what the tracer
+    computes anyway. A thickness spread, bandwidth or angle spread of the fit smooths the
+    thin-film interference, which the incoherent coating does not have: nothing is lost.
     """
     names = [lay.name for lay in stack.layers]
     if len(stack.layers) != 1 or isinstance(stack.layers[0].material, Roughness):
         raise ValueError(
             f"{where}: the tracer has one coating over the substrate; this fit's stack has "
             f"{len(names)} layer(s) {names} ({hint})"
+        )
+    m = stack.layers[0].material
+    if isinstance(m, Graded) and m.top != m.bottom:
+        raise ValueError(
+            f"{where}: layer {names[0]!r} is graded ({m.parameter} from {m.top:.6g} at the top "
+            f"to {m.bottom:.6g} at the bottom); the tracer's coating is one homogeneous "
+            f"layer, which cannot have two indices ({hint} without a gradient)"
+        )
+    if stack.substrate_thickness_nm is not None:
+        warnings.warn(
+            f"{where}: the fit's substrate is {stack.substrate_thickness_nm:g} nm thick, with "
+            "the light of its backside; the tracer's substrate is semi-infinite, so that light "
+            "is left out of the prediction",
+            CoatingWarning,
+            stacklevel=2,
         )
     wl = float(wavelength_nm)
     lo, hi = float(fitted_range_nm[0]), float(fitted_range_nm[1])

@@ -13,7 +13,8 @@ from labbrdf import films
 from labbrdf.cli import main
 from labbrdf.fitting.film import fit_film
 from labbrdf.nk.dispersion import Cauchy
-from labbrdf.sample import coating_from_fit
+from labbrdf.sample import coating_from_fit, coating_of_stack, trace_config_from_inputs
+from labbrdf.sample.coating import CoatingWarning
 
 CAUCHY = {"A": 1.52, "B": 0.006, "C": 0.0}
 D_NM = 250.0
@@ -103,6 +104,46 @@ def test_trace_coating_from_errors_are_exit_2(fit_json: Path, capsys, extra, mes
 def test_trace_coating_from_a_missing_file_is_exit_2(tmp_path: Path, capsys) -> None:
     assert main([*BASE, "--coating-from", str(tmp_path / "none.json")]) == 2
     assert "none.json" in capsys.readouterr().err
+
+
+def _with_stack(fit_json: Path, tmp_path: Path, stack: films.Stack, name: str) -> Path:
+    """The fit JSON with its stack replaced (the fitted range kept)."""
+    doc = json.loads(fit_json.read_text())
+    doc["stack"] = stack.to_dict()
+    out = tmp_path / name
+    out.write_text(json.dumps(doc))
+    return out
+
+
+def test_a_graded_coating_is_refused_naming_the_layer(fit_json: Path, tmp_path: Path, capsys):
+    graded = films.Graded(Cauchy(**CAUCHY), "A", top=1.50, bottom=1.56, sublayers=10)
+    st = films.Stack([films.Layer(graded, D_NM, "coat")], 1.7)
+    with pytest.raises(
+        ValueError, match=r"layer 'coat' is graded \(A from 1.5 at the top to 1.56"
+    ):
+        coating_of_stack(st, 633.0, (450.0, 750.0), where="fit")
+    path = _with_stack(fit_json, tmp_path, st, "graded.json")
+    assert main([*BASE, "--coating-from", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "one homogeneous layer" in err and len(err.strip().splitlines()) == 1
+    flat = films.Graded(Cauchy(**CAUCHY), "A", top=1.52, bottom=1.52, sublayers=10)
+    same = coating_of_stack(
+        films.Stack([films.Layer(flat, D_NM, "coat")], 1.7), 633.0, (450.0, 750.0), where="f"
+    )
+    plain = films.Stack([films.Layer(Cauchy(**CAUCHY), D_NM, "coat")], 1.7)
+    assert same == coating_of_stack(plain, 633.0, (450.0, 750.0), where="f")
+
+
+def test_a_backside_left_out_is_said(fit_json: Path, tmp_path: Path):
+    st = films.Stack([films.Layer(Cauchy(**CAUCHY), D_NM, "coat")], 1.7, 1.0, 1e6)
+    with pytest.warns(CoatingWarning, match=r"1e\+06 nm thick.*semi-infinite"):
+        coating_of_stack(st, 633.0, (450.0, 750.0), where="fit")
+    path = _with_stack(fit_json, tmp_path, st, "glass.json")
+    with pytest.warns(CoatingWarning, match="left out of the prediction"):
+        cfg = trace_config_from_inputs(
+            633.0, 45.0, substrate_index=1.7, alpha=0.2, coating_from=path
+        )
+    assert cfg.coating is not None and cfg.coating.thickness_nm == D_NM
 
 
 # ---------------------------------------------------- a hand-edited fit JSON: its schema
