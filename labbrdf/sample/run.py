@@ -31,13 +31,17 @@ from .coating import coating_from_fit
 from .index import bulk_index
 from .slopes import analytic_table, height_map, measured_substrate, pitch
 
-__all__ = ["trace_config_from_inputs"]
+__all__ = ["SampleWarning", "trace_config_from_inputs"]
 
 PathLike = str | os.PathLike[str]
 
 
+class SampleWarning(UserWarning):
+    """Something a sample was built with that its files did not state (e.g. a pixel size)."""
+
+
 def _warn(message: str) -> None:
-    warnings.warn(message, UserWarning, stacklevel=3)
+    warnings.warn(message, SampleWarning, stacklevel=3)
 
 
 def _substrate(

@@ -17,6 +17,7 @@ from labbrdf.errors import SetupError
 from labbrdf.microfacet import TabulatedNDF
 from labbrdf.nk import bulk_index_at, read_nk
 from labbrdf.sample import slopes, trace_config_from_inputs
+from labbrdf.sample.run import SampleWarning
 from labbrdf.tracer import Coating, Substrate, TraceConfig
 
 TA = "woollam-wvase-ascii/w2_10102006.dat"
@@ -154,7 +155,8 @@ def test_height_map_files_are_read_with_their_warnings(monkeypatch) -> None:
     assert calls == [("m.di", "Height", "nm", (1e-8, 1e-8))]
     assert said == ["m.di: pixel size not stated"]
     assert cfg.substrate.ndf is not None
-    with pytest.warns(UserWarning, match="pixel size not stated"):
+    # a labbrdf warning class, so the command line prints it as one line
+    with pytest.warns(SampleWarning, match="pixel size not stated"):
         trace_config_from_inputs(633.0, 45.0, substrate_index=2j, surface="m.di")
 
 
