@@ -100,8 +100,8 @@ def cell_nodes(grid: Grid, rows: int, n_sub: int) -> tuple[NDArray[np.int64], F6
     first ``rows`` polar rows each cell is averaged over ``n_sub`` Gauss-Legendre nodes in
     ``sin^2 theta``, i.e. uniformly in cos-weighted solid angle, as the walk's rays fill a
     cell that is small against the spread of the light inside the coating. The azimuth
-    keeps the cell's centre: near the pole a cell's arc is short (sub-nodes across it
-    changed the measured bias by < 0.1 %, docs/tracer.md).
+    keeps the cell's centre, as the centroid does (sub-nodes across it moved the rows
+    near the pole by < 0.1 %, docs/tracer.md).
 
     Returns
     -------

@@ -17,9 +17,9 @@ deg is evaluated.
 
 Storage: the spectrum in complex64 (float32 parts), shape (n_freq, 4 n_theta, 4 n_cells):
 91 x 91 x 181 x 16 x 8 bytes = 192 MB for the 1-degree grid. The cell discretisation
-(each ray treated as if it left from its cell's centroid, or, for the cells near the
-pole that are wide against the exit lobe, as spread uniformly over the cell's polar
-extent: :func:`pole_cells`) is the operator's only approximation (docs/tracer.md).
+(each ray treated as if it left from its cell's centroid, or, where cells are wide
+against the exit lobe, as spread evenly over its cell's polar extent: :func:`cell_rule`)
+is the operator's only approximation (docs/tracer.md).
 """
 
 from __future__ import annotations
@@ -56,13 +56,10 @@ _MEMORY: ContextVar[OrderedDict[str, ExitOperator] | None] = ContextVar(
 #: operators :func:`memory_cache` keeps (the most recently used)
 MEMORY_OPERATORS = 2
 
-#: internal cells whose lower edge is within this polar angle [deg] are averaged over
-#: sub-cell nodes where they are wide against the exit lobe (:func:`pole_cells`)
-POLE_CELL_DEG = 20.0
 #: polar sub-cell nodes per unit of (the cell's image in the air / the exit lobe)
-POLE_NODES_PER_LOBE = 2.5
+CELL_NODES_PER_LOBE = 2.5
 #: at most this many polar sub-cell nodes
-POLE_MAX_NODES = 6
+CELL_MAX_NODES = 6
 
 PARITY = np.array([1, 1, -1, -1])[:, None] * np.array([1, 1, -1, -1])[None, :]
 
@@ -158,7 +155,7 @@ def build_exit_operator(
     nt, npf = grid.n_theta, grid.n_phi
     half = npf // 2 + 1
     theta_o, dphi_o, w = bin_nodes(grid, *nodes)
-    q_row, q_theta, q_w = cell_nodes(grid, *pole_cells(grid, n_below, alpha, n_above))
+    q_row, q_theta, q_w = cell_nodes(grid, *cell_rule(grid, n_below, alpha, n_above))
     step = np.radians(grid.phi_step_deg)
     ni, nj = w.shape[1:]
 
@@ -172,8 +169,7 @@ def build_exit_operator(
         return ggx.smith_g1(v[2], alpha)
 
     # per output row: every (node, internal node, azimuth difference in [0, 180] deg)
-    # point; with one node per cell (rows away from the pole) the same points, in the
-    # same order, as a rule with the centroids alone
+    # point; with one node per cell the same points, in the same order, as the centroids
     grids = np.meshgrid(np.arange(ni * nj), np.arange(q_row.size), np.arange(half), indexing="ij")
     a, iq, dj = (g.ravel() for g in grids)
     ai, aj = a // nj, a % nj
@@ -202,30 +198,32 @@ def build_exit_operator(
     return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
 
 
-def pole_cells(grid: Grid, n_below: float, alpha: float, n_above: float = 1.0) -> tuple[int, int]:
-    """Polar rows of internal cells averaged over sub-cell nodes, and nodes per cell.
+def cell_rule(grid: Grid, n_below: float, alpha: float, n_above: float = 1.0) -> tuple[int, int]:
+    """Rows of internal cells averaged over polar sub-cell nodes, and nodes per cell.
 
-    Near the pole the centroid rule is wrong where a cell is wide against the exit lobe:
-    the first cell is a cap around the pole whose centroid is off it, and the output bins
-    there see every internal cell of the first rows from close by (``docs/tracer.md``).
-    Cells whose lower edge is within :data:`POLE_CELL_DEG` of the pole are averaged over
-    ``n`` polar nodes (:func:`.evaluate.cell_nodes`), ``n = ceil(POLE_NODES_PER_LOBE x``
+    Where a cell is wide against the exit lobe, treating all its rays as if they left
+    from its centroid is wrong near the pole: the first cell is a cap around the pole
+    whose centroid is off it, and the output bins there see every internal cell of the
+    first rows from close by (``docs/tracer.md``). There every cell is averaged over
+    ``n`` polar nodes (:func:`.evaluate.cell_nodes`), ``n = ceil(CELL_NODES_PER_LOBE x``
     the cell's polar width as seen in the air, ``n_below / n_above x step``, over the
-    lobe width :func:`.exit_sampled.lobe_width_rad`), at most :data:`POLE_MAX_NODES`.
-    Where ``n = 1`` (for ``n_below = 1.5``: 1-degree cells at ``alpha >= 0.14``, 3-degree
-    cells at ``alpha >= 0.4``) the operator is the centroid rule's, bit for bit.
+    lobe width :func:`.exit_sampled.lobe_width_rad`), at most :data:`CELL_MAX_NODES`.
+    All rows are averaged, not only those near the pole: a seam between averaged and
+    centroid cells biased the output rows it feeds (docs/tracer.md). Where ``n = 1`` (for
+    ``n_below = 1.5``: 1-degree cells at ``alpha >= 0.14``, 3-degree cells at ``alpha >=
+    0.4``) the operator is the centroid rule's, bit for bit.
 
     Returns
     -------
     (rows, n) : (int, int)
-        Rows averaged (0: none) and nodes per cell.
+        Rows averaged (0 or all) and nodes per cell.
     """
     image = np.radians(grid.theta_step_deg) * n_below / n_above
     ratio = image / lobe_width_rad(n_below, n_above, alpha)
-    n = int(min(POLE_MAX_NODES, np.ceil(POLE_NODES_PER_LOBE * ratio - 1e-9)))
+    n = int(min(CELL_MAX_NODES, np.ceil(CELL_NODES_PER_LOBE * ratio - 1e-9)))
     if n <= 1:
         return 0, 1
-    return int(np.count_nonzero(grid.theta_edges_deg[:-1] < POLE_CELL_DEG)), n
+    return grid.n_theta, n
 
 
 @contextmanager
@@ -256,7 +254,7 @@ def _key(grid: Grid, n_below: float, alpha: float, n_above: float, nodes: tuple)
         "alpha": float(alpha),
         "nodes": [int(v) for v in nodes],
         "distribution": "ggx",
-        "pole_cells": list(pole_cells(grid, n_below, alpha, n_above)),
+        "cell_rule": list(cell_rule(grid, n_below, alpha, n_above)),
     }
     return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
 

@@ -1,4 +1,4 @@
-"""The exit operator near the pole: internal cells wide against the exit lobe are averaged."""
+"""The exit operator's internal cells, averaged where wide against the exit lobe (the pole)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
 from labbrdf.tracer.agreement import agreement
 from labbrdf.tracer.binning import Grid
 from labbrdf.tracer.evaluate import cell_centroids, cell_nodes
-from labbrdf.tracer.operator import build_exit_operator, pole_cells
+from labbrdf.tracer.operator import cell_rule
 
 
 def test_cell_nodes_are_a_rule_in_sin2_theta_over_each_cell():
@@ -28,30 +28,14 @@ def test_cell_nodes_are_a_rule_in_sin2_theta_over_each_cell():
     assert np.array_equal(theta1, cell_centroids(grid)) and np.all(weight1 == 1.0)
 
 
-def test_pole_cells_follow_the_cell_against_the_lobe():
-    # 3-degree cells at alpha 0.2 (lobe 5.7 deg in the air, cell image 4.5 deg): 2 nodes
-    # in the rows below 20 deg; 1-degree cells at alpha 0.2: the centroids
-    assert pole_cells(Grid(3.0, 6.0), 1.5, 0.2) == (8, 2)
-    assert pole_cells(Grid(3.0, 6.0), 1.5, 0.1) == (8, 4)
-    assert pole_cells(Grid(1.0, 1.0), 1.5, 0.2) == (0, 1)
-
-
-def test_averaging_changes_only_the_polar_cells_columns():
-    """Rows of internal cells beyond the averaged ones keep the centroid rule's numbers."""
-    grid = Grid(10.0, 20.0)
-    rows, n = pole_cells(grid, 1.5, 0.05)
-    assert (rows, n) == (3, 6)  # cells from 0, 5 and 15 deg
-    op = build_exit_operator(grid, 1.5, 0.05, nodes=(2, 2)).spectrum
-    import labbrdf.tracer.operator as operator
-
-    old = operator.POLE_CELL_DEG
-    try:
-        operator.POLE_CELL_DEG = 0.0
-        ref = build_exit_operator(grid, 1.5, 0.05, nodes=(2, 2)).spectrum
-    finally:
-        operator.POLE_CELL_DEG = old
-    changed = np.flatnonzero(np.any(op != ref, axis=(0, 1))) // 4
-    assert set(changed.tolist()) == {0, 1, 2}
+def test_cell_rule_follows_the_cell_against_the_lobe():
+    # 3-degree cells at alpha 0.2 (lobe 5.7 deg in the air, cell image 4.5 deg): 2 nodes;
+    # 1-degree cells at alpha 0.2 (the paper's case): the centroids
+    assert cell_rule(Grid(3.0, 6.0), 1.5, 0.2) == (31, 2)
+    assert cell_rule(Grid(3.0, 6.0), 1.5, 0.1) == (31, 4)
+    assert cell_rule(Grid(3.0, 6.0), 1.5, 0.02) == (31, 6)
+    assert cell_rule(Grid(1.0, 1.0), 1.5, 0.2) == (0, 1)
+    assert cell_rule(Grid(3.0, 6.0), 1.5, 0.4) == (0, 1)
 
 
 @pytest.mark.slow
