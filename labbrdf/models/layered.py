@@ -25,7 +25,6 @@ References
 from __future__ import annotations
 
 import math
-import warnings
 from collections import OrderedDict
 from collections.abc import Mapping
 from typing import Any
@@ -35,7 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .base import Model, ModelError, Parameters, lambert
 
-__all__ = ["Layered", "PoleBiasWarning"]
+__all__ = ["Layered"]
 
 _BASES = ("conductor", "diffuse")
 #: traces kept per model instance (two small maps each): a fit's Jacobian and polish come
@@ -49,16 +48,6 @@ _PHI_STEPS = (2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0)
 #: a fitted alpha 2.4 % low); the cost of a trace barely depends on the grid
 _AUTO_THETA_STEPS = (1.0, 2.0, 3.0)
 _AUTO_PHI_STEPS = (2.0, 3.0, 4.0, 5.0, 6.0)
-#: the traced exit operator is biased low within this many degrees of the normal [deg]
-#: (its polar cells put every ray at the cell's centroid: -8.6 / -4.4 / -2.2 % in the rows
-#: at 0 / 3 / 6 deg at normal incidence on coated Al, alpha 0.2; docs/tracer.md)
-POLE_BIAS_DEG = 9.0
-POLE_WARNING = (
-    "layered: {n} point(s) lie within {deg:g} deg of the surface normal, where the traced "
-    "exit operator is biased low (-9 to -2 % in the rows at 0-6 deg, measured on coated "
-    "Al at alpha 0.2; more for narrower lobes; docs/tracer.md); leave them out "
-    "(--theta-r 9:) or read their residuals with that in mind"
-)
 
 
 def _distribution(name: Any, base: str, coherent: bool) -> str:
@@ -151,8 +140,7 @@ class Layered(Model):
     ``a T(theta_i) T(theta_o) / (pi n^2 (1 - a R))`` plus the first surface
     (:mod:`labbrdf.tracer.coated_lambert`; agrees with the counting walk over every bin,
     ``docs/tracer.md``). The model evaluates that, on the tracer's grid and interpolated
-    like a traced map, so it is the traced model without its noise (and without the exit
-    operator's bias near the pole).
+    like a traced map, so it is the traced model without its noise.
     Single scattering (the separable Smith G1 G1 per interface) loses energy for rough
     interfaces; the multiple-scattering walk would count rays, whose noise no fit can
     use (``docs/tracer.md``).
@@ -311,7 +299,6 @@ class Layered(Model):
         expectation is a closed form (:mod:`labbrdf.tracer.coated_lambert`): no rays. The
         coherent mode's map is evaluated in closed form too. Both are deterministic.
         """
-        self._pole_warned = False  # the traced operator's pole warning, given once
         self._first_maps: OrderedDict[tuple, NDArray] = OrderedDict()  # closed form's
         closed = base == "diffuse"
         if closed or self._coherent:
@@ -587,7 +574,6 @@ class Layered(Model):
         val = np.zeros(ti_deg.shape)
         dev: NDArray | None = None
         up = (tr_deg >= 0) & (tr_deg <= 90)
-        self._warn_pole(p, tr_deg[up])
         dt, dp = self._grid
         pairs = np.unique(np.stack([np.round(ti_deg, 9).ravel(), wl.ravel()], axis=1), axis=0)
         for t, w in pairs:
@@ -601,25 +587,6 @@ class Layered(Model):
             val[sel] = _bilinear(f, u, v)
             dev[:, sel] = _bilinear(d, u, v)
         return val, np.zeros((1, *ti_deg.shape)) if dev is None else dev
-
-    def _warn_pole(self, p: Mapping[str, float], tr_deg: NDArray) -> None:
-        """Warn once if points near the normal go through the traced exit operator.
-
-        Not for the closed-form diffuse base, the coherent mode (no operator) or a top
-        smooth enough for the sampled exit (:func:`labbrdf.tracer.exit_sampled.exit_is_sampled`).
-        """
-        from ..tracer import Grid
-        from ..tracer.exit_sampled import exit_is_sampled
-
-        if self._closed or self._coherent or self._pole_warned or self._grid is None:
-            return
-        near = int(np.count_nonzero(tr_deg < POLE_BIAS_DEG))
-        grid = Grid(*self._grid)
-        if near and not exit_is_sampled(grid, float(p["n_coat"]), float(p["alpha_top"])):
-            warnings.warn(
-                POLE_WARNING.format(n=near, deg=POLE_BIAS_DEG), PoleBiasWarning, stacklevel=4
-            )
-            self._pole_warned = True
 
     # ------------------------------------------------------------------ model API
     def _evaluate(
@@ -713,10 +680,6 @@ class Layered(Model):
                     albedo = trace(cfg).albedo()
             out.append(albedo + (p["kd"] if self._floor else 0.0))
         return np.asarray(out, float).reshape(np.shape(theta_i_deg))
-
-
-class PoleBiasWarning(UserWarning):
-    """Points near the normal go through the traced exit operator, biased low there."""
 
 
 def _flag(v: Any, name: str) -> bool:

@@ -51,10 +51,10 @@ __all__ = [
 MIN_LOBE_NODES = 2.0
 
 #: with the operator, rays in this many polar rows of cells around the pole may exit
-#: through their own facet (the centroid of the polar cap is off the pole). Off (0): on
-#: the paper's case (1-degree grid, 60 deg) 4 rows made the tiny polar bins so noisy that
-#: the lobe's RMS relative error rose from 0.93 % to 11.7 %; on the 3 x 6 grid at normal
-#: incidence 4 rows removed a 2-9 % bias of the rows at 0-6 deg (docs/tracer.md)
+#: through their own facet. Off (0): the operator averages those cells instead
+#: (:func:`.operator.cell_rule`); on the paper's case (1-degree grid, 60 deg) 4 rows made
+#: the tiny polar bins so noisy that the lobe's RMS relative error rose from 0.93 % to
+#: 11.7 % (docs/tracer.md)
 POLE_ROWS = 0
 
 

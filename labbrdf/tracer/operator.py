@@ -17,8 +17,9 @@ deg is evaluated.
 
 Storage: the spectrum in complex64 (float32 parts), shape (n_freq, 4 n_theta, 4 n_cells):
 91 x 91 x 181 x 16 x 8 bytes = 192 MB for the 1-degree grid. The cell discretisation
-(each ray treated as if it left from its cell's centroid) is the operator's only
-approximation; its bias is of order (cell width / lobe width)^2 / 24 (docs/tracer.md).
+(each ray treated as if it left from its cell's centroid, or, where cells are wide
+against the exit lobe, as spread evenly over its cell's polar extent: :func:`cell_rule`)
+is the operator's only approximation (docs/tracer.md).
 """
 
 from __future__ import annotations
@@ -39,13 +40,14 @@ from ..microfacet import ggx
 from . import cache as _cache
 from .binning import Grid
 from .cache import cache_dir
-from .evaluate import bin_nodes, cell_centroids, transmission_mueller
+from .evaluate import bin_nodes, cell_nodes, transmission_mueller
+from .exit_sampled import lobe_width_rad
 from .interfaces import fresnel_abcs
 
 __all__ = ["ExitOperator", "build_exit_operator", "cache_dir", "exit_operator", "memory_cache"]
 
 # part of the cache key: bump when the operator's definition or its file format changes
-VERSION = 2
+VERSION = 3
 
 #: operators kept in memory inside :func:`memory_cache` (None outside: the disk cache)
 _MEMORY: ContextVar[OrderedDict[str, ExitOperator] | None] = ContextVar(
@@ -53,6 +55,11 @@ _MEMORY: ContextVar[OrderedDict[str, ExitOperator] | None] = ContextVar(
 )
 #: operators :func:`memory_cache` keeps (the most recently used)
 MEMORY_OPERATORS = 2
+
+#: polar sub-cell nodes per unit of (the cell's image in the air / the exit lobe)
+CELL_NODES_PER_LOBE = 2.5
+#: at most this many polar sub-cell nodes
+CELL_MAX_NODES = 6
 
 PARITY = np.array([1, 1, -1, -1])[:, None] * np.array([1, 1, -1, -1])[None, :]
 
@@ -148,7 +155,7 @@ def build_exit_operator(
     nt, npf = grid.n_theta, grid.n_phi
     half = npf // 2 + 1
     theta_o, dphi_o, w = bin_nodes(grid, *nodes)
-    theta_u = cell_centroids(grid)
+    q_row, q_theta, q_w = cell_nodes(grid, *cell_rule(grid, n_below, alpha, n_above))
     step = np.radians(grid.phi_step_deg)
     ni, nj = w.shape[1:]
 
@@ -161,21 +168,23 @@ def build_exit_operator(
     def g1_of(v: NDArray[np.float64]) -> NDArray[np.float64]:
         return ggx.smith_g1(v[2], alpha)
 
-    # per output row: every (node, cell row, azimuth difference in [0, 180] deg) point
-    grids = np.meshgrid(np.arange(ni * nj), np.arange(nt), np.arange(half), indexing="ij")
-    a, iu, dj = (g.ravel() for g in grids)
+    # per output row: every (node, internal node, azimuth difference in [0, 180] deg)
+    # point; with one node per cell the same points, in the same order, as the centroids
+    grids = np.meshgrid(np.arange(ni * nj), np.arange(q_row.size), np.arange(half), indexing="ij")
+    a, iq, dj = (g.ravel() for g in grids)
     ai, aj = a // nj, a % nj
-    flat = iu * half + dj
-    tu = theta_u[iu]
+    flat = q_row[iq] * half + dj
+    tu = q_theta[iq]
     ku = np.stack([np.sin(tu), np.zeros_like(tu), np.cos(tu)])
     ph = dj * step + dphi_o[aj]
+    wq = q_w[iq]
     rest = np.arange(half, npf)
     spec = np.empty((half, nt * 4, nt * 4), dtype=np.complex64)
     for io in range(nt):
         th = theta_o[io, ai]
         wo = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)])
         M = transmission_mueller(ku, wo, n_below, n_above, abcs_t, d_of, g1_of)
-        rows = M.reshape(16, -1) * w[io, ai, aj]
+        rows = M.reshape(16, -1) * (w[io, ai, aj] * wq)
         T = np.empty((16, nt * half))
         for e in range(16):
             T[e] = np.bincount(flat, weights=rows[e], minlength=nt * half)
@@ -187,6 +196,34 @@ def build_exit_operator(
         sp = np.fft.rfft(full, axis=-1)  # (i, k, u, F)
         spec[:, io * 4 : io * 4 + 4, :] = sp.transpose(3, 0, 2, 1).reshape(half, 4, nt * 4)
     return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
+
+
+def cell_rule(grid: Grid, n_below: float, alpha: float, n_above: float = 1.0) -> tuple[int, int]:
+    """Rows of internal cells averaged over polar sub-cell nodes, and nodes per cell.
+
+    Where a cell is wide against the exit lobe, treating all its rays as if they left
+    from its centroid is wrong near the pole: the first cell is a cap around the pole
+    whose centroid is off it, and the output bins there see every internal cell of the
+    first rows from close by (``docs/tracer.md``). There every cell is averaged over
+    ``n`` polar nodes (:func:`.evaluate.cell_nodes`), ``n = ceil(CELL_NODES_PER_LOBE x``
+    the cell's polar width as seen in the air, ``n_below / n_above x step``, over the
+    lobe width :func:`.exit_sampled.lobe_width_rad`), at most :data:`CELL_MAX_NODES`.
+    All rows are averaged, not only those near the pole: a seam between averaged and
+    centroid cells biased the output rows it feeds (docs/tracer.md). Where ``n = 1`` (for
+    ``n_below = 1.5``: 1-degree cells at ``alpha >= 0.14``, 3-degree cells at ``alpha >=
+    0.4``) the operator is the centroid rule's, bit for bit.
+
+    Returns
+    -------
+    (rows, n) : (int, int)
+        Rows averaged (0 or all) and nodes per cell.
+    """
+    image = np.radians(grid.theta_step_deg) * n_below / n_above
+    ratio = image / lobe_width_rad(n_below, n_above, alpha)
+    n = int(min(CELL_MAX_NODES, np.ceil(CELL_NODES_PER_LOBE * ratio - 1e-9)))
+    if n <= 1:
+        return 0, 1
+    return grid.n_theta, n
 
 
 @contextmanager
@@ -217,6 +254,7 @@ def _key(grid: Grid, n_below: float, alpha: float, n_above: float, nodes: tuple)
         "alpha": float(alpha),
         "nodes": [int(v) for v in nodes],
         "distribution": "ggx",
+        "cell_rule": list(cell_rule(grid, n_below, alpha, n_above)),
     }
     return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
 
