@@ -26,7 +26,7 @@ def _film_model(args: argparse.Namespace) -> Any:
     if args.model is not None:
         if args.layer or args.substrate:
             raise UsageError("give --model FILE or --substrate/--layer, not both")
-        return films.load_model(args.model)
+        return films.load_model(args.model, tabulated_from_file)
     if not args.layer:
         if args.substrate not in (None, "si"):
             raise UsageError("--substrate without --layer: give the layers with --layer")
