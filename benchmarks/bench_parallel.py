@@ -112,7 +112,7 @@ _WORKER_PEAK_MB: list[float] = []
 
 def note_dask_workers() -> None:
     """Record the peak RSS of the running LocalCluster's workers (before it is replaced)."""
-    client = parallel._LOCAL.get("client")
+    client = parallel.cluster._LOCAL.get("client")
     if client is not None:
         _WORKER_PEAK_MB.extend(client.run(peak_rss_mb).values())
 

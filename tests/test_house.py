@@ -312,11 +312,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
 #: the package's face (lazy names of every layer) and the fixtures' generator script
 ABOVE_ALL = ("labbrdf", "labbrdf.data.fixtures.make_fixtures")
 #: imports that still run up a layer, each with why; this list may only shrink
-UPWARD_BASELINE = {
-    # a film material named by a file reads it as the file says: an n,k table, or an
-    # ellipsometer export through the readers and the psi/Delta inversion tables
-    ("labbrdf.films.materials", "labbrdf.nk.reading"),
-}
+UPWARD_BASELINE: set[tuple[str, str]] = set()
 
 
 def layer_of(module: str) -> int | None:

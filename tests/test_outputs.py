@@ -198,7 +198,7 @@ def test_os_error_at_rename_is_an_output_error_naming_the_path(tmp_path, monkeyp
     def boom(*a, **k):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(outputs.os, "replace", boom)
+    monkeypatch.setattr(outputs.files.os, "replace", boom)
     with pytest.raises(OutputError, match=r"a\.csv: No space left on device; the disk is full"):
         with atomic_output(tmp_path / "a.csv") as tmp:
             Path(tmp).write_text("x")
@@ -283,7 +283,7 @@ def test_without_hard_links_an_existing_file_is_still_refused(tmp_path, monkeypa
     def no_link(*a, **k):
         raise OSError(code, os.strerror(code))
 
-    monkeypatch.setattr(outputs.os, "link", no_link)
+    monkeypatch.setattr(outputs.files.os, "link", no_link)
     with write_policy(overwrite=False):
         with atomic_output(tmp_path / "new.csv") as tmp:
             Path(tmp).write_text("new")
@@ -298,7 +298,7 @@ def test_an_os_error_of_the_hard_link_names_the_output(tmp_path, monkeypatch):
     def broken(*a, **k):
         raise OSError(errno.EIO, os.strerror(errno.EIO))
 
-    monkeypatch.setattr(outputs.os, "link", broken)
+    monkeypatch.setattr(outputs.files.os, "link", broken)
     with write_policy(overwrite=False):
         with pytest.raises(OutputError, match=r"cannot write .*new\.csv: Input/output error"):
             with atomic_output(tmp_path / "new.csv") as tmp:
@@ -376,8 +376,9 @@ def test_leftovers_of_a_killed_run_are_cleaned_by_the_next_run(tmp_path):
     assert len(left) == 2 and all("labbrdf-" in n for n in left), left
     # look-alikes that are not ours: no marker, foreign host, a live process, other names
     (tmp_path / ".rep.labbrdf-new-ffffff-1-abc").mkdir()
-    (tmp_path / f".rep.labbrdf-new-{outputs._host_tag()}-999999999-abc").mkdir()
-    (tmp_path / f".a.csv.labbrdf-tmp-{outputs._host_tag()}-{os.getpid()}-xyz.tmp").write_text("")
+    host = outputs.files._host_tag()
+    (tmp_path / f".rep.labbrdf-new-{host}-999999999-abc").mkdir()
+    (tmp_path / f".a.csv.labbrdf-tmp-{host}-{os.getpid()}-xyz.tmp").write_text("")
     (tmp_path / ".a.csv.mine.tmp").write_text("")
     foreign = sorted(p.name for p in tmp_path.iterdir() if p.name not in left)
     with atomic_output(tmp_path / "a.csv") as tmp:
@@ -391,14 +392,14 @@ def test_report_moved_aside_by_a_killed_run_is_put_back(tmp_path):
     replace_dir(tmp_path / "rep", _report)
     _killed_writer(
         """
-        real = outputs.os.replace
+        real = outputs.files.os.replace
         calls = []
         def replace(a, b):
             real(a, b)
             calls.append(1)
             if len(calls) == 1:  # the old report is aside, the new one not yet in place
                 die()
-        outputs.os.replace = replace
+        outputs.files.os.replace = replace
         outputs.replace_dir(tmp_path / "rep", lambda d: (d / "index.html").write_text("2"))
         """,
         tmp_path,

@@ -374,7 +374,7 @@ def test_batch_fit_on_two_worker_local_cluster_equals_serial_bit_for_bit(
     table = fit_many(frame, "smooth3", scheduler="local", workers=2, chunks=5, progress=False)
     assert serial_table["success"].all() and len(serial_table) == 12
     assert_same_table(serial_table, table)
-    info = parallel._LOCAL["client"].scheduler_info()
+    info = parallel.cluster._LOCAL["client"].scheduler_info()
     assert len(info["workers"]) == 2  # --workers really gave two worker processes
 
 
@@ -504,7 +504,7 @@ def test_failed_dask_run_leaves_no_tasks_running_on_the_reused_cluster(dask_ok):
         parallel.run(sleepy_fail, range(40), scheduler="local", workers=2)
     # excinfo keeps the generator's frame (and its futures) alive, as a caller's error
     # handler would: only an explicit cancel stops the ~14 submitted tasks (3 s of work)
-    client = parallel._LOCAL["client"]
+    client = parallel.cluster._LOCAL["client"]
     deadline = time.monotonic() + 1.0
     while client.run_on_scheduler(scheduler_tasks) and time.monotonic() < deadline:
         time.sleep(0.05)
@@ -540,7 +540,7 @@ class LateFuture(Future):
 
 def test_progress_counts_a_task_that_finishes_while_results_are_collected():
     bar = parallel.Progress(5, enabled=False)
-    out = list(parallel._ordered(LateFuture, 5, 2, bar, lambda f: f.result()))
+    out = list(parallel.executor._ordered(LateFuture, 5, 2, bar, lambda f: f.result()))
     assert out == [0, 1, 2, 3, 4]
     assert bar.done == 5  # every task counted exactly once
 
@@ -592,7 +592,7 @@ def test_cli_local_cluster_that_does_not_start_is_one_message(
 
     parallel.shutdown()
     monkeypatch.setattr(_ClusterThatFails, "error", error)
-    monkeypatch.setattr(parallel, "_import_dask", lambda: (Client, _ClusterThatFails))
+    monkeypatch.setattr(parallel.cluster, "_import_dask", lambda: (Client, _ClusterThatFails))
     assert main([*trace_sample, "--rays", "1000", "--scheduler", "local"]) == code
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err
@@ -655,14 +655,14 @@ class Spy:
 @pytest.fixture
 def spy(monkeypatch) -> Spy:
     s = Spy()
-    monkeypatch.setattr(parallel, "imap", s.imap)
-    real_pool = parallel.ProcessPoolExecutor
+    monkeypatch.setattr(parallel.executor, "imap", s.imap)
+    real_pool = parallel.executor.ProcessPoolExecutor
 
     def pool(max_workers: int) -> Any:
         s.pools.append(max_workers)
         return real_pool(max_workers=max_workers)
 
-    monkeypatch.setattr(parallel, "ProcessPoolExecutor", pool)
+    monkeypatch.setattr(parallel.executor, "ProcessPoolExecutor", pool)
     return s
 
 
@@ -834,7 +834,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 @pytest.fixture
 def reset_parallel_options() -> Any:
-    options = getattr(parallel, "_OPTIONS", {})
+    options = parallel.options._OPTIONS
     saved = dict(options)
     yield
     parallel.shutdown()
@@ -864,7 +864,7 @@ LISTEN = textwrap.dedent(
 
     def main():
         assert parallel.run(abs, [-1, 2], scheduler="local", workers=2) == [1, 2]
-        client = parallel._LOCAL["client"]
+        client = parallel.cluster._LOCAL["client"]
         deaf = parallel.run(blocked, [0, 1], scheduler="local", workers=2)
         if os.environ.get("RESTART_A_WORKER"):  # a worker restarted by its nanny
             client.restart_workers([sorted(client.scheduler_info()["workers"])[0]])
@@ -1035,7 +1035,7 @@ def test_tls_from_the_dask_config_and_a_local_cluster_on_tls(certs, serial):
     }
     with dask.config.set(cfg):
         table = fit_many(frame, "smooth3", scheduler="local", workers=2, chunks=3, progress=False)
-        info = parallel._LOCAL["client"].scheduler_info()
+        info = parallel.cluster._LOCAL["client"].scheduler_info()
         assert info["address"].startswith("tls://127.0.0.1:")
         assert all(w.startswith("tls://127.0.0.1:") for w in info["workers"])
     assert_same_table(table0, table)
@@ -1061,7 +1061,7 @@ def test_tcp_to_another_host_warns_that_it_is_unauthenticated(monkeypatch, capsy
         def __init__(self, *a: Any, **k: Any) -> None:
             raise OSError("connection refused")
 
-    monkeypatch.setattr(parallel, "_import_dask", lambda: (Refused, None))
+    monkeypatch.setattr(parallel.cluster, "_import_dask", lambda: (Refused, None))
     with pytest.raises(parallel.ParallelError, match="cannot reach"):
         parallel.run(abs, [1], scheduler="tcp://192.0.2.7:8786")
     err = capsys.readouterr().err
@@ -1101,10 +1101,10 @@ def test_local_cluster_is_tls_and_refuses_clients_without_its_credentials():
     from distributed.security import Security
 
     assert parallel.run(abs, [-1, 2], scheduler="local", workers=1) == [1, 2]
-    cluster = parallel._LOCAL["cluster"]
+    cluster = parallel.cluster._LOCAL["cluster"]
     addr = cluster.scheduler_address
     assert addr.startswith("tls://127.0.0.1:"), addr
-    info = parallel._LOCAL["client"].scheduler_info()
+    info = parallel.cluster._LOCAL["client"].scheduler_info()
     assert info["workers"] and all(w.startswith("tls://127.0.0.1:") for w in info["workers"])
     own = cluster.security
     # the cluster's own credentials are answered (so the refusals below are about them)
@@ -1133,7 +1133,7 @@ def test_local_cluster_without_cryptography_says_how_to_install_it(monkeypatch):
     monkeypatch.setattr(Security, "temporary", classmethod(no_cryptography))
     with pytest.raises(ImportError, match=r"cryptography.*pip install cryptography"):
         parallel.run(abs, [1], scheduler="local", workers=1)
-    assert "client" not in parallel._LOCAL
+    assert "client" not in parallel.cluster._LOCAL
     # checked up front too (the CLI and validate call check_scheduler before any work)
     monkeypatch.setitem(sys.modules, "cryptography", None)
     with pytest.raises(ImportError, match=r"pip install cryptography"):
@@ -1192,7 +1192,7 @@ def test_cli_scheduler_without_workers_exits_2_with_the_address(
 
 def test_default_worker_timeout_is_a_minute():
     assert parallel.DEFAULT_WORKER_TIMEOUT == 60.0
-    assert parallel._OPTIONS.get("worker_timeout") is None  # the default applies
+    assert parallel.options._OPTIONS.get("worker_timeout") is None  # the default applies
 
 
 @pytest.mark.parametrize("bad", ["0", "-1", "nan", "inf"])

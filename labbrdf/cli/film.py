@@ -36,7 +36,7 @@ def _film_model(args: argparse.Namespace) -> Any:
                 f"{given[0]} with --model: give it in the model file (thickness_spread, "
                 "bandwidth_nm, angle_spread_deg, [substrate] thickness_nm)"
             )
-        return films.load_model(args.model)
+        return films.load_model(args.model, tabulated_from_file)
     try:
         beam, beam_free = films.layers.parse_stack_values(written)
     except films.FilmError as exc:

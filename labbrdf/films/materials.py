@@ -4,13 +4,18 @@
 a number, a name, a dict) into one; :class:`Roughness` is the Bruggeman effective medium of
 the material below and the ambient, :class:`~labbrdf.films.ema.Ema` that of two or three
 named constituents (``"ema(@film, void)"``).
+
+A material named by a file (``{"model": "tabulated", "file": PATH}``) is read by the
+caller's :data:`TableReader` (e.g. :func:`labbrdf.nk.tabulated_from_file`, which reads
+ellipsometer exports through the instrument readers, a layer above the films): the films
+never open such a file themselves.
 """
 
 from __future__ import annotations
 
 import os
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -56,20 +61,24 @@ class Roughness:
 
 Material = disp.Dispersion | Roughness | Ema | Graded
 
+#: reads a material's table or ellipsometer file into its ``n, k``; supplied by whoever
+#: builds a stack from a model file or a fit JSON (:func:`labbrdf.nk.tabulated_from_file`)
+TableReader = Callable[[str | os.PathLike[str]], disp.Tabulated]
+
 _EMA_NAME = re.compile(r"^ema\((.*)\)$")
 
 
-def _constituent(c: Any) -> disp.Dispersion | str:
+def _constituent(c: Any, read_table: TableReader | None) -> disp.Dispersion | str:
     """An EMA constituent: ``void`` and ``@NAME`` stay strings, the rest a dispersion."""
     if isinstance(c, str) and (c.strip().lower() == VOID or c.strip().startswith("@")):
         return c.strip()
-    m = as_material(c)
+    m = as_material(c, read_table)
     if not isinstance(m, disp.Dispersion):
         raise FilmError(f"ema: constituent {c!r} is {m.name}; expected a material")
     return m
 
 
-def _ema(m: Mapping[str, Any]) -> Ema:
+def _ema(m: Mapping[str, Any], read_table: TableReader | None = None) -> Ema:
     comps = m.get("components")
     if not isinstance(comps, (list, tuple)):
         raise FilmError("ema: expected components = [2 or 3 constituents]")
@@ -80,14 +89,30 @@ def _ema(m: Mapping[str, Any]) -> Ema:
     for k, v in fr.items():
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             raise FilmError(f"ema: {k} must be a number, got {v!r}")
-    return Ema(tuple(_constituent(c) for c in comps), **{k: float(v) for k, v in fr.items()})
+    return Ema(
+        tuple(_constituent(c, read_table) for c in comps), **{k: float(v) for k, v in fr.items()}
+    )
 
 
-def as_material(m: Any) -> Material:
+def as_material(m: Any, read_table: TableReader | None = None) -> Material:
     """A material from a Dispersion, a number, a table name, a model name or a dict.
 
     Numbers are constant indices; names are reference tables (``"si"``, ``"sio2"``) or
     registry names (default parameters).
+
+    Parameters
+    ----------
+    m : Dispersion, Roughness, Ema, Graded, number, str or mapping
+        The material as written (a mapping is a ``to_dict`` form).
+    read_table : callable, optional
+        Reads a ``{"model": "tabulated", "file": PATH}`` material (and such a constituent
+        of a mixture or base of a graded material), e.g.
+        :func:`labbrdf.nk.tabulated_from_file`. Without it such a material is refused.
+
+    Raises
+    ------
+    FilmError
+        An unknown name or form, or a file material without ``read_table``.
     """
     if isinstance(m, (disp.Dispersion, Roughness, Ema, Graded)):
         return m
@@ -117,22 +142,22 @@ def as_material(m: Any) -> Material:
         if model == "roughness":
             return Roughness(float(m.get("fraction", 0.5)))
         if model == "ema":
-            return _ema(m)
+            return _ema(m, read_table)
         if model == "graded":
-            return _graded(m)
+            return _graded(m, read_table)
         if model == "tabulated" and "file" in m:
-            return _table_file(str(m["file"]))
+            return _table_file(str(m["file"]), read_table)
         return disp.from_dict(m)
     raise FilmError(f"material: expected a dispersion model, a number or a name, got {m!r}")
 
 
-def _graded(m: Mapping[str, Any]) -> Graded:
+def _graded(m: Mapping[str, Any], read_table: TableReader | None) -> Graded:
     bad = sorted(set(m) - {"model", "base", "parameter", "top", "bottom", "shape", "sublayers"})
     if bad or not {"base", "parameter", "top", "bottom"} <= set(m):
         raise FilmError(
             f"graded: expected base, parameter, top, bottom (shape, sublayers); got {sorted(m)}"
         )
-    base = as_material(m["base"])
+    base = as_material(m["base"], read_table)
     try:
         return Graded(
             base,
@@ -146,11 +171,14 @@ def _graded(m: Mapping[str, Any]) -> Graded:
         raise FilmError(f"graded: {exc}") from None
 
 
-def _table_file(path: str | os.PathLike[str]) -> disp.Tabulated:
-    """A table or ellipsometer file's ``n, k`` (:func:`labbrdf.nk.tabulated_from_file`)."""
-    from ..nk.reading import tabulated_from_file  # the dataset layer: pandas and the adapters
-
-    return tabulated_from_file(path)
+def _table_file(path: str | os.PathLike[str], read_table: TableReader | None) -> disp.Tabulated:
+    """A table or ellipsometer file's ``n, k``, read by the caller's ``read_table``."""
+    if read_table is None:
+        raise FilmError(
+            f"material file {os.fspath(path)!r}: no table reader was given; pass "
+            "read_table=labbrdf.nk.tabulated_from_file to read n,k tables and ellipsometer files"
+        )
+    return read_table(path)
 
 
 def _with_params(m: Material, values: Mapping[str, float]) -> Material:

@@ -28,7 +28,14 @@ from .limits import (
     FilmError,
     check_wavelength_range,
 )
-from .materials import Material, Roughness, _table_file, _with_params, as_material
+from .materials import (
+    Material,
+    Roughness,
+    TableReader,
+    _table_file,
+    _with_params,
+    as_material,
+)
 from .model import FilmModel
 from .modelsamples import ModelSamples, parse_samples, sample_files
 from .nonuniform import MAX_SPREAD
@@ -146,7 +153,9 @@ def _named_file(value: str, base: Path) -> Path:
     return p if p.is_absolute() else base / p
 
 
-def _material_of(tbl: Mapping[str, Any], base: Path, at: Any) -> Material:
+def _material_of(
+    tbl: Mapping[str, Any], base: Path, at: Any, read_table: TableReader | None
+) -> Material:
     """The material a [substrate] or [[layer]] table names (before its parameters)."""
     kinds = [k for k in ("material", "model", "file", "reference") if k in tbl]
     if len(kinds) != 1:
@@ -162,9 +171,9 @@ def _material_of(tbl: Mapping[str, Any], base: Path, at: Any) -> Material:
         raise FilmError(f'{at("components")}: components belong to material = "ema"')
     try:
         if kind == "file":
-            return _table_file(_named_file(val, base))
+            return _table_file(_named_file(val, base), read_table)
         if val.strip().lower() == "ema":
-            return _ema_of(tbl.get("components"), base)
+            return _ema_of(tbl.get("components"), base, read_table)
         return as_material(val)
     except (FilmError, disp.DispersionError) as exc:
         raise FilmError(
@@ -192,14 +201,14 @@ def _graded_of(m: Material, tbl: Mapping[str, Any], at: Any) -> Material:
         raise FilmError(f"{at(key)}: {exc}") from None
 
 
-def _ema_of(components: Any, base: Path) -> Material:
+def _ema_of(components: Any, base: Path, read_table: TableReader | None) -> Material:
     """``material = "ema"``, ``components = [...]``: names, @LAYER, void, {model...}, {file}."""
     if not isinstance(components, list):
         raise FilmError('material = "ema" needs components = [2 or 3 constituents]')
     comps: list[Any] = []
     for c in components:
         if isinstance(c, dict) and set(c) == {"file"} and isinstance(c["file"], str):
-            comps.append(_table_file(_named_file(c["file"], base)))
+            comps.append(_table_file(_named_file(c["file"], base), read_table))
         elif isinstance(c, (str, dict)):
             comps.append(c)
         else:
@@ -211,14 +220,19 @@ def _ema_of(components: Any, base: Path) -> Material:
 
 
 def _material_from_table(
-    tbl: Mapping[str, Any], where: str, base: Path, lines: _KeyLines, table: str, index: int | None
+    tbl: Mapping[str, Any],
+    where: str,
+    base: Path,
+    lines: _KeyLines,
+    at_table: tuple[str, int | None],
+    read_table: TableReader | None,
 ) -> tuple[Material, dict[str, float], dict[str, tuple[float, float]]]:
     """(material, parameter values, free boxes) of a [substrate] or [[layer]] table."""
 
     def at(key: str | None) -> str:
-        return f"{where}, line {lines(table, index, key)}"
+        return f"{where}, line {lines(*at_table, key)}"
 
-    m = _material_of(tbl, base, at)
+    m = _material_of(tbl, base, at, read_table)
     if "graded" in tbl or "sublayers" in tbl:
         m = _graded_of(m, tbl, at)
     values: dict[str, float] = {}
@@ -314,7 +328,12 @@ def _ambient_and_range(
 
 
 def _layer_of(
-    tbl: Mapping[str, Any], j: int, where: str, base: Path, lines: _KeyLines
+    tbl: Mapping[str, Any],
+    j: int,
+    where: str,
+    base: Path,
+    lines: _KeyLines,
+    read_table: TableReader | None,
 ) -> tuple[Layer, dict[str, tuple[float, float]]]:
     """The ``j``-th [[layer]] table and its free boxes (``"<layer>.<name>"``)."""
     name = tbl.get("name", f"layer{j + 1}")
@@ -322,7 +341,7 @@ def _layer_of(
         raise FilmError(f"{where}, line {lines('layer', j, 'name')}: name must be a string")
     if "thickness_nm" not in tbl:
         raise FilmError(f"{where}, line {lines('layer', j)}: layer {name!r} has no thickness_nm")
-    m, values, mfree = _material_from_table(tbl, where, base, lines, "layer", j)
+    m, values, mfree = _material_from_table(tbl, where, base, lines, ("layer", j), read_table)
     at = f"{where}, line {lines('layer', j, 'thickness_nm')}: thickness_nm"
     d, dbox = _spec(tbl["thickness_nm"], at)
     if d < 0 or (dbox is not None and dbox[0] < 0):
@@ -368,7 +387,7 @@ def _substrate_thickness(
     return d, box
 
 
-def load_model(path: str | os.PathLike[str]) -> FilmModel:
+def load_model(path: str | os.PathLike[str], read_table: TableReader | None = None) -> FilmModel:
     """Read a film model file (TOML).
 
     Format::
@@ -406,6 +425,14 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
     :data:`MAX_MODEL_BYTES` and names at most :data:`MAX_LAYERS` layers, each at most
     :data:`MAX_THICKNESS_NM` thick; every number is finite.
 
+    Parameters
+    ----------
+    path : path-like
+        The model file.
+    read_table : callable, optional
+        Reads a ``file = ...`` material (:data:`labbrdf.films.materials.TableReader`, e.g.
+        :func:`labbrdf.nk.tabulated_from_file`); without it a model naming a file is refused.
+
     Raises
     ------
     FilmError
@@ -418,7 +445,7 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
     _check_top(doc, where, text, lines)
     ambient, wl_range = _ambient_and_range(doc, where, lines)
     sub, _, sub_free = _material_from_table(
-        doc["substrate"], where, p.parent, lines, "substrate", None
+        doc["substrate"], where, p.parent, lines, ("substrate", None), read_table
     )
     if isinstance(sub, Roughness):
         raise FilmError(f"{where}, line {lines('substrate')}: roughness is a layer")
@@ -429,7 +456,7 @@ def load_model(path: str | os.PathLike[str]) -> FilmModel:
         free["substrate.thickness_nm"] = sub_box
     seen: set[str] = set()
     for j, tbl in enumerate(doc.get("layer", [])):
-        layer, layer_free = _layer_of(tbl, j, where, p.parent, lines)
+        layer, layer_free = _layer_of(tbl, j, where, p.parent, lines, read_table)
         if layer.name and (layer.name in seen or layer.name in ("substrate", "ambient", "stack")):
             raise FilmError(
                 f"{where}, line {lines('layer', j, 'name')}: layer name {layer.name!r} is "

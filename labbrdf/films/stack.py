@@ -33,7 +33,7 @@ from .fitjson import _check_indices, _fit_doc, _tabulated
 from .graded import Graded
 from .layers import Layer
 from .limits import MAX_LAYERS, MAX_THICKNESS_NM, FilmError, check_wavelength_range
-from .materials import Roughness, _with_params, as_material
+from .materials import Roughness, TableReader, _with_params, as_material
 
 __all__ = ["Stack", "read_fit_json"]
 
@@ -390,19 +390,24 @@ class Stack:
         return out
 
     @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> Stack:
-        """A stack from :meth:`to_dict`'s form."""
+    def from_dict(cls, d: Mapping[str, Any], read_table: TableReader | None = None) -> Stack:
+        """A stack from :meth:`to_dict`'s form.
+
+        ``read_table`` reads a material named by a file (:func:`as_material`, e.g.
+        :func:`labbrdf.nk.tabulated_from_file`); without it such a stack is refused.
+        """
         try:
             layers = [
                 Layer(
-                    as_material(x["material"]),
+                    as_material(x["material"], read_table),
                     float(x["thickness_nm"]),
                     str(x.get("name", "")),
                     bool(x.get("coherent", True)),
                 )
                 for x in d.get("layers", [])
             ]
-            sub, amb = as_material(d["substrate"]), as_material(d.get("ambient", 1.0))
+            sub = as_material(d["substrate"], read_table)
+            amb = as_material(d.get("ambient", 1.0), read_table)
             beam = {
                 k: d[k] for k in ("thickness_spread", "bandwidth_nm", "angle_spread_deg") if k in d
             }
@@ -411,9 +416,11 @@ class Stack:
             raise FilmError(f"stack: missing key {exc}") from None
 
     @classmethod
-    def from_fit_json(cls, path: str | os.PathLike[str]) -> Stack:
+    def from_fit_json(
+        cls, path: str | os.PathLike[str], read_table: TableReader | None = None
+    ) -> Stack:
         """The best-fit stack of a :meth:`FilmFit.save_json` file (:func:`read_fit_json`)."""
-        return read_fit_json(path)[0]
+        return read_fit_json(path, read_table)[0]
 
     def __repr__(self) -> str:
         inner = ", ".join(
@@ -503,7 +510,9 @@ def _substrate_thickness(d: Any) -> float | None:
     return v
 
 
-def read_fit_json(path: str | os.PathLike[str]) -> tuple[Stack, tuple[float, float]]:
+def read_fit_json(
+    path: str | os.PathLike[str], read_table: TableReader | None = None
+) -> tuple[Stack, tuple[float, float]]:
     """The best-fit stack and the fitted wavelength range of a film fit JSON.
 
     The file (:meth:`labbrdf.FilmFit.save_json`, ``labbrdf film --fit-json``) is checked
@@ -521,6 +530,9 @@ def read_fit_json(path: str | os.PathLike[str]) -> tuple[Stack, tuple[float, flo
     ----------
     path : path-like
         The fit JSON.
+    read_table : callable, optional
+        Reads a material named by a file (:func:`labbrdf.nk.tabulated_from_file`); without
+        it a stack naming a file is refused.
 
     Returns
     -------
@@ -535,7 +547,7 @@ def read_fit_json(path: str | os.PathLike[str]) -> tuple[Stack, tuple[float, flo
     """
     p, doc = _fit_doc(path)
     try:
-        stack = Stack.from_dict(doc["stack"])
+        stack = Stack.from_dict(doc["stack"], read_table)
     except (FilmError, disp.DispersionError) as exc:
         raise FilmError(f"{p}: stack: {exc}") from None
     try:

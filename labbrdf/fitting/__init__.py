@@ -18,13 +18,17 @@ pandas and nlopt; the physics layer never imports this module.
 
 Modules: :mod:`~labbrdf.fitting.data` (FitData, row selection),
 :mod:`~labbrdf.fitting.objective` (Objective, profiling, starting points),
-:mod:`~labbrdf.fitting.core` (nlopt stages, :func:`fit`),
+:mod:`~labbrdf.fitting.core` (:func:`fit`: set-up, search, result),
+:mod:`~labbrdf.fitting.stages` (the nlopt stages and the polish),
+:mod:`~labbrdf.fitting.parameters` (checked parameters and start),
+:mod:`~labbrdf.fitting.energy` (rho <= 1), :mod:`~labbrdf.fitting.profiles` (profile
+intervals),
 :mod:`~labbrdf.fitting.uncertainty` (covariance and flags), :mod:`~labbrdf.fitting.result`
 (FitResult), :mod:`~labbrdf.fitting.batch` (:func:`fit_many`).
 
 Internal API: names without an underscore that the modules share but this package does not
 re-export (``data.as_fit_data``, ``data.clean_fit_data``, ``data.select_rows``,
-``data.several_groups_message``, ``FitData.from_arrays``, ``core.setup_params``,
+``data.several_groups_message``, ``FitData.from_arrays``, ``parameters.setup_params``,
 ``uncertainty.jacobian``, ``uncertainty.uncertainties``); each module lists its functions
 among them in its own ``__all__``. They may change without notice.
 
@@ -43,11 +47,11 @@ _LAZY: dict[str, str] = {
     "fit_many": "batch",
     "fit_many_nk": "batch",
     "fit_records": "batch",
-    "ALGORITHMS": "core",
-    "CONSTRAINED": "core",
+    "ALGORITHMS": "stages",
+    "CONSTRAINED": "stages",
     "fit": "core",
     "fit_replicates": "core",
-    "parse_method": "core",
+    "parse_method": "stages",
     "METHOD": "defaults",
     "FITTABLE_QUANTITIES": "data",
     "FitData": "data",
@@ -64,12 +68,13 @@ _LAZY: dict[str, str] = {
 
 if TYPE_CHECKING:
     from .batch import auto_weighting, fit_many, fit_many_nk, fit_records
-    from .core import ALGORITHMS, CONSTRAINED, fit, fit_replicates, parse_method
+    from .core import fit, fit_replicates
     from .data import FITTABLE_QUANTITIES, FitData, FitError
     from .defaults import METHOD
     from .objective import Objective
     from .replicates import combine_replicates
     from .result import FitResult
+    from .stages import ALGORITHMS, CONSTRAINED, parse_method
     from .uncertainty import AT_BOUND_FRAC, COND_MAX, CORREL_MAX, REL_STDERR_MAX, REL_STDERR_POOR
 
 __all__ = [

@@ -18,10 +18,12 @@ from .. import parallel  # imports only labbrdf.errors: usable from every layer
 from ..dataset import Measurement
 from ..models import Model
 from ..models import get as get_model
-from .core import METHOD, check_seed, fit, parse_method, setup_params
+from .core import METHOD, fit
 from .data import FitData, FitError, select_rows, several_groups_message
+from .parameters import check_seed, setup_params
 from .replicates import check_replicates
 from .result import FitResult
+from .stages import parse_method
 
 __all__ = ["auto_weighting", "fit_many", "fit_many_nk", "fit_records", "group_keys"]
 

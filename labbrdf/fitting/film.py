@@ -30,6 +30,7 @@ from ..films import incoherent as inc
 from ..jsonsafe import jsonable
 from ..models import Model, Parameters
 from ..nk import dispersion as disp
+from ..nk.reading import tabulated_from_file
 from ..samples import SampleFile, stated_names
 from .core import METHOD, fit
 from .data import FitData, FitError
@@ -731,7 +732,7 @@ def fit_film(
     elif isinstance(stack_or_model, FilmModel):
         fm = stack_or_model
     elif isinstance(stack_or_model, (str, os.PathLike)):
-        fm = load_model(stack_or_model)
+        fm = load_model(stack_or_model, tabulated_from_file)
     else:
         raise FilmError(
             f"expected a Stack, a FilmModel or a model file, got {type(stack_or_model).__name__}"

@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 
 from ..films import NK_REPORT_NM, FilmError, FilmModel, Stack, load_model
+from ..nk.reading import tabulated_from_file
 from .core import METHOD
 
 __all__ = ["FilmMap", "MapPoint", "fit_film_map", "read_map_listing"]
@@ -268,7 +269,7 @@ def fit_film_map(
     elif isinstance(stack_or_model, FilmModel):
         fm = stack_or_model
     else:
-        fm = load_model(stack_or_model)
+        fm = load_model(stack_or_model, tabulated_from_file)
     if isinstance(points, (str, os.PathLike)):
         pts = read_map_listing(points)
     else:

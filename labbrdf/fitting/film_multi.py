@@ -26,6 +26,7 @@ from scipy import special
 from ..films import FilmError, FilmModel, Stack, load_model, load_samples
 from ..jsonsafe import jsonable
 from ..models import Model, Parameters
+from ..nk.reading import tabulated_from_file
 from .core import METHOD, fit
 from .data import FitData, FitError
 from .film import FilmFit, _check_coverage, _film_rows, _FilmFitModel, woollam_mse
@@ -260,7 +261,7 @@ def _as_model(stack_or_model: Any) -> FilmModel:
     if isinstance(stack_or_model, FilmModel):
         return stack_or_model
     if isinstance(stack_or_model, (str, os.PathLike)):
-        return load_model(stack_or_model)
+        return load_model(stack_or_model, tabulated_from_file)
     raise FilmError(
         f"expected a Stack, a FilmModel or a model file, got {type(stack_or_model).__name__}"
     )

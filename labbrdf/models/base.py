@@ -372,7 +372,7 @@ class Model(ABC):
         """``value`` for the parameter ``name``, checked against its declared bounds.
 
         Every value a caller fixes or starts a parameter at goes through this check (the
-        fitting core's :func:`~labbrdf.fitting.core.setup_params`), so a value the model
+        fitting core's :func:`~labbrdf.fitting.parameters.setup_params`), so a value the model
         was not made for never reaches its formula.
 
         Parameters

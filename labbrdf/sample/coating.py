@@ -20,6 +20,7 @@ from ..errors import SampleError
 from ..films.graded import Graded
 from ..films.materials import Roughness
 from ..films.stack import read_fit_json
+from ..nk.reading import tabulated_from_file
 from ..roughness.topography import SlopeFit
 from ..tracer.config import Coating
 
@@ -57,7 +58,7 @@ def coating_from_fit(path: str | os.PathLike[str], wavelength_nm: float) -> tupl
         wavelength lies outside the fitted range (a dispersion model is not extrapolated
         beyond the data that fixed it).
     """
-    stack, fitted = read_fit_json(path)
+    stack, fitted = read_fit_json(path, tabulated_from_file)
     layer_n, thickness, _ = coating_of_stack(
         stack,
         wavelength_nm,

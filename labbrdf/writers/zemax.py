@@ -22,6 +22,7 @@ from ..adapters.zemax_bsdf import HEADER_LISTS, SCATTER_TYPES, SPECTRAL, WAVELEN
 from ..bsdf_geometry import SYMMETRIES, scatter_to_angles
 from ..dataset import atomic_output
 from ..integrate import grid_integral
+from ..outputs import check_file_output
 
 __all__ = ["angle_grid", "binned_to_bsdf", "model_to_bsdf", "write_bsdf"]
 
@@ -184,16 +185,21 @@ def write_bsdf(
     digits : int
         Significant digits of each value (and TIS), 1..17.
     overwrite : bool
-        Replace an existing file.
+        Replace an existing file (never an input of the :func:`labbrdf.outputs.write_policy`
+        in force).
 
     Returns
     -------
     pathlib.Path
         The file written.
+
+    Raises
+    ------
+    labbrdf.outputs.OutputError
+        The output is refused (:func:`labbrdf.outputs.check_file_output`): an existing file
+        without ``overwrite``, an input, a folder, a non-regular file.
     """
-    target = Path(path)
-    if target.exists() and not overwrite:
-        raise FileExistsError(f"{target} exists; pass overwrite=True to replace it")
+    target = check_file_output(path, overwrite=overwrite)  # the one rule of every output
     _check_keywords(symmetry, scatter_type, digits)
     lists = _grid_lists(symmetry, rotation_deg, theta_i_deg, azimuth_deg, radial_deg)
     v = np.asarray(values, float)

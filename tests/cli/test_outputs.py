@@ -184,8 +184,8 @@ def _deny_writes(monkeypatch):
     def mkdtemp(*a, dir=None, **k):
         raise PermissionError(13, "Permission denied", str(dir))
 
-    monkeypatch.setattr(outputs.tempfile, "mkstemp", mkstemp)
-    monkeypatch.setattr(outputs.tempfile, "mkdtemp", mkdtemp)
+    monkeypatch.setattr(outputs.files.tempfile, "mkstemp", mkstemp)
+    monkeypatch.setattr(outputs.files.tempfile, "mkdtemp", mkdtemp)
 
 
 def test_unwritable_output_folder_is_a_message_and_exit_2(

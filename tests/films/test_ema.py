@@ -8,6 +8,7 @@ import pytest
 from labbrdf.films import FilmError, Layer, Roughness, Stack, as_material, load_model, named_inputs
 from labbrdf.films import matrices as stk
 from labbrdf.films.ema import Ema, bruggeman_mix
+from labbrdf.nk import tabulated_from_file
 from labbrdf.nk.dispersion import Cauchy, Constant
 
 EPS = [
@@ -159,7 +160,7 @@ def test_model_file_reads_mixtures_and_names_their_files(tmp_path):
     (tmp_path / "extra.csv").write_text("300,1.5,0.0\n1200,1.6,0.0\n")
     p = tmp_path / "m.toml"
     p.write_text(MODEL)
-    m = load_model(p)
+    m = load_model(p, tabulated_from_file)
     rough, _, iface = m.stack.layers
     assert isinstance(rough.material, Ema) and len(rough.material.components) == 3
     assert rough.material.fraction3 == 0.1 and iface.material.references == ["film", "substrate"]
@@ -188,5 +189,5 @@ def test_bad_mixtures_in_a_model_file_name_the_file(tmp_path, edit, match):
     p = tmp_path / "bad.toml"
     p.write_text(edit(MODEL))
     with pytest.raises(FilmError, match=match) as exc:
-        load_model(p)
+        load_model(p, tabulated_from_file)
     assert "bad.toml" in str(exc.value)

@@ -19,6 +19,7 @@ from labbrdf.films import (
     read_fit_json,
 )
 from labbrdf.films import matrices as stk
+from labbrdf.nk import tabulated_from_file
 from labbrdf.nk.dispersion import Cauchy, Sellmeier, Tabulated
 
 
@@ -157,7 +158,7 @@ def test_model_file_with_a_table_file_substrate_relative_to_the_model(tmp_path):
     p.write_text(
         '[substrate]\nfile = "metal.csv"\n\n[[layer]]\nmaterial = "sio2"\nthickness_nm = 10\n'
     )
-    fm = load_model(p)
+    fm = load_model(p, tabulated_from_file)
     assert fm.stack.substrate.nk(750.0) == pytest.approx(1.75 + 3.5j)
     assert fm.free == {}
 
@@ -255,7 +256,7 @@ def test_a_device_or_a_fifo_named_in_a_model_is_refused_at_once(tmp_path):
         p = tmp_path / "m.toml"
         p.write_text(f'[substrate]\nfile = "{name}"\n')
         with pytest.raises(FilmError, match=rf"m.toml, line 2: .*{kind}"):
-            load_model(p)
+            load_model(p, tabulated_from_file)
     with pytest.raises(FilmError, match="FIFO"):
         load_model(fifo)  # the model file itself
 
@@ -269,9 +270,9 @@ def test_named_inputs_are_the_files_the_loaders_open(tmp_path):
         '[[layer]]\nmaterial = "sio2"\nthickness_nm = 10\n'
     )
     assert named_inputs(p, "model") == [tmp_path / "metal.csv", tmp_path / "film.csv"]
-    st = load_model(p).stack
+    st = load_model(p, tabulated_from_file).stack
     doc = {"stack": st.to_dict(), "wavelength_range_nm": [400.0, 800.0]}
     fit = tmp_path / "fit.json"
     fit.write_text(json.dumps(doc))
     assert named_inputs(fit, "fit") == [tmp_path / "metal.csv", tmp_path / "film.csv"]
-    assert read_fit_json(fit)[0].to_dict() == st.to_dict()
+    assert read_fit_json(fit, tabulated_from_file)[0].to_dict() == st.to_dict()

@@ -18,9 +18,9 @@ import pandas as pd
 import pytest
 
 import labbrdf
-from labbrdf.fitting import FitData, Objective, core, fit
-from labbrdf.fitting.core import CHI2_TOL, EXACT_RTOL, LOCAL_ROUNDS, POLISH, _polish, _run_local
+from labbrdf.fitting import FitData, Objective, fit, stages
 from labbrdf.fitting.data import as_fit_data
+from labbrdf.fitting.stages import CHI2_TOL, EXACT_RTOL, LOCAL_ROUNDS, POLISH, _polish, _run_local
 from labbrdf.report.validate import validate
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -144,21 +144,21 @@ def test_the_polish_reaches_the_minimum_from_where_the_local_stage_stalled():
 def test_a_polish_that_runs_out_of_budget_is_not_a_success(monkeypatch):
     g = next(g for s, w, g in GROUPS if s == "OSR" and w == 860.0)
     obj = _objective("five_param", g)
-    monkeypatch.setattr(core, "_POLISH_MAXEVAL_PER_DIM", 1)  # n trial points: too few
+    monkeypatch.setattr(stages, "_POLISH_MAXEVAL_PER_DIM", 1)  # n trial points: too few
     x0 = obj.to_vector(STALLED)
     f0 = obj.solve(obj.from_vector(x0))[1]
     x, info = _polish(obj, x0, len(g) - 5, True)
     assert info["code"] == 0 and "not converged" in info["message"]
     assert info["chisqr"] <= f0 and info["nfev"] == obj.nfev
     # and the fit reports it: not a success, whatever the stages said
-    real = core.optimize.least_squares
+    real = stages.optimize.least_squares
 
     def starved(*args, **kwargs):
         res = real(*args, **{**kwargs, "max_nfev": 1})
         res.status, res.message = 0, "budget"
         return res
 
-    monkeypatch.setattr(core.optimize, "least_squares", starved)
+    monkeypatch.setattr(stages.optimize, "least_squares", starved)
     r = fit("five_param", g, seed=0)
     assert r.stages[-1]["algorithm"] == POLISH and r.stages[-1]["code"] == 0
     assert not r.success and "not converged" in r.message
@@ -170,7 +170,7 @@ def test_a_polish_that_fails_keeps_the_local_point_and_says_so(monkeypatch):
     def broken(*args, **kwargs):
         raise ValueError("Residuals are not finite in the initial point.")
 
-    monkeypatch.setattr(core.optimize, "least_squares", broken)
+    monkeypatch.setattr(stages.optimize, "least_squares", broken)
     r = fit("five_param", g, seed=0)
     assert r.stages[-1]["code"] == -1 and r.stages[-1]["nfev"] == 0
     assert r.chisqr == r.stages[-2]["chisqr"]

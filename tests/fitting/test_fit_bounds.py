@@ -1,7 +1,7 @@
 """A value fixed or started outside a parameter's declared bounds is refused, for every model.
 
 The bounds are the model's (:meth:`labbrdf.models.Model.default_params`); the fitting core
-(:func:`labbrdf.fitting.core.setup_params`, which :func:`labbrdf.fitting.fit` and
+(:func:`labbrdf.fitting.parameters.setup_params`, which :func:`labbrdf.fitting.fit` and
 :func:`labbrdf.fitting.fit_many` call before any evaluation) refuses a fixed or start value
 outside them, NaN or infinite, naming the parameter and the allowed range.
 """
@@ -16,7 +16,7 @@ import pytest
 
 from labbrdf import models
 from labbrdf.fitting import FitError, fit, fit_many
-from labbrdf.fitting.core import setup_params
+from labbrdf.fitting.parameters import setup_params
 
 #: every registry model, in each of its option sets that changes the parameters
 CONFIGS = [

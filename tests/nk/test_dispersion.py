@@ -151,7 +151,7 @@ def test_tabulated_from_a_three_and_a_two_column_file(tmp_path):
     p2 = tmp_path / "glass.txt"
     p2.write_text("500 1.5\n600 1.49\n")
     assert tabulated_from_file(p2).nk(550.0) == pytest.approx(1.495 + 0j)
-    assert as_material(t.to_dict()).nk(600.0) == t.nk(600.0)
+    assert as_material(t.to_dict(), tabulated_from_file).nk(600.0) == t.nk(600.0)
 
 
 @pytest.mark.parametrize(

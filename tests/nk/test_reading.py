@@ -58,7 +58,7 @@ def test_a_file_keyed_table_is_read_back_by_as_material_not_by_from_dict(tmp_pat
     d = tabulated_from_file(p).to_dict()
     with pytest.raises(disp.DispersionError, match="glass.txt.*tabulated_from_file"):
         disp.from_dict(d)
-    assert as_material(d).nk(550.0) == pytest.approx(1.495 + 0j)
+    assert as_material(d, tabulated_from_file).nk(550.0) == pytest.approx(1.495 + 0j)
 
 
 def test_a_file_neither_table_nor_export_names_both_reasons(tmp_path: Path) -> None:
@@ -76,5 +76,5 @@ def test_a_film_model_file_entry_reads_the_table(tmp_path: Path) -> None:
         '[substrate]\nfile = "sub.txt"\n\n[[layer]]\nname = "oxide"\nmaterial = "sio2"\n'
         "thickness_nm = 10\n"
     )
-    fm = labbrdf.films.load_model(model)
+    fm = labbrdf.films.load_model(model, tabulated_from_file)
     assert fm.stack.substrate.nk(650.0) == pytest.approx(2.75 + 0.3j)

@@ -13,6 +13,7 @@ import pytest
 
 from labbrdf import films
 from labbrdf.cli import main
+from labbrdf.nk import tabulated_from_file
 from labbrdf.report.builder import Builder
 from labbrdf.report.context import Context
 from labbrdf.report.inputs import ingest_inputs
@@ -25,7 +26,7 @@ TABLE = "# wavelength_nm n k\n300 3.9 0.02\n1000 3.6 0.01\n"
 
 def _model(substrate: Path) -> films.FilmModel:
     stack = films.Stack([films.Layer("sio2", 100.0, "film")], films.as_material(
-        {"model": "tabulated", "file": str(substrate)}))  # fmt: skip
+        {"model": "tabulated", "file": str(substrate)}, tabulated_from_file))  # fmt: skip
     return films.FilmModel(stack, {"film.thickness_nm": (0.0, 300.0)})
 
 

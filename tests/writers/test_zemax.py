@@ -11,6 +11,7 @@ import pytest
 import labbrdf
 from labbrdf import bsdf_geometry, models
 from labbrdf.adapters import zemax_bsdf as zb
+from labbrdf.outputs import OutputError, write_policy
 from labbrdf.writers import zemax as bx
 
 
@@ -20,7 +21,7 @@ def test_writer_refuses_overwrite_and_leaves_no_temp(tmp_path):
     )
     p = bx.write_bsdf(tmp_path / "a.bsdf", symmetry="PlaneSymmetrical", **kw)
     before = p.read_bytes()
-    with pytest.raises(FileExistsError):
+    with pytest.raises(OutputError, match="exists"):
         bx.write_bsdf(p, symmetry="PlaneSymmetrical", **kw)
     with pytest.raises(ValueError, match="finite"):
         bad = dict(kw, values=np.full((1, 1, 1, 2, 2), np.nan))
@@ -31,6 +32,19 @@ def test_writer_refuses_overwrite_and_leaves_no_temp(tmp_path):
         bx.write_bsdf(
             tmp_path / "b.bsdf", **dict(kw, azimuth_deg=[0, 270]), symmetry="PlaneSymmetrical"
         )
+
+
+def test_writer_follows_the_one_output_rule(tmp_path):
+    kw = dict(
+        theta_i_deg=[10], radial_deg=[0, 10], azimuth_deg=[0, 180], values=np.ones((1, 1, 1, 2, 2))
+    )
+    p = bx.write_bsdf(tmp_path / "in.bsdf", symmetry="PlaneSymmetrical", **kw)
+    before = p.read_bytes()
+    with write_policy(overwrite=True, inputs=[p]), pytest.raises(OutputError, match="input"):
+        bx.write_bsdf(p, overwrite=True, symmetry="PlaneSymmetrical", **kw)
+    with pytest.raises(OutputError, match="folder"):
+        bx.write_bsdf(tmp_path, overwrite=True, symmetry="PlaneSymmetrical", **kw)
+    assert p.read_bytes() == before
 
 
 def test_model_to_bsdf(tmp_path):

@@ -62,7 +62,7 @@ def from_dict(d: Mapping[str, Any]) -> Dispersion:
         if "file" in d:
             raise DispersionError(
                 f"tabulated: {d['file']!r} is a file; read it with "
-                "labbrdf.nk.tabulated_from_file (labbrdf.films.as_material does)"
+                "labbrdf.nk.tabulated_from_file (labbrdf.films.as_material's read_table)"
             )
         if "wavelength_nm" in d:
             return Tabulated(

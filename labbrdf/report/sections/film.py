@@ -600,4 +600,4 @@ def film_model_of(
         return None, ""
     if isinstance(model, films.FilmModel):
         return model, model.source
-    return films.load_model(model), f"model file {model}"
+    return films.load_model(model, nkmod.tabulated_from_file), f"model file {model}"

@@ -1,43 +1,6 @@
-"""Output-path safety: every file or folder labbrdf writes goes through this module.
+"""File outputs and inputs: the write policy, checks, atomic writes, leftover clean-up.
 
-Nothing a user owns is lost by our outputs. The command line follows one rule for every
-output it writes, sidecar files included: **an existing file (or earlier report folder) is
-never replaced unless ``--overwrite`` is given; an input is never replaced, even with
-``--overwrite``; every write is atomic.** The CLI states the rule once per command with
-:func:`write_policy` (whether to overwrite, and all the command's inputs); every check and
-every write below consults it, so a writer added later follows it without being told.
-Outside a :func:`write_policy` block (the library used from Python) an existing output is
-replaced, as :func:`open` with ``"w"`` would, and only the inputs passed explicitly are
-refused.
-
-* :func:`check_file_output` refuses a file output that is one of the inputs, an existing
-  file (unless overwriting), an existing folder or anything but a regular file, a name
-  ending in a path separator (a folder), or a name without the expected suffix.
-* :func:`check_report_dir` refuses a report folder that is (or contains, or lies inside)
-  an input, an existing file, the current working folder, or an existing folder that is
-  neither empty nor a previous labbrdf report; a previous report in which the user put
-  a file of their own is refused too, naming that file, and a previous report is
-  replaced only when overwriting. A report folder is recognised by
-  its marker file :data:`REPORT_MARKER` (a small JSON that lists the files we wrote), or,
-  for reports written before the marker existed, by its exact layout (``index.html``,
-  ``results.json`` with the report keys, ``tables/*.csv`` and nothing else).
-* :func:`atomic_output` (files) and :func:`replace_dir` (report folders) build the output
-  under a temporary hidden name beside it and rename it into place; outputs get the
-  permissions of the umask (``0o666 & ~umask``; a replaced file keeps its mode). When
-  not overwriting, the file is put in place with a hard link, which fails rather than
-  replace a file that appeared while we worked. Any OS error while writing (a full
-  disk, a read-only folder, ...) becomes an :class:`OutputError` that names the output
-  path and the cause.
-* Temporary names carry our pattern, a host tag and the process id
-  (``.NAME.labbrdf-tmp-HOST-PID-XXXX.tmp``, ``.NAME.labbrdf-new-HOST-PID-XXXX``,
-  ``.NAME.labbrdf-old-HOST-PID-XXXX``). A run killed with SIGKILL leaves them behind; the
-  next write of the same output removes those whose process is gone (on this host), and
-  for folders only when they hold our marker. Nothing else is ever removed.
-
-Every refusal raises :class:`OutputError` (a ValueError: the CLI prints it and exits 2)
-naming the path and what was expected.
-
-This module imports nothing from labbrdf at import time, so every layer may use it.
+The rules every output follows are stated in :mod:`labbrdf.outputs`.
 """
 
 from __future__ import annotations
@@ -53,38 +16,14 @@ import socket
 import stat
 import tempfile
 import time
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from contextvars import ContextVar
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
-
-__all__ = [
-    "CSV_FORMULA_PREFIXES",
-    "REPORT_MARKER",
-    "InputFileError",
-    "OutputError",
-    "WritePolicy",
-    "atomic_output",
-    "check_file_output",
-    "check_input_files",
-    "check_report_dir",
-    "clean_leftovers",
-    "csv_safe_cell",
-    "csv_safe_frame",
-    "note_inputs",
-    "read_input_file",
-    "refuse_input_as_output",
-    "replace_dir",
-    "write_policy",
-]
 
 #: the marker file written into every report folder
 REPORT_MARKER = ".labbrdf-report"
 
-#: text cells starting with one of these are prefixed with ``'`` in CSVs meant for people
-#: (OWASP "CSV injection"): a spreadsheet would otherwise run them as a formula
-CSV_FORMULA_PREFIXES = ("=", "+", "-", "@", "\t", "\r")
 
 _LEGACY_REPORT_KEYS = {"title", "meta", "sections", "tables", "checks", "summary"}
 
@@ -704,78 +643,6 @@ def _foreign(d: Path, ours: set[str]) -> list[str]:
     return out
 
 
-def check_report_dir(
-    path: str | os.PathLike[str],
-    *,
-    inputs: Iterable[str | os.PathLike[str]] = (),
-    option: str = "-o",
-    overwrite: bool | None = None,
-) -> Path:
-    """Validate a report folder before any work is done; return it resolved.
-
-    ``overwrite`` (default: the :func:`write_policy` in force, whose inputs are refused
-    too) allows an earlier report to be replaced.
-
-    Raises
-    ------
-    OutputError
-        ``path`` is an existing file, equals or contains an input (or lies inside an
-        input folder), is the current working folder, or is an existing folder that is
-        neither empty nor a previous labbrdf report, or a previous report that holds a
-        file we did not write (named in the message), or a previous report and not
-        ``overwrite``.
-    """
-    if not os.fspath(path):
-        raise OutputError(f"{option}: empty folder name")
-    shown = os.fspath(path)
-    if os.path.lexists(path) and not os.path.isdir(path):
-        raise OutputError(
-            f"{option} {shown}: is an existing file; expected a folder for the report "
-            "(a new name, an empty folder or an earlier report)"
-        )
-    out = _resolved(path)
-    refuse_input_as_output(path, inputs=inputs, kind="dir", option=option)
-    try:
-        cwd = Path.cwd().resolve()
-    except OSError:
-        cwd = None
-    if cwd is not None and _is_within(cwd, out):
-        raise OutputError(
-            f"{option} {shown}: is the current folder (or contains it); expected a new "
-            "folder name for the report, e.g. -o report"
-        )
-    if out.is_dir():
-        try:
-            empty = not any(out.iterdir())
-        except OSError as exc:
-            raise _wraps_oserror(out, "cannot read the folder", exc) from None
-        if not empty:
-            ours = _marker_files(out)
-            if ours is None:
-                raise OutputError(
-                    f"{option} {shown}: is a folder that is not empty and not a labbrdf "
-                    "report; expected a new folder name, an empty folder or an earlier "
-                    "report (nothing in it was changed)"
-                )
-            foreign = _foreign(out, ours)
-            if foreign:
-                names = ", ".join(foreign[:5]) + (", ..." if len(foreign) > 5 else "")
-                raise OutputError(
-                    f"{option} {shown}: is an earlier labbrdf report that now also holds "
-                    f"files labbrdf did not write ({names}); move them out or choose "
-                    "another folder (nothing was changed)"
-                )
-            if not _overwrite(overwrite):
-                raise OutputError(
-                    f"{option} {shown}: is an earlier labbrdf report; pass --overwrite to "
-                    "replace it (nothing was changed)"
-                )
-    if out.parent.exists() and not out.parent.is_dir():
-        raise OutputError(f"{option} {shown}: {out.parent} is not a folder")
-    _check_writable(out, option, shown)
-    return out
-
-
 def _listing(d: Path) -> list[str]:
     return sorted(
         (Path(root) / n).relative_to(d).as_posix()
@@ -785,112 +652,4 @@ def _listing(d: Path) -> list[str]:
     )
 
 
-def _write_marker(d: Path, files: list[str], status: str) -> None:
-    try:
-        from labbrdf import __version__ as version
-    except ImportError:  # pragma: no cover
-        version = "?"
-    info = {"labbrdf": "report", "version": version, "status": status, "files": files}
-    (d / REPORT_MARKER).write_text(json.dumps(info, indent=1) + "\n", encoding="utf-8")
-
-
-def replace_dir(
-    out: str | os.PathLike[str],
-    write: Callable[[Path], Any],
-    *,
-    inputs: Iterable[str | os.PathLike[str]] = (),
-    option: str = "-o",
-) -> Path:
-    """Build a report folder with ``write(tmp)`` and move it into place at ``out``.
-
-    ``out`` is checked with :func:`check_report_dir` before and again after building
-    (so an earlier report is replaced only when the :func:`write_policy` allows it). An
-    OS error of ``write`` becomes :class:`OutputError` naming the report and the cause.
-    The folder is built in a hidden temporary sibling (marked as ours from the start),
-    then an existing ``out`` (an earlier report) is renamed aside, the new folder renamed
-    in, and the old one deleted. If ``write`` raises, the temporary folder is removed and
-    ``out`` is left untouched.
-    """
-    inputs = list(inputs)
-    target = check_report_dir(out, inputs=inputs, option=option)
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise _wraps_oserror(target.parent, "cannot create the folder", exc) from None
-    clean_leftovers(target)
-    try:
-        tmp = Path(
-            tempfile.mkdtemp(prefix=f".{target.name}.labbrdf-new-{_tag()}-", dir=target.parent)
-        )
-    except OSError as exc:
-        raise _wraps_oserror(target, "cannot write the report folder", exc) from None
-    try:
-        try:
-            _write_marker(tmp, [], "building")
-            os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700; a report is shared
-        except OSError as exc:
-            raise _wraps_oserror(target, "cannot write the report folder", exc) from None
-        try:
-            write(tmp)
-        except OutputError:
-            raise
-        except OSError as exc:  # a full disk, ...: name the report and the file
-            inner = Path(exc.filename) if isinstance(exc.filename, str) else None
-            shown = target
-            if inner is not None and _is_within(_resolved(inner), _resolved(tmp)):
-                shown = target / _resolved(inner).relative_to(_resolved(tmp))
-            raise _wraps_oserror(shown, "cannot write the report", exc) from exc
-        _write_marker(tmp, _listing(tmp), "complete")
-        check_report_dir(out, inputs=inputs, option=option)  # changed while we worked?
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    old: Path | None = None
-    try:
-        if target.exists():
-            old = Path(
-                tempfile.mkdtemp(prefix=f".{target.name}.labbrdf-old-{_tag()}-", dir=target.parent)
-            )
-            old.rmdir()
-            os.replace(target, old)
-        try:
-            os.replace(tmp, target)
-        except BaseException:
-            if old is not None:
-                os.replace(old, target)
-                old = None
-            raise
-    except OSError as exc:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise _wraps_oserror(target, "cannot replace the report folder", exc) from None
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
-    return target
-
-
 # --------------------------------------------------------------------------- CSV cells
-
-
-def csv_safe_cell(value: Any) -> Any:
-    """Neutralise a text cell that a spreadsheet would run as a formula.
-
-    A cell starting with ``= + - @``, TAB or CR gets a leading ``'``; anything else is
-    returned unchanged (numbers too).
-    """
-    if isinstance(value, str) and value.startswith(CSV_FORMULA_PREFIXES):
-        return "'" + value
-    return value
-
-
-def csv_safe_frame(df: Any) -> Any:
-    """Copy a DataFrame with every text cell passed through :func:`csv_safe_cell`.
-
-    For CSV tables meant to be opened by people, not for the dataset CSV (read back
-    exactly).
-    """
-    out = df.copy()
-    for col in out.columns:
-        if out[col].dtype == object or str(out[col].dtype) in ("string", "str"):
-            out[col] = out[col].map(csv_safe_cell)
-    out.columns = [csv_safe_cell(c) if isinstance(c, str) else c for c in out.columns]
-    return out
