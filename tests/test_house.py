@@ -290,7 +290,9 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
         ),
     ),
     ("data", ("dataset", "selection", "samples")),
-    ("files", ("adapters",)),
+    # n,k read from files (tables, an ellipsometer file's pseudo-constants): what the film
+    # objects and the models are handed to read a material named by a file
+    ("files", ("adapters", "nk.reading", "nk.tables")),
     ("models", ("models", "integrate")),
     ("measured constants and samples", ("nk", "sample")),
     (

@@ -321,17 +321,21 @@ def _film(
             "rayleigh_rice: the film's stack gives the substrate's index; leave out n, k, "
             "free_index (and --nk-from)"
         )
+    # a material named by a file (an n,k table, an ellipsometer file) is read as the film
+    # commands read it; the reader sits in the files layer, below the models
+    from ..nk.reading import tabulated_from_file
+
     rng: tuple[float, float] | None
     if isinstance(film, (Stack, Mapping)):  # a Stack, or its dict (the model's options)
         try:
-            stack = film if isinstance(film, Stack) else Stack.from_dict(film)
+            stack = film if isinstance(film, Stack) else Stack.from_dict(film, tabulated_from_file)
         except (FilmError, ValueError) as exc:
             raise ModelError(f"rayleigh_rice option 'film': {exc}") from None
         rng = None
         shown: Any = stack.to_dict()
     elif isinstance(film, (str, os.PathLike)):
         try:
-            stack, rng = read_fit_json(film)
+            stack, rng = read_fit_json(film, tabulated_from_file)
         except FilmError as exc:
             raise ModelError(f"rayleigh_rice option 'film': {exc}") from None
         shown = os.fspath(film)

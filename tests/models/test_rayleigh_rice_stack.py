@@ -145,3 +145,27 @@ def test_cli_film_that_is_not_a_film_fit_exits_2(coated_bsdf, tmp_path, capsys) 
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert "notafit.json" in err and "Traceback" not in err
+
+
+def test_a_substrate_named_by_a_file_is_read_as_the_film_commands_read_it(tmp_path) -> None:
+    """A fit of ``labbrdf film ... --substrate FILE`` names its substrate by the file.
+
+    The model reads it through the n,k file reader, from a fit JSON path and from the
+    options it records (their dict names the file again), and the stack equals one built
+    from the same table in memory.
+    """
+    from labbrdf.nk import tabulated_from_file
+
+    table = tmp_path / "al.csv"
+    table.write_text("wavelength_nm,n,k\n400,1.55,7.71\n900,1.55,7.71\n", encoding="utf-8")
+    stack = films.Stack([films.Layer(COAT, 120.0, "coat")], tabulated_from_file(table))
+    doc = {"stack": stack.to_dict()}
+    assert doc["stack"]["substrate"]["file"] == str(table)
+    m = models.get("rayleigh_rice", film=doc["stack"])
+    again = models.get("rayleigh_rice", **m.options)
+    want = models.get("rayleigh_rice", film=_stack()).evaluate(
+        0.3, 0.4, 3.0, wavelength=WL_NM, params=TRUE
+    )
+    for model in (m, again):
+        got = model.evaluate(0.3, 0.4, 3.0, wavelength=WL_NM, params=TRUE)
+        assert got == pytest.approx(want, rel=1e-12)
