@@ -152,7 +152,8 @@ def top_walk(
     ray = np.arange(n)
     w = np.ones(n)
     kz = np.where(below, -k[2], k[2])
-    _, h = sample_height(kz, top.smith_lambda(k, below), np.full(n, np.inf), rng.random(n))
+    u = np.asarray(rng.random(n), float)
+    _, h = sample_height(kz, top.smith_lambda(k, below), np.full(n, np.inf), u)
     out: list[tuple] = []
     for order in range(1, MAX_EVENTS + 1):
         if ray.size == 0:
@@ -235,7 +236,9 @@ def _unit(v: F64) -> F64:
 
 def _per_ray(esc: Escapes, sel: NDArray[np.bool_], weight: F64, n: int) -> F64:
     """Each launched ray's booked power (escapes in ``sel``, times ``weight``)."""
-    return np.bincount(esc.ray[sel], weights=(esc.weight * weight)[sel], minlength=n)
+    return np.asarray(
+        np.bincount(esc.ray[sel], weights=(esc.weight * weight)[sel], minlength=n), float
+    )
 
 
 def _from_above(theta_deg: F64, rays: int) -> tuple[F64, NDArray[np.bool_]]:
@@ -291,7 +294,7 @@ def internal_reflectance_ms(
 
 def higher_orders_map(
     n_coat: float, alpha: float, theta_i_deg: float, grid: Grid, rays: int
-) -> tuple[F64, F64]:
+) -> tuple[F64, float]:
     """The first surface's reflection of order >= 2: bin averages [sr^-1].
 
     Counted into the bins of ``grid`` (cos-weighted averages, like the tracer's maps)
@@ -324,6 +327,8 @@ def first_surface_ms(cfg: TraceConfig, rays: int | None = None) -> tuple[F64, fl
     """
     grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
     coat = cfg.coating
+    if coat is None:
+        raise ValueError("first_surface_ms needs a coating")
     row = height_correlation(coat.alpha, cfg.theta_i_deg, grid)
     first = first_surface_map(cfg)[..., 0, 0] * row[:, None]
     hi, se = higher_orders_map(
