@@ -71,6 +71,21 @@ def _distribution(name: Any, base: str, coherent: bool) -> str:
     return str(name)
 
 
+def _scattering(name: Any, base: str) -> bool:
+    """The checked ``scattering`` option; True for multiple scattering on the top."""
+    if name not in ("single", "multiple"):
+        raise ModelError(
+            f"layered option 'scattering' must be 'single' or 'multiple'; got {name!r}"
+        )
+    if name == "multiple" and base != "diffuse":
+        raise ModelError(
+            "layered option scattering='multiple' needs base='diffuse' (the renewal form of "
+            "a Lambertian base; over a conductor the multiple-scattering walk is only "
+            "counted, docs/tracer.md)"
+        )
+    return name == "multiple"
+
+
 def _auto_step(spacing: float, steps: tuple[float, ...]) -> float:
     """The largest allowed step not above half the data's angular spacing [deg]."""
     ok = [s for s in steps if s <= spacing / 2.0]
@@ -120,6 +135,13 @@ class Layered(Model):
         traced through its slope table and its exit is sampled through the walk's facets
         (``docs/tracer.md``); conductor base and incoherent mode only (the closed form of a
         diffuse base and the coherent facets are written for GGX).
+    scattering : {"single", "multiple"}, default "single"
+        Scattering on the coating's rough top, the tracer's word: "single" (one facet
+        event per crossing, separable Smith ``G1 G1``) or "multiple" (the Heitz et al.
+        2016 random walk on the microsurface, all orders; ``base="diffuse"`` only:
+        :mod:`labbrdf.tracer.coated_lambert_ms`). Single scattering loses energy at the
+        rough top (a lossless coating over a white base returns 0.977 / 0.927 / 0.803 at
+        ``alpha_top`` 0.05 / 0.1 / 0.2); "multiple" conserves it.
 
     Parameters: ``n_coat`` [1] in [1.2, 2.2], fixed at 1.5 by default (``--free n_coat``);
     ``alpha_top`` [1] in [0.02, 1] (log), GGX roughness of the coating's top;
@@ -139,11 +161,13 @@ class Layered(Model):
     way it came, so the walk is a renewal process and its expectation is the series
     ``a T(theta_i) T(theta_o) / (pi n^2 (1 - a R))`` plus the first surface
     (:mod:`labbrdf.tracer.coated_lambert`; agrees with the counting walk over every bin,
-    ``docs/tracer.md``). The model evaluates that, on the tracer's grid and interpolated
-    like a traced map, so it is the traced model without its noise.
-    Single scattering (the separable Smith G1 G1 per interface) loses energy for rough
-    interfaces; the multiple-scattering walk would count rays, whose noise no fit can
-    use (``docs/tracer.md``).
+    ``docs/tracer.md``), evaluated on the tracer's grid and interpolated like a traced
+    map: the traced model without its noise.
+    Single scattering (separable Smith G1 G1) loses energy at rough interfaces. Over a
+    conductor the multiple-scattering walk only counts rays, whose noise no fit can use;
+    over a diffuse base the renewal form holds for the whole microsurface walk
+    (``scattering="multiple"``; ``T`` and ``R`` from walks with fixed seeds, about 3 s
+    per ``(n_coat, alpha_top)``; ``docs/tracer.md``).
     A nearly smooth top (``alpha_top`` below about ``0.035 / (n_coat - 1)``, 0.07 for
     n_coat = 1.5) has an exit lobe narrower than the tracer's exit operator resolves; there
     the tracer exits through the walk's own sampled facet instead (unbiased, no operator to
@@ -195,13 +219,14 @@ class Layered(Model):
         grid: str | tuple[float, float] = "auto",
         wavelength_nm: float = 550.0,
         distribution: str = "ggx",
+        scattering: str = "single",
         **options: Any,
     ) -> None:
         if options:
             raise ModelError(
                 f"model 'layered' got unknown options {sorted(options)}; options are "
                 "['n', 'k', 'base', 'coherent', 'coating_k', 'thickness_nm', 'floor', "
-                "'rays', 'seed', 'grid', 'wavelength_nm', 'distribution']"
+                "'rays', 'seed', 'grid', 'wavelength_nm', 'distribution', 'scattering']"
             )
         if base not in _BASES:
             raise ModelError(f"layered option 'base' must be one of {list(_BASES)}; got {base!r}")
@@ -210,7 +235,7 @@ class Layered(Model):
         self._distribution = _distribution(distribution, base, self._coherent)
         self._floor = _flag(floor, "floor")
         self._nk = (1.0, 0.0)
-        self._closed = self._closed_form(base)
+        self._closed = self._closed_form(base, scattering)
         if base == "diffuse":
             if n is not None or k is not None:
                 raise ModelError(
@@ -272,7 +297,12 @@ class Layered(Model):
         self._cache: OrderedDict[tuple, tuple[NDArray, NDArray]] = OrderedDict()
         self._operators: OrderedDict[str, Any] = OrderedDict()  # exit operators in memory
         self.traces = 0  # traces run (cache misses), for benchmarks
-        opts: dict[str, Any] = {"base": base, "rays": self._rays, "seed": self._seed}
+        opts: dict[str, Any] = {
+            "base": base,
+            "rays": self._rays,
+            "seed": self._seed,
+            **({"scattering": "multiple"} if self._multiple else {}),
+        }
         if self._wl_default != 550.0:
             opts["wavelength_nm"] = self._wl_default
         if base == "conductor":
@@ -292,17 +322,20 @@ class Layered(Model):
         opts["grid"] = "auto" if self._grid is None else f"{self._grid[0]:g}x{self._grid[1]:g}"
         super().__init__(**opts)
 
-    def _closed_form(self, base: str) -> bool:
+    def _closed_form(self, base: str, scattering: Any) -> bool:
         """Whether a diffuse base is evaluated in closed form; marks a deterministic model.
 
-        A Lambertian base makes the single-scattering walk a renewal process, whose
-        expectation is a closed form (:mod:`labbrdf.tracer.coated_lambert`): no rays. The
-        coherent mode's map is evaluated in closed form too. Both are deterministic.
+        A Lambertian base makes the walk a renewal process, whose expectation is a closed
+        form (:mod:`labbrdf.tracer.coated_lambert`): no rays. The coherent mode's map is
+        evaluated in closed form too. Both are deterministic. Multiple scattering: walks
+        with fixed seeds (:mod:`labbrdf.tracer.coated_lambert_ms`) whose binned higher
+        orders jump below a parameter step of ~1e-3, so finite differences keep a step.
         """
+        self._multiple = _scattering(scattering, base)
         self._first_maps: OrderedDict[tuple, NDArray] = OrderedDict()  # closed form's
         closed = base == "diffuse"
         if closed or self._coherent:
-            self.fd_rel_step = None
+            self.fd_rel_step = 3e-3 if self._multiple else None
             self.stochastic = False
             self.default_replicates = 1
         return closed
@@ -507,25 +540,38 @@ class Layered(Model):
         """
         from ..tracer import Grid
         from ..tracer.coated_lambert import coated_lambert
+        from ..tracer.coated_lambert_ms import coated_lambert_ms
+
+        coat = cfg.coating
+        form = coated_lambert_ms if self._multiple else coated_lambert
+        grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
+        body = form(coat.n, coat.alpha, coat.k, coat.thickness_nm, cfg.wavelength_nm).bin_map(
+            float(cfg.substrate.albedo), cfg.theta_i_deg, grid
+        )
+        self.traces += 1
+        return np.asarray(self._first_map(cfg) + body, float)
+
+    def _first_map(self, cfg: Any) -> NDArray[np.float64]:
+        """The first surface's S0 map: closed form, plus the walk's higher orders if asked.
+
+        It does not depend on the albedo: kept per (coating, incidence, grid).
+        """
+        from ..tracer.coated_lambert_ms import first_surface_ms
         from ..tracer.estimator import first_surface_map
 
         coat = cfg.coating
-        body = coated_lambert(
-            coat.n, coat.alpha, coat.k, coat.thickness_nm, cfg.wavelength_nm
-        ).bin_map(
-            float(cfg.substrate.albedo),
-            cfg.theta_i_deg,
-            Grid(cfg.theta_step_deg, cfg.phi_step_deg),
-        )
-        self.traces += 1
         # the first surface does not depend on the albedo: kept per (coating, incidence)
         key = (coat.n, coat.alpha, cfg.theta_i_deg, cfg.theta_step_deg, cfg.phi_step_deg)
         first = self._first_maps.get(key)
         if first is None:
-            first = self._first_maps[key] = first_surface_map(cfg)[..., 0, 0]
+            if self._multiple:
+                first = first_surface_ms(cfg)[0]
+            else:
+                first = first_surface_map(cfg)[..., 0, 0]
+            self._first_maps[key] = first
             if len(self._first_maps) > _CACHE_SIZE:
                 self._first_maps.popitem(last=False)
-        return np.asarray(first + body, float)
+        return np.asarray(first, float)
 
     @property
     def grid_deg(self) -> tuple[float, float] | None:
