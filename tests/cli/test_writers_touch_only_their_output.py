@@ -286,6 +286,11 @@ NOT_PATHS = {
     ("trace", "pixel_size"),
     ("trace", "unit"),
     ("report", "prediction_slopes"),
+    # a number or a LO..HI box (the metavar ends in ".HI")
+    ("film", "substrate_thickness"),
+    ("film", "thickness_spread"),
+    ("film", "bandwidth"),
+    ("film", "angle_spread"),
 }
 
 
