@@ -46,6 +46,7 @@ class _MultiFilmModel(Model):
     name = "film (several samples)"
     quantities = _FilmFitModel.quantities
     reference = _FilmFitModel.reference
+    least_squares_local = _FilmFitModel.least_squares_local
 
     def __init__(
         self,
