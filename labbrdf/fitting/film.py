@@ -462,6 +462,7 @@ class FilmFit:
                 "success": res.success,
                 "message": res.message,
                 "method": res.method,
+                "search": [str(st["algorithm"]) for st in res.stages],
                 "seed": res.seed,
                 "nfev": res.nfev,
                 "elapsed_s": res.elapsed_s,

@@ -215,6 +215,7 @@ class MultiFilmFit:
                 "success": res.success,
                 "message": res.message,
                 "method": res.method,
+                "search": [str(st["algorithm"]) for st in res.stages],
                 "seed": res.seed,
                 "ci_method": res.ci_method,
                 "correlations": {

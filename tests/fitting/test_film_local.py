@@ -75,3 +75,9 @@ def test_a_least_squares_stage_stopped_by_its_budget_is_not_converged(data):
     assert last["code"] == nlopt.MAXEVAL_REACHED
     assert not f.result.success
     assert "budget" in f.result.message
+
+
+def test_the_report_names_the_stages_that_ran(data):
+    f = fit_film(FilmModel(START, BOX), data, ci="wald")
+    assert f.summary()["search"] == ["GN_CRS2_LM", stages.LEAST_SQUARES]
+    assert f"GN_CRS2_LM then {stages.LEAST_SQUARES}, seed 0" in f.fit_report()
