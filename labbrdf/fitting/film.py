@@ -56,6 +56,10 @@ class _FilmFitModel(Model):
         "coherent transfer matrices (labbrdf.films.matrices) with labbrdf.nk.dispersion materials"
     )
 
+    #: a smooth residual vector: the default local stage runs as trust-region least
+    #: squares (:func:`labbrdf.fitting.stages._least_squares_local`), not BOBYQA's rounds
+    least_squares_local = True
+
     _CH = {"psi": 0, "delta": 1, "rs": 2, "rp": 3, "r": 4, "ts": 5, "tp": 6, "t": 7, "dpol": 8}
 
     def __init__(self, fm: FilmModel, channels: NDArray, y: NDArray) -> None:
@@ -458,6 +462,7 @@ class FilmFit:
                 "success": res.success,
                 "message": res.message,
                 "method": res.method,
+                "search": [str(st["algorithm"]) for st in res.stages],
                 "seed": res.seed,
                 "nfev": res.nfev,
                 "elapsed_s": res.elapsed_s,

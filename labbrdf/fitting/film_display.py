@@ -86,12 +86,17 @@ def _nk_line(wl: str, nk: Mapping[str, Any]) -> str:
     return f"  n, k at {wl} nm: {_nk_text(nk)}"
 
 
+def _search_text(summary: Mapping[str, Any]) -> str:
+    """The stages that ran, in turn (the film's local stage may be least squares)."""
+    return " then ".join(summary.get("search") or [summary["method"]])
+
+
 def _fit_line(summary: Mapping[str, Any]) -> str:
     wl = summary["wavelength_range_nm"]
     return (
         f"fit: {summary['ndata']} values, {wl[0]:g}-{wl[1]:g} nm, {summary['nvarys']} free; "
         f"chi2/nu = {summary['redchi']:.4g}, MSE = {summary['mse']:.4g} (Woollam); "
-        f"{summary['nfev']} evaluations, {summary['method']}, seed {summary['seed']}, "
+        f"{summary['nfev']} evaluations, {_search_text(summary)}, seed {summary['seed']}, "
         f"intervals: {intervals_text(summary)}"
     )
 
@@ -206,7 +211,7 @@ def film_fit_html(summary: Mapping[str, Any]) -> str:
         ("free parameters", summary["nvarys"]),
         ("chi2/nu", f"{summary['redchi']:.4g}"),
         ("MSE (Woollam)", f"{summary['mse']:.4g}"),
-        ("method", f"{summary['method']} (seed {summary['seed']})"),
+        ("method", f"{_search_text(summary)} (seed {summary['seed']})"),
         ("intervals", intervals_text(summary)),
         ("success", f"{summary['success']} ({summary['message']})"),
     ]

@@ -46,6 +46,7 @@ class _MultiFilmModel(Model):
     name = "film (several samples)"
     quantities = _FilmFitModel.quantities
     reference = _FilmFitModel.reference
+    least_squares_local = _FilmFitModel.least_squares_local
 
     def __init__(
         self,
@@ -214,6 +215,7 @@ class MultiFilmFit:
                 "success": res.success,
                 "message": res.message,
                 "method": res.method,
+                "search": [str(st["algorithm"]) for st in res.stages],
                 "seed": res.seed,
                 "ci_method": res.ci_method,
                 "correlations": {

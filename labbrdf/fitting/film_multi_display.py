@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from .film_display import _param_text
+from .film_display import _param_text, _search_text
 
 __all__ = ["multi_fit_report"]
 
@@ -29,7 +29,8 @@ def multi_fit_report(s: Mapping[str, Any]) -> str:
         lines.append(f"  {smp['n']} points, chi2/N = {smp['chi2_per_point']:.4g}")
     lines.append(
         f"fit: {s['ndata']} points, {s['nvarys']} parameters, chi2/nu = {s['redchi']:.4g}, "
-        f"MSE = {s['mse']:.4g}, {s['method']} (seed {s['seed']}), intervals: {s['ci_method']}"
+        f"MSE = {s['mse']:.4g}, {_search_text(s)} (seed {s['seed']}), "
+        f"intervals: {s['ci_method']}"
     )
     if not s["success"]:
         lines.append(f"  optimiser: {s['message']}")
