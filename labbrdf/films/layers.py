@@ -262,7 +262,7 @@ def parse_stack_values(
 ) -> tuple[dict[str, float], dict[str, tuple[float, float]]]:
     """The stack-wide values of the command line (``--bandwidth 0..5`` ...).
 
-    The grammar of :func:`parse_value`, the ranges of :class:`~labbrdf.films.Stack`.
+    The grammar of :func:`parse_value`, the ranges of ``labbrdf.films.Stack``.
 
     Parameters
     ----------

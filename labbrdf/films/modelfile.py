@@ -430,7 +430,7 @@ def load_model(path: str | os.PathLike[str], read_table: TableReader | None = No
     path : path-like
         The model file.
     read_table : callable, optional
-        Reads a ``file = ...`` material (:data:`labbrdf.films.materials.TableReader`, e.g.
+        Reads a ``file = ...`` material (``labbrdf.films.materials.TableReader``, e.g.
         :func:`labbrdf.nk.tabulated_from_file`); without it a model naming a file is refused.
 
     Raises

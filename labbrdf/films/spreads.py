@@ -132,7 +132,7 @@ def beam_sums(
     one-dimensional rules. The angle spread is taken in the plane of incidence only; the
     rays of a cone that leave it also turn the s and p frames, an effect of the same
     (second) order in the cone's half-angle that this model leaves out. The caller decides
-    what varies with the wavelength: :class:`labbrdf.films.Stack` holds the materials'
+    what varies with the wavelength: ``labbrdf.films.Stack`` holds the materials'
     indices at the centre wavelength, so that only the layers' phases ``2 pi N d cos /
     lambda`` vary over the band (the index changes by ``dn/dlambda`` times a few nm,
     far less than the phase does).

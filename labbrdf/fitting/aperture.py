@@ -50,7 +50,7 @@ class Aperture:
     ----------
     detector_deg, beam_deg : float
         Half-angles of the detector's cone and of the beam's divergence [deg], each in
-        [0, :data:`~labbrdf.models.aperture.MAX_APERTURE_DEG`].
+        [0, ``labbrdf.models.aperture.MAX_APERTURE_DEG``].
     source : str
         Where the values came from (``"--aperture"``, ``"stated by FILE"`` ...).
     """

@@ -218,7 +218,7 @@ def fit_many(
     executor : Executor or str, optional
         Where the fits run (:class:`labbrdf.parallel.Executor`, or a scheduler name:
         ``serial``, ``processes``, ``local``, ``tcp://host:port``); default
-        :data:`labbrdf.parallel.DEFAULT_SCHEDULER`.
+        ``labbrdf.parallel.DEFAULT_SCHEDULER``.
     scheduler, workers :
         The older spelling of ``executor``: a scheduler name and a worker count, turned
         into an Executor once by :func:`labbrdf.parallel.as_executor` (``scheduler`` not

@@ -117,7 +117,7 @@ def speos_tis_comparison(
 
     The like-for-like comparison of :func:`tis_comparison` on a Speos
     ``.anisotropicbsdf`` grid: the measurement's integral ``int f cos(theta) d omega`` by
-    the reader's trapezoid rule (:func:`labbrdf.adapters.speos_bsdf.hemispherical_integral`)
+    the reader's trapezoid rule (``labbrdf.adapters.speos_bsdf.hemispherical_integral``)
     with the reader's scaling (the table at the spectrum's incidence integrates to the
     stated coefficient), and the model's on the same nodes.
 

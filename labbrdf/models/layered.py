@@ -131,7 +131,7 @@ class Layered(Model):
         Wavelength [nm] for points that carry none.
     distribution : str, default "ggx"
         Microfacet distribution of both rough interfaces, a name of
-        :data:`labbrdf.microfacet.DISTRIBUTIONS` (e.g. "beckmann"). Other than GGX it is
+        ``labbrdf.microfacet.DISTRIBUTIONS`` (e.g. "beckmann"). Other than GGX it is
         traced through its slope table and its exit is sampled through the walk's facets
         (``docs/tracer.md``); conductor base and incoherent mode only (the closed form of a
         diffuse base and the coherent facets are written for GGX).

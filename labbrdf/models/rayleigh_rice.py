@@ -96,7 +96,7 @@ class RayleighRice(Model):
         span angles where the polarization factors differ.
     film : path-like or labbrdf.films.Stack, optional
         A coated sample: a film fit's JSON (``labbrdf film --fit-json``, read by
-        :func:`labbrdf.films.read_fit_json`) or a :class:`~labbrdf.films.Stack`. Its layers
+        :func:`labbrdf.films.read_fit_json`) or a ``labbrdf.films.Stack``. Its layers
         and substrate replace ``n``, ``k`` (leave them out); the scatter is that of the
         stack's rough interfaces (:mod:`labbrdf.roughness.rr_stack`), each with the fitted
         PSD.

@@ -83,7 +83,7 @@ class Context:
 
     b: Builder
     quick: bool = False
-    #: where the fits and tracer runs go (default: :data:`labbrdf.parallel.DEFAULT_SCHEDULER`)
+    #: where the fits and tracer runs go (default: ``labbrdf.parallel.DEFAULT_SCHEDULER``)
     executor: Executor = field(default_factory=Executor)
     method: str = METHOD
     seed: int = 0

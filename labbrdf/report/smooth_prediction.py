@@ -128,7 +128,7 @@ def choose_theory(
 ) -> Theory:
     """The theory for one measured ``.bsdf`` of the sample whose height map is ``hm``.
 
-    ``coated``: the sample has a film fit, whose ``stack`` (a :class:`labbrdf.films.Stack`)
+    ``coated``: the sample has a film fit, whose ``stack`` (a ``labbrdf.films.Stack``)
     Rayleigh-Rice takes if it can (coherent layers); else only the tracer predicts it.
     """
     name = Path(path).name

@@ -196,7 +196,7 @@ def validate(
         Progress lines on stderr.
     executor : Executor or str, optional
         Where the fits and the tracer runs go (:class:`labbrdf.parallel.Executor`, or a
-        scheduler name); default :data:`labbrdf.parallel.DEFAULT_SCHEDULER`.
+        scheduler name); default ``labbrdf.parallel.DEFAULT_SCHEDULER``.
     workers : int, optional
         Worker processes, with a scheduler name or the default executor.
     scheduler : str, optional

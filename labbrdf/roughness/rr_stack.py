@@ -9,10 +9,11 @@ interface. Physics layer: NumPy only. Derivation, conventions and the checks:
 ``docs/rayleigh-rice.md`` (section *Film stacks with rough interfaces*).
 
 For interface ``j`` (between media ``a`` above and ``b`` below, ``Delta eps_j = eps_b -
-eps_a``) the polarization factors that replace :func:`~labbrdf.roughness.rayleigh_rice.
-jones_factors` are, with ``E_y`` (s), ``E_x`` and ``H_y`` (p) the tangential fields at the
-interface of unit-amplitude plane waves from the incident (superscript i) and the scatter
-(superscript s) directions, ``phi_s = phi_r - pi``::
+eps_a``) the polarization factors that replace
+``labbrdf.roughness.rayleigh_rice.jones_factors`` are, with ``E_y`` (s), ``E_x`` and
+``H_y`` (p) the tangential fields at the interface of unit-amplitude plane waves from the
+incident (superscript i) and the scatter (superscript s) directions,
+``phi_s = phi_r - pi``::
 
     q_ss = K E_y^i E_y^s cos phi_s
     q_ps = -K E_x^i E_y^s sin phi_s                         (p -> s)
@@ -169,7 +170,7 @@ def interface_factors(
     """The polarization factors ``[[q_ss, q_ps], [q_sp, q_pp]]`` of every interface [1].
 
     Module docstring; for one interface (no layers) they equal
-    :func:`labbrdf.roughness.rayleigh_rice.jones_factors`.
+    ``labbrdf.roughness.rayleigh_rice.jones_factors``.
 
     Parameters
     ----------
