@@ -172,6 +172,8 @@ class ABg(Model):
     """
 
     name = "abg"
+    #: the linear amplitude that multiplies the scatter shape (profiled out in fits)
+    amplitude = "A"
     reference = (
         "Harvey J. E., Vernold C. L., Transfer function characterization of scattering "
         "surfaces: revisited, Proc. SPIE 3141 (1997); Stover, Optical Scattering (2012)"
@@ -238,7 +240,7 @@ class ABg(Model):
         phi_r: NDArray,
         wavelength: NDArray | None,
     ) -> NDArray:
-        out = p["A"] * self._scatter(p, theta_i, theta_r, phi_r)
+        out = p[self.amplitude] * self._scatter(p, theta_i, theta_r, phi_r)
         if self._diffuse:
             out = out + p["kd"] * lambert(theta_i, theta_r)
         return out
@@ -251,8 +253,12 @@ class ABg(Model):
         phi_r: NDArray,
         wavelength: NDArray | None,
     ) -> dict[str, NDArray] | None:
-        """``{"A": 1 / (B + |beta - beta0|^g)}`` (and ``"kd": 1 / pi`` with ``diffuse``)."""
-        out = {"A": self._scatter(p, theta_i, theta_r, phi_r)}
+        """``{amplitude: the scatter shape}`` (and ``"kd": 1 / pi`` with ``diffuse``).
+
+        For ABg ``{"A": 1 / (B + |beta - beta0|^g)}``; a subclass names its own amplitude
+        (:attr:`amplitude`) and shape (``_scatter``).
+        """
+        out = {self.amplitude: self._scatter(p, theta_i, theta_r, phi_r)}
         if self._diffuse:
             out["kd"] = np.broadcast_to(lambert(theta_i, theta_r), np.shape(theta_r)).copy()
         return out

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .abg import ABg, shift_invariant_tis
-from .base import ModelError, Parameters, lambert
+from .base import ModelError, Parameters
 
 __all__ = ["HarveyShack", "knee_integral"]
 
@@ -71,6 +71,7 @@ class HarveyShack(ABg):
     """
 
     name = "harvey_shack"
+    amplitude = "b0"
     reference = (
         "Harvey J. E., Vernold C. L., Transfer function characterization of scattering "
         "surfaces: revisited, Proc. SPIE 3141 (1997); K-correlation PSD of Church et al. (1989)"
@@ -112,33 +113,6 @@ class HarveyShack(ABg):
         up = (np.cos(ti) > 0) & (np.cos(ts) > 0)
         x = self.delta_beta(ti, ts, ps) / L
         return np.where(up, (1.0 + x * x) ** (0.5 * S), 0.0)
-
-    def _evaluate(
-        self,
-        p: Mapping[str, float],
-        theta_i: NDArray,
-        theta_r: NDArray,
-        phi_r: NDArray,
-        wavelength: NDArray | None,
-    ) -> NDArray:
-        out = p["b0"] * self._scatter(p, theta_i, theta_r, phi_r)
-        if self._diffuse:
-            out = out + p["kd"] * lambert(theta_i, theta_r)
-        return out
-
-    def linear_components(
-        self,
-        p: Mapping[str, float],
-        theta_i: NDArray,
-        theta_r: NDArray,
-        phi_r: NDArray,
-        wavelength: NDArray | None,
-    ) -> dict[str, NDArray] | None:
-        """``{"b0": (1 + |beta - beta0|^2/L^2)^(S/2)}`` (and ``"kd": 1 / pi``)."""
-        out = {"b0": self._scatter(p, theta_i, theta_r, phi_r)}
-        if self._diffuse:
-            out["kd"] = np.broadcast_to(lambert(theta_i, theta_r), np.shape(theta_r)).copy()
-        return out
 
     def guess(self, theta_i: NDArray, theta_r: NDArray, value: NDArray) -> dict[str, float]:
         """L from the half width of the in-plane lobe, S = -2 and b0 = the peak."""
