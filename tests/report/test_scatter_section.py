@@ -146,8 +146,11 @@ def test_fred_script_evaluates_to_the_fitted_abg(brdf: tuple[dict, Path]) -> Non
 def test_best_fit_table_reads_back(brdf: tuple[dict, Path]) -> None:
     res, out = brdf
     fits = res["tables"]["scatter_fits_s_555_0"]["rows"]
-    t = read_table(out / "designer" / f"s_555_0_{_best(fits)}.bsdf")
+    path = out / "designer" / f"s_555_0_{_best(fits)}.bsdf"
+    t = read_table(path)
     assert list(t.theta_i_deg) == list(TI)
+    # the measurement stated no wavelength, so neither does the table written from its fit
+    assert "wavelength_nm" not in path.read_text(encoding="ascii")
     assert np.all(np.asarray(t.values) >= 0) and np.asarray(t.values).max() > 1.0
 
 

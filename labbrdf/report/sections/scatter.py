@@ -400,7 +400,7 @@ def _designer_files(
             )
     if best is None or best["options"].get("transmission"):
         return
-    _tables(ctx, stem, best)
+    _tables(ctx, stem, best, stated)
 
 
 def _attach(ctx: Context, name: str, label: str, write: Callable[[Path], Any]) -> None:
@@ -426,8 +426,13 @@ def _fred(res: Any, stated: bool, path: Path) -> Path:
     return write_fred_script(res, path, wavelength_stated=stated)
 
 
-def _tables(ctx: Context, stem: str, best: dict[str, Any]) -> None:
-    """The best Harvey fit tabulated for Zemax, Speos and ASTM readers."""
+def _tables(ctx: Context, stem: str, best: dict[str, Any], stated: bool) -> None:
+    """The best Harvey fit tabulated for Zemax, Speos and ASTM readers.
+
+    A measurement that states no wavelength gives a ``.bsdf`` that states none either
+    (its 555 nm is the reader's photopic label: written as a wavelength comment it would be
+    read back as a measured one); Speos and ASTM tables need a number and carry the label.
+    """
     from ...writers.astm import model_to_astm
     from ...writers.speos import model_to_speos
     from ...writers.zemax import model_to_bsdf
@@ -450,7 +455,7 @@ def _tables(ctx: Context, stem: str, best: dict[str, Any]) -> None:
             theta_i_deg=tis,
             radial_deg=radial,
             azimuth_deg=np.arange(0, 181, 5.0),
-            wavelength_nm=wl,
+            wavelength_nm=wl if stated else None,
         ),  # fmt: skip
     )
     _attach(
