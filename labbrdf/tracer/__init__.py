@@ -65,6 +65,7 @@ import numpy as np
 
 from .binning import Grid
 from .config import Coating, Substrate, TraceConfig
+from .medium import Medium
 from .result import TraceResult, trace_summary
 from .walk import BlockTally, GroupTally, _unit, run_unit, trace_block, trace_group
 
@@ -73,6 +74,7 @@ __all__ = [
     "Coating",
     "GroupTally",
     "Grid",
+    "Medium",
     "Substrate",
     "TraceConfig",
     "TraceResult",

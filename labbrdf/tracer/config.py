@@ -11,6 +11,8 @@ import numpy as np
 
 from labbrdf.microfacet import TabulatedNDF
 
+from .medium import Medium
+
 __all__ = ["Coating", "Substrate", "TraceConfig"]
 
 SCATTERING = ("single", "multiple")
@@ -224,6 +226,11 @@ class Coating:
         None = GGX with ``alpha``. The exit operator of the evaluated estimator is built
         for GGX, so with a table on the coating the evaluated walk exits through the
         facets it samples (:mod:`labbrdf.tracer.exit_sampled`).
+    medium : Medium or None
+        A homogeneous Henyey-Greenstein medium filling the coating (optical thickness,
+        single-scattering albedo, asymmetry; :mod:`labbrdf.tracer.medium`); its rays are
+        followed through it at every crossing. None = a clear coating (the walk as
+        without the field, bit for bit). Not combinable with ``coherent=True``.
     """
 
     n: float = 1.5
@@ -231,6 +238,7 @@ class Coating:
     thickness_nm: float = 162.5
     alpha: float = 0.2
     ndf: TabulatedNDF | None = None
+    medium: Medium | None = None
 
     @classmethod
     def from_surface(
@@ -252,11 +260,23 @@ class Coating:
             "thickness_nm": self.thickness_nm,
             "alpha": self.alpha,
             "ndf": None if self.ndf is None else self.ndf.to_dict(),
+            # a clear coating's dict (and so its JSON) is the same as before the field
+            **({} if self.medium is None else {"medium": self.medium.to_dict()}),
         }
 
     def __post_init__(self) -> None:
         if isinstance(self.ndf, dict):
             object.__setattr__(self, "ndf", TabulatedNDF.from_dict(self.ndf))
+        if isinstance(self.medium, dict):
+            extra = sorted(set(self.medium) - {"tau", "ssa", "g"})
+            _check(not extra, "coating.medium", "a dict of tau, ssa and g", extra)
+            object.__setattr__(self, "medium", Medium(**self.medium))
+        _check(
+            self.medium is None or isinstance(self.medium, Medium),
+            "coating.medium",
+            "a Medium or None",
+            type(self.medium).__name__,
+        )
         _check(
             self.ndf is None or isinstance(self.ndf, TabulatedNDF),
             "coating.ndf",
@@ -473,6 +493,10 @@ class TraceConfig:
                 "a tabulated coating NDF (the coherent facets are GGX)",
             ),
             (self.substrate.mirror, "an ideal-mirror substrate (the film needs n + ik)"),
+            (
+                self.coating is not None and self.coating.medium is not None,
+                "a scattering coating (the film's amplitudes are coherent)",
+            ),
         )
         for bad, what in why:
             _check(not bad, "coherent", f"False with {what}", True)
@@ -526,7 +550,9 @@ class TraceConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-safe dict."""
-        coat_table = self.coating is not None and self.coating.ndf is not None
+        coat_table = self.coating is not None and (
+            self.coating.ndf is not None or self.coating.medium is not None
+        )
         if self.substrate.ndf is None and not coat_table:
             return asdict(self)
         d = asdict(self.replace(substrate=Substrate(), coating=None))

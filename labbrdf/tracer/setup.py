@@ -72,6 +72,10 @@ class WalkSetup:
         self.scalar = bool(cfg.scalar)
         # Lambertian base instead of the conductor's microsurface (None: the conductor)
         self.albedo = sub.albedo
+        # a scattering coating (labbrdf.tracer.medium) and the absorption optical
+        # thickness of the coating's k along the normal, 4 pi k d / lambda
+        self.medium = coat.medium if (coat is not None and self.layered) else None
+        self.a_abs = 4 * np.pi * self.k_coat * self.d / self.lam
 
     # -- the interfaces ---------------------------------------------------------------
     def _each(

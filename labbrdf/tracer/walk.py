@@ -69,6 +69,7 @@ from .binning import Grid
 from .config import TraceConfig
 from .exit_sampled import record_up
 from .interfaces import apply_fresnel, rotate_frame, s_axis
+from .medium import traverse
 from .setup import WalkSetup, grid_of
 from .tally import BlockTally, Ledger, block_tally
 
@@ -477,9 +478,12 @@ def _cross(
 ) -> tuple[float, NDArray[np.int64]]:
     """Carry the rays ``ci`` across the coating to the other interface (in place).
 
-    Beer-Lambert along the way; a ray reaching a Lambertian base is re-emitted there
-    (:func:`_base_event`) and crosses back up in the same step, with the attenuation of
-    its new direction, to arrive at the top interface from below. With multiple
+    A scattering coating (``Coating.medium``) sends each ray to the top or the base as its
+    free flights and scattering events in the medium fall, a Lambertian base re-emitting
+    it (:func:`labbrdf.tracer.medium.traverse`). A clear coating: Beer-Lambert along the
+    way; a ray reaching a Lambertian base is re-emitted there (:func:`_base_event`) and
+    crosses back up in the same step, with the attenuation of its new direction, to
+    arrive at the top interface from below. With multiple
     scattering the arrival height on the next microsurface is drawn (always a hit: the ray
     travels towards it).
 
@@ -490,21 +494,29 @@ def _cross(
     base : ndarray of int
         The rays that had a base event (one event each).
     """
-    absorbed = 0.0
-    att = su.beer_lambert(k[2, ci])
-    if att is not None:
-        absorbed += float((M[0, 0, ci] * (1.0 - att)).sum())
-        M[:, :, ci] *= att
-    up = iface[ci] == SUB
-    base = ci[:0]
-    if su.albedo is not None and not up.all():
-        base = ci[~up]
-        absorbed += _base_event(su.albedo, rng, base, k, s, M)
-        att = su.beer_lambert(k[2, base])
+    if su.medium is not None:
+        # a scattering coating (labbrdf.tracer.medium): a ray goes wherever the medium
+        # sends it, to the top from below or to the base (re-emitted there and crossing
+        # again if it is Lambertian)
+        albedo = su.albedo
+        emit = None if albedo is None else (lambda i: _base_event(albedo, rng, i, k, s, M))
+        absorbed, up, base = traverse(su.medium, su.a_abs, rng, ci, k, s, M, emit)
+    else:
+        absorbed = 0.0
+        att = su.beer_lambert(k[2, ci])
         if att is not None:
-            absorbed += float((M[0, 0, base] * (1.0 - att)).sum())
-            M[:, :, base] *= att
-        up[:] = True
+            absorbed += float((M[0, 0, ci] * (1.0 - att)).sum())
+            M[:, :, ci] *= att
+        up = iface[ci] == SUB
+        base = ci[:0]
+        if su.albedo is not None and not up.all():
+            base = ci[~up]
+            absorbed += _base_event(su.albedo, rng, base, k, s, M)
+            att = su.beer_lambert(k[2, base])
+            if att is not None:
+                absorbed += float((M[0, 0, base] * (1.0 - att)).sum())
+                M[:, :, base] *= att
+            up[:] = True
     iface[ci] = np.where(up, TOP, SUB)
     below[ci] = up
     if not su.single:
