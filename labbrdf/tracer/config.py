@@ -554,7 +554,10 @@ class TraceConfig:
             self.coating.ndf is not None or self.coating.medium is not None
         )
         if self.substrate.ndf is None and not coat_table:
-            return asdict(self)
+            d = asdict(self)
+            if d["coating"] is not None:
+                del d["coating"]["medium"]  # a clear coating: the JSON of before the field
+            return d
         d = asdict(self.replace(substrate=Substrate(), coating=None))
         d["substrate"] = self.substrate.to_dict()
         d["coating"] = None if self.coating is None else self.coating.to_dict()
