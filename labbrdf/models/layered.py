@@ -142,13 +142,24 @@ class Layered(Model):
         :mod:`labbrdf.tracer.coated_lambert_ms`). Single scattering loses energy at the
         rough top (a lossless coating over a white base returns 0.977 / 0.927 / 0.803 at
         ``alpha_top`` 0.05 / 0.1 / 0.2); "multiple" conserves it.
+    medium : bool, default False
+        A scattering coating (paints, plastics, vinyls): a homogeneous Henyey-Greenstein
+        medium fills the coating (:class:`labbrdf.tracer.Medium`,
+        :mod:`labbrdf.tracer.medium`), with the parameters ``medium_tau``, ``medium_ssa``
+        and ``medium_g``. Traced with the evaluated estimator whatever the base: a
+        diffuse base then goes through the walk (``rays`` rays, Monte Carlo error, seed
+        replicates), not the renewal closed form, which holds for a clear coating only.
+        Single scattering on the top and the incoherent mode only.
 
     Parameters: ``n_coat`` [1] in [1.2, 2.2], fixed at 1.5 by default (``--free n_coat``);
     ``alpha_top`` [1] in [0.02, 1] (log), GGX roughness of the coating's top;
     ``alpha_sub`` [1] in [0.02, 1] (log), GGX roughness of the conductor (incoherent);
     ``albedo`` [1] in [0, 1], of the diffuse base;
     ``thickness_nm`` [nm] in [0, 2000] (coherent only); ``scale`` [1] in [0, 10], fixed at
-    1 (free it for relative data; linear); ``kd`` [1] in [0, 1] with ``floor`` (linear).
+    1 (free it for relative data; linear); ``kd`` [1] in [0, 1] with ``floor`` (linear);
+    with ``medium``: ``medium_tau`` [1] in [0.01, 10] (log), the medium's optical
+    thickness along the normal, ``medium_ssa`` [1] in [0, 1], its single-scattering
+    albedo, ``medium_g`` [1] in [-0.5, 0.95], its HG asymmetry.
 
     Notes
     -----
@@ -220,13 +231,15 @@ class Layered(Model):
         wavelength_nm: float = 550.0,
         distribution: str = "ggx",
         scattering: str = "single",
+        medium: bool = False,
         **options: Any,
     ) -> None:
         if options:
             raise ModelError(
                 f"model 'layered' got unknown options {sorted(options)}; options are "
                 "['n', 'k', 'base', 'coherent', 'coating_k', 'thickness_nm', 'floor', "
-                "'rays', 'seed', 'grid', 'wavelength_nm', 'distribution', 'scattering']"
+                "'rays', 'seed', 'grid', 'wavelength_nm', 'distribution', 'scattering', "
+                "'medium']"
             )
         if base not in _BASES:
             raise ModelError(f"layered option 'base' must be one of {list(_BASES)}; got {base!r}")
@@ -236,6 +249,7 @@ class Layered(Model):
         self._floor = _flag(floor, "floor")
         self._nk = (1.0, 0.0)
         self._closed = self._closed_form(base, scattering)
+        self._use_medium(medium, scattering)
         if base == "diffuse":
             if n is not None or k is not None:
                 raise ModelError(
@@ -319,6 +333,8 @@ class Layered(Model):
         if self._floor:
             opts["floor"] = True
             self.linear = ("scale", "kd")
+        if self._medium:
+            opts["medium"] = True
         opts["grid"] = "auto" if self._grid is None else f"{self._grid[0]:g}x{self._grid[1]:g}"
         super().__init__(**opts)
 
@@ -339,6 +355,27 @@ class Layered(Model):
             self.stochastic = False
             self.default_replicates = 1
         return closed
+
+    def _use_medium(self, medium: Any, scattering: Any) -> None:
+        """The checked ``medium`` option; a scattering coating makes the model traced.
+
+        The renewal closed form of a diffuse base assumes a clear coating, so with a
+        medium a diffuse base goes through the walk (evaluated estimator, Monte Carlo
+        error, seed replicates) like a conductor.
+        """
+        self._medium = _flag(medium, "medium")
+        if not self._medium:
+            return
+        if self._coherent or scattering != "single":
+            raise ModelError(
+                "layered option medium=True needs scattering='single' without coherent: "
+                "the scattering coating is traced by the evaluated walk (the coherent film "
+                "has no volume; multiple scattering on the top is only counted there)"
+            )
+        self._closed = False
+        self.fd_rel_step = type(self).fd_rel_step
+        self.stochastic = True
+        self.default_replicates = type(self).default_replicates
 
     def reseeded(self, seed: int) -> Layered:
         """The same model (options, grid) with the tracer seed ``seed`` and a fresh cache."""
@@ -397,6 +434,8 @@ class Layered(Model):
         )
         if self._floor:
             p.add("kd", 0.0, 0.0, 1.0, units="1", description="Lambertian floor albedo")
+        if self._medium:
+            _add_medium_params(p)
         return p
 
     def lobe_width(self, p: Mapping[str, float]) -> float:
@@ -459,6 +498,7 @@ class Layered(Model):
             thickness_nm=thick,
             alpha=a_top,
             ndf=table_for(dist, a_top),
+            medium=_medium_of(p) if self._medium else None,
         )
         if self._base == "diffuse":
             sub = Substrate.lambertian(float(p["albedo"]))
@@ -481,7 +521,7 @@ class Layered(Model):
         )
 
     def _key_params(self, p: Mapping[str, float]) -> tuple[float, ...]:
-        names = ("n_coat", "alpha_top", "alpha_sub", "thickness_nm", "albedo")
+        names = ("n_coat", "alpha_top", "alpha_sub", "thickness_nm", "albedo", *_MEDIUM_NAMES)
         return tuple(float(p[k]) for k in names if k in self.params)
 
     def trace_maps(
@@ -759,3 +799,43 @@ def _bilinear(m: NDArray, u: NDArray, v: NDArray) -> NDArray[np.float64]:
         + a * b * m[..., i0 + 1, j1],
         float,
     )
+
+
+#: the parameters of a scattering coating (``medium=True``)
+_MEDIUM_NAMES = ("medium_tau", "medium_ssa", "medium_g")
+
+
+def _add_medium_params(p: Parameters) -> None:
+    """The scattering coating's parameters (:class:`labbrdf.tracer.Medium`)."""
+    p.add(
+        "medium_tau",
+        0.5,
+        0.01,
+        10.0,
+        units="1",
+        log=True,
+        description="optical thickness of the coating's scattering medium (normal)",
+    )
+    p.add(
+        "medium_ssa",
+        0.9,
+        0.0,
+        1.0,
+        units="1",
+        description="single-scattering albedo of the coating's medium",
+    )
+    p.add(
+        "medium_g",
+        0.3,
+        -0.5,
+        0.95,
+        units="1",
+        description="Henyey-Greenstein asymmetry of the coating's medium",
+    )
+
+
+def _medium_of(p: Mapping[str, float]) -> Any:
+    """The :class:`labbrdf.tracer.Medium` of the parameter values ``p``."""
+    from ..tracer import Medium
+
+    return Medium(float(p["medium_tau"]), float(p["medium_ssa"]), float(p["medium_g"]))
