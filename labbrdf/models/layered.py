@@ -33,6 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .base import Model, ModelError, Parameters, lambert
+from .layered_medium import MEDIUM_NAMES, add_medium_params, medium_of, medium_option
 
 __all__ = ["Layered"]
 
@@ -143,23 +144,15 @@ class Layered(Model):
         rough top (a lossless coating over a white base returns 0.977 / 0.927 / 0.803 at
         ``alpha_top`` 0.05 / 0.1 / 0.2); "multiple" conserves it.
     medium : bool, default False
-        A scattering coating (paints, plastics, vinyls): a homogeneous Henyey-Greenstein
-        medium fills the coating (:class:`labbrdf.tracer.Medium`,
-        :mod:`labbrdf.tracer.medium`), with the parameters ``medium_tau``, ``medium_ssa``
-        and ``medium_g``. Traced with the evaluated estimator whatever the base: a
-        diffuse base then goes through the walk (``rays`` rays, Monte Carlo error, seed
-        replicates), not the renewal closed form, which holds for a clear coating only.
-        Single scattering on the top and the incoherent mode only.
+        A Henyey-Greenstein medium in the coating, traced even over a diffuse base
+        (:mod:`labbrdf.models.layered_medium`: its parameters and limits).
 
     Parameters: ``n_coat`` [1] in [1.2, 2.2], fixed at 1.5 by default (``--free n_coat``);
     ``alpha_top`` [1] in [0.02, 1] (log), GGX roughness of the coating's top;
     ``alpha_sub`` [1] in [0.02, 1] (log), GGX roughness of the conductor (incoherent);
     ``albedo`` [1] in [0, 1], of the diffuse base;
     ``thickness_nm`` [nm] in [0, 2000] (coherent only); ``scale`` [1] in [0, 10], fixed at
-    1 (free it for relative data; linear); ``kd`` [1] in [0, 1] with ``floor`` (linear);
-    with ``medium``: ``medium_tau`` [1] in [0.01, 10] (log), the medium's optical
-    thickness along the normal, ``medium_ssa`` [1] in [0, 1], its single-scattering
-    albedo, ``medium_g`` [1] in [-0.5, 0.95], its HG asymmetry.
+    1 (free it for relative data; linear); ``kd`` [1] in [0, 1] with ``floor`` (linear).
 
     Notes
     -----
@@ -215,6 +208,8 @@ class Layered(Model):
     #: three seeds: the seed spread is estimated with 2 degrees of freedom at 3x the cost
     #: of one fit (docs/models.md 7)
     default_replicates: int = 3
+    #: a scattering coating (option ``medium``; :mod:`labbrdf.models.layered_medium`)
+    _medium: bool = False
 
     def __init__(
         self,
@@ -248,8 +243,7 @@ class Layered(Model):
         self._distribution = _distribution(distribution, base, self._coherent)
         self._floor = _flag(floor, "floor")
         self._nk = (1.0, 0.0)
-        self._closed = self._closed_form(base, scattering)
-        self._use_medium(medium, scattering)
+        self._closed = medium_option(self, medium, scattering, self._closed_form(base, scattering))
         if base == "diffuse":
             if n is not None or k is not None:
                 raise ModelError(
@@ -316,6 +310,7 @@ class Layered(Model):
             "rays": self._rays,
             "seed": self._seed,
             **({"scattering": "multiple"} if self._multiple else {}),
+            **({"medium": True} if self._medium else {}),
         }
         if self._wl_default != 550.0:
             opts["wavelength_nm"] = self._wl_default
@@ -333,8 +328,6 @@ class Layered(Model):
         if self._floor:
             opts["floor"] = True
             self.linear = ("scale", "kd")
-        if self._medium:
-            opts["medium"] = True
         opts["grid"] = "auto" if self._grid is None else f"{self._grid[0]:g}x{self._grid[1]:g}"
         super().__init__(**opts)
 
@@ -355,27 +348,6 @@ class Layered(Model):
             self.stochastic = False
             self.default_replicates = 1
         return closed
-
-    def _use_medium(self, medium: Any, scattering: Any) -> None:
-        """The checked ``medium`` option; a scattering coating makes the model traced.
-
-        The renewal closed form of a diffuse base assumes a clear coating, so with a
-        medium a diffuse base goes through the walk (evaluated estimator, Monte Carlo
-        error, seed replicates) like a conductor.
-        """
-        self._medium = _flag(medium, "medium")
-        if not self._medium:
-            return
-        if self._coherent or scattering != "single":
-            raise ModelError(
-                "layered option medium=True needs scattering='single' without coherent: "
-                "the scattering coating is traced by the evaluated walk (the coherent film "
-                "has no volume; multiple scattering on the top is only counted there)"
-            )
-        self._closed = False
-        self.fd_rel_step = type(self).fd_rel_step
-        self.stochastic = True
-        self.default_replicates = type(self).default_replicates
 
     def reseeded(self, seed: int) -> Layered:
         """The same model (options, grid) with the tracer seed ``seed`` and a fresh cache."""
@@ -435,7 +407,7 @@ class Layered(Model):
         if self._floor:
             p.add("kd", 0.0, 0.0, 1.0, units="1", description="Lambertian floor albedo")
         if self._medium:
-            _add_medium_params(p)
+            add_medium_params(p)
         return p
 
     def lobe_width(self, p: Mapping[str, float]) -> float:
@@ -498,7 +470,7 @@ class Layered(Model):
             thickness_nm=thick,
             alpha=a_top,
             ndf=table_for(dist, a_top),
-            medium=_medium_of(p) if self._medium else None,
+            medium=medium_of(p) if self._medium else None,
         )
         if self._base == "diffuse":
             sub = Substrate.lambertian(float(p["albedo"]))
@@ -521,7 +493,7 @@ class Layered(Model):
         )
 
     def _key_params(self, p: Mapping[str, float]) -> tuple[float, ...]:
-        names = ("n_coat", "alpha_top", "alpha_sub", "thickness_nm", "albedo", *_MEDIUM_NAMES)
+        names = ("n_coat", "alpha_top", "alpha_sub", "thickness_nm", "albedo", *MEDIUM_NAMES)
         return tuple(float(p[k]) for k in names if k in self.params)
 
     def trace_maps(
@@ -799,43 +771,3 @@ def _bilinear(m: NDArray, u: NDArray, v: NDArray) -> NDArray[np.float64]:
         + a * b * m[..., i0 + 1, j1],
         float,
     )
-
-
-#: the parameters of a scattering coating (``medium=True``)
-_MEDIUM_NAMES = ("medium_tau", "medium_ssa", "medium_g")
-
-
-def _add_medium_params(p: Parameters) -> None:
-    """The scattering coating's parameters (:class:`labbrdf.tracer.Medium`)."""
-    p.add(
-        "medium_tau",
-        0.5,
-        0.01,
-        10.0,
-        units="1",
-        log=True,
-        description="optical thickness of the coating's scattering medium (normal)",
-    )
-    p.add(
-        "medium_ssa",
-        0.9,
-        0.0,
-        1.0,
-        units="1",
-        description="single-scattering albedo of the coating's medium",
-    )
-    p.add(
-        "medium_g",
-        0.3,
-        -0.5,
-        0.95,
-        units="1",
-        description="Henyey-Greenstein asymmetry of the coating's medium",
-    )
-
-
-def _medium_of(p: Mapping[str, float]) -> Any:
-    """The :class:`labbrdf.tracer.Medium` of the parameter values ``p``."""
-    from ..tracer import Medium
-
-    return Medium(float(p["medium_tau"]), float(p["medium_ssa"]), float(p["medium_g"]))
