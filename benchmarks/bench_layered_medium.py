@@ -1,7 +1,7 @@
 """The brown vinyl fitted with and without a scattering coating (``layered``, ``medium=True``).
 
 Run: ``python benchmarks/bench_layered_medium.py [--rays 10000] [--replicates 1]
-[--incidences 15,45,75] [--file F.bsdf] [--max-theta-r 90]``
+[--incidences 15,45,75] [--file F.bsdf] [--max-theta-r 90] [--check N]``
 
 Data: the Radiant IS-SA brown vinyl export of ``../shared/real-exports`` (three
 incidences, relative weights, as ``bench_layered.py``). Models: the layered model over a
@@ -12,6 +12,8 @@ estimator, ``--rays`` rays per trace, ``--replicates`` seeds). Per model: chi2/n
 the fitted parameters with their errors, the median relative residual ``(model - data) /
 data`` at 75 deg incidence over all its points and over the forward lobe (azimuth within
 30 deg of the specular plane's forward side, theta_r >= 45 deg), evaluations, CPU seconds.
+``--check N``: the fitted medium's evaluated map against the counting walk (N rays, every
+bin) at each incidence.
 
 Not a timed test: the traced fit takes minutes (about 1 s of CPU per evaluation at 2e4
 rays and three incidences); numbers depend on the machine and its load (report ``uptime``
@@ -46,7 +48,35 @@ def residuals(model: Any, res: Any, df: Any) -> tuple[float, float, int]:
     return float(np.median(rel)), float(np.median(rel[lobe])), int(lobe.sum())
 
 
-def run(label: str, model: Any, df: Any, replicates: int | None) -> None:
+def check(values: dict[str, float], incidences: list[float], rays: int) -> None:
+    """The model's evaluated trace at ``values`` against the counting walk, every bin.
+
+    Each incidence: the layered model's configuration (diffuse base, the medium of
+    ``values``, 3 x 6 degree bins, scalar M00) traced ``rays`` rays with either estimator
+    (seeds 0 and 99); M00 over every bin pooled into groups of 400 counted rays.
+    """
+    from labbrdf.tracer import Coating, Medium, Substrate, TraceConfig, trace
+    from labbrdf.tracer.agreement import agreement
+
+    med = Medium(values["medium_tau"], values["medium_ssa"], values["medium_g"])
+    for t in incidences:
+        cfg = TraceConfig(
+            rays=rays,
+            theta_i_deg=t,
+            wavelength_nm=555.0,
+            substrate=Substrate.lambertian(values["albedo"]),
+            coating=Coating(n=1.5, alpha=values["alpha_top"], thickness_nm=1000.0, medium=med),
+            scattering="single",
+            theta_step_deg=3.0,
+            phi_step_deg=6.0,
+        )
+        ev = trace(cfg.replace(estimator="evaluated"))
+        co = trace(cfg.replace(estimator="counting", seed=99))
+        ag = agreement(ev, co, elements="m00")
+        print(f"  {t:g} deg: evaluated vs counting ({rays} rays): {ag}")
+
+
+def run(label: str, model: Any, df: Any, replicates: int | None) -> dict[str, float]:
     """Fit, time and print one model."""
     t0, c0 = time.perf_counter(), time.process_time()
     res = fit(model, df, weighting="relative", replicates=replicates if model.stochastic else None)
@@ -66,6 +96,7 @@ def run(label: str, model: Any, df: Any, replicates: int | None) -> None:
     )
     for k, sb in (res.seed_spread or {}).items():
         print(f"    {k}: seed spread {sb:.4g}")
+    return {k: p.value for k, p in res.params.items()}
 
 
 def main() -> None:
@@ -75,6 +106,7 @@ def main() -> None:
     ap.add_argument("--file", type=Path, default=REAL)
     ap.add_argument("--incidences", default="15,45,75")
     ap.add_argument("--max-theta-r", type=float, default=90.0, help="drop points beyond [deg]")
+    ap.add_argument("--check", type=int, default=0, help="rays of the counting check (0: none)")
     args = ap.parse_args()
     if not args.file.exists():
         raise SystemExit(f"{args.file}: not found (the shared real exports)")
@@ -84,12 +116,14 @@ def main() -> None:
     df = df[df["theta_r_deg"] <= args.max_theta_r]
     print(f"{args.file.name}: {len(df)} points at {inc} deg, {args.rays} rays per trace")
     run("layered, diffuse base, clear coating", models.get("layered", base="diffuse"), df, None)
-    run(
+    values = run(
         f"layered, diffuse base, HG medium ({args.replicates} seed(s))",
         models.get("layered", base="diffuse", medium=True, rays=args.rays),
         df,
         args.replicates,
     )
+    if args.check:
+        check(values, inc, args.check)
 
 
 if __name__ == "__main__":

@@ -236,9 +236,15 @@ def cross_slab(medium: Medium, a_abs: float, k: F64, s: F64, rng: np.random.Gene
         act, z = _flight(medium, a_abs, rng, out, act, z)
     # rays still inside after MAX_EVENTS events: dropped
     out.weight[act] = 0.0
+    _park(out.k, out.s, act)
     out.up[act] = True
-    out.k[:, act] = np.array([[0.0], [0.0], [1.0]])
     return out
+
+
+def _park(k: F64, s: F64, idx: NDArray[np.int64]) -> None:
+    """Dropped rays (weight 0): straight up with a valid frame, to the top from below."""
+    k[:, idx] = np.array([[0.0], [0.0], [1.0]])
+    s[:, idx] = np.array([[1.0], [0.0], [0.0]])
 
 
 def _flight(
@@ -277,7 +283,7 @@ def _flight(
     out.weight[act] = w
     dead = act[sc & ~live]
     out.up[dead] = True
-    out.k[:, dead] = np.array([[0.0], [0.0], [1.0]])
+    _park(out.k, out.s, dead)
     keep = sc & live
     return act[keep], z[keep]
 
@@ -331,6 +337,6 @@ def traverse(
     j = idx[todo]  # still bouncing between the base and the medium: dropped
     absorbed += float(M[0, 0, j].sum())
     M[:, :, j] = 0.0
-    k[:, j] = np.array([[0.0], [0.0], [1.0]])
+    _park(k, s, j)
     up[todo] = True
     return absorbed, up, idx[based]
