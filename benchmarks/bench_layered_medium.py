@@ -95,7 +95,8 @@ def run(label: str, model: Any, df: Any, replicates: int | None) -> dict[str, fl
         f"({n_lobe} points) {100 * lobe75:+.1f} %"
     )
     for k, sb in (res.seed_spread or {}).items():
-        print(f"    {k}: seed spread {sb:.4g}")
+        seeds = ", ".join(f"{r[k]:.4g}" for r in res.replicates or [])
+        print(f"    {k}: seeds {seeds}; seed spread {sb:.4g}")
     return {k: p.value for k, p in res.params.items()}
 
 
