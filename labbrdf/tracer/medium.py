@@ -39,10 +39,10 @@ absorbed weight (the crossing reports one loss), so the walk's energy ledger sti
 References
 ----------
 .. [1] Henyey L. G., Greenstein J. L., "Diffuse radiation in the galaxy", Astrophys. J.
-   93, 70-83 (1941), eq. (7) (the phase function). doi:10.1086/144246
+   93, 70-83 (1941) (the phase function). doi:10.1086/144246
 .. [2] Guo Y., Hasan M., Zhao S., "Position-free Monte Carlo simulation for arbitrary
-   layered BSDFs", ACM Trans. Graph. 37(6), 279 (2018), sec. 4 (free flights in depth
-   between the interfaces). doi:10.1145/3272127.3275053
+   layered BSDFs", ACM Trans. Graph. 37(6), 279 (2018) (free flights in depth between
+   the interfaces). doi:10.1145/3272127.3275053
 """
 
 from __future__ import annotations
@@ -132,7 +132,7 @@ class Medium:
 
 
 def hg_phase(cos_theta: ArrayLike, g: float) -> F64:
-    """Henyey-Greenstein phase function [sr^-1] ([1]_ eq. (7), normalised over 4 pi sr).
+    """Henyey-Greenstein phase function [sr^-1] ([1]_, normalised over 4 pi sr).
 
     ``p = (1 - g^2) / (4 pi (1 + g^2 - 2 g cos theta)^(3/2))``, ``theta`` the angle
     between the travel directions before and after the event.
@@ -162,8 +162,8 @@ def hg_sample_cos(g: float, u: F64) -> F64:
 def _basis(k: F64) -> tuple[F64, F64]:
     """Two unit vectors completing ``k`` (3, n) to a right-handed orthonormal frame.
 
-    The branch-free frame of Duff et al., JCGT 6(1) 2017, listing 3 (continuous except
-    where ``k_z`` changes sign).
+    The branch-free frame of Duff et al., "Building an orthonormal basis, revisited",
+    JCGT 6(1) 2017 (continuous except where ``k_z`` changes sign).
     """
     sign = np.where(k[2] >= 0.0, 1.0, -1.0)
     a = -1.0 / (sign + k[2])
