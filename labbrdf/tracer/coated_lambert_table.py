@@ -40,6 +40,7 @@ from __future__ import annotations
 import hashlib
 import inspect
 import math
+from collections.abc import Callable
 from functools import lru_cache
 
 import numpy as np
@@ -114,7 +115,7 @@ def _key(*parts: object) -> str:
     return hashlib.blake2b(text.encode(), digest_size=16).hexdigest()
 
 
-def _cached(key: str, shape: tuple[int, ...], build) -> F64:  # type: ignore[no-untyped-def]
+def _cached(key: str, shape: tuple[int, ...], build: Callable[[], F64]) -> F64:
     """The array of ``key`` from the disk cache, or built and stored."""
     got = _cache.load(key, shape, np.float64)
     if got is not None:

@@ -192,3 +192,31 @@ def test_the_disk_cache_is_reused_and_a_damaged_file_rebuilt(fresh, tmp_path):
     tb.ms_table(1.5, *AB)
     assert len(calls) == 12
     assert len(list((tmp_path / "labbrdf" / "tracer").glob("exit-*.op"))) == 2
+
+
+def test_outside_the_tables_the_model_walks_directly(fresh):
+    """An alpha_top beyond the tabulated range is the direct walks' form, not extrapolated."""
+    from labbrdf import models
+
+    fresh.setattr(tb, "ALPHA_RANGE", NARROW)
+    for name, rays in (("TABLE_RAYS", 200), ("EMISSION_RAYS", 2_500), ("HIGHER_ORDER_RAYS", 500)):
+        fresh.setattr(ms, name, rays)
+    ms.coated_lambert_ms.cache_clear()
+    try:
+        lay = models.get("layered", base="diffuse", scattering="multiple", grid="3x6")
+        p = {"alpha_top": 0.5, "albedo": 0.4}
+        got = lay.hemispherical([30.0], p)
+        cfg = TraceConfig(
+            theta_i_deg=30.0,
+            substrate=Substrate.lambertian(0.4),
+            coating=Coating(n=1.5, alpha=0.5, thickness_nm=1000.0),
+            theta_step_deg=3.0,
+            phi_step_deg=6.0,
+        )
+        grid = Grid(3.0, 6.0)
+        body = ms.coated_lambert_ms(1.5, 0.5, 0.0, 1000.0, 550.0).bin_map(0.4, 30.0, grid)
+        want = float(((ms.first_surface_ms(cfg)[0] + body) * grid.cos_solid_angle_sr).sum())
+    finally:
+        ms.coated_lambert_ms.cache_clear()
+    assert got is not None
+    assert got[0] == pytest.approx(want, rel=1e-12)
