@@ -212,13 +212,10 @@ def first_surface_s0(n_coat: float, alpha: float, theta_i_deg: float, grid: Grid
     from .estimator import first_surface_nodes
 
     n = first_surface_nodes(alpha, min(grid.theta_step_deg, grid.phi_step_deg))
-    theta, dphi, w = bin_nodes(grid, n, n)
+    wo, w = _half_plane_nodes(grid.theta_step_deg, grid.phi_step_deg, n)
     nt, npf = grid.n_theta, grid.n_phi
     half = npf // 2 + 1
     th = math.radians(theta_i_deg)
-    t = theta[:, None, :, None]
-    p = np.radians(grid.phi_centres_deg)[:half][None, :, None, None] + dphi[None, None, None, :]
-    wo = np.stack(np.broadcast_arrays(np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)))
     wi = np.array([math.sin(th), 0.0, math.cos(th)]).reshape(3, 1, 1, 1, 1)
     h = wi + wo
     h = h / np.sqrt((h * h).sum(axis=0))
@@ -233,12 +230,31 @@ def first_surface_s0(n_coat: float, alpha: float, theta_i_deg: float, grid: Grid
             / (4.0 * wi[2] * wo[2])
         )
     f = np.where((wo[2] > 0) & (h[2] > 0), f, 0.0)
-    rows = (f * w[:, None, :, :]).sum(axis=(2, 3))
+    rows = (f * w).sum(axis=(2, 3))
     out = np.empty((nt, npf))
     out[:, :half] = rows
     rest = np.arange(half, npf)
     out[:, half:] = out[:, npf - rest]
     return out
+
+
+@lru_cache(maxsize=16)
+def _half_plane_nodes(theta_step: float, phi_step: float, n: int) -> tuple[F64, F64]:
+    """The half plane's node directions and weights of :func:`first_surface_s0`.
+
+    Exit directions (3, n_theta, half, n, n) and weights (n_theta, 1, n, n); kept, as they
+    depend on the grid only.
+    """
+    grid = Grid(theta_step, phi_step)
+    theta, dphi, w = bin_nodes(grid, n, n)
+    half = grid.n_phi // 2 + 1
+    t = theta[:, None, :, None]
+    p = np.radians(grid.phi_centres_deg)[:half][None, :, None, None] + dphi[None, None, None, :]
+    wo = np.stack(np.broadcast_arrays(np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)))
+    wo.flags.writeable = False
+    w = np.ascontiguousarray(w[:, None, :, :])
+    w.flags.writeable = False
+    return wo, w
 
 
 def _unpolarized_reflectance(n: float, c: F64) -> F64:

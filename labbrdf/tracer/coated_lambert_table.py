@@ -199,7 +199,12 @@ def higher_orders_table(
     return _higher_orders_table(*args, tuple(map(float, alpha_nodes())), NODE_RAYS)
 
 
-@lru_cache(maxsize=32)
+#: higher-order tables kept in memory: a joint fit of 13 incidences keeps each of its own;
+#: at most ~10 MB each (18 nodes of a 1 x 2 degree grid, spline coefficients)
+_HIGHER_KEPT = 16
+
+
+@lru_cache(maxsize=_HIGHER_KEPT)
 def _higher_orders_table(
     n_coat: float,
     theta_i_deg: float,
