@@ -21,12 +21,13 @@ and the source of the walk, so a file from other code or other inputs is never r
 this one).
 
 Errors. The spline's interpolation error, measured against the smooth single-scattering
-closed forms tabulated the same way (``docs/tracer.md``), is at most 2e-4 in ``T`` and
-``R`` (at ``alpha`` near 1; below 1e-5 at ``alpha`` <= 0.5), below the walks' own Monte
-Carlo error at these walk counts. The walks per node are fewer than the direct form's
-(:data:`NODE_RAYS`): the Monte Carlo error of a fitted parameter is measured by seed
-replicates (``layered``'s ``seed``: every walk's seed moves with it), which the fit adds to
-its error (:func:`labbrdf.fitting.combine_replicates`).
+closed forms tabulated the same way (``docs/tracer.md``), is at most 1.9e-4 in ``T`` and
+2.4e-4 in ``R`` (both near ``alpha`` 1; in ``T`` below 2.5e-5 up to ``alpha`` 0.6): below
+the walks' own Monte Carlo error at these walk counts (:data:`NODE_RAYS`; ``R`` 1.1e-3,
+``T`` 3e-5-3e-4) except in ``T`` near ``alpha`` 1, where it is of that order. The walks
+per node are fewer than the direct form's: the Monte Carlo error of a fitted parameter is
+measured by seed replicates (``layered``'s ``seed``: every walk's seed moves with it),
+which the fit adds to its error (:func:`labbrdf.fitting.combine_replicates`).
 
 References
 ----------
