@@ -100,12 +100,18 @@ def _walk_seed(seed: int) -> int:
 
 @lru_cache(maxsize=1)
 def _code_digest() -> str:
-    """A digest of the walk's source: a table built by other code is another table."""
-    from ..microfacet import ggx, height
-    from . import interfaces
+    """A digest of the walk's source: a table built by other code is another table.
+
+    The walk, its distribution, heights and Fresnel numbers, the binning of the higher
+    orders and this module (a changed source only costs a rebuild).
+    """
+    import sys
+
+    from ..microfacet import ggx, height, interface
+    from . import binning, interfaces
 
     h = hashlib.blake2b(digest_size=16)
-    for mod in (_ms, ggx, height, interfaces):
+    for mod in (_ms, ggx, height, interface, interfaces, binning, sys.modules[__name__]):
         h.update(inspect.getsource(mod).encode())
     return h.hexdigest()
 
