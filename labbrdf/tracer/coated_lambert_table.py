@@ -16,9 +16,9 @@ jumps). An evaluation is then a few spline evaluations.
   seed (:func:`higher_orders_table`).
 
 Both are kept in memory (bounded :func:`functools.lru_cache`) and on disk through
-:mod:`.cache` (verified on load; the key hashes every input, the walk counts, the nodes
-and the source of the walk, so a file from other code or other inputs is never read as
-this one).
+:mod:`labbrdf.tracer.cache` (verified on load; the key hashes every input, the walk
+counts, the nodes and the source of the walk, so a file from other code or other inputs is
+never read as this one).
 
 Errors. The spline's interpolation error, measured against the smooth single-scattering
 closed forms tabulated the same way (``docs/tracer.md``), is at most 1.9e-4 in ``T`` and
