@@ -161,6 +161,9 @@ def ms_table(
     seed : int
         Replicate seed of the walks.
 
+    A clear coating (``k_coat`` or ``thickness_nm`` 0) has one table whatever the
+    wavelength (the walks do not depend on it).
+
     Returns
     -------
     spline_t, spline_r : CubicSpline
@@ -169,6 +172,8 @@ def ms_table(
         Their standard errors at the nodes (nodes, 46) and (nodes,) [1].
     """
     ab = (float(k_coat), float(thickness_nm), float(wavelength_nm))
+    if k_coat == 0 or thickness_nm == 0:  # no absorption: one table for every wavelength
+        ab = (0.0, 0.0, 550.0)
     return _ms_table(float(n_coat), ab, int(seed), tuple(map(float, alpha_nodes())), NODE_RAYS)
 
 

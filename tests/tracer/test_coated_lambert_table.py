@@ -181,6 +181,8 @@ def test_the_disk_cache_is_reused_and_a_damaged_file_rebuilt(fresh, tmp_path):
         warnings.simplefilter("error", CacheWarning)
         again = tb.ms_table(1.5, *AB)[1](math.log(0.3))
     assert len(calls) == 4 and again == first
+    tb.ms_table(1.5, 0.0, 1000.0, 555.0)  # a clear coating: the same table at any wavelength
+    assert len(calls) == 4
     raw = bytearray(files[0].read_bytes())
     raw[-5] ^= 0xFF
     files[0].write_bytes(bytes(raw))
