@@ -203,7 +203,7 @@ def first_surface_s0(n_coat: float, alpha: float, theta_i_deg: float, grid: Grid
     point BRDF is ``A(cos_i) D(h) G1(w_i) G1(w_o) / (4 cos theta_i cos theta_o)`` (Walter
     et al. 2007, eq. (20); the unpolarized Fresnel reflectance in real arithmetic),
     averaged with the same nodes (:func:`.estimator.first_surface_nodes`,
-    :func:`.bin_nodes`) over the half plane ``phi`` in [0, 180] deg and mirrored. 10-15
+    :func:`.bin_nodes`) over the half plane ``phi`` in [0, 180] deg and mirrored. 9-15
     times faster than the Mueller map, equal to it to round-off.
 
     Parameters
