@@ -1,7 +1,8 @@
 """Cost of fitting the traced layered model, against microfacet + Lambertian on the same data.
 
 Run: ``python benchmarks/bench_layered.py [--repeat 3] [--rays 20000] [--file F.bsdf]
-[--incidences 15,45,75] [--replicates R] [--scattering single|multiple|both] [--check N]``
+[--incidences 15,45,75] [--replicates R] [--scattering single|multiple|both] [--check N]
+[--workers W] [--no-parts]``
 
 Data: the Radiant IS-SA brown vinyl export of ``../shared/real-exports`` (``--file``),
 fitted with the layered model over a diffuse base, or, where it is absent, a synthetic
@@ -34,11 +35,21 @@ then compares with the counting multiple-scattering walk. Measured (load average
 2 cores; ``--scattering both --check 200000 --no-parts``): single alpha_top 0.3442,
 albedo 0.2411, chi2/nu 0.1336, AIC -925.8, 13.2 s CPU; multiple 0.3561, 0.2038, 0.1459,
 -885.5, 297 s CPU (``docs/tracer.md``, multiple scattering over a Lambertian base).
+That was one seed; the walks of each new alpha_top were nearly all of it. Now
+(``labbrdf.tracer.coated_lambert_table``) the walks are tabulated in alpha_top once per
+coating and seed and splined, and the fit of ``scattering=multiple`` takes three seed
+replicates by default (their spread in its error): each run here first times the tables
+(cold, into an empty cache folder, then read back), then the fit cold (a fresh cache
+folder: every replicate builds its tables) and cached (the same folder again), with
+``--workers`` processes for the replicates (default 2; 1: serial). Wall and CPU seconds
+include the worker processes. Numbers: ``docs/tracer.md``.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import resource
 import statistics
 import tempfile
 import time
@@ -47,8 +58,9 @@ from typing import Any
 
 import numpy as np
 
-from labbrdf import adapters, fit, models
+from labbrdf import adapters, fit, models, parallel
 from labbrdf.bsdf_geometry import scatter_to_angles
+from labbrdf.fitting import fit_replicates
 from labbrdf.writers.zemax import write_bsdf
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -83,21 +95,39 @@ def synthetic(path: Path, incidences: list[float], rays: int) -> Path:
     )
 
 
-def run(label: str, make: Any, df: Any, repeat: int, replicates: int | None = None) -> dict:
+def _cpu() -> float:
+    """CPU seconds of this process and its finished children [s]."""
+    me, kids = (resource.getrusage(w) for w in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+def _fit(model: Any, df: Any, replicates: int | None, workers: int) -> Any:
+    """One fit; seed replicates of a stochastic model on ``workers`` processes."""
+    R = replicates if model.stochastic else None
+    R = model.default_replicates if R is None and model.stochastic else R
+    if R is not None and R > 1 and workers > 1:
+        ex = parallel.Executor("processes", workers=workers)
+        return fit_replicates(model, df, R, executor=ex, weighting="relative")
+    return fit(model, df, weighting="relative", replicates=R)
+
+
+def run(
+    label: str, make: Any, df: Any, repeat: int, replicates: int | None = None, workers: int = 1
+) -> dict:
     """Median wall time, nfev and fit statistics of ``repeat`` fits of ``make()``.
 
     ``replicates``: seed replicates of a stochastic model (None: the model's default);
-    their traces run in fresh model instances and are not counted.
+    their traces run in fresh model instances and are not counted; on ``workers``
+    processes.
     """
     walls, cpus, nfevs, traces = [], [], [], []
     res = None
     for _ in range(repeat):
         model = make()
-        t0, c0 = time.perf_counter(), time.process_time()
-        R = replicates if model.stochastic else None
-        res = fit(model, df, weighting="relative", replicates=R)
+        t0, c0 = time.perf_counter(), _cpu()
+        res = _fit(model, df, replicates, workers)
         walls.append(time.perf_counter() - t0)
-        cpus.append(time.process_time() - c0)
+        cpus.append(_cpu() - c0)
         nfevs.append(res.nfev)
         traces.append(getattr(model, "traces", 0))
     assert res is not None
@@ -115,6 +145,64 @@ def run(label: str, make: Any, df: Any, repeat: int, replicates: int | None = No
         se = res.params[k].stderr or float("nan")
         print(f"    {k}: seeds {vals}; s_between {sb:.4f}; reported stderr {se:.4f}")
     return {"wall": wall, "nfev": nfev, "result": res}
+
+
+def tables(incidences: list[float], grid: tuple[float, float]) -> None:
+    """Seconds to build the multiple-scattering tables of one seed, cold and from disk."""
+    from labbrdf.tracer import coated_lambert_table as tb
+
+    tb.clear_memory()
+    c0 = time.process_time()
+    tb.ms_table(1.5, 0.0, 1000.0, 550.0)
+    c1 = time.process_time()
+    for t in incidences:
+        tb.higher_orders_table(1.5, t, grid)
+    c2 = time.process_time()
+    tb.clear_memory()
+    tb.ms_table(1.5, 0.0, 1000.0, 550.0)
+    for t in incidences:
+        tb.higher_orders_table(1.5, t, grid)
+    c3 = time.process_time()
+    tb.clear_memory()
+    print(
+        f"tables of one seed ({tb.alpha_nodes().size} alpha nodes, walks {tb.NODE_RAYS}): "
+        f"T and R {c1 - c0:.1f} s CPU, higher orders at {len(incidences)} incidences "
+        f"{c2 - c1:.1f} s; from the disk cache {c3 - c2:.3f} s"
+    )
+
+
+def multiple(df: Any, args: Any, inc: list[float]) -> dict:
+    """The multiple-scattering fit: tables, then the fit cold and cached (fresh folder)."""
+    from labbrdf.tracer import coated_lambert_table as tb
+
+    old = os.environ.get("XDG_CACHE_HOME")
+    with tempfile.TemporaryDirectory() as tmp:
+        os.environ["XDG_CACHE_HOME"] = tmp
+        try:
+            probe = models.get("layered", base="diffuse", scattering="multiple")
+            probe._set_grid(df["theta_i_deg"].to_numpy(float))  # the fit's grid
+            assert probe.grid_deg is not None
+            tables(inc, probe.grid_deg)
+            out: dict = {}
+            for state in ("cold", "cached"):
+                if state == "cold":
+                    for f in Path(tmp).rglob("exit-*.op"):
+                        f.unlink()
+                tb.clear_memory()
+                out = run(
+                    f"layered, diffuse base, multiple ({state})",
+                    lambda: models.get("layered", base="diffuse", scattering="multiple"),
+                    df,
+                    args.repeat,
+                    args.replicates,
+                    args.workers,
+                )
+        finally:
+            if old is None:
+                os.environ.pop("XDG_CACHE_HOME", None)
+            else:
+                os.environ["XDG_CACHE_HOME"] = old
+    return out
 
 
 def parts(df: Any, rays: int) -> None:
@@ -156,11 +244,14 @@ def parts(df: Any, rays: int) -> None:
 
 
 def check(res: Any, incidences: list[float], rays: int, scattering: str = "single") -> None:
-    """The closed-form diffuse base at the fitted parameters against the counting walk."""
-    from labbrdf.tracer import Coating, Substrate, TraceConfig, trace
+    """The closed-form diffuse base at the fitted parameters against the counting walk.
+
+    Multiple scattering: the tabulated form the fit used (seed 0's tables).
+    """
+    from labbrdf.tracer import Coating, Grid, Substrate, TraceConfig, trace
     from labbrdf.tracer.agreement import pool_bins
-    from labbrdf.tracer.coated_lambert import coated_lambert
-    from labbrdf.tracer.coated_lambert_ms import coated_lambert_ms, first_surface_ms
+    from labbrdf.tracer.coated_lambert import coated_lambert, first_surface_s0
+    from labbrdf.tracer.coated_lambert_table import tabulated_first_surface, tabulated_ms
     from labbrdf.tracer.estimator import first_surface_map
 
     a, alb = res.params["alpha_top"].value, res.params["albedo"].value
@@ -179,8 +270,10 @@ def check(res: Any, incidences: list[float], rays: int, scattering: str = "singl
         )
         ct = trace(cfg)
         if scattering == "multiple":
-            f = first_surface_ms(cfg)[0]
-            body = coated_lambert_ms(1.5, a, 0.0, 1000.0, cfg.wavelength_nm)
+            grid = (cfg.theta_step_deg, cfg.phi_step_deg)
+            single = first_surface_s0(1.5, a, t, Grid(*grid))
+            f = tabulated_first_surface(single, 1.5, a, t, Grid(*grid))
+            body = tabulated_ms(1.5, a, 0.0, 1000.0, cfg.wavelength_nm)
         else:
             f = first_surface_map(cfg)[..., 0, 0]
             body = coated_lambert(1.5, a, 0.0, 1000.0, cfg.wavelength_nm)
@@ -213,6 +306,7 @@ def main() -> None:
     ap.add_argument("--check", type=int, default=0, help="rays of the counting check (0: none)")
     ap.add_argument("--scattering", choices=("single", "multiple", "both"), default="single")
     ap.add_argument("--no-parts", action="store_true", help="skip the traced conductor parts")
+    ap.add_argument("--workers", type=int, default=2, help="processes for seed replicates")
     args = ap.parse_args()
     inc = [float(x) for x in args.incidences.split(",")]
     with tempfile.TemporaryDirectory() as tmp:
@@ -231,13 +325,16 @@ def main() -> None:
         if path == args.file:  # the vinyl: a clear layer over a diffuse body
             kinds = ("single", "multiple") if args.scattering == "both" else (args.scattering,)
             for sc in kinds:
-                out = run(
-                    f"layered, diffuse base, {sc}",
-                    lambda sc=sc: models.get("layered", base="diffuse", scattering=sc),
-                    df,
-                    args.repeat,
-                    args.replicates,
-                )
+                if sc == "multiple":
+                    out = multiple(df, args, inc)
+                else:
+                    out = run(
+                        "layered, diffuse base, single",
+                        lambda: models.get("layered", base="diffuse"),
+                        df,
+                        args.repeat,
+                        args.replicates,
+                    )
                 if args.check:
                     check(out["result"], inc, args.check, sc)
         else:

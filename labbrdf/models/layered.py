@@ -123,7 +123,8 @@ class Layered(Model):
         over the lobe of a coating on Al (``docs/models.md`` 7).
     seed : int, default 0
         Seed of every trace (common random numbers: the same for all parameter values;
-        conductor base only).
+        conductor base), or of the walks tabulated for ``scattering="multiple"`` over a
+        diffuse base.
     grid : "auto", "THETAxPHI" or (float, float), default "auto"
         Tracer bin steps (theta, phi) [deg], e.g. "3x6"; "auto" derives them from the
         number of points per incidence of the first evaluation (:meth:`_set_grid`; at
@@ -170,8 +171,10 @@ class Layered(Model):
     Single scattering (separable Smith G1 G1) loses energy at rough interfaces. Over a
     conductor the multiple-scattering walk only counts rays, whose noise no fit can use;
     over a diffuse base the renewal form holds for the whole microsurface walk
-    (``scattering="multiple"``; ``T`` and ``R`` from walks with fixed seeds, about 3 s
-    per ``(n_coat, alpha_top)``; ``docs/tracer.md``).
+    (``scattering="multiple"``; ``T``, ``R`` and the first surface's higher orders from
+    walks with fixed seeds, tabulated once per coating over ``alpha_top`` in [0.02, 1]
+    and splined, about 10 s of walks per seed and coating, cached on disk; each new
+    ``n_coat`` is a new table; three seed replicates by default; ``docs/tracer.md``).
     A nearly smooth top (``alpha_top`` below about ``0.035 / (n_coat - 1)``, 0.07 for
     n_coat = 1.5) has an exit lobe narrower than the tracer's exit operator resolves; there
     the tracer exits through the walk's own sampled facet instead (unbiased, no operator to
@@ -337,16 +340,22 @@ class Layered(Model):
         A Lambertian base makes the walk a renewal process, whose expectation is a closed
         form (:mod:`labbrdf.tracer.coated_lambert`): no rays. The coherent mode's map is
         evaluated in closed form too. Both are deterministic. Multiple scattering: walks
-        with fixed seeds (:mod:`labbrdf.tracer.coated_lambert_ms`) whose binned higher
-        orders jump below a parameter step of ~1e-3, so finite differences keep a step.
+        of the model's seed tabulated in ``alpha_top`` and splined
+        (:mod:`labbrdf.tracer.coated_lambert_table`): smooth in the parameters (ordinary
+        finite differences), but the value depends on the seed, so the fit takes three
+        seed replicates by default.
         """
         self._multiple = _scattering(scattering, base)
         self._first_maps: OrderedDict[tuple, NDArray] = OrderedDict()  # closed form's
         closed = base == "diffuse"
         if closed or self._coherent:
-            self.fd_rel_step = 3e-3 if self._multiple else None
+            self.fd_rel_step = None
             self.stochastic = False
             self.default_replicates = 1
+        if closed and self._multiple:
+            # tables in alpha_top from walks of the model's seed: smooth, seed-dependent
+            self.stochastic = True
+            self.default_replicates = 3
         return closed
 
     def reseeded(self, seed: int) -> Layered:
@@ -552,10 +561,9 @@ class Layered(Model):
         """
         from ..tracer import Grid
         from ..tracer.coated_lambert import coated_lambert
-        from ..tracer.coated_lambert_ms import coated_lambert_ms
 
         coat = cfg.coating
-        form = coated_lambert_ms if self._multiple else coated_lambert
+        form = self._ms_form(coat.alpha) if self._multiple else coated_lambert
         grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
         body = form(coat.n, coat.alpha, coat.k, coat.thickness_nm, cfg.wavelength_nm).bin_map(
             float(cfg.substrate.albedo), cfg.theta_i_deg, grid
@@ -563,12 +571,29 @@ class Layered(Model):
         self.traces += 1
         return np.asarray(self._first_map(cfg) + body, float)
 
+    def _ms_form(self, alpha: float) -> Any:
+        """Multiple scattering's ``T``, ``R`` at ``alpha``: tabulated for the model's seed.
+
+        Inside :data:`labbrdf.tracer.coated_lambert_table.ALPHA_RANGE` the tables in
+        ``alpha_top`` (smooth, built once); outside it the direct walks of
+        :func:`labbrdf.tracer.coated_lambert_ms.coated_lambert_ms` (about 4 s each).
+        """
+        from functools import partial
+
+        from ..tracer.coated_lambert_ms import coated_lambert_ms
+        from ..tracer.coated_lambert_table import in_range, tabulated_ms
+
+        return partial(tabulated_ms, seed=self._seed) if in_range(alpha) else coated_lambert_ms
+
     def _first_map(self, cfg: Any) -> NDArray[np.float64]:
         """The first surface's S0 map: closed form, plus the walk's higher orders if asked.
 
         It does not depend on the albedo: kept per (coating, incidence, grid).
         """
+        from ..tracer import Grid
+        from ..tracer.coated_lambert import first_surface_s0
         from ..tracer.coated_lambert_ms import first_surface_ms
+        from ..tracer.coated_lambert_table import in_range, tabulated_first_surface
         from ..tracer.estimator import first_surface_map
 
         coat = cfg.coating
@@ -576,7 +601,13 @@ class Layered(Model):
         key = (coat.n, coat.alpha, cfg.theta_i_deg, cfg.theta_step_deg, cfg.phi_step_deg)
         first = self._first_maps.get(key)
         if first is None:
-            if self._multiple:
+            if self._multiple and in_range(coat.alpha):
+                grid = Grid(cfg.theta_step_deg, cfg.phi_step_deg)
+                single = first_surface_s0(coat.n, coat.alpha, cfg.theta_i_deg, grid)
+                first = tabulated_first_surface(
+                    single, coat.n, coat.alpha, cfg.theta_i_deg, grid, self._seed
+                )
+            elif self._multiple:
                 first = first_surface_ms(cfg)[0]
             else:
                 first = first_surface_map(cfg)[..., 0, 0]

@@ -257,10 +257,11 @@ def transmittance_table(
     alpha: float,
     absorption: tuple[float, float, float],
     rays: int = TABLE_RAYS,
+    seed: int = SEED,
 ) -> tuple[F64, F64]:
     """``T(theta)`` at :data:`TABLE_DEG` with all orders, and its standard error [1]."""
     k, below = _from_above(TABLE_DEG, rays)
-    esc = top_walk(k, below, n_coat, alpha)
+    esc = top_walk(k, below, n_coat, alpha, seed)
     per = _per_ray(esc, esc.below, beer_lambert(esc.k[2], *absorption), k.shape[1])
     per = per.reshape(TABLE_DEG.size, rays)
     return per.mean(axis=1), per.std(axis=1, ddof=1) / math.sqrt(rays)
@@ -271,14 +272,15 @@ def internal_reflectance_ms(
     alpha: float,
     absorption: tuple[float, float, float],
     rays: int = EMISSION_RAYS,
+    seed: int = SEED,
 ) -> tuple[float, float]:
     """``R`` with all orders and its standard error [1]: the base's cosine emission.
 
     Stratified cosine-law directions (Malley's method on a regular grid of the unit
     square, jittered), Beer-Lambert up, the walk on the top's lower side, Beer-Lambert
-    down along each reflected escape.
+    down along each reflected escape. ``seed``: the walks use ``seed + 1`` and ``seed + 2``.
     """
-    rng = np.random.default_rng(SEED + 1)
+    rng = np.random.default_rng(seed + 1)
     side = int(math.isqrt(rays))
     a, b = np.meshgrid(np.arange(side), np.arange(side), indexing="ij")
     u0 = (a.ravel() + rng.random(side * side)) / side
@@ -286,23 +288,23 @@ def internal_reflectance_ms(
     r = np.sqrt(u0)
     phi = 2.0 * np.pi * u1
     k = np.stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1.0 - u0)])
-    esc = top_walk(k, np.ones(k.shape[1], bool), n_coat, alpha, SEED + 2)
+    esc = top_walk(k, np.ones(k.shape[1], bool), n_coat, alpha, seed + 2)
     att = beer_lambert(k[2], *absorption)
     per = att * _per_ray(esc, esc.below, beer_lambert(esc.k[2], *absorption), k.shape[1])
     return float(per.mean()), float(per.std(ddof=1) / math.sqrt(per.size))
 
 
 def higher_orders_map(
-    n_coat: float, alpha: float, theta_i_deg: float, grid: Grid, rays: int
+    n_coat: float, alpha: float, theta_i_deg: float, grid: Grid, rays: int, seed: int = SEED
 ) -> tuple[F64, float]:
     """The first surface's reflection of order >= 2: bin averages [sr^-1].
 
     Counted into the bins of ``grid`` (cos-weighted averages, like the tracer's maps)
     from ``rays`` walks at the incidence; returns the map (n_theta, n_phi) and the
-    standard error of its albedo [1] (per-ray totals).
+    standard error of its albedo [1] (per-ray totals). The walks use ``seed + 3``.
     """
     k, below = _from_above(np.array([theta_i_deg]), rays)
-    esc = top_walk(k, below, n_coat, alpha, SEED + 3)
+    esc = top_walk(k, below, n_coat, alpha, seed + 3)
     sel = ~esc.below & (esc.order >= 2) & (esc.k[2] > 0)
     idx, _ = grid.index(esc.k[:, sel])
     s = np.bincount(idx, weights=esc.weight[sel], minlength=grid.n_bins)

@@ -185,25 +185,27 @@ def test_a_nearly_smooth_coating_keeps_its_energy():
 
 def test_multiple_scattering_over_a_white_base_returns_all_the_light(monkeypatch):
     """Lossless coating, white base, alpha_top 0.3: the model's albedo is 1 (to 4e-3 with
-    the few walks used here) where single scattering's is 0.69; the option round-trips."""
-    from labbrdf.tracer import coated_lambert_ms as ms
+    the tables' walks) where single scattering's is 0.69; the option round-trips; the
+    tables' seed is the model's (seed replicates), and another seed moves the value by its
+    Monte Carlo error only."""
+    from labbrdf.tracer import coated_lambert_table as tb
 
-    for name, rays in (("TABLE_RAYS", 4_000), ("EMISSION_RAYS", 160_000)):
-        monkeypatch.setattr(ms, name, rays)
-    monkeypatch.setattr(ms, "HIGHER_ORDER_RAYS", 40_000)
-    ms.coated_lambert_ms.cache_clear()
+    monkeypatch.setattr(tb, "ALPHA_RANGE", (0.28, 0.36))  # four nodes: cheap walks
+    tb.clear_memory()
     p = {"alpha_top": 0.3, "albedo": 1.0}
     try:
         lay = models.get("layered", base="diffuse", scattering="multiple", grid="3x6")
         got = lay.hemispherical([20.0, 60.0], p)
+        other = lay.reseeded(1).hemispherical([20.0], p)
     finally:
-        ms.coated_lambert_ms.cache_clear()
+        tb.clear_memory()
     single = models.get("layered", base="diffuse", grid="3x6").hemispherical([20.0], p)
-    assert got is not None and single is not None
+    assert got is not None and single is not None and other is not None
     np.testing.assert_allclose(got, 1.0, atol=4e-3)
+    assert other[0] != got[0] and abs(other[0] - got[0]) < 4e-3
     assert single[0] < 0.7
-    assert lay.options["scattering"] == "multiple" and lay.fd_rel_step == 3e-3
-    assert not lay.stochastic
+    assert lay.options["scattering"] == "multiple" and lay.fd_rel_step is None
+    assert lay.stochastic and lay.default_replicates == 3
 
 
 def test_points_near_the_normal_evaluate_without_a_warning():
