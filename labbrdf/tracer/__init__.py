@@ -217,10 +217,10 @@ def _evaluated(
     config: TraceConfig, grid: Grid, cells: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
     """First-surface map (n_theta, n_phi, 4, 4) and per-batch exit sums (B, ...) [sr^-1]."""
-    from .estimator import exit_map, first_surface_map
+    from .estimator import exit_map, first_surface_map, masking_of
 
     t0 = time.perf_counter()
-    first = first_surface_map(config)
+    first = first_surface_map(config, masking=masking_of(config))
     info = {"first_surface_seconds": time.perf_counter() - t0}
     shape = (config.batches, grid.n_theta, grid.n_phi, 4, 4)
     if config.coating is not None and not config.coherent:

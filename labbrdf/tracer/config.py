@@ -320,7 +320,9 @@ class TraceConfig:
     estimator : {"auto", "evaluated", "counting"}
         How the map is estimated (``docs/tracer.md``). ``"counting"``: exiting rays are
         counted into bins (the paper's estimator). ``"evaluated"`` (single scattering
-        with a rough first interface only): the first interface's reflection is evaluated
+        with a rough first interface, or multiple scattering under an incoherent coating
+        with a rough GGX top, :attr:`evaluated_multiple_applies`): the first interface's
+        reflection is evaluated
         in closed form at every bin, the walk below it follows reflection and refraction
         with their Mueller weights instead of a random choice, and the exit through a
         rough top interface is applied as an operator on the up-going internal
@@ -443,7 +445,9 @@ class TraceConfig:
             self.estimator != "evaluated" or self.evaluated_applies,
             "estimator",
             "'counting' or 'auto' here: 'evaluated' needs scattering='single' and a rough "
-            "first interface (alpha > 0), or a bare Lambertian base",
+            "first interface (alpha > 0), or a bare Lambertian base; with "
+            "scattering='multiple' an incoherent coating with a rough GGX top (alpha > 0, "
+            "no slope table): a bare substrate's or a coherent film's walk is counted",
             self.estimator,
         )
         # the incoherent walk treats the coating as a separate rough layer between two
@@ -481,18 +485,29 @@ class TraceConfig:
     def evaluated_applies(self) -> bool:
         """Whether ``estimator="evaluated"`` covers this run.
 
-        It needs single scattering (the multiple-scattering walk's exits are counted) and a
-        rough first interface (the coating's top, or the substrate, or the coherent facets),
-        whose reflection has a closed form (GGX, or a slope table's). A bare Lambertian
-        base is its own closed form (``albedo / pi``) in either scattering mode.
+        Single scattering: a rough first interface (the coating's top, or the substrate,
+        or the coherent facets), whose reflection has a closed form (GGX, or a slope
+        table's). Multiple scattering: :attr:`evaluated_multiple_applies`. A bare
+        Lambertian base is its own closed form (``albedo / pi``) in either scattering mode.
         """
         if self.coating is None and self.substrate.albedo is not None:
             return True
         if self.scattering != "single":
-            return False
+            return self.evaluated_multiple_applies
         if self.coating is not None:
             return self.coating.alpha > 0
         return self.substrate.ndf is not None or self.substrate.alpha > 0
+
+    @property
+    def evaluated_multiple_applies(self) -> bool:
+        """Whether the evaluated estimator covers this multiple-scattering run.
+
+        An incoherent coating with a rough GGX top (its single events have closed forms
+        with the height-correlated masking; ``docs/tracer.md``), over any base. A bare
+        substrate and the coherent film keep counting.
+        """
+        c = self.coating
+        return c is not None and not self.coherent and c.alpha > 0 and c.ndf is None
 
     @property
     def resolved_estimator(self) -> str:

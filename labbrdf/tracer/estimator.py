@@ -19,7 +19,13 @@ from numpy.typing import NDArray
 from ..microfacet.interface import ClosedForm
 from .binning import Grid
 from .config import TraceConfig
-from .evaluate import bin_nodes, reflection_mueller, transmission_mueller
+from .evaluate import (
+    bin_nodes,
+    correlated_reflection,
+    correlated_transmission,
+    reflection_mueller,
+    transmission_mueller,
+)
 from .operator import PARITY, exit_operator
 from .setup import WalkSetup, scalar_abcs
 
@@ -28,8 +34,19 @@ __all__ = [
     "first_surface_map",
     "first_surface_nodes",
     "first_surface_point",
+    "masking_of",
     "nee_exit",
 ]
+
+
+def masking_of(cfg: TraceConfig) -> str:
+    """The masking of the evaluated single events: ``"separable"`` or ``"correlated"``.
+
+    The multiple-scattering walk's single reflection and single refraction carry the
+    height-correlated masking (:func:`.evaluate.correlated_reflection`,
+    :func:`.evaluate.correlated_transmission`); single scattering the separable one.
+    """
+    return "separable" if cfg.scattering == "single" else "correlated"
 
 
 def first_surface_nodes(alpha: float, step_deg: float) -> int:
@@ -61,6 +78,21 @@ def _first_surface(cfg: TraceConfig) -> tuple:  # noqa: ANN401
     if cfg.scalar:
         abcs = _scalar_abcs(abcs)
     return abcs, face.d, face.smith_g1, face.alpha
+
+
+def _masking(cfg: TraceConfig, masking: str) -> object:
+    """The ``g2_of`` of the first interface for :func:`.evaluate.reflection_mueller`."""
+    if masking == "separable":
+        return None
+    if masking != "correlated":
+        raise ValueError(f"masking must be 'separable' or 'correlated', got {masking!r}")
+    su = WalkSetup(cfg)
+    face = su.top if su.top is not None else su.sub
+
+    def lam(v: NDArray) -> NDArray:
+        return face.smith_lambda(np.stack([v[0], v[1], np.abs(v[2])]))
+
+    return correlated_reflection(lam)
 
 
 def first_surface_point(
@@ -95,8 +127,13 @@ def first_surface_point(
     return out
 
 
-def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.float64]:
+def first_surface_map(
+    cfg: TraceConfig, chunk: int = 200_000, masking: str = "separable"
+) -> NDArray[np.float64]:
     """Bin-averaged Mueller BRDF of the first interface's single reflection [sr^-1].
+
+    ``masking``: ``"separable"`` (``G1 G1``) or ``"correlated"`` (``1 / (1 + L_i +
+    L_o)``, the multiple-scattering walk's single event, :func:`masking_of`).
 
     Returns
     -------
@@ -113,6 +150,7 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
     k_in = np.array([-np.sin(th), 0.0, -np.cos(th)])
     s_in = np.array([0.0, 1.0, 0.0])
     abcs, d_of, g1_of, alpha = _first_surface(cfg)
+    g2_of = _masking(cfg, masking)
     n = first_surface_nodes(alpha, min(cfg.theta_step_deg, cfg.phi_step_deg))
     if table:
         n = 6
@@ -133,7 +171,7 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
         t = theta[it[sl], a[sl]]
         p = phi_c[jp[sl]] + dphi[b[sl]]
         wo = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)])
-        M = reflection_mueller(k_in, s_in, wo, abcs, d_of, g1_of)
+        M = reflection_mueller(k_in, s_in, wo, abcs, d_of, g1_of, g2_of)  # type: ignore[arg-type]
         rows = M.reshape(16, -1) * w[it[sl], a[sl], b[sl]]
         for e in range(16):
             out[e] += np.bincount(flat[sl], weights=rows[e], minlength=nt * half)
@@ -210,7 +248,7 @@ def _operator_map(
     """The exit operator applied to the internal cell sums (B, n_theta, n_phi, 4, 4)."""
     # one output node per degree of bin width (a coarse bin is not one point)
     nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
-    op = exit_operator(grid, su.n_coat, su.alpha_top, nodes=nodes)
+    op = exit_operator(grid, su.n_coat, su.alpha_top, nodes=nodes, masking=masking_of(cfg))
     info = {"operator_seconds": op.seconds, "operator_mb": op.nbytes / 1e6}
     if cfg.scalar:
         # the scalar walk carries M00 alone; the operator's (0, 0) element is the scalar
@@ -263,6 +301,14 @@ def nee_exit(
 
     assert su.top is not None
     d_of, g1_of = su.top.d, su.top.smith_g1
+    top = su.top
+    g2_of = (
+        None
+        if cfg.scattering == "single"
+        else correlated_transmission(
+            lambda v: top.smith_lambda(np.stack([v[0], v[1], np.abs(v[2])]))
+        )
+    )
     nb = cfg.batches
     acc = np.zeros((nb, len(bins), 4, 4))
     omega = grid.cos_solid_angle_sr
@@ -289,6 +335,7 @@ def nee_exit(
                         abcs_t,
                         d_of,
                         g1_of,
+                        g2_of,
                     )
                     contrib = np.einsum("ikn,kjn->nij", T, rows) * w[i, a, b]
                     for bb in range(nb):

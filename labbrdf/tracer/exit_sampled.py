@@ -37,6 +37,7 @@ from .interfaces import apply_fresnel, rotate_frame
 __all__ = [
     "MIN_LOBE_NODES",
     "deposit_cells",
+    "deposit_escape",
     "deposit_exit",
     "exit_is_sampled",
     "lobe_width_rad",
@@ -140,6 +141,40 @@ def deposit_exit(
     rotate_frame(Mt, kt, s_loc[:, idx], s_out)
     # after the operator's cells (record_up): keys from batches * n_bins on
     keys.append((batches + rid[idx] % batches) * grid.n_bins + bin_)
+    rows.append(Mt.reshape(16, -1))
+
+
+def deposit_escape(
+    grid: Grid,
+    batches: int,
+    k: F64,
+    s: F64,
+    M: F64,
+    rid: NDArray[np.int64],
+    keys: list[NDArray],
+    rows: list[NDArray],
+) -> None:
+    """Sum rays leaving into the air, with their weights as they are, into exit bins.
+
+    The escapes of the evaluated multiple-scattering walk that no closed form or operator
+    describes (:mod:`.walk`): keyed as :func:`deposit_exit`'s, after the operator's cells.
+
+    Parameters
+    ----------
+    k, s : ndarray, shape (3, n)
+        Exit directions (up) and their Stokes frames' x axes.
+    M : ndarray, shape (4, 4, n)
+        The escaping Mueller weights in the frames ``s`` (not changed).
+    rid : ndarray of int, shape (n,)
+        Global ray indices (batch = index modulo ``batches``).
+    """
+    if k.shape[1] == 0:
+        return
+    Mt = M.copy()
+    bin_, phi = grid.index(k)
+    s_out = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+    rotate_frame(Mt, k, s, s_out)
+    keys.append((batches + rid % batches) * grid.n_bins + bin_)
     rows.append(Mt.reshape(16, -1))
 
 

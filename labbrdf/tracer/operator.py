@@ -40,7 +40,7 @@ from ..microfacet import ggx
 from . import cache as _cache
 from .binning import Grid
 from .cache import cache_dir
-from .evaluate import bin_nodes, cell_nodes, transmission_mueller
+from .evaluate import bin_nodes, cell_nodes, correlated_transmission, transmission_mueller
 from .exit_sampled import lobe_width_rad
 from .interfaces import fresnel_abcs
 
@@ -60,6 +60,11 @@ MEMORY_OPERATORS = 2
 CELL_NODES_PER_LOBE = 2.5
 #: at most this many polar sub-cell nodes
 CELL_MAX_NODES = 6
+
+#: the masking of the operator's BTDF: separable ``G1 G1`` (single scattering) or the
+#: height-correlated ``B(1 + L_i, 1 + L_o)`` of the multiple-scattering walk's single
+#: refraction (:func:`.evaluate.correlated_transmission`)
+MASKINGS = ("separable", "correlated")
 
 PARITY = np.array([1, 1, -1, -1])[:, None] * np.array([1, 1, -1, -1])[None, :]
 
@@ -131,6 +136,7 @@ def build_exit_operator(
     *,
     n_above: float = 1.0,
     nodes: tuple[int, int] = (1, 1),
+    masking: str = "separable",
 ) -> ExitOperator:
     """Build ``T10`` for a GGX interface from a dielectric ``n_below`` into ``n_above``.
 
@@ -144,6 +150,8 @@ def build_exit_operator(
         GGX roughness of the interface [1], > 0.
     nodes : (int, int)
         Gauss-Legendre nodes per output bin in sin^2 theta and phi.
+    masking : {"separable", "correlated"}
+        :data:`MASKINGS`: ``G1(k_u) G1(w_o)`` or the height-correlated ``G2_T``.
 
     Returns
     -------
@@ -151,6 +159,8 @@ def build_exit_operator(
     """
     if not alpha > 0:
         raise ValueError(f"the exit operator needs a rough interface, got alpha={alpha!r}")
+    if masking not in MASKINGS:
+        raise ValueError(f"masking must be one of {MASKINGS}, got {masking!r}")
     t0 = time.perf_counter()
     nt, npf = grid.n_theta, grid.n_phi
     half = npf // 2 + 1
@@ -168,6 +178,11 @@ def build_exit_operator(
     def g1_of(v: NDArray[np.float64]) -> NDArray[np.float64]:
         return ggx.smith_g1(v[2], alpha)
 
+    def lambda_of(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        return ggx.smith_lambda(np.abs(v[2]), alpha)
+
+    g2_of = correlated_transmission(lambda_of) if masking == "correlated" else None
+
     # per output row: every (node, internal node, azimuth difference in [0, 180] deg)
     # point; with one node per cell the same points, in the same order, as the centroids
     grids = np.meshgrid(np.arange(ni * nj), np.arange(q_row.size), np.arange(half), indexing="ij")
@@ -183,7 +198,7 @@ def build_exit_operator(
     for io in range(nt):
         th = theta_o[io, ai]
         wo = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)])
-        M = transmission_mueller(ku, wo, n_below, n_above, abcs_t, d_of, g1_of)
+        M = transmission_mueller(ku, wo, n_below, n_above, abcs_t, d_of, g1_of, g2_of)
         rows = M.reshape(16, -1) * (w[io, ai, aj] * wq)
         T = np.empty((16, nt * half))
         for e in range(16):
@@ -244,8 +259,10 @@ def memory_cache(store: OrderedDict[str, ExitOperator] | None = None) -> Iterato
         _MEMORY.reset(token)
 
 
-def _key(grid: Grid, n_below: float, alpha: float, n_above: float, nodes: tuple) -> str:
-    spec = {
+def _key(
+    grid: Grid, n_below: float, alpha: float, n_above: float, nodes: tuple, masking: str
+) -> str:
+    spec: dict[str, object] = {
         "version": VERSION,
         "theta_step_deg": float(grid.theta_step_deg),
         "phi_step_deg": float(grid.phi_step_deg),
@@ -256,6 +273,8 @@ def _key(grid: Grid, n_below: float, alpha: float, n_above: float, nodes: tuple)
         "distribution": "ggx",
         "cell_rule": list(cell_rule(grid, n_below, alpha, n_above)),
     }
+    if masking != "separable":  # the separable operators keep the keys they had
+        spec["masking"] = masking
     return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
 
 
@@ -267,11 +286,12 @@ def exit_operator(
     n_above: float = 1.0,
     nodes: tuple[int, int] = (1, 1),
     cache: bool = True,
+    masking: str = "separable",
 ) -> ExitOperator:
     """:func:`build_exit_operator`, cached under :func:`cache_dir`.
 
     The cache key is a hash of everything the operator depends on (grid, indices, alpha,
-    quadrature, format version); :mod:`labbrdf.tracer.cache` keeps the file: verified on
+    quadrature, masking, format version); :mod:`labbrdf.tracer.cache` keeps the file: verified on
     load (key, shape, dtype and a digest of the contents), private to the user, written
     atomically and bounded by a size cap with least-recently-used eviction. A file that
     fails a check is rebuilt with a :class:`~labbrdf.tracer.cache.CacheWarning` naming
@@ -279,24 +299,28 @@ def exit_operator(
     :func:`memory_cache` the operator is kept in memory instead.
     """
     if not cache:
-        return build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes)
+        return build_exit_operator(
+            grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking
+        )
     memory = _MEMORY.get()
     if memory is not None:
-        key = _key(grid, n_below, alpha, n_above, nodes)
+        key = _key(grid, n_below, alpha, n_above, nodes, masking)
         op = memory.get(key)
         if op is None:
-            op = build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes)
+            op = build_exit_operator(
+                grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking
+            )
             memory[key] = op
             while len(memory) > MEMORY_OPERATORS:
                 memory.popitem(last=False)
         memory.move_to_end(key)
         return op
-    key = _key(grid, n_below, alpha, n_above, nodes)
+    key = _key(grid, n_below, alpha, n_above, nodes, masking)
     nt, npf = grid.n_theta, grid.n_phi
     t0 = time.perf_counter()
     spec = _cache.load(key, (npf // 2 + 1, 4 * nt, 4 * nt), np.complex64)
     if spec is not None:
         return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
-    op = build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes)
+    op = build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking)
     _cache.store(key, op.spectrum)
     return op

@@ -59,6 +59,11 @@ class WalkSetup:
             facets(self.alpha_top, coat.ndf) if (coat is not None and self.layered) else None
         )
         self.evaluated = cfg.resolved_estimator == "evaluated"
+        # evaluated multiple scattering under a coating (walk._escape_air): the random
+        # walk, with the escapes into the air booked and the single events evaluated
+        self.ms_evaluated = self.evaluated and self.layered and not self.single
+        self.grid = grid_of(cfg)
+        self.batches = cfg.batches
         # evaluated, with a nearly smooth top, or one the GGX exit operator does not
         # describe (a slope table): the exit is the walk's own facet (exit_sampled)
         self.sampled_exit = (

@@ -64,10 +64,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..microfacet.height import sample_height
+from ..microfacet.height import height_c1, sample_height
 from .binning import Grid
 from .config import TraceConfig
-from .exit_sampled import record_up
+from .exit_sampled import deposit_cells, deposit_escape, record_up
 from .interfaces import apply_fresnel, rotate_frame, s_axis
 from .setup import WalkSetup, grid_of
 from .tally import BlockTally, Ledger, block_tally
@@ -75,6 +75,8 @@ from .tally import BlockTally, Ledger, block_tally
 __all__ = ["BlockTally", "GroupTally", "run_unit", "trace_block", "trace_group"]
 
 TOP, SUB = 0, 1
+#: evaluated multiple scattering: the single events that a closed form describes
+FIRST_REFLECTED, FIRST_REFRACTED = 1, 2
 
 
 @dataclass
@@ -87,9 +89,13 @@ class _Rays:
     iface: NDArray[np.int8]  # TOP or SUB
     below: NDArray[np.bool_]  # under the top interface, inside the coating
     h: NDArray[np.float64]  # height on the microsurface (+inf: arriving from the bulk)
-    fresh: NDArray[np.bool_]  # single scattering: not yet hit at this interface
+    fresh: NDArray[np.bool_]  # not yet hit on this visit of the interface
     bounces: NDArray[np.int32]  # facet events so far
     rid: NDArray[np.int64]  # global ray index
+    # evaluated multiple scattering: the last vertex was the first on the top from the air
+    # and reflected (FIRST_REFLECTED), or the first from below and refracted
+    # (FIRST_REFRACTED), else 0: what an escape into the air right after it is
+    kind: NDArray[np.int8] | None = None
 
     @classmethod
     def launch(cls, cfg: TraceConfig, su: WalkSetup, block: int, n: int) -> _Rays:
@@ -105,6 +111,7 @@ class _Rays:
             fresh=np.ones(n, dtype=bool),
             bounces=np.zeros(n, dtype=np.int32),
             rid=cfg.block_rays * block + np.arange(n, dtype=np.int64),
+            kind=np.zeros(n, dtype=np.int8),
         )
 
     def keep(self, alive: NDArray[np.bool_]) -> None:
@@ -114,6 +121,8 @@ class _Rays:
             self.iface, self.below, self.h = self.iface[alive], self.below[alive], self.h[alive]
             self.fresh, self.bounces = self.fresh[alive], self.bounces[alive]
             self.rid = self.rid[alive]
+            if self.kind is not None:
+                self.kind = self.kind[alive]
 
 
 @dataclass
@@ -214,9 +223,65 @@ def _leave_or_hit(
             leave = go
     else:
         lam = su.lambda_of(k, iface == SUB, below)
-        leave, h_new = sample_height(kz_loc, lam, rays.h, rng.random(m_))
+        u = rng.random(m_)
+        if su.ms_evaluated:
+            u = _escape_air(su, rays, led, lam, kz_loc, u)
+        leave, h_new = sample_height(kz_loc, lam, rays.h, u)
         rays.h = np.where(leave, rays.h, h_new)
     return leave, alive
+
+
+def _escape_air(
+    su: WalkSetup,
+    rays: _Rays,
+    led: Ledger,
+    lam: NDArray[np.float64],
+    kz_loc: NDArray[np.float64],
+    u: NDArray[np.float64],
+) -> NDArray[np.float64]:
+    """Evaluated multiple scattering: the escape estimator on the top's air side.
+
+    A ray going up on the air side of the top microsurface leaves with the probability
+    ``g = C1(h)^Lambda`` of its height (Heitz et al. 2016, sec. 4). Instead of drawing
+    leave or hit, its part ``g M`` is booked here, and the ray goes on with
+    ``(1 - g) M`` to a hit drawn from the heights given that it hits (the uniform is
+    rescaled into ``[0, 1 - g)``). The booked part right after the first vertex of a
+    visit, reflected from the air or refracted from below, is the expectation the closed
+    form first surface and the exit operator add (only counted for the ledger); every
+    other escape is deposited into its exit bin per batch (:func:`.exit_sampled.deposit_escape`).
+
+    Returns the uniforms for :func:`sample_height` (in place on the rays' weights).
+    """
+    air = (rays.iface == TOP) & ~rays.below & (kz_loc > 0)
+    if not air.any():
+        return u
+    idx = np.flatnonzero(air)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        g = height_c1(rays.h[idx]) ** lam[idx]
+    g = np.where(np.isfinite(g), np.clip(g, 0.0, 1.0), 0.0)
+    esc = rays.M[:, :, idx] * g
+    led.booked += float(esc[0, 0].sum())
+    assert rays.kind is not None
+    kind = rays.kind[idx]
+    evaluated = kind == FIRST_REFLECTED
+    if not su.sampled_exit:
+        evaluated |= kind == FIRST_REFRACTED
+    dep = ~evaluated
+    if dep.any():
+        deposit_escape(
+            su.grid,
+            su.batches,
+            rays.k[:, idx[dep]],
+            rays.s[:, idx[dep]],
+            esc[:, :, dep],
+            rays.rid[idx[dep]],
+            led.dep_key,
+            led.dep_rows,
+        )
+    rays.M[:, :, idx] *= 1.0 - g
+    out = u.copy()
+    out[idx] = u[idx] * (1.0 - g)
+    return out
 
 
 def _route(
@@ -287,6 +352,13 @@ def _scatter(
     rays.bounces += 1
     if kill_all:
         return True
+    if su.ms_evaluated and trans is not None:
+        first = rays.fresh & hit.on_top
+        rays.kind = np.where(
+            first & ~rays.below & ~trans,
+            FIRST_REFLECTED,
+            np.where(first & rays.below & trans, FIRST_REFRACTED, 0),
+        ).astype(np.int8)
     rays.fresh[:] = False
     if trans is not None and trans.any():
         rays.below = rays.below ^ trans
@@ -332,7 +404,17 @@ def _layered_event(
     with np.errstate(divide="ignore", invalid="ignore"):
         pr = np.where(s0 > 0, (refl[0] * s0 + refl[1] * M[1, 0]) / s0, refl[0])
         pr = np.where(on_top, np.clip(pr, 0.0, 1.0), 1.0)  # opaque substrate
-        if su.evaluated:
+        if su.ms_evaluated:
+            # the counting walk's random branch; the rays arriving at the top from the
+            # bulk are recorded for the exit operator (its single refraction into the
+            # air, which _escape_air then only books)
+            first_up = on_top & below & rays.fresh
+            if first_up.any() and not su.sampled_exit:
+                deposit_cells(
+                    grid, cfg.batches, k, hit.s_loc, M, first_up, rays.rid,
+                    led.dep_key, led.dep_rows, raw,
+                )  # fmt: skip
+        if su.evaluated and not su.ms_evaluated:
             # no random branch: refract into the coating from air (the reflection is
             # evaluated), reflect at the top from below (the transmission is applied by
             # the exit operator), both with their Mueller weights
@@ -357,7 +439,7 @@ def _layered_event(
             trans = hit.u >= pr
             wr = np.where(trans, 0.0, 1.0 / np.where(trans, 1.0, pr))
             wt = np.where(trans, 1.0 / np.where(trans, 1.0 - pr, 1.0), 0.0)
-    if su.evaluated:
+    if su.evaluated and not su.ms_evaluated:
         w_o, g = _other_branch(
             su, k, hit.m, hit.kr, M, cos_i, (refl, tr, cos_t, eta), on_top, below
         )
