@@ -67,7 +67,7 @@ from numpy.typing import NDArray
 from ..microfacet.height import height_c1, sample_height
 from .binning import Grid
 from .config import TraceConfig
-from .exit_sampled import deposit_cells, deposit_escape, record_up
+from .exit_sampled import deposit_branch, deposit_cells, record_up
 from .interfaces import apply_fresnel, rotate_frame, s_axis
 from .setup import WalkSetup, grid_of
 from .tally import BlockTally, Ledger, block_tally
@@ -75,8 +75,6 @@ from .tally import BlockTally, Ledger, block_tally
 __all__ = ["BlockTally", "GroupTally", "run_unit", "trace_block", "trace_group"]
 
 TOP, SUB = 0, 1
-#: evaluated multiple scattering: the single events that a closed form describes
-FIRST_REFLECTED, FIRST_REFRACTED = 1, 2
 
 
 @dataclass
@@ -92,10 +90,6 @@ class _Rays:
     fresh: NDArray[np.bool_]  # not yet hit on this visit of the interface
     bounces: NDArray[np.int32]  # facet events so far
     rid: NDArray[np.int64]  # global ray index
-    # evaluated multiple scattering: the last vertex was the first on the top from the air
-    # and reflected (FIRST_REFLECTED), or the first from below and refracted
-    # (FIRST_REFRACTED), else 0: what an escape into the air right after it is
-    kind: NDArray[np.int8] | None = None
 
     @classmethod
     def launch(cls, cfg: TraceConfig, su: WalkSetup, block: int, n: int) -> _Rays:
@@ -111,7 +105,6 @@ class _Rays:
             fresh=np.ones(n, dtype=bool),
             bounces=np.zeros(n, dtype=np.int32),
             rid=cfg.block_rays * block + np.arange(n, dtype=np.int64),
-            kind=np.zeros(n, dtype=np.int8),
         )
 
     def keep(self, alive: NDArray[np.bool_]) -> None:
@@ -121,8 +114,6 @@ class _Rays:
             self.iface, self.below, self.h = self.iface[alive], self.below[alive], self.h[alive]
             self.fresh, self.bounces = self.fresh[alive], self.bounces[alive]
             self.rid = self.rid[alive]
-            if self.kind is not None:
-                self.kind = self.kind[alive]
 
 
 @dataclass
@@ -243,12 +234,11 @@ def _escape_air(
 
     A ray going up on the air side of the top microsurface leaves with the probability
     ``g = C1(h)^Lambda`` of its height (Heitz et al. 2016, sec. 4). Instead of drawing
-    leave or hit, its part ``g M`` is booked here, and the ray goes on with
-    ``(1 - g) M`` to a hit drawn from the heights given that it hits (the uniform is
-    rescaled into ``[0, 1 - g)``). The booked part right after the first vertex of a
-    visit, reflected from the air or refracted from below, is the expectation the closed
-    form first surface and the exit operator add (only counted for the ledger); every
-    other escape is deposited into its exit bin per batch (:func:`.exit_sampled.deposit_escape`).
+    leave or hit, its part ``g M`` is booked as exited (the ledger), and the ray goes on
+    with ``(1 - g) M`` to a hit drawn from the heights given that it hits (the uniform is
+    rescaled into ``[0, 1 - g)``). The map never counts these escapes: their expectation
+    is what the first surface's closed form, the exit operator and the vertex deposits
+    (:func:`_vertex_escapes`) add.
 
     Returns the uniforms for :func:`sample_height` (in place on the rays' weights).
     """
@@ -256,32 +246,67 @@ def _escape_air(
     if not air.any():
         return u
     idx = np.flatnonzero(air)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        g = height_c1(rays.h[idx]) ** lam[idx]
-    g = np.where(np.isfinite(g), np.clip(g, 0.0, 1.0), 0.0)
-    esc = rays.M[:, :, idx] * g
-    led.booked += float(esc[0, 0].sum())
-    assert rays.kind is not None
-    kind = rays.kind[idx]
-    evaluated = kind == FIRST_REFLECTED
-    if not su.sampled_exit:
-        evaluated |= kind == FIRST_REFRACTED
-    dep = ~evaluated
-    if dep.any():
-        deposit_escape(
-            su.grid,
-            su.batches,
-            rays.k[:, idx[dep]],
-            rays.s[:, idx[dep]],
-            esc[:, :, dep],
-            rays.rid[idx[dep]],
-            led.dep_key,
-            led.dep_rows,
-        )
+    g = _leave_prob(lam[idx], rays.h[idx])
+    led.booked += float((rays.M[0, 0, idx] * g).sum())
     rays.M[:, :, idx] *= 1.0 - g
     out = u.copy()
     out[idx] = u[idx] * (1.0 - g)
     return out
+
+
+def _leave_prob(lam: NDArray[np.float64], h: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``C1(h)^Lambda`` of up-going directions, 0 where it is not finite."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        g = height_c1(h) ** lam
+    return np.where(np.isfinite(g), np.clip(g, 0.0, 1.0), 0.0)
+
+
+def _vertex_escapes(
+    su: WalkSetup,
+    cfg: TraceConfig,
+    grid: Grid,
+    rays: _Rays,
+    led: Ledger,
+    raw: list[tuple[NDArray, NDArray, NDArray]] | None,
+    hit: _Hit,
+    fresnel: tuple,
+) -> None:
+    """Evaluated multiple scattering: what each vertex on the top sends into the air.
+
+    * first vertex from the air, reflected: nothing (the closed-form first surface with
+      the height-correlated masking);
+    * first vertex from the coating's bulk, refracted: the ray is recorded in its cell
+      for the exit operator built with the height-correlated ``G2_T`` (a nearly smooth
+      top: deposited as below);
+    * every later vertex: its reflected (air side) or refracted (from below) branch
+      leaves at once with ``C1(h)^Lambda(w)`` of the vertex's height on the air side;
+      that branch, Fresnel-weighted, is deposited into its exit bin per batch
+      (:func:`.exit_sampled.deposit_branch`): no random branch or leave draw in it.
+    """
+    refl, tr, cos_t, eta = fresnel
+    k, M, fresh = rays.k, rays.M, rays.fresh
+    air = hit.on_top & ~rays.below
+    under = hit.on_top & rays.below
+    into = (led.dep_key, led.dep_rows)
+    if not su.sampled_exit and (under & fresh).any():
+        deposit_cells(grid, cfg.batches, k, hit.s_loc, M, under & fresh, rays.rid, *into, raw)
+    assert su.top is not None
+    for sel, is_refl in ((air & ~fresh, True), (under & (~fresh | su.sampled_exit), False)):
+        if not sel.any():
+            continue
+        i = np.flatnonzero(sel)
+        if is_refl:
+            d, abcs, h = hit.kr[:, i], refl, rays.h[i]
+        else:
+            e = eta[i] if np.ndim(eta) else eta
+            d = e * k[:, i] + (e * hit.cos_i[i] - cos_t[i]) * hit.m[:, i]
+            abcs, h = tr, -rays.h[i]
+        d = d / np.sqrt((d * d).sum(axis=0))
+        g = np.where(d[2] > 0, _leave_prob(su.top.smith_lambda(d), h), 0.0)
+        deposit_branch(
+            grid, cfg.batches, d, hit.s_loc[:, i], M[:, :, i], tuple(a[i] for a in abcs),
+            g, rays.rid[i], into, su.scalar,
+        )  # fmt: skip
 
 
 def _route(
@@ -352,13 +377,6 @@ def _scatter(
     rays.bounces += 1
     if kill_all:
         return True
-    if su.ms_evaluated and trans is not None:
-        first = rays.fresh & hit.on_top
-        rays.kind = np.where(
-            first & ~rays.below & ~trans,
-            FIRST_REFLECTED,
-            np.where(first & rays.below & trans, FIRST_REFRACTED, 0),
-        ).astype(np.int8)
     rays.fresh[:] = False
     if trans is not None and trans.any():
         rays.below = rays.below ^ trans
@@ -400,20 +418,13 @@ def _layered_event(
     """
     k, M, below, on_top, cos_i = rays.k, rays.M, rays.below, hit.on_top, hit.cos_i
     refl, tr, cos_t, eta = su.layered_abcs(cos_i, on_top, below)
+    if su.ms_evaluated:
+        # the counting walk's random branch below; first what the vertex sends into the air
+        _vertex_escapes(su, cfg, grid, rays, led, raw, hit, (refl, tr, cos_t, eta))
     s0 = M[0, 0]
     with np.errstate(divide="ignore", invalid="ignore"):
         pr = np.where(s0 > 0, (refl[0] * s0 + refl[1] * M[1, 0]) / s0, refl[0])
         pr = np.where(on_top, np.clip(pr, 0.0, 1.0), 1.0)  # opaque substrate
-        if su.ms_evaluated:
-            # the counting walk's random branch; the rays arriving at the top from the
-            # bulk are recorded for the exit operator (its single refraction into the
-            # air, which _escape_air then only books)
-            first_up = on_top & below & rays.fresh
-            if first_up.any() and not su.sampled_exit:
-                deposit_cells(
-                    grid, cfg.batches, k, hit.s_loc, M, first_up, rays.rid,
-                    led.dep_key, led.dep_rows, raw,
-                )  # fmt: skip
         if su.evaluated and not su.ms_evaluated:
             # no random branch: refract into the coating from air (the reflection is
             # evaluated), reflect at the top from below (the transmission is applied by
