@@ -66,6 +66,7 @@ import numpy as np
 from .binning import Grid
 from .config import Coating, Substrate, TraceConfig
 from .result import TraceResult, trace_summary
+from .setup import WalkSetup
 from .walk import BlockTally, GroupTally, _unit, run_unit, trace_block, trace_group
 
 __all__ = [
@@ -144,7 +145,8 @@ def trace(
     block_rays = np.zeros(config.n_blocks, dtype=np.int64)
     evaluated = config.resolved_estimator == "evaluated"
     # evaluated: per batch, the cells for the exit operator, then the sampled exits' bins
-    cells = np.zeros((2 * config.batches * nb, 16)) if evaluated else None
+    channels = WalkSetup(config).channels  # the operator's cells, exits, (levels)
+    cells = np.zeros((channels * config.batches * nb, 16)) if evaluated else None
     batch_rays = np.zeros(config.batches, dtype=np.int64)
     expected = 0
     for tallies in map(_unit, work_units(config, blocks_per_unit)):
@@ -224,7 +226,7 @@ def _evaluated(
     info = {"first_surface_seconds": time.perf_counter() - t0}
     shape = (config.batches, grid.n_theta, grid.n_phi, 4, 4)
     if config.coating is not None and not config.coherent:
-        sums, more = exit_map(config, cells.reshape((2, *shape)))
+        sums, more = exit_map(config, cells.reshape((-1, *shape)))
         info.update(more)
     else:
         sums = np.zeros(shape)

@@ -22,7 +22,6 @@ from .config import TraceConfig
 from .evaluate import (
     bin_nodes,
     correlated_reflection,
-    correlated_transmission,
     reflection_mueller,
     transmission_mueller,
 )
@@ -216,9 +215,11 @@ def exit_map(
 
     Parameters
     ----------
-    cells : ndarray, shape (2, batches, n_theta, n_phi, 4, 4)
+    cells : ndarray, shape (channels, batches, n_theta, n_phi, 4, 4)
         ``cells[0]``: the internal cell sums for the exit operator; ``cells[1]``: the
-        sampled exits' weight sums per output bin (:mod:`.exit_sampled`).
+        sampled exits' weight sums per output bin (:mod:`.exit_sampled`); multiple
+        scattering through the operator: then the levels (:mod:`.height_basis`) of the
+        later vertices from below and from above (:func:`.walk._vertex_escapes`).
 
     Returns
     -------
@@ -235,6 +236,8 @@ def exit_map(
     if not su.sampled_exit:
         op_sums, info = _operator_map(cfg, su, grid, cells[0])
         out = out + op_sums
+    if cells.shape[0] > 2:
+        out = out + _vertex_map(cfg, su, grid, cells[2:], info)
     if cfg.scalar:
         m00 = out[..., 0, 0].copy()
         out[...] = 0.0
@@ -259,6 +262,40 @@ def _operator_map(
     return op.apply(cells), info
 
 
+def _vertex_map(
+    cfg: TraceConfig,
+    su: WalkSetup,
+    grid: Grid,
+    levels: NDArray[np.float64],
+    info: dict[str, float],
+) -> NDArray[np.float64]:
+    """The later vertices' escapes: ``sum_k V_k(row) Op(level k)`` [sr^-1 x rays].
+
+    ``levels``: (2 LEVELS, B, ...), the transmission levels then the reflection levels
+    (:mod:`.height_basis`); the operators carry ``G1`` of the vertex's direction only,
+    the rows' ``V_k`` the escape ``c^Lambda(theta_o)``. ``info`` gains the build seconds.
+    """
+    from .height_basis import LEVELS, row_basis
+
+    nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
+    v = row_basis(cfg.theta_step_deg, cfg.phi_step_deg, float(su.alpha_top))
+    out = np.zeros(levels.shape[1:])
+    for j, kind in enumerate(("transmission", "reflection")):
+        op = exit_operator(
+            grid, su.n_coat, su.alpha_top, nodes=nodes, masking="incident", kind=kind
+        )
+        info["operator_seconds"] = info.get("operator_seconds", 0.0) + op.seconds
+        info["operator_mb"] = info.get("operator_mb", 0.0) + op.nbytes / 1e6
+        for lvl in range(LEVELS):
+            c = levels[j * LEVELS + lvl]
+            if cfg.scalar:
+                c = c.copy()
+                c[..., 1:, :] = 0.0
+                c[..., :, 1:] = 0.0
+            out += op.apply(c) * v[lvl][None, :, None, None, None]
+    return out
+
+
 def nee_exit(
     cfg: TraceConfig, bins: list[tuple[int, int]], nodes: int = 3
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -281,6 +318,11 @@ def nee_exit(
 
     if cfg.resolved_estimator != "evaluated" or cfg.coating is None or cfg.coherent:
         raise ValueError("nee_exit needs an evaluated run with an incoherent coating")
+    if cfg.scattering != "single":
+        raise ValueError(
+            "nee_exit checks the single-scattering exit operator; with multiple "
+            "scattering the later vertices' levels are not evaluated per bin"
+        )
     su = WalkSetup(cfg)
     if su.sampled_exit:
         raise ValueError(
@@ -301,14 +343,6 @@ def nee_exit(
 
     assert su.top is not None
     d_of, g1_of = su.top.d, su.top.smith_g1
-    top = su.top
-    g2_of = (
-        None
-        if cfg.scattering == "single"
-        else correlated_transmission(
-            lambda v: top.smith_lambda(np.stack([v[0], v[1], np.abs(v[2])]))
-        )
-    )
     nb = cfg.batches
     acc = np.zeros((nb, len(bins), 4, 4))
     omega = grid.cos_solid_angle_sr
@@ -335,7 +369,6 @@ def nee_exit(
                         abcs_t,
                         d_of,
                         g1_of,
-                        g2_of,
                     )
                     contrib = np.einsum("ikn,kjn->nij", T, rows) * w[i, a, b]
                     for bb in range(nb):

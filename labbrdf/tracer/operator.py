@@ -40,7 +40,13 @@ from ..microfacet import ggx
 from . import cache as _cache
 from .binning import Grid
 from .cache import cache_dir
-from .evaluate import bin_nodes, cell_nodes, correlated_transmission, transmission_mueller
+from .evaluate import (
+    bin_nodes,
+    cell_nodes,
+    correlated_transmission,
+    reflection_mueller,
+    transmission_mueller,
+)
 from .exit_sampled import lobe_width_rad
 from .interfaces import fresnel_abcs
 
@@ -53,18 +59,23 @@ VERSION = 3
 _MEMORY: ContextVar[OrderedDict[str, ExitOperator] | None] = ContextVar(
     "labbrdf_tracer_operator_memory", default=None
 )
-#: operators :func:`memory_cache` keeps (the most recently used)
-MEMORY_OPERATORS = 2
+#: operators :func:`memory_cache` keeps (the most recently used): the three of one
+#: parameter set with multiple scattering (:func:`.estimator.exit_map`)
+MEMORY_OPERATORS = 3
 
 #: polar sub-cell nodes per unit of (the cell's image in the air / the exit lobe)
 CELL_NODES_PER_LOBE = 2.5
 #: at most this many polar sub-cell nodes
 CELL_MAX_NODES = 6
 
-#: the masking of the operator's BTDF: separable ``G1 G1`` (single scattering) or the
+#: the masking of the operator's kernel: separable ``G1 G1`` (single scattering), the
 #: height-correlated ``B(1 + L_i, 1 + L_o)`` of the multiple-scattering walk's single
-#: refraction (:func:`.evaluate.correlated_transmission`)
-MASKINGS = ("separable", "correlated")
+#: refraction (:func:`.evaluate.correlated_transmission`), or ``G1(w_in)`` alone (the exit
+#: masking applied per output row by the caller, :mod:`.height_basis`)
+MASKINGS = ("separable", "correlated", "incident")
+#: the kernel: transmission from below (the exit), or reflection of rays going down on
+#: the air side (the multiple-scattering walk's later vertices)
+KINDS = ("transmission", "reflection")
 
 PARITY = np.array([1, 1, -1, -1])[:, None] * np.array([1, 1, -1, -1])[None, :]
 
@@ -137,8 +148,14 @@ def build_exit_operator(
     n_above: float = 1.0,
     nodes: tuple[int, int] = (1, 1),
     masking: str = "separable",
+    kind: str = "transmission",
 ) -> ExitOperator:
     """Build ``T10`` for a GGX interface from a dielectric ``n_below`` into ``n_above``.
+
+    ``kind="reflection"``: the same operator for the reflection on the interface's air
+    side of rays going down (cells of their directions mirrored to z > 0, in the
+    meridional frames of their azimuth), with the Fresnel reflection ``n_above ->
+    n_below`` (:func:`.evaluate.reflection_mueller`).
 
     Parameters
     ----------
@@ -150,8 +167,11 @@ def build_exit_operator(
         GGX roughness of the interface [1], > 0.
     nodes : (int, int)
         Gauss-Legendre nodes per output bin in sin^2 theta and phi.
-    masking : {"separable", "correlated"}
-        :data:`MASKINGS`: ``G1(k_u) G1(w_o)`` or the height-correlated ``G2_T``.
+    masking : {"separable", "correlated", "incident"}
+        :data:`MASKINGS`: ``G1(k_u) G1(w_o)``, the height-correlated ``G2_T``, or
+        ``G1(k_u)`` alone.
+    kind : {"transmission", "reflection"}
+        :data:`KINDS`.
 
     Returns
     -------
@@ -161,6 +181,8 @@ def build_exit_operator(
         raise ValueError(f"the exit operator needs a rough interface, got alpha={alpha!r}")
     if masking not in MASKINGS:
         raise ValueError(f"masking must be one of {MASKINGS}, got {masking!r}")
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     t0 = time.perf_counter()
     nt, npf = grid.n_theta, grid.n_phi
     half = npf // 2 + 1
@@ -181,7 +203,22 @@ def build_exit_operator(
     def lambda_of(v: NDArray[np.float64]) -> NDArray[np.float64]:
         return ggx.smith_lambda(np.abs(v[2]), alpha)
 
-    g2_of = correlated_transmission(lambda_of) if masking == "correlated" else None
+    g2_of = {
+        "separable": None,
+        "correlated": correlated_transmission(lambda_of),
+        "incident": lambda a, b: ggx.smith_g1(np.abs(a[2]), alpha),
+    }[masking]
+
+    def kernel(ku: NDArray[np.float64], wo: NDArray[np.float64]) -> NDArray[np.float64]:
+        if kind == "transmission":
+            return transmission_mueller(ku, wo, n_below, n_above, abcs_t, d_of, g1_of, g2_of)
+        k_in = ku * np.array([1.0, 1.0, -1.0])[:, None]
+        s_in = np.broadcast_to(np.array([0.0, 1.0, 0.0])[:, None], ku.shape)
+
+        def abcs_r(c: NDArray[np.float64]) -> tuple:
+            return fresnel_abcs(n_above, n_below, c)[0]
+
+        return reflection_mueller(k_in, s_in, wo, abcs_r, d_of, g1_of, g2_of)
 
     # per output row: every (node, internal node, azimuth difference in [0, 180] deg)
     # point; with one node per cell the same points, in the same order, as the centroids
@@ -198,7 +235,7 @@ def build_exit_operator(
     for io in range(nt):
         th = theta_o[io, ai]
         wo = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)])
-        M = transmission_mueller(ku, wo, n_below, n_above, abcs_t, d_of, g1_of, g2_of)
+        M = kernel(ku, wo)
         rows = M.reshape(16, -1) * (w[io, ai, aj] * wq)
         T = np.empty((16, nt * half))
         for e in range(16):
@@ -249,7 +286,7 @@ def memory_cache(store: OrderedDict[str, ExitOperator] | None = None) -> Iterato
     incidences, such as a fit that varies the coating's roughness: on disk every operator
     would be a new file that is never read again (3.8 MB each on a 3 x 6 degree grid,
     192 MB on the 1-degree grid). The last :data:`MEMORY_OPERATORS` operators are kept,
-    so the incidences of one parameter set share one build. Blocks share operators only
+    so the incidences of one parameter set share its builds. Blocks share operators only
     through a ``store`` (an OrderedDict the caller keeps from one block to the next).
     """
     token = _MEMORY.set(OrderedDict() if store is None else store)
@@ -260,7 +297,13 @@ def memory_cache(store: OrderedDict[str, ExitOperator] | None = None) -> Iterato
 
 
 def _key(
-    grid: Grid, n_below: float, alpha: float, n_above: float, nodes: tuple, masking: str
+    grid: Grid,
+    n_below: float,
+    alpha: float,
+    n_above: float,
+    nodes: tuple,
+    masking: str,
+    kind: str = "transmission",
 ) -> str:
     spec: dict[str, object] = {
         "version": VERSION,
@@ -273,8 +316,10 @@ def _key(
         "distribution": "ggx",
         "cell_rule": list(cell_rule(grid, n_below, alpha, n_above)),
     }
-    if masking != "separable":  # the separable operators keep the keys they had
+    if masking != "separable":  # the separable exit operators keep the keys they had
         spec["masking"] = masking
+    if kind != "transmission":
+        spec["kind"] = kind
     return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
 
 
@@ -287,40 +332,43 @@ def exit_operator(
     nodes: tuple[int, int] = (1, 1),
     cache: bool = True,
     masking: str = "separable",
+    kind: str = "transmission",
 ) -> ExitOperator:
     """:func:`build_exit_operator`, cached under :func:`cache_dir`.
 
     The cache key is a hash of everything the operator depends on (grid, indices, alpha,
-    quadrature, masking, format version); :mod:`labbrdf.tracer.cache` keeps the file: verified on
-    load (key, shape, dtype and a digest of the contents), private to the user, written
-    atomically and bounded by a size cap with least-recently-used eviction. A file that
+    quadrature, masking, kind, format version); :mod:`labbrdf.tracer.cache` keeps the
+    file: verified on load (key, shape, dtype and a digest of the contents), private to
+    the user, written atomically and bounded by a size cap with least-recently-used eviction. A file that
     fails a check is rebuilt with a :class:`~labbrdf.tracer.cache.CacheWarning` naming
     it; a cache folder that cannot be written only costs the rebuild next time. Inside
     :func:`memory_cache` the operator is kept in memory instead.
     """
     if not cache:
         return build_exit_operator(
-            grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking
+            grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking, kind=kind
         )
     memory = _MEMORY.get()
     if memory is not None:
-        key = _key(grid, n_below, alpha, n_above, nodes, masking)
+        key = _key(grid, n_below, alpha, n_above, nodes, masking, kind)
         op = memory.get(key)
         if op is None:
             op = build_exit_operator(
-                grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking
+                grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking, kind=kind
             )
             memory[key] = op
             while len(memory) > MEMORY_OPERATORS:
                 memory.popitem(last=False)
         memory.move_to_end(key)
         return op
-    key = _key(grid, n_below, alpha, n_above, nodes, masking)
+    key = _key(grid, n_below, alpha, n_above, nodes, masking, kind)
     nt, npf = grid.n_theta, grid.n_phi
     t0 = time.perf_counter()
     spec = _cache.load(key, (npf // 2 + 1, 4 * nt, 4 * nt), np.complex64)
     if spec is not None:
         return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
-    op = build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking)
+    op = build_exit_operator(
+        grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking, kind=kind
+    )
     _cache.store(key, op.spectrum)
     return op

@@ -62,6 +62,10 @@ class WalkSetup:
         # evaluated multiple scattering under a coating (walk._escape_air): the random
         # walk, with the escapes into the air booked and the single events evaluated
         self.ms_evaluated = self.evaluated and self.layered and not self.single
+        # the evaluated walk's deposits, per batch and bin: the exit operator's cells, the
+        # exits binned, then (multiple scattering through the operator) the later
+        # vertices' levels of cells from below and from above (:mod:`.height_basis`)
+        self.channels = 2
         self.grid = grid_of(cfg)
         self.batches = cfg.batches
         # evaluated, with a nearly smooth top, or one the GGX exit operator does not
@@ -74,6 +78,10 @@ class WalkSetup:
                 or exit_is_sampled(grid_of(cfg), self.n_coat, self.alpha_top)
             )
         )
+        if self.ms_evaluated and not self.sampled_exit:
+            from .height_basis import LEVELS
+
+            self.channels = 2 + 2 * LEVELS
         self.scalar = bool(cfg.scalar)
         # Lambertian base instead of the conductor's microsurface (None: the conductor)
         self.albedo = sub.albedo

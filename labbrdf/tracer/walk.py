@@ -68,6 +68,7 @@ from ..microfacet.height import height_c1, sample_height
 from .binning import Grid
 from .config import TraceConfig
 from .exit_sampled import deposit_branch, deposit_cells, record_up
+from .height_basis import LEVELS, level_weights
 from .interfaces import apply_fresnel, rotate_frame, s_axis
 from .setup import WalkSetup, grid_of
 from .tally import BlockTally, Ledger, block_tally
@@ -176,7 +177,7 @@ def trace_block(
             break
         alive, led.terminated = _weight_cut(cfg, rng, rays.M, led.terminated)
         rays.keep(alive)
-    return block_tally(cfg, grid, block, n, led, su.evaluated)
+    return block_tally(cfg, grid, block, n, led, su.evaluated, su.channels)
 
 
 def _bare_base(
@@ -276,22 +277,67 @@ def _vertex_escapes(
     * first vertex from the air, reflected: nothing (the closed-form first surface with
       the height-correlated masking);
     * first vertex from the coating's bulk, refracted: the ray is recorded in its cell
-      for the exit operator built with the height-correlated ``G2_T`` (a nearly smooth
-      top: deposited as below);
+      for the exit operator built with the height-correlated ``G2_T``;
     * every later vertex: its reflected (air side) or refracted (from below) branch
-      leaves at once with ``C1(h)^Lambda(w)`` of the vertex's height on the air side;
-      that branch, Fresnel-weighted, is deposited into its exit bin per batch
-      (:func:`.exit_sampled.deposit_branch`): no random branch or leave draw in it.
+      leaves at once with ``c^Lambda(w)``, ``c = C1(h)`` of the vertex's height on the
+      air side. The ray is recorded in the cell of its direction, in the levels of
+      :mod:`.height_basis` with the weights ``U_k(c)``, for the operators of those
+      vertices (:func:`.estimator.exit_map`).
+
+    A nearly smooth top (``su.sampled_exit``, no operators): the branch of every vertex
+    but the first from the air, Fresnel-weighted, times its ``c^Lambda(w)``, is deposited
+    into its exit bin (:func:`.exit_sampled.deposit_branch`).
     """
-    refl, tr, cos_t, eta = fresnel
     k, M, fresh = rays.k, rays.M, rays.fresh
     air = hit.on_top & ~rays.below
     under = hit.on_top & rays.below
     into = (led.dep_key, led.dep_rows)
-    if not su.sampled_exit and (under & fresh).any():
+    if su.sampled_exit:
+        _vertex_branches(su, cfg, grid, rays, into, hit, fresnel, (air & ~fresh, under))
+        return
+    if (under & fresh).any():
         deposit_cells(grid, cfg.batches, k, hit.s_loc, M, under & fresh, rays.rid, *into, raw)
+    # the operators take rays travelling towards the mean plane (up from below, down on
+    # the air side); a ray that hits again while travelling away from it is binned
+    towards = np.where(rays.below, k[2] > 0, k[2] < 0)
+    away = ~fresh & ~towards
+    _vertex_branches(su, cfg, grid, rays, into, hit, fresnel, (air & away, under & away))
+    for sel, h, ch in (
+        (under & ~fresh & towards, -rays.h, 2),
+        (air & ~fresh & towards, rays.h, 2 + LEVELS),
+    ):
+        if not sel.any():
+            continue
+        i = np.flatnonzero(sel)
+        u = level_weights(grid, su.alpha_top, height_c1(h[i]))  # (n, LEVELS)
+        kc = k[:, i].copy()
+        kc[2] = np.abs(kc[2])  # a down-going ray's cell: its direction mirrored up
+        cell, phi = grid.index(kc)
+        Mc = M[:, :, i].copy()
+        s_det = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+        rotate_frame(Mc, k[:, i], hit.s_loc[:, i], s_det)
+        rows = Mc.reshape(16, -1)
+        batch = rays.rid[i] % cfg.batches
+        for lvl in range(LEVELS):
+            into[0].append(((ch + lvl) * cfg.batches + batch) * grid.n_bins + cell)
+            into[1].append(rows * u[:, lvl])
+
+
+def _vertex_branches(
+    su: WalkSetup,
+    cfg: TraceConfig,
+    grid: Grid,
+    rays: _Rays,
+    into: tuple[list[NDArray], list[NDArray]],
+    hit: _Hit,
+    fresnel: tuple,
+    sels: tuple[NDArray[np.bool_], NDArray[np.bool_]],
+) -> None:
+    """The sampled exit of :func:`_vertex_escapes`: each vertex's leaving branch, binned."""
+    refl, tr, cos_t, eta = fresnel
+    k, M = rays.k, rays.M
     assert su.top is not None
-    for sel, is_refl in ((air & ~fresh, True), (under & (~fresh | su.sampled_exit), False)):
+    for sel, is_refl in zip(sels, (True, False), strict=True):
         if not sel.any():
             continue
         i = np.flatnonzero(sel)
@@ -679,7 +725,7 @@ def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
     bh = np.zeros((len(blocks), 16))
     br = np.zeros(len(blocks), dtype=np.int64)
     ev = cfg.resolved_estimator == "evaluated"
-    cells = np.zeros((2 * cfg.batches * nb, 16)) if ev else None
+    cells = np.zeros((WalkSetup(cfg).channels * cfg.batches * nb, 16)) if ev else None
     brays = np.zeros(cfg.batches, dtype=np.int64) if ev else None
     for i, b in enumerate(blocks):
         t = trace_block(cfg, b)
