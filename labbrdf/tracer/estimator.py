@@ -280,19 +280,21 @@ def _vertex_map(
     nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
     v = row_basis(cfg.theta_step_deg, cfg.phi_step_deg, float(su.alpha_top))
     out = np.zeros(levels.shape[1:])
-    for j, kind in enumerate(("transmission", "reflection")):
+    for j, kind in enumerate(("transmission", "reflection", "reflection_away")):
         op = exit_operator(
             grid, su.n_coat, su.alpha_top, nodes=nodes, masking="incident", kind=kind
         )
         info["operator_seconds"] = info.get("operator_seconds", 0.0) + op.seconds
         info["operator_mb"] = info.get("operator_mb", 0.0) + op.nbytes / 1e6
-        for lvl in range(LEVELS):
-            c = levels[j * LEVELS + lvl]
-            if cfg.scalar:
-                c = c.copy()
-                c[..., 1:, :] = 0.0
-                c[..., :, 1:] = 0.0
-            out += op.apply(c) * v[lvl][None, :, None, None, None]
+        # the levels as more batches: one pass over the operator for all of them
+        c = levels[j * LEVELS : (j + 1) * LEVELS]
+        c = c.reshape(-1, *c.shape[2:])
+        if cfg.scalar:
+            c = c.copy()
+            c[..., 1:, :] = 0.0
+            c[..., :, 1:] = 0.0
+        y = op.apply(c).reshape(levels[j * LEVELS : (j + 1) * LEVELS].shape)
+        out += np.einsum("lr,lbr...->br...", v, y)
     return out
 
 

@@ -21,7 +21,7 @@ binning of heights). A vertex is then recorded ``LEVELS`` times, with the weight
 Notes
 -----
 Two approximations, both documented in ``docs/tracer.md``: the rank (the projection's
-residual is below 3e-3 of the factor at alpha 0.2 on the 1-degree grid with 5 levels)
+residual is below 7e-3 of the factor at alpha 0.2 on the 1-degree grid with 4 levels)
 and the factor's separation from the kernel inside a polar row with several nodes (the
 row's mean factor multiplies the row's kernel).
 """
@@ -40,7 +40,7 @@ from .evaluate import bin_nodes
 __all__ = ["LEVELS", "level_weights", "row_basis"]
 
 #: rank of the expansion (levels of cells per operator)
-LEVELS = 5
+LEVELS = 4
 #: the c grid of the singular value decomposition (dense near c = 0, where c^L is steep)
 _C_GRID = np.linspace(0.0, 1.0, 2001) ** 2
 

@@ -75,7 +75,9 @@ CELL_MAX_NODES = 6
 MASKINGS = ("separable", "correlated", "incident")
 #: the kernel: transmission from below (the exit), or reflection of rays going down on
 #: the air side (the multiple-scattering walk's later vertices)
-KINDS = ("transmission", "reflection")
+#: the air side of rays going up that hit the microsurface again ("reflection_away",
+#: the multiple-scattering walk's later vertices; masking "incident" only)
+KINDS = ("transmission", "reflection", "reflection_away")
 
 PARITY = np.array([1, 1, -1, -1])[:, None] * np.array([1, 1, -1, -1])[None, :]
 
@@ -206,13 +208,13 @@ def build_exit_operator(
     g2_of = {
         "separable": None,
         "correlated": correlated_transmission(lambda_of),
-        "incident": lambda a, b: ggx.smith_g1(np.abs(a[2]), alpha),
+        "incident": _incident(alpha, kind == "reflection_away"),
     }[masking]
 
     def kernel(ku: NDArray[np.float64], wo: NDArray[np.float64]) -> NDArray[np.float64]:
         if kind == "transmission":
             return transmission_mueller(ku, wo, n_below, n_above, abcs_t, d_of, g1_of, g2_of)
-        k_in = ku * np.array([1.0, 1.0, -1.0])[:, None]
+        k_in = ku * np.array([1.0, 1.0, 1.0 if kind == "reflection_away" else -1.0])[:, None]
         s_in = np.broadcast_to(np.array([0.0, 1.0, 0.0])[:, None], ku.shape)
 
         def abcs_r(c: NDArray[np.float64]) -> tuple:
@@ -248,6 +250,24 @@ def build_exit_operator(
         sp = np.fft.rfft(full, axis=-1)  # (i, k, u, F)
         spec[:, io * 4 : io * 4 + 4, :] = sp.transpose(3, 0, 2, 1).reshape(half, 4, nt * 4)
     return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
+
+
+def _incident(alpha: float, away: bool):  # noqa: ANN202
+    """``g2_of`` of the masking "incident": the visible-normal weight of the direction.
+
+    Towards the surface: ``G1(w_i)``. A ray travelling away from it (``w_i`` below the
+    horizon) that hits it again: its visible normals are normalised by the projected area
+    ``|cos theta_i| Lambda(-w_i)`` (Heitz et al. 2016, sec. 4) instead of ``cos theta_i
+    (1 + Lambda(w_i))``, so the factor over ``cos theta_i`` is ``-1 / Lambda(-w_i)``.
+    """
+
+    def g2(w_i: NDArray[np.float64], w_o: NDArray[np.float64]) -> NDArray[np.float64]:
+        if away:
+            with np.errstate(divide="ignore"):
+                return np.asarray(-1.0 / ggx.smith_lambda(np.abs(w_i[2]), alpha), float)
+        return np.asarray(ggx.smith_g1(np.abs(w_i[2]), alpha), float)
+
+    return g2
 
 
 def cell_rule(grid: Grid, n_below: float, alpha: float, n_above: float = 1.0) -> tuple[int, int]:

@@ -81,7 +81,7 @@ class WalkSetup:
         if self.ms_evaluated and not self.sampled_exit:
             from .height_basis import LEVELS
 
-            self.channels = 2 + 2 * LEVELS
+            self.channels = 2 + 3 * LEVELS
         self.scalar = bool(cfg.scalar)
         # Lambertian base instead of the conductor's microsurface (None: the conductor)
         self.albedo = sub.albedo

@@ -301,10 +301,11 @@ def _vertex_escapes(
     # the air side); a ray that hits again while travelling away from it is binned
     towards = np.where(rays.below, k[2] > 0, k[2] < 0)
     away = ~fresh & ~towards
-    _vertex_branches(su, cfg, grid, rays, into, hit, fresnel, (air & away, under & away))
+    _vertex_branches(su, cfg, grid, rays, into, hit, fresnel, (air & False, under & away))
     for sel, h, ch in (
         (under & ~fresh & towards, -rays.h, 2),
         (air & ~fresh & towards, rays.h, 2 + LEVELS),
+        (air & away, rays.h, 2 + 2 * LEVELS),
     ):
         if not sel.any():
             continue
