@@ -359,10 +359,11 @@ def exit_operator(
     The cache key is a hash of everything the operator depends on (grid, indices, alpha,
     quadrature, masking, kind, format version); :mod:`labbrdf.tracer.cache` keeps the
     file: verified on load (key, shape, dtype and a digest of the contents), private to
-    the user, written atomically and bounded by a size cap with least-recently-used eviction. A file that
-    fails a check is rebuilt with a :class:`~labbrdf.tracer.cache.CacheWarning` naming
-    it; a cache folder that cannot be written only costs the rebuild next time. Inside
-    :func:`memory_cache` the operator is kept in memory instead.
+    the user, written atomically and bounded by a size cap with least-recently-used
+    eviction. A file that fails a check is rebuilt with a
+    :class:`~labbrdf.tracer.cache.CacheWarning` naming it; a cache folder that cannot be
+    written only costs the rebuild next time. Inside :func:`memory_cache` the operator is
+    kept in memory instead.
     """
     if not cache:
         return build_exit_operator(

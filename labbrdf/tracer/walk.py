@@ -215,44 +215,9 @@ def _leave_or_hit(
             leave = go
     else:
         lam = su.lambda_of(k, iface == SUB, below)
-        u = rng.random(m_)
-        if su.ms_evaluated:
-            u = _escape_air(su, rays, led, lam, kz_loc, u)
-        leave, h_new = sample_height(kz_loc, lam, rays.h, u)
+        leave, h_new = sample_height(kz_loc, lam, rays.h, rng.random(m_))
         rays.h = np.where(leave, rays.h, h_new)
     return leave, alive
-
-
-def _escape_air(
-    su: WalkSetup,
-    rays: _Rays,
-    led: Ledger,
-    lam: NDArray[np.float64],
-    kz_loc: NDArray[np.float64],
-    u: NDArray[np.float64],
-) -> NDArray[np.float64]:
-    """Evaluated multiple scattering: the escape estimator on the top's air side.
-
-    A ray going up on the air side of the top microsurface leaves with the probability
-    ``g = C1(h)^Lambda`` of its height (Heitz et al. 2016, sec. 4). Instead of drawing
-    leave or hit, its part ``g M`` is booked as exited (the ledger), and the ray goes on
-    with ``(1 - g) M`` to a hit drawn from the heights given that it hits (the uniform is
-    rescaled into ``[0, 1 - g)``). The map never counts these escapes: their expectation
-    is what the first surface's closed form, the exit operator and the vertex deposits
-    (:func:`_vertex_escapes`) add.
-
-    Returns the uniforms for :func:`sample_height` (in place on the rays' weights).
-    """
-    air = (rays.iface == TOP) & ~rays.below & (kz_loc > 0)
-    if not air.any():
-        return u
-    idx = np.flatnonzero(air)
-    g = _leave_prob(lam[idx], rays.h[idx])
-    led.booked += float((rays.M[0, 0, idx] * g).sum())
-    rays.M[:, :, idx] *= 1.0 - g
-    out = u.copy()
-    out[idx] = u[idx] * (1.0 - g)
-    return out
 
 
 def _leave_prob(lam: NDArray[np.float64], h: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -370,7 +335,12 @@ def _route(
     iface, below = rays.iface, rays.below
     out = leave & (((iface == TOP) & ~below) | ((iface == SUB) & (not su.layered)))
     if out.any():
-        led.exit(rays.k[:, out], rays.s[:, out], rays.M[:, :, out])
+        if su.ms_evaluated:
+            # evaluated multiple scattering: every vertex has already sent its expected
+            # escape to the map (_vertex_escapes); the walk's own exits close the ledger
+            led.booked += float(rays.M[0, 0, out].sum())
+        else:
+            led.exit(rays.k[:, out], rays.s[:, out], rays.M[:, :, out])
         alive &= ~out
     if su.layered:
         cross_ = leave & ~out
