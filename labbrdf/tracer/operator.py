@@ -189,7 +189,7 @@ def build_exit_operator(
     nt, npf = grid.n_theta, grid.n_phi
     half = npf // 2 + 1
     theta_o, dphi_o, w = bin_nodes(grid, *nodes)
-    q_row, q_theta, q_w = cell_nodes(grid, *cell_rule(grid, n_below, alpha, n_above))
+    q_row, q_theta, q_w = cell_nodes(grid, *_cell_rule(grid, n_below, alpha, n_above, kind))
     step = np.radians(grid.phi_step_deg)
     ni, nj = w.shape[1:]
 
@@ -270,6 +270,18 @@ def _incident(alpha: float, away: bool):  # noqa: ANN202
     return g2
 
 
+def _cell_rule(
+    grid: Grid, n_below: float, alpha: float, n_above: float, kind: str
+) -> tuple[int, int]:
+    """:func:`cell_rule` of an operator kind: a reflection's lobe is ``2 alpha`` wide and
+    its cells are seen without the refraction's magnification ``n_below / n_above``."""
+    if kind == "transmission":
+        return cell_rule(grid, n_below, alpha, n_above)
+    ratio = np.radians(grid.theta_step_deg) / (2.0 * alpha)
+    n = int(min(CELL_MAX_NODES, np.ceil(CELL_NODES_PER_LOBE * ratio - 1e-9)))
+    return (0, 1) if n <= 1 else (grid.n_theta, n)
+
+
 def cell_rule(grid: Grid, n_below: float, alpha: float, n_above: float = 1.0) -> tuple[int, int]:
     """Rows of internal cells averaged over polar sub-cell nodes, and nodes per cell.
 
@@ -334,7 +346,7 @@ def _key(
         "alpha": float(alpha),
         "nodes": [int(v) for v in nodes],
         "distribution": "ggx",
-        "cell_rule": list(cell_rule(grid, n_below, alpha, n_above)),
+        "cell_rule": list(_cell_rule(grid, n_below, alpha, n_above, kind)),
     }
     if masking != "separable":  # the separable exit operators keep the keys they had
         spec["masking"] = masking
