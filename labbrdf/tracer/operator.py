@@ -273,8 +273,11 @@ def _incident(alpha: float, away: bool):  # noqa: ANN202
 def _cell_rule(
     grid: Grid, n_below: float, alpha: float, n_above: float, kind: str
 ) -> tuple[int, int]:
-    """:func:`cell_rule` of an operator kind: a reflection's lobe is ``2 alpha`` wide and
-    its cells are seen without the refraction's magnification ``n_below / n_above``."""
+    """:func:`cell_rule` of an operator kind.
+
+    A reflection's lobe is ``2 alpha`` wide and its cells are seen without the
+    refraction's magnification ``n_below / n_above``.
+    """
     if kind == "transmission":
         return cell_rule(grid, n_below, alpha, n_above)
     ratio = np.radians(grid.theta_step_deg) / (2.0 * alpha)
