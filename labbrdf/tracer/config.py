@@ -320,8 +320,9 @@ class TraceConfig:
     estimator : {"auto", "evaluated", "counting"}
         How the map is estimated (``docs/tracer.md``). ``"counting"``: exiting rays are
         counted into bins (the paper's estimator). ``"evaluated"`` (single scattering
-        with a rough first interface, or multiple scattering under an incoherent coating
-        with a rough GGX top, :attr:`evaluated_multiple_applies`): the first interface's
+        with a rough first interface, or, when asked for, multiple scattering under an
+        incoherent coating with a rough GGX top, :attr:`evaluated_multiple_applies`): the
+        first interface's
         reflection is evaluated
         in closed form at every bin, the walk below it follows reflection and refraction
         with their Mueller weights instead of a random choice, and the exit through a
@@ -511,9 +512,16 @@ class TraceConfig:
 
     @property
     def resolved_estimator(self) -> str:
-        """``"evaluated"`` or ``"counting"`` (``"auto"`` resolved)."""
+        """``"evaluated"`` or ``"counting"`` (``"auto"`` resolved).
+
+        ``"auto"`` keeps counting for multiple scattering under a coating: its evaluated
+        estimator builds four operators per coating (768 MB and tens of seconds on the
+        1-degree grid when not cached), dearer than a short counting run; ask for it with
+        ``estimator="evaluated"`` (``docs/tracer.md``).
+        """
         if self.estimator == "auto":
-            return "evaluated" if self.evaluated_applies else "counting"
+            coated_multiple = self.scattering != "single" and self.coating is not None
+            return "evaluated" if self.evaluated_applies and not coated_multiple else "counting"
         return self.estimator
 
     @property

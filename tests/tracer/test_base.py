@@ -107,7 +107,6 @@ def test_white_base_under_a_lossless_coating_absorbs_nothing():
         scattering="multiple",
         theta_step_deg=5.0,
         phi_step_deg=10.0,
-        estimator="counting",  # the map is the walk's own exits
     )
     res = trace(cfg)
     led = res.ledger
@@ -199,7 +198,7 @@ def test_auto_picks_the_evaluated_estimator_where_it_applies():
     assert TraceConfig(substrate=base).resolved_estimator == "evaluated"
     assert TraceConfig(substrate=base, scattering="single").resolved_estimator == "evaluated"
     coated = TraceConfig(substrate=base, coating=VARNISH)
-    assert coated.resolved_estimator == "evaluated"  # multiple scattering under a rough top
+    assert coated.resolved_estimator == "counting"
     assert coated.replace(scattering="single").resolved_estimator == "evaluated"
     smooth_top = Coating(alpha=0.0)
     assert (

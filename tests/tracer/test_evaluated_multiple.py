@@ -150,6 +150,7 @@ def _cfg(alpha: float, scalar: bool, theta: float) -> TraceConfig:
         scalar=scalar,
         theta_step_deg=3.0,
         phi_step_deg=6.0,
+        estimator="evaluated",
     )
 
 
@@ -209,6 +210,7 @@ def test_white_furnace():
         max_bounces=1000,
         rays=6_000,
         seed=3,
+        estimator="evaluated",
     )
     res = trace(cfg)
     assert cfg.resolved_estimator == "evaluated"
@@ -223,7 +225,9 @@ def test_refusals_name_what_is_not_covered():
         base.replace(coating=None, estimator="evaluated")
     with pytest.raises(ValueError, match="scattering='multiple'"):
         base.replace(coherent=True, estimator="evaluated")
-    assert base.replace(coating=None).resolved_estimator == "counting"
+    # auto keeps counting here (the operators' build; docs/tracer.md)
+    assert base.replace(estimator="auto").resolved_estimator == "counting"
+    assert base.replace(coating=None, estimator="auto").resolved_estimator == "counting"
 
 
 def test_per_bin_check_refuses_multiple_scattering():
