@@ -128,13 +128,16 @@ def evaluated_multiple(rays: int, counting: tuple | None) -> None:
         )
     print(f"   albedo {a.albedo():.4f} / {b.albedo():.4f} +- {a.albedo_stderr():.4f}")
     if counting is not None:
+        # the lobe chosen on the evaluated map: chosen on the noisy counted one, it would
+        # pick the counted bins that fluctuated up
         ms = (counting[0].s0() + counting[1].s0()) / 2
         ev = (a.s0() + b.s0()) / 2
-        lobe = ms > 0.1 * ms.max()
-        rel = float(np.mean((ev - ms)[lobe] / ms[lobe]))
+        lobe = ev > 0.1 * ev.max()
+        w = a.grid.cos_solid_angle_sr[lobe]
+        rel = float((ev[lobe] * w).sum() / (ms[lobe] * w).sum() - 1.0)
         print(
             f"   counting albedo {(counting[0].albedo() + counting[1].albedo()) / 2:.4f}; "
-            f"lobe mean relative difference evaluated - counting {rel:+.2%}"
+            f"the lobe's power, evaluated / counting - 1: {rel:+.2%}"
         )
 
 
