@@ -145,8 +145,8 @@ def trace(
     block_rays = np.zeros(config.n_blocks, dtype=np.int64)
     evaluated = config.resolved_estimator == "evaluated"
     # evaluated: per batch, the cells for the exit operator, then the sampled exits' bins
-    channels = WalkSetup(config).channels  # the operator's cells, exits, (levels)
-    cells = np.zeros((channels * config.batches * nb, 16)) if evaluated else None
+    # (multiple scattering: then the later vertices' levels, WalkSetup.channels)
+    cells = np.zeros((WalkSetup(config).channels * config.batches * nb, 16)) if evaluated else None
     batch_rays = np.zeros(config.batches, dtype=np.int64)
     expected = 0
     for tallies in map(_unit, work_units(config, blocks_per_unit)):
