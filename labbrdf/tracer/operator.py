@@ -59,9 +59,9 @@ VERSION = 3
 _MEMORY: ContextVar[OrderedDict[str, ExitOperator] | None] = ContextVar(
     "labbrdf_tracer_operator_memory", default=None
 )
-#: operators :func:`memory_cache` keeps (the most recently used): the three of one
+#: operators :func:`memory_cache` keeps (the most recently used): the four of one
 #: parameter set with multiple scattering (:func:`.estimator.exit_map`)
-MEMORY_OPERATORS = 3
+MEMORY_OPERATORS = 4
 
 #: polar sub-cell nodes per unit of (the cell's image in the air / the exit lobe)
 CELL_NODES_PER_LOBE = 2.5
