@@ -30,6 +30,9 @@ One step, for every live ray:
    ``(Rs + Rp)/2``, which is the same for an unpolarized ray), the Mueller weight divided
    by that probability. A refracted ray changes side and its height changes sign (Heitz
    2016, dielectric walk).
+   With ``estimator="evaluated"`` and multiple scattering under a coating, each vertex on
+   the top also records what it sends into the air (:func:`_vertex_escapes`), and the
+   walk's own exits into the air only close the ledger (``docs/tracer.md``).
 4. *Terminate*: after ``max_bounces`` events, or below the weight threshold ``tau``
    (``termination="threshold"``, Dong 2022 sec. 2.3) or by Russian roulette.
 
@@ -262,11 +265,13 @@ def _vertex_escapes(
         return
     if (under & fresh).any():
         deposit_cells(grid, cfg.batches, k, hit.s_loc, M, under & fresh, rays.rid, *into, raw)
-    # the operators take rays travelling towards the mean plane (up from below, down on
-    # the air side); a ray that hits again while travelling away from it is binned
+    # rays travelling towards the mean plane (up from below, down on the air side), and
+    # on the air side rays going up that hit again, have operators; under the top a ray
+    # going down that hits again has its sampled branch binned (rare: docs/tracer.md)
     towards = np.where(rays.below, k[2] > 0, k[2] < 0)
     away = ~fresh & ~towards
-    _vertex_branches(su, cfg, grid, rays, into, hit, fresnel, (air & False, under & away))
+    none = np.zeros_like(air)
+    _vertex_branches(su, cfg, grid, rays, into, hit, fresnel, (none, under & away))
     for sel, h, ch in (
         (under & ~fresh & towards, -rays.h, 2),
         (air & ~fresh & towards, rays.h, 2 + LEVELS),
