@@ -241,3 +241,14 @@ def test_operator_kind_and_masking_are_checked():
         build_exit_operator(grid, 1.5, 0.2, masking="joint")
     with pytest.raises(ValueError, match="kind"):
         build_exit_operator(grid, 1.5, 0.2, kind="scattering")
+
+
+def test_layered_over_a_conductor_traces_multiple_scattering():
+    """The model over Al with scattering=multiple traces the evaluated multiple-scattering
+    walk (its maps: the tests above; a fit: benchmarks/bench_multiple.py --fit)."""
+    from labbrdf import models
+
+    multi = models.get("layered", scattering="multiple", n=1.55, k=7.71, grid="3x6")
+    cfg = multi._config({"n_coat": 1.5, "alpha_top": 0.3, "alpha_sub": 0.2}, 45.0, 550.0)
+    assert (cfg.scattering, cfg.resolved_estimator) == ("multiple", "evaluated")
+    assert multi.options["scattering"] == "multiple" and multi.stochastic
