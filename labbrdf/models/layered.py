@@ -72,17 +72,21 @@ def _distribution(name: Any, base: str, coherent: bool) -> str:
     return str(name)
 
 
-def _scattering(name: Any, base: str) -> bool:
-    """The checked ``scattering`` option; True for multiple scattering on the top."""
+def _scattering(name: Any, base: str, coherent: bool = False, distribution: str = "ggx") -> bool:
+    """The checked ``scattering`` option; True for multiple scattering on the top.
+
+    Over a conductor, multiple scattering is traced with the evaluated estimator
+    (``docs/tracer.md``), which needs the incoherent coating's GGX top.
+    """
     if name not in ("single", "multiple"):
         raise ModelError(
             f"layered option 'scattering' must be 'single' or 'multiple'; got {name!r}"
         )
-    if name == "multiple" and base != "diffuse":
+    if name == "multiple" and base != "diffuse" and (coherent or distribution != "ggx"):
         raise ModelError(
-            "layered option scattering='multiple' needs base='diffuse' (the renewal form of "
-            "a Lambertian base; over a conductor the multiple-scattering walk is only "
-            "counted, docs/tracer.md)"
+            "layered option scattering='multiple' over a conductor needs the incoherent "
+            "coating with distribution='ggx' (its single events have closed forms there; "
+            "docs/tracer.md)"
         )
     return name == "multiple"
 
@@ -345,7 +349,7 @@ class Layered(Model):
         finite differences), but the value depends on the seed, so the fit takes three
         seed replicates by default.
         """
-        self._multiple = _scattering(scattering, base)
+        self._multiple = _scattering(scattering, base, self._coherent, self._distribution)
         self._first_maps: OrderedDict[tuple, NDArray] = OrderedDict()  # closed form's
         closed = base == "diffuse"
         if closed or self._coherent:
@@ -494,7 +498,7 @@ class Layered(Model):
             coating=coat,
             rays=self._rays,
             seed=self._seed,
-            scattering="single",
+            scattering="multiple" if self._multiple else "single",
             estimator="evaluated",
             coherent=self._coherent,
             theta_step_deg=self._grid[0],

@@ -67,6 +67,7 @@ from .binning import Grid
 from .config import Coating, Substrate, TraceConfig
 from .medium import Medium
 from .result import TraceResult, trace_summary
+from .setup import WalkSetup
 from .walk import BlockTally, GroupTally, _unit, run_unit, trace_block, trace_group
 
 __all__ = [
@@ -146,7 +147,8 @@ def trace(
     block_rays = np.zeros(config.n_blocks, dtype=np.int64)
     evaluated = config.resolved_estimator == "evaluated"
     # evaluated: per batch, the cells for the exit operator, then the sampled exits' bins
-    cells = np.zeros((2 * config.batches * nb, 16)) if evaluated else None
+    # (multiple scattering: then the later vertices' levels, WalkSetup.channels)
+    cells = np.zeros((WalkSetup(config).channels * config.batches * nb, 16)) if evaluated else None
     batch_rays = np.zeros(config.batches, dtype=np.int64)
     expected = 0
     for tallies in map(_unit, work_units(config, blocks_per_unit)):
@@ -219,14 +221,14 @@ def _evaluated(
     config: TraceConfig, grid: Grid, cells: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
     """First-surface map (n_theta, n_phi, 4, 4) and per-batch exit sums (B, ...) [sr^-1]."""
-    from .estimator import exit_map, first_surface_map
+    from .estimator import exit_map, first_surface_map, masking_of
 
     t0 = time.perf_counter()
-    first = first_surface_map(config)
+    first = first_surface_map(config, masking=masking_of(config))
     info = {"first_surface_seconds": time.perf_counter() - t0}
     shape = (config.batches, grid.n_theta, grid.n_phi, 4, 4)
     if config.coating is not None and not config.coherent:
-        sums, more = exit_map(config, cells.reshape((2, *shape)))
+        sums, more = exit_map(config, cells.reshape((-1, *shape)))
         info.update(more)
     else:
         sums = np.zeros(shape)

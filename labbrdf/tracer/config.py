@@ -340,7 +340,10 @@ class TraceConfig:
     estimator : {"auto", "evaluated", "counting"}
         How the map is estimated (``docs/tracer.md``). ``"counting"``: exiting rays are
         counted into bins (the paper's estimator). ``"evaluated"`` (single scattering
-        with a rough first interface only): the first interface's reflection is evaluated
+        with a rough first interface, or, when asked for, multiple scattering under an
+        incoherent coating with a rough GGX top, :attr:`evaluated_multiple_applies`): the
+        first interface's
+        reflection is evaluated
         in closed form at every bin, the walk below it follows reflection and refraction
         with their Mueller weights instead of a random choice, and the exit through a
         rough top interface is applied as an operator on the up-going internal
@@ -463,7 +466,9 @@ class TraceConfig:
             self.estimator != "evaluated" or self.evaluated_applies,
             "estimator",
             "'counting' or 'auto' here: 'evaluated' needs scattering='single' and a rough "
-            "first interface (alpha > 0), or a bare Lambertian base",
+            "first interface (alpha > 0), or a bare Lambertian base; with "
+            "scattering='multiple' an incoherent coating with a rough GGX top (alpha > 0, "
+            "no slope table): a bare substrate's or a coherent film's walk is counted",
             self.estimator,
         )
         # the incoherent walk treats the coating as a separate rough layer between two
@@ -505,24 +510,42 @@ class TraceConfig:
     def evaluated_applies(self) -> bool:
         """Whether ``estimator="evaluated"`` covers this run.
 
-        It needs single scattering (the multiple-scattering walk's exits are counted) and a
-        rough first interface (the coating's top, or the substrate, or the coherent facets),
-        whose reflection has a closed form (GGX, or a slope table's). A bare Lambertian
-        base is its own closed form (``albedo / pi``) in either scattering mode.
+        Single scattering: a rough first interface (the coating's top, or the substrate,
+        or the coherent facets), whose reflection has a closed form (GGX, or a slope
+        table's). Multiple scattering: :attr:`evaluated_multiple_applies`. A bare
+        Lambertian base is its own closed form (``albedo / pi``) in either scattering mode.
         """
         if self.coating is None and self.substrate.albedo is not None:
             return True
         if self.scattering != "single":
-            return False
+            return self.evaluated_multiple_applies
         if self.coating is not None:
             return self.coating.alpha > 0
         return self.substrate.ndf is not None or self.substrate.alpha > 0
 
     @property
+    def evaluated_multiple_applies(self) -> bool:
+        """Whether the evaluated estimator covers this multiple-scattering run.
+
+        An incoherent coating with a rough GGX top (its single events have closed forms
+        with the height-correlated masking; ``docs/tracer.md``), over any base. A bare
+        substrate and the coherent film keep counting.
+        """
+        c = self.coating
+        return c is not None and not self.coherent and c.alpha > 0 and c.ndf is None
+
+    @property
     def resolved_estimator(self) -> str:
-        """``"evaluated"`` or ``"counting"`` (``"auto"`` resolved)."""
+        """``"evaluated"`` or ``"counting"`` (``"auto"`` resolved).
+
+        ``"auto"`` keeps counting for multiple scattering under a coating: its evaluated
+        estimator builds four operators per coating (768 MB and tens of seconds on the
+        1-degree grid when not cached), dearer than a short counting run; ask for it with
+        ``estimator="evaluated"`` (``docs/tracer.md``).
+        """
         if self.estimator == "auto":
-            return "evaluated" if self.evaluated_applies else "counting"
+            coated_multiple = self.scattering != "single" and self.coating is not None
+            return "evaluated" if self.evaluated_applies and not coated_multiple else "counting"
         return self.estimator
 
     @property

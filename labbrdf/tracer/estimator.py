@@ -19,7 +19,12 @@ from numpy.typing import NDArray
 from ..microfacet.interface import ClosedForm
 from .binning import Grid
 from .config import TraceConfig
-from .evaluate import bin_nodes, reflection_mueller, transmission_mueller
+from .evaluate import (
+    bin_nodes,
+    correlated_reflection,
+    reflection_mueller,
+    transmission_mueller,
+)
 from .operator import PARITY, exit_operator
 from .setup import WalkSetup, scalar_abcs
 
@@ -28,8 +33,19 @@ __all__ = [
     "first_surface_map",
     "first_surface_nodes",
     "first_surface_point",
+    "masking_of",
     "nee_exit",
 ]
+
+
+def masking_of(cfg: TraceConfig) -> str:
+    """The masking of the evaluated single events: ``"separable"`` or ``"correlated"``.
+
+    The multiple-scattering walk's single reflection and single refraction carry the
+    height-correlated masking (:func:`.evaluate.correlated_reflection`,
+    :func:`.evaluate.correlated_transmission`); single scattering the separable one.
+    """
+    return "separable" if cfg.scattering == "single" else "correlated"
 
 
 def first_surface_nodes(alpha: float, step_deg: float) -> int:
@@ -61,6 +77,21 @@ def _first_surface(cfg: TraceConfig) -> tuple:  # noqa: ANN401
     if cfg.scalar:
         abcs = _scalar_abcs(abcs)
     return abcs, face.d, face.smith_g1, face.alpha
+
+
+def _masking(cfg: TraceConfig, masking: str) -> object:
+    """The ``g2_of`` of the first interface for :func:`.evaluate.reflection_mueller`."""
+    if masking == "separable":
+        return None
+    if masking != "correlated":
+        raise ValueError(f"masking must be 'separable' or 'correlated', got {masking!r}")
+    su = WalkSetup(cfg)
+    face = su.top if su.top is not None else su.sub
+
+    def lam(v: NDArray) -> NDArray:
+        return face.smith_lambda(np.stack([v[0], v[1], np.abs(v[2])]))
+
+    return correlated_reflection(lam)
 
 
 def first_surface_point(
@@ -95,8 +126,13 @@ def first_surface_point(
     return out
 
 
-def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.float64]:
+def first_surface_map(
+    cfg: TraceConfig, chunk: int = 200_000, masking: str = "separable"
+) -> NDArray[np.float64]:
     """Bin-averaged Mueller BRDF of the first interface's single reflection [sr^-1].
+
+    ``masking``: ``"separable"`` (``G1 G1``) or ``"correlated"`` (``1 / (1 + L_i +
+    L_o)``, the multiple-scattering walk's single event, :func:`masking_of`).
 
     Returns
     -------
@@ -113,6 +149,7 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
     k_in = np.array([-np.sin(th), 0.0, -np.cos(th)])
     s_in = np.array([0.0, 1.0, 0.0])
     abcs, d_of, g1_of, alpha = _first_surface(cfg)
+    g2_of = _masking(cfg, masking)
     n = first_surface_nodes(alpha, min(cfg.theta_step_deg, cfg.phi_step_deg))
     if table:
         n = 6
@@ -133,7 +170,7 @@ def first_surface_map(cfg: TraceConfig, chunk: int = 200_000) -> NDArray[np.floa
         t = theta[it[sl], a[sl]]
         p = phi_c[jp[sl]] + dphi[b[sl]]
         wo = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)])
-        M = reflection_mueller(k_in, s_in, wo, abcs, d_of, g1_of)
+        M = reflection_mueller(k_in, s_in, wo, abcs, d_of, g1_of, g2_of)  # type: ignore[arg-type]
         rows = M.reshape(16, -1) * w[it[sl], a[sl], b[sl]]
         for e in range(16):
             out[e] += np.bincount(flat[sl], weights=rows[e], minlength=nt * half)
@@ -178,9 +215,11 @@ def exit_map(
 
     Parameters
     ----------
-    cells : ndarray, shape (2, batches, n_theta, n_phi, 4, 4)
+    cells : ndarray, shape (channels, batches, n_theta, n_phi, 4, 4)
         ``cells[0]``: the internal cell sums for the exit operator; ``cells[1]``: the
-        sampled exits' weight sums per output bin (:mod:`.exit_sampled`).
+        sampled exits' weight sums per output bin (:mod:`.exit_sampled`); multiple
+        scattering through the operator: then the levels (:mod:`.height_basis`) of the
+        later vertices from below and from above (:func:`.walk._vertex_escapes`).
 
     Returns
     -------
@@ -197,6 +236,8 @@ def exit_map(
     if not su.sampled_exit:
         op_sums, info = _operator_map(cfg, su, grid, cells[0])
         out = out + op_sums
+    if cells.shape[0] > 2:
+        out = out + _vertex_map(cfg, su, grid, cells[2:], info)
     if cfg.scalar:
         m00 = out[..., 0, 0].copy()
         out[...] = 0.0
@@ -210,7 +251,7 @@ def _operator_map(
     """The exit operator applied to the internal cell sums (B, n_theta, n_phi, 4, 4)."""
     # one output node per degree of bin width (a coarse bin is not one point)
     nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
-    op = exit_operator(grid, su.n_coat, su.alpha_top, nodes=nodes)
+    op = exit_operator(grid, su.n_coat, su.alpha_top, nodes=nodes, masking=masking_of(cfg))
     info = {"operator_seconds": op.seconds, "operator_mb": op.nbytes / 1e6}
     if cfg.scalar:
         # the scalar walk carries M00 alone; the operator's (0, 0) element is the scalar
@@ -219,6 +260,42 @@ def _operator_map(
         cells[..., 1:, :] = 0.0
         cells[..., :, 1:] = 0.0
     return op.apply(cells), info
+
+
+def _vertex_map(
+    cfg: TraceConfig,
+    su: WalkSetup,
+    grid: Grid,
+    levels: NDArray[np.float64],
+    info: dict[str, float],
+) -> NDArray[np.float64]:
+    """The later vertices' escapes: ``sum_k V_k(row) Op(level k)`` [sr^-1 x rays].
+
+    ``levels``: (2 LEVELS, B, ...), the transmission levels then the reflection levels
+    (:mod:`.height_basis`); the operators carry ``G1`` of the vertex's direction only,
+    the rows' ``V_k`` the escape ``c^Lambda(theta_o)``. ``info`` gains the build seconds.
+    """
+    from .height_basis import LEVELS, row_basis
+
+    nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
+    v = row_basis(cfg.theta_step_deg, cfg.phi_step_deg, float(su.alpha_top))
+    out = np.zeros(levels.shape[1:])
+    for j, kind in enumerate(("transmission", "reflection", "reflection_away")):
+        op = exit_operator(
+            grid, su.n_coat, su.alpha_top, nodes=nodes, masking="incident", kind=kind
+        )
+        info["operator_seconds"] = info.get("operator_seconds", 0.0) + op.seconds
+        info["operator_mb"] = info.get("operator_mb", 0.0) + op.nbytes / 1e6
+        # the levels as more batches: one pass over the operator for all of them
+        c = levels[j * LEVELS : (j + 1) * LEVELS]
+        c = c.reshape(-1, *c.shape[2:])
+        if cfg.scalar:
+            c = c.copy()
+            c[..., 1:, :] = 0.0
+            c[..., :, 1:] = 0.0
+        y = op.apply(c).reshape(levels[j * LEVELS : (j + 1) * LEVELS].shape)
+        out += np.einsum("lr,lbr...->br...", v, y)
+    return out
 
 
 def nee_exit(
@@ -243,6 +320,11 @@ def nee_exit(
 
     if cfg.resolved_estimator != "evaluated" or cfg.coating is None or cfg.coherent:
         raise ValueError("nee_exit needs an evaluated run with an incoherent coating")
+    if cfg.scattering != "single":
+        raise ValueError(
+            "nee_exit checks the single-scattering exit operator; with multiple "
+            "scattering the later vertices' levels are not evaluated per bin"
+        )
     su = WalkSetup(cfg)
     if su.sampled_exit:
         raise ValueError(

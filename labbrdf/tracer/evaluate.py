@@ -26,6 +26,9 @@ refracting normal on the incident side is ``m = (n2 w_o - n1 k_u) / |n2 w_o - n1
 (not radiance) transfer function, as the tracer's ray weights are.
 
 ``G1`` is the separable Smith masking of ``scattering="single"`` (the oracles' model).
+With ``scattering="multiple"`` the walk's single events carry the height-correlated
+masking instead (:func:`correlated_reflection`, :func:`correlated_transmission`), passed
+as ``g2_of``.
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.special import beta
 
 from .binning import Grid
 from .interfaces import apply_fresnel, rotate_frame, s_axis
@@ -42,6 +46,8 @@ __all__ = [
     "bin_nodes",
     "cell_centroids",
     "cell_nodes",
+    "correlated_reflection",
+    "correlated_transmission",
     "reflection_mueller",
     "transmission_mueller",
 ]
@@ -51,6 +57,55 @@ F64 = NDArray[np.float64]
 Abcs = Callable[[F64], tuple[F64, F64, F64, F64]]
 # (direction (3, n), direction's cosine to its own side's normal) -> D or G1
 DFunc = Callable[[F64], F64]
+# (direction in, direction out), both as seen from their own side (z > 0) -> G2
+G2Func = Callable[[F64, F64], F64]
+
+
+def correlated_reflection(lambda_of: DFunc) -> G2Func:
+    """Height-correlated masking-shadowing of a reflection, ``1 / (1 + L_i + L_o)``.
+
+    The single-scattering term of the Heitz et al. (2016) walk on an uncorrelated Smith
+    microsurface (sec. 4; Heitz 2014, eq. (99)): the first hit's height has the CDF
+    ``C1(h)^(1 + L_i)``, the reflected ray leaves with ``C1(h)^L_o``, and the visible
+    normal carries ``G1(w_i) = 1 / (1 + L_i)``.
+
+    Parameters
+    ----------
+    lambda_of : callable
+        Smith Lambda of directions (3, n) with z > 0.
+    """
+
+    def g2(w_i: F64, w_o: F64) -> F64:
+        return 1.0 / (1.0 + lambda_of(w_i) + lambda_of(w_o))
+
+    return g2
+
+
+def correlated_transmission(lambda_of: DFunc) -> G2Func:
+    """Height-correlated masking of a refraction, ``B(1 + L_i, 1 + L_o)`` (Beta function).
+
+    From the Heitz et al. (2016) walk (sec. 4-5): a ray arriving from one side's bulk first
+    hits at a height ``h`` whose ``x = C1(h)`` has the density ``(1 + L_i) x^L_i``; the
+    refracted ray is on the other side of the height field, where the same point lies at
+    ``-h`` and ``C1(-h) = 1 - x``, and leaves with ``(1 - x)^L_o``. With the visible
+    normal's ``1 / (1 + L_i)``,
+
+        G2_T = int_0^1 x^L_i (1 - x)^L_o dx = B(1 + L_i, 1 + L_o),
+
+    which is ``G1(w_i)`` for ``L_o = 0`` and below ``G1(w_i) G1(w_o)`` otherwise (the
+    two sides' masking are anti-correlated in height).
+
+    Parameters
+    ----------
+    lambda_of : callable
+        Smith Lambda of directions (3, n) with z > 0 (the incident direction mirrored to
+        its own side, as :func:`transmission_mueller` passes it).
+    """
+
+    def g2(w_i: F64, w_o: F64) -> F64:
+        return np.asarray(beta(1.0 + lambda_of(w_i), 1.0 + lambda_of(w_o)), float)
+
+    return g2
 
 
 def bin_nodes(grid: Grid, n_theta: int, n_phi: int) -> tuple[F64, F64, F64]:
@@ -135,6 +190,7 @@ def reflection_mueller(
     abcs: Abcs,
     d_of: DFunc,
     g1_of: DFunc,
+    g2_of: G2Func | None = None,
 ) -> F64:
     """Point Mueller BRDF of reflection on a rough interface seen from above [sr^-1].
 
@@ -151,6 +207,9 @@ def reflection_mueller(
     d_of, g1_of : callable
         ``D(m)`` of upward normals (3, n) [sr^-1] and Smith ``G1(w)`` of upward
         directions (3, n).
+    g2_of : callable or None
+        Joint masking-shadowing ``G2(w_i, w_o)`` in place of ``G1(w_i) G1(w_o)``
+        (:func:`correlated_reflection`); None: separable.
 
     Returns
     -------
@@ -172,7 +231,8 @@ def reflection_mueller(
     apply_fresnel(M, *abcs(cos_i))
     rotate_frame(M, w_o, s_loc, _phi_hat(w_o))
     with np.errstate(divide="ignore", invalid="ignore"):
-        scale = d_of(h) * g1_of(wi) * g1_of(w_o) / (4.0 * wi[2] * w_o[2])
+        g2 = g1_of(wi) * g1_of(w_o) if g2_of is None else g2_of(wi, w_o)
+        scale = d_of(h) * g2 / (4.0 * wi[2] * w_o[2])
     scale = np.where((w_o[2] > 0) & (h[2] > 0), scale, 0.0)
     return M * scale
 
@@ -185,6 +245,7 @@ def transmission_mueller(
     abcs_t: Abcs,
     d_of: DFunc,
     g1_of: DFunc,
+    g2_of: G2Func | None = None,
 ) -> F64:
     """Point Mueller BTDF from inside a dielectric (index n1) up into n2 [sr^-1].
 
@@ -203,6 +264,9 @@ def transmission_mueller(
     d_of, g1_of : callable
         ``D`` and ``G1`` of the interface as seen from *above* (normals and directions
         with z > 0); the lower side's D and G1 follow from them (see the code).
+    g2_of : callable or None
+        Joint masking ``G2(k_u, w_o)`` in place of ``G1(k_u) G1(w_o)``
+        (:func:`correlated_transmission`); None: separable.
 
     Returns
     -------
@@ -230,6 +294,7 @@ def transmission_mueller(
         # facet with upward normal -m, and the masking of the direction w_i = -k_u
         # below is that of k_u above (the mirror image z -> -z of the slope
         # distribution is its point reflection through the origin)
-        scale = d_of(-m) * g1_of(k_u) * g1_of(w_o) * jac
+        g2 = g1_of(k_u) * g1_of(w_o) if g2_of is None else g2_of(k_u, w_o)
+        scale = d_of(-m) * g2 * jac
     scale = np.where(valid, scale, 0.0)
     return M * scale

@@ -37,6 +37,7 @@ from .interfaces import apply_fresnel, rotate_frame
 __all__ = [
     "MIN_LOBE_NODES",
     "deposit_cells",
+    "deposit_branch",
     "deposit_exit",
     "exit_is_sampled",
     "lobe_width_rad",
@@ -141,6 +142,58 @@ def deposit_exit(
     # after the operator's cells (record_up): keys from batches * n_bins on
     keys.append((batches + rid[idx] % batches) * grid.n_bins + bin_)
     rows.append(Mt.reshape(16, -1))
+
+
+def deposit_branch(
+    grid: Grid,
+    batches: int,
+    k_out: F64,
+    s_loc: F64,
+    M: F64,
+    abcs: tuple[F64, F64, F64, F64],
+    weight: F64,
+    rid: NDArray[np.int64],
+    into: tuple[list[NDArray], list[NDArray]],
+    scalar: bool,
+) -> None:
+    """Sum one branch of facet events, leaving into the air, into exit bins per batch.
+
+    The branch's Mueller weight is ``weight F M``: ``F`` the facet's Fresnel matrix
+    (``abcs``), ``weight`` its probability of leaving the microsurface at once (the
+    evaluated multiple-scattering walk, :mod:`.walk`). Keyed as :func:`deposit_exit`'s,
+    after the operator's cells.
+
+    Parameters
+    ----------
+    k_out : ndarray, shape (3, n)
+        The branch's directions, up into the air.
+    s_loc : ndarray, shape (3, n)
+        The facets' s axes, the frame of ``M``.
+    M : ndarray, shape (4, 4, n)
+        The rays' Mueller matrices before the facet (not changed).
+    abcs : (A, B, C, S)
+        The branch's Fresnel numbers, one per ray.
+    weight : ndarray, shape (n,)
+        Leave probability [1].
+    rid : ndarray of int, shape (n,)
+        Global ray indices (batch = index modulo ``batches``).
+    into : (keys, rows)
+        Lists that receive the flat keys and the Mueller rows (16, n).
+    """
+    keep = weight > 0
+    if not keep.any():
+        return
+    Mt = M[:, :, keep].copy()
+    apply_fresnel(Mt, *(a[keep] for a in abcs))
+    if scalar:
+        Mt[1:] = 0.0
+    Mt *= weight[keep]
+    k = k_out[:, keep]
+    bin_, phi = grid.index(k)
+    s_out = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+    rotate_frame(Mt, k, s_loc[:, keep], s_out)
+    into[0].append((batches + rid[keep] % batches) * grid.n_bins + bin_)
+    into[1].append(Mt.reshape(16, -1))
 
 
 def deposit_cells(

@@ -40,7 +40,13 @@ from ..microfacet import ggx
 from . import cache as _cache
 from .binning import Grid
 from .cache import cache_dir
-from .evaluate import bin_nodes, cell_nodes, transmission_mueller
+from .evaluate import (
+    bin_nodes,
+    cell_nodes,
+    correlated_transmission,
+    reflection_mueller,
+    transmission_mueller,
+)
 from .exit_sampled import lobe_width_rad
 from .interfaces import fresnel_abcs
 
@@ -53,13 +59,25 @@ VERSION = 3
 _MEMORY: ContextVar[OrderedDict[str, ExitOperator] | None] = ContextVar(
     "labbrdf_tracer_operator_memory", default=None
 )
-#: operators :func:`memory_cache` keeps (the most recently used)
-MEMORY_OPERATORS = 2
+#: operators :func:`memory_cache` keeps (the most recently used): the four of one
+#: parameter set with multiple scattering (:func:`.estimator.exit_map`)
+MEMORY_OPERATORS = 4
 
 #: polar sub-cell nodes per unit of (the cell's image in the air / the exit lobe)
 CELL_NODES_PER_LOBE = 2.5
 #: at most this many polar sub-cell nodes
 CELL_MAX_NODES = 6
+
+#: the masking of the operator's kernel: separable ``G1 G1`` (single scattering), the
+#: height-correlated ``B(1 + L_i, 1 + L_o)`` of the multiple-scattering walk's single
+#: refraction (:func:`.evaluate.correlated_transmission`), or ``G1(w_in)`` alone (the exit
+#: masking applied per output row by the caller, :mod:`.height_basis`)
+MASKINGS = ("separable", "correlated", "incident")
+#: the kernel: transmission from below (the exit), or reflection of rays going down on
+#: the air side (the multiple-scattering walk's later vertices)
+#: the air side of rays going up that hit the microsurface again ("reflection_away",
+#: the multiple-scattering walk's later vertices; masking "incident" only)
+KINDS = ("transmission", "reflection", "reflection_away")
 
 PARITY = np.array([1, 1, -1, -1])[:, None] * np.array([1, 1, -1, -1])[None, :]
 
@@ -131,8 +149,15 @@ def build_exit_operator(
     *,
     n_above: float = 1.0,
     nodes: tuple[int, int] = (1, 1),
+    masking: str = "separable",
+    kind: str = "transmission",
 ) -> ExitOperator:
     """Build ``T10`` for a GGX interface from a dielectric ``n_below`` into ``n_above``.
+
+    ``kind="reflection"``: the same operator for the reflection on the interface's air
+    side of rays going down (cells of their directions mirrored to z > 0, in the
+    meridional frames of their azimuth), with the Fresnel reflection ``n_above ->
+    n_below`` (:func:`.evaluate.reflection_mueller`).
 
     Parameters
     ----------
@@ -144,6 +169,11 @@ def build_exit_operator(
         GGX roughness of the interface [1], > 0.
     nodes : (int, int)
         Gauss-Legendre nodes per output bin in sin^2 theta and phi.
+    masking : {"separable", "correlated", "incident"}
+        :data:`MASKINGS`: ``G1(k_u) G1(w_o)``, the height-correlated ``G2_T``, or
+        ``G1(k_u)`` alone.
+    kind : {"transmission", "reflection"}
+        :data:`KINDS`.
 
     Returns
     -------
@@ -151,11 +181,15 @@ def build_exit_operator(
     """
     if not alpha > 0:
         raise ValueError(f"the exit operator needs a rough interface, got alpha={alpha!r}")
+    if masking not in MASKINGS:
+        raise ValueError(f"masking must be one of {MASKINGS}, got {masking!r}")
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     t0 = time.perf_counter()
     nt, npf = grid.n_theta, grid.n_phi
     half = npf // 2 + 1
     theta_o, dphi_o, w = bin_nodes(grid, *nodes)
-    q_row, q_theta, q_w = cell_nodes(grid, *cell_rule(grid, n_below, alpha, n_above))
+    q_row, q_theta, q_w = cell_nodes(grid, *_cell_rule(grid, n_below, alpha, n_above, kind))
     step = np.radians(grid.phi_step_deg)
     ni, nj = w.shape[1:]
 
@@ -167,6 +201,26 @@ def build_exit_operator(
 
     def g1_of(v: NDArray[np.float64]) -> NDArray[np.float64]:
         return ggx.smith_g1(v[2], alpha)
+
+    def lambda_of(v: NDArray[np.float64]) -> NDArray[np.float64]:
+        return ggx.smith_lambda(np.abs(v[2]), alpha)
+
+    g2_of = {
+        "separable": None,
+        "correlated": correlated_transmission(lambda_of),
+        "incident": _incident(alpha, kind == "reflection_away"),
+    }[masking]
+
+    def kernel(ku: NDArray[np.float64], wo: NDArray[np.float64]) -> NDArray[np.float64]:
+        if kind == "transmission":
+            return transmission_mueller(ku, wo, n_below, n_above, abcs_t, d_of, g1_of, g2_of)
+        k_in = ku * np.array([1.0, 1.0, 1.0 if kind == "reflection_away" else -1.0])[:, None]
+        s_in = np.broadcast_to(np.array([0.0, 1.0, 0.0])[:, None], ku.shape)
+
+        def abcs_r(c: NDArray[np.float64]) -> tuple:
+            return fresnel_abcs(n_above, n_below, c)[0]
+
+        return reflection_mueller(k_in, s_in, wo, abcs_r, d_of, g1_of, g2_of)
 
     # per output row: every (node, internal node, azimuth difference in [0, 180] deg)
     # point; with one node per cell the same points, in the same order, as the centroids
@@ -183,7 +237,7 @@ def build_exit_operator(
     for io in range(nt):
         th = theta_o[io, ai]
         wo = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)])
-        M = transmission_mueller(ku, wo, n_below, n_above, abcs_t, d_of, g1_of)
+        M = kernel(ku, wo)
         rows = M.reshape(16, -1) * (w[io, ai, aj] * wq)
         T = np.empty((16, nt * half))
         for e in range(16):
@@ -196,6 +250,39 @@ def build_exit_operator(
         sp = np.fft.rfft(full, axis=-1)  # (i, k, u, F)
         spec[:, io * 4 : io * 4 + 4, :] = sp.transpose(3, 0, 2, 1).reshape(half, 4, nt * 4)
     return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
+
+
+def _incident(alpha: float, away: bool):  # noqa: ANN202
+    """``g2_of`` of the masking "incident": the visible-normal weight of the direction.
+
+    Towards the surface: ``G1(w_i)``. A ray travelling away from it (``w_i`` below the
+    horizon) that hits it again: its visible normals are normalised by the projected area
+    ``|cos theta_i| Lambda(-w_i)`` (Heitz et al. 2016, sec. 4) instead of ``cos theta_i
+    (1 + Lambda(w_i))``, so the factor over ``cos theta_i`` is ``-1 / Lambda(-w_i)``.
+    """
+
+    def g2(w_i: NDArray[np.float64], w_o: NDArray[np.float64]) -> NDArray[np.float64]:
+        if away:
+            with np.errstate(divide="ignore"):
+                return np.asarray(-1.0 / ggx.smith_lambda(np.abs(w_i[2]), alpha), float)
+        return np.asarray(ggx.smith_g1(np.abs(w_i[2]), alpha), float)
+
+    return g2
+
+
+def _cell_rule(
+    grid: Grid, n_below: float, alpha: float, n_above: float, kind: str
+) -> tuple[int, int]:
+    """:func:`cell_rule` of an operator kind.
+
+    A reflection's lobe is ``2 alpha`` wide and its cells are seen without the
+    refraction's magnification ``n_below / n_above``.
+    """
+    if kind == "transmission":
+        return cell_rule(grid, n_below, alpha, n_above)
+    ratio = np.radians(grid.theta_step_deg) / (2.0 * alpha)
+    n = int(min(CELL_MAX_NODES, np.ceil(CELL_NODES_PER_LOBE * ratio - 1e-9)))
+    return (0, 1) if n <= 1 else (grid.n_theta, n)
 
 
 def cell_rule(grid: Grid, n_below: float, alpha: float, n_above: float = 1.0) -> tuple[int, int]:
@@ -234,7 +321,7 @@ def memory_cache(store: OrderedDict[str, ExitOperator] | None = None) -> Iterato
     incidences, such as a fit that varies the coating's roughness: on disk every operator
     would be a new file that is never read again (3.8 MB each on a 3 x 6 degree grid,
     192 MB on the 1-degree grid). The last :data:`MEMORY_OPERATORS` operators are kept,
-    so the incidences of one parameter set share one build. Blocks share operators only
+    so the incidences of one parameter set share its builds. Blocks share operators only
     through a ``store`` (an OrderedDict the caller keeps from one block to the next).
     """
     token = _MEMORY.set(OrderedDict() if store is None else store)
@@ -244,8 +331,16 @@ def memory_cache(store: OrderedDict[str, ExitOperator] | None = None) -> Iterato
         _MEMORY.reset(token)
 
 
-def _key(grid: Grid, n_below: float, alpha: float, n_above: float, nodes: tuple) -> str:
-    spec = {
+def _key(
+    grid: Grid,
+    n_below: float,
+    alpha: float,
+    n_above: float,
+    nodes: tuple,
+    masking: str,
+    kind: str = "transmission",
+) -> str:
+    spec: dict[str, object] = {
         "version": VERSION,
         "theta_step_deg": float(grid.theta_step_deg),
         "phi_step_deg": float(grid.phi_step_deg),
@@ -254,8 +349,12 @@ def _key(grid: Grid, n_below: float, alpha: float, n_above: float, nodes: tuple)
         "alpha": float(alpha),
         "nodes": [int(v) for v in nodes],
         "distribution": "ggx",
-        "cell_rule": list(cell_rule(grid, n_below, alpha, n_above)),
+        "cell_rule": list(_cell_rule(grid, n_below, alpha, n_above, kind)),
     }
+    if masking != "separable":  # the separable exit operators keep the keys they had
+        spec["masking"] = masking
+    if kind != "transmission":
+        spec["kind"] = kind
     return hashlib.sha256(json.dumps(spec, sort_keys=True).encode()).hexdigest()[:32]
 
 
@@ -267,36 +366,45 @@ def exit_operator(
     n_above: float = 1.0,
     nodes: tuple[int, int] = (1, 1),
     cache: bool = True,
+    masking: str = "separable",
+    kind: str = "transmission",
 ) -> ExitOperator:
     """:func:`build_exit_operator`, cached under :func:`cache_dir`.
 
     The cache key is a hash of everything the operator depends on (grid, indices, alpha,
-    quadrature, format version); :mod:`labbrdf.tracer.cache` keeps the file: verified on
-    load (key, shape, dtype and a digest of the contents), private to the user, written
-    atomically and bounded by a size cap with least-recently-used eviction. A file that
-    fails a check is rebuilt with a :class:`~labbrdf.tracer.cache.CacheWarning` naming
-    it; a cache folder that cannot be written only costs the rebuild next time. Inside
-    :func:`memory_cache` the operator is kept in memory instead.
+    quadrature, masking, kind, format version); :mod:`labbrdf.tracer.cache` keeps the
+    file: verified on load (key, shape, dtype and a digest of the contents), private to
+    the user, written atomically and bounded by a size cap with least-recently-used
+    eviction. A file that fails a check is rebuilt with a
+    :class:`~labbrdf.tracer.cache.CacheWarning` naming it; a cache folder that cannot be
+    written only costs the rebuild next time. Inside :func:`memory_cache` the operator is
+    kept in memory instead.
     """
     if not cache:
-        return build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes)
+        return build_exit_operator(
+            grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking, kind=kind
+        )
     memory = _MEMORY.get()
     if memory is not None:
-        key = _key(grid, n_below, alpha, n_above, nodes)
+        key = _key(grid, n_below, alpha, n_above, nodes, masking, kind)
         op = memory.get(key)
         if op is None:
-            op = build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes)
+            op = build_exit_operator(
+                grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking, kind=kind
+            )
             memory[key] = op
             while len(memory) > MEMORY_OPERATORS:
                 memory.popitem(last=False)
         memory.move_to_end(key)
         return op
-    key = _key(grid, n_below, alpha, n_above, nodes)
+    key = _key(grid, n_below, alpha, n_above, nodes, masking, kind)
     nt, npf = grid.n_theta, grid.n_phi
     t0 = time.perf_counter()
     spec = _cache.load(key, (npf // 2 + 1, 4 * nt, 4 * nt), np.complex64)
     if spec is not None:
         return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
-    op = build_exit_operator(grid, n_below, alpha, n_above=n_above, nodes=nodes)
+    op = build_exit_operator(
+        grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking, kind=kind
+    )
     _cache.store(key, op.spectrum)
     return op

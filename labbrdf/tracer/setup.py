@@ -59,6 +59,15 @@ class WalkSetup:
             facets(self.alpha_top, coat.ndf) if (coat is not None and self.layered) else None
         )
         self.evaluated = cfg.resolved_estimator == "evaluated"
+        # evaluated multiple scattering under a coating (walk._escape_air): the random
+        # walk, with the escapes into the air booked and the single events evaluated
+        self.ms_evaluated = self.evaluated and self.layered and not self.single
+        # the evaluated walk's deposits, per batch and bin: the exit operator's cells, the
+        # exits binned, then (multiple scattering through the operator) the later
+        # vertices' levels of cells from below and from above (:mod:`.height_basis`)
+        self.channels = 2
+        self.grid = grid_of(cfg)
+        self.batches = cfg.batches
         # evaluated, with a nearly smooth top, or one the GGX exit operator does not
         # describe (a slope table): the exit is the walk's own facet (exit_sampled)
         self.sampled_exit = (
@@ -69,6 +78,10 @@ class WalkSetup:
                 or exit_is_sampled(grid_of(cfg), self.n_coat, self.alpha_top)
             )
         )
+        if self.ms_evaluated and not self.sampled_exit:
+            from .height_basis import LEVELS
+
+            self.channels = 2 + 3 * LEVELS
         self.scalar = bool(cfg.scalar)
         # Lambertian base instead of the conductor's microsurface (None: the conductor)
         self.albedo = sub.albedo

@@ -63,13 +63,22 @@ class Ledger:
 
 
 def block_tally(
-    cfg: TraceConfig, grid: Grid, block: int, n: int, led: Ledger, evaluated: bool
+    cfg: TraceConfig,
+    grid: Grid,
+    block: int,
+    n: int,
+    led: Ledger,
+    evaluated: bool,
+    channels: int = 2,
 ) -> BlockTally:
-    """Bin the exits (and fold the deposits of the evaluated walk) into the block's tally."""
+    """Bin the exits (and fold the deposits of the evaluated walk) into the block's tally.
+
+    ``channels``: the evaluated walk's deposit channels (``WalkSetup.channels``).
+    """
     cell_keys = cell_sums = batch_rays = None
     if evaluated:
         cell_keys, cell_sums, batch_rays = cell_tally(
-            cfg, grid, block, n, led.dep_key, led.dep_rows
+            cfg, grid, block, n, led.dep_key, led.dep_rows, channels
         )
     sums, sumsq, counts, hemi = bin_exit_rays(grid, led.ex_k, led.ex_s, led.ex_M)
     return BlockTally(
@@ -96,10 +105,12 @@ def cell_tally(
     n: int,
     dep_key: list[NDArray],
     dep_rows: list[NDArray],
+    channels: int = 2,
 ) -> tuple[NDArray[np.int64], NDArray[np.float64], NDArray[np.int64]]:
     """Evaluated estimator: the recorded up-going rays summed per (batch, cell).
 
-    Returns the occupied keys, their (n_keys, 16) Mueller sums and the rays per batch.
+    Keys are ``(channel * batches + batch) * n_bins + cell``. Returns the occupied keys,
+    their (n_keys, 16) Mueller sums and the rays per batch.
     """
     batch_rays = np.bincount(
         (cfg.block_rays * block + np.arange(n)) % cfg.batches, minlength=cfg.batches
@@ -108,13 +119,14 @@ def cell_tally(
         return np.zeros(0, dtype=np.int64), np.zeros((0, 16)), batch_rays
     key = np.concatenate(dep_key)
     rows_d = np.concatenate(dep_rows, axis=1)
-    nkeys = 2 * cfg.batches * grid.n_bins  # cells for the operator, then sampled exits
-    cnt = np.bincount(key, minlength=nkeys)
-    cell_keys = np.flatnonzero(cnt)
-    dense = np.empty((16, nkeys))
+    # the occupied keys only (the channels of multiple scattering make the dense key
+    # range large); bincount adds each key's rows in deposit order either way
+    cell_keys, inv = np.unique(key, return_inverse=True)
+    assert cell_keys[-1] < channels * cfg.batches * grid.n_bins
+    sums = np.empty((16, cell_keys.size))
     for e in range(16):
-        dense[e] = np.bincount(key, weights=rows_d[e], minlength=nkeys)
-    return cell_keys, dense[:, cell_keys].T.copy(), batch_rays
+        sums[e] = np.bincount(inv, weights=rows_d[e], minlength=cell_keys.size)
+    return cell_keys, sums.T.copy(), batch_rays
 
 
 def bin_exit_rays(

@@ -30,6 +30,9 @@ One step, for every live ray:
    ``(Rs + Rp)/2``, which is the same for an unpolarized ray), the Mueller weight divided
    by that probability. A refracted ray changes side and its height changes sign (Heitz
    2016, dielectric walk).
+   With ``estimator="evaluated"`` and multiple scattering under a coating, each vertex on
+   the top also records what it sends into the air (:func:`_vertex_escapes`), and the
+   walk's own exits into the air only close the ledger (``docs/tracer.md``).
 4. *Terminate*: after ``max_bounces`` events, or below the weight threshold ``tau``
    (``termination="threshold"``, Dong 2022 sec. 2.3) or by Russian roulette.
 
@@ -64,10 +67,11 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from ..microfacet.height import sample_height
+from ..microfacet.height import height_c1, sample_height
 from .binning import Grid
 from .config import TraceConfig
-from .exit_sampled import record_up
+from .exit_sampled import deposit_branch, deposit_cells, record_up
+from .height_basis import LEVELS, level_weights
 from .interfaces import apply_fresnel, rotate_frame, s_axis
 from .medium import traverse
 from .setup import WalkSetup, grid_of
@@ -88,7 +92,7 @@ class _Rays:
     iface: NDArray[np.int8]  # TOP or SUB
     below: NDArray[np.bool_]  # under the top interface, inside the coating
     h: NDArray[np.float64]  # height on the microsurface (+inf: arriving from the bulk)
-    fresh: NDArray[np.bool_]  # single scattering: not yet hit at this interface
+    fresh: NDArray[np.bool_]  # not yet hit on this visit of the interface
     bounces: NDArray[np.int32]  # facet events so far
     rid: NDArray[np.int64]  # global ray index
 
@@ -177,7 +181,7 @@ def trace_block(
             break
         alive, led.terminated = _weight_cut(cfg, rng, rays.M, led.terminated)
         rays.keep(alive)
-    return block_tally(cfg, grid, block, n, led, su.evaluated)
+    return block_tally(cfg, grid, block, n, led, su.evaluated, su.channels)
 
 
 def _bare_base(
@@ -220,6 +224,109 @@ def _leave_or_hit(
     return leave, alive
 
 
+def _leave_prob(lam: NDArray[np.float64], h: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``C1(h)^Lambda`` of up-going directions, 0 where it is not finite."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        g = height_c1(h) ** lam
+    return np.where(np.isfinite(g), np.clip(g, 0.0, 1.0), 0.0)
+
+
+def _vertex_escapes(
+    su: WalkSetup,
+    cfg: TraceConfig,
+    grid: Grid,
+    rays: _Rays,
+    led: Ledger,
+    raw: list[tuple[NDArray, NDArray, NDArray]] | None,
+    hit: _Hit,
+    fresnel: tuple,
+) -> None:
+    """Evaluated multiple scattering: what each vertex on the top sends into the air.
+
+    * first vertex from the air, reflected: nothing (the closed-form first surface with
+      the height-correlated masking);
+    * first vertex from the coating's bulk, refracted: the ray is recorded in its cell
+      for the exit operator built with the height-correlated ``G2_T``;
+    * every later vertex: its reflected (air side) or refracted (from below) branch
+      leaves at once with ``c^Lambda(w)``, ``c = C1(h)`` of the vertex's height on the
+      air side. The ray is recorded in the cell of its direction, in the levels of
+      :mod:`.height_basis` with the weights ``U_k(c)``, for the operators of those
+      vertices (:func:`.estimator.exit_map`).
+
+    A nearly smooth top (``su.sampled_exit``, no operators): the branch of every vertex
+    but the first from the air, Fresnel-weighted, times its ``c^Lambda(w)``, is deposited
+    into its exit bin (:func:`.exit_sampled.deposit_branch`).
+    """
+    k, M, fresh = rays.k, rays.M, rays.fresh
+    air = hit.on_top & ~rays.below
+    under = hit.on_top & rays.below
+    into = (led.dep_key, led.dep_rows)
+    if su.sampled_exit:
+        _vertex_branches(su, cfg, grid, rays, into, hit, fresnel, (air & ~fresh, under))
+        return
+    if (under & fresh).any():
+        deposit_cells(grid, cfg.batches, k, hit.s_loc, M, under & fresh, rays.rid, *into, raw)
+    # rays travelling towards the mean plane (up from below, down on the air side), and
+    # on the air side rays going up that hit again, have operators; under the top a ray
+    # going down that hits again has its sampled branch binned (rare: docs/tracer.md)
+    towards = np.where(rays.below, k[2] > 0, k[2] < 0)
+    away = ~fresh & ~towards
+    none = np.zeros_like(air)
+    _vertex_branches(su, cfg, grid, rays, into, hit, fresnel, (none, under & away))
+    for sel, h, ch in (
+        (under & ~fresh & towards, -rays.h, 2),
+        (air & ~fresh & towards, rays.h, 2 + LEVELS),
+        (air & away, rays.h, 2 + 2 * LEVELS),
+    ):
+        if not sel.any():
+            continue
+        i = np.flatnonzero(sel)
+        u = level_weights(grid, su.alpha_top, height_c1(h[i]))  # (n, LEVELS)
+        kc = k[:, i].copy()
+        kc[2] = np.abs(kc[2])  # a down-going ray's cell: its direction mirrored up
+        cell, phi = grid.index(kc)
+        Mc = M[:, :, i].copy()
+        s_det = np.stack([-np.sin(phi), np.cos(phi), np.zeros_like(phi)])
+        rotate_frame(Mc, k[:, i], hit.s_loc[:, i], s_det)
+        rows = Mc.reshape(16, -1)
+        batch = rays.rid[i] % cfg.batches
+        for lvl in range(LEVELS):
+            into[0].append(((ch + lvl) * cfg.batches + batch) * grid.n_bins + cell)
+            into[1].append(rows * u[:, lvl])
+
+
+def _vertex_branches(
+    su: WalkSetup,
+    cfg: TraceConfig,
+    grid: Grid,
+    rays: _Rays,
+    into: tuple[list[NDArray], list[NDArray]],
+    hit: _Hit,
+    fresnel: tuple,
+    sels: tuple[NDArray[np.bool_], NDArray[np.bool_]],
+) -> None:
+    """The sampled exit of :func:`_vertex_escapes`: each vertex's leaving branch, binned."""
+    refl, tr, cos_t, eta = fresnel
+    k, M = rays.k, rays.M
+    assert su.top is not None
+    for sel, is_refl in zip(sels, (True, False), strict=True):
+        if not sel.any():
+            continue
+        i = np.flatnonzero(sel)
+        if is_refl:
+            d, abcs, h = hit.kr[:, i], refl, rays.h[i]
+        else:
+            e = eta[i] if np.ndim(eta) else eta
+            d = e * k[:, i] + (e * hit.cos_i[i] - cos_t[i]) * hit.m[:, i]
+            abcs, h = tr, -rays.h[i]
+        d = d / np.sqrt((d * d).sum(axis=0))
+        g = np.where(d[2] > 0, _leave_prob(su.top.smith_lambda(d), h), 0.0)
+        deposit_branch(
+            grid, cfg.batches, d, hit.s_loc[:, i], M[:, :, i], tuple(a[i] for a in abcs),
+            g, rays.rid[i], into, su.scalar,
+        )  # fmt: skip
+
+
 def _route(
     su: WalkSetup,
     rng: np.random.Generator,
@@ -234,7 +341,12 @@ def _route(
     iface, below = rays.iface, rays.below
     out = leave & (((iface == TOP) & ~below) | ((iface == SUB) & (not su.layered)))
     if out.any():
-        led.exit(rays.k[:, out], rays.s[:, out], rays.M[:, :, out])
+        if su.ms_evaluated:
+            # evaluated multiple scattering: every vertex has already sent its expected
+            # escape to the map (_vertex_escapes); the walk's own exits close the ledger
+            led.booked += float(rays.M[0, 0, out].sum())
+        else:
+            led.exit(rays.k[:, out], rays.s[:, out], rays.M[:, :, out])
         alive &= ~out
     if su.layered:
         cross_ = leave & ~out
@@ -329,11 +441,14 @@ def _layered_event(
     """
     k, M, below, on_top, cos_i = rays.k, rays.M, rays.below, hit.on_top, hit.cos_i
     refl, tr, cos_t, eta = su.layered_abcs(cos_i, on_top, below)
+    if su.ms_evaluated:
+        # the counting walk's random branch below; first what the vertex sends into the air
+        _vertex_escapes(su, cfg, grid, rays, led, raw, hit, (refl, tr, cos_t, eta))
     s0 = M[0, 0]
     with np.errstate(divide="ignore", invalid="ignore"):
         pr = np.where(s0 > 0, (refl[0] * s0 + refl[1] * M[1, 0]) / s0, refl[0])
         pr = np.where(on_top, np.clip(pr, 0.0, 1.0), 1.0)  # opaque substrate
-        if su.evaluated:
+        if su.evaluated and not su.ms_evaluated:
             # no random branch: refract into the coating from air (the reflection is
             # evaluated), reflect at the top from below (the transmission is applied by
             # the exit operator), both with their Mueller weights
@@ -358,7 +473,7 @@ def _layered_event(
             trans = hit.u >= pr
             wr = np.where(trans, 0.0, 1.0 / np.where(trans, 1.0, pr))
             wt = np.where(trans, 1.0 / np.where(trans, 1.0 - pr, 1.0), 0.0)
-    if su.evaluated:
+    if su.evaluated and not su.ms_evaluated:
         w_o, g = _other_branch(
             su, k, hit.m, hit.kr, M, cos_i, (refl, tr, cos_t, eta), on_top, below
         )
@@ -598,7 +713,7 @@ def trace_group(cfg: TraceConfig, group: int) -> GroupTally:
     bh = np.zeros((len(blocks), 16))
     br = np.zeros(len(blocks), dtype=np.int64)
     ev = cfg.resolved_estimator == "evaluated"
-    cells = np.zeros((2 * cfg.batches * nb, 16)) if ev else None
+    cells = np.zeros((WalkSetup(cfg).channels * cfg.batches * nb, 16)) if ev else None
     brays = np.zeros(cfg.batches, dtype=np.int64) if ev else None
     for i, b in enumerate(blocks):
         t = trace_block(cfg, b)

@@ -48,7 +48,8 @@ def test_layered_is_registered_and_names_its_parameters():
         ({"distribution": "beckmann", "base": "diffuse"}, "coated Lambertian base is written"),
         ({"distribution": "beckmann", "coherent": True, **AL}, "coherent mode's facets are GGX"),
         ({"scattering": "double", "base": "diffuse"}, "'scattering' must be 'single' or"),
-        ({"scattering": "multiple", **AL}, "scattering='multiple' needs base='diffuse'"),
+        ({"scattering": "multiple", "coherent": True, **AL}, "needs the incoherent coating"),
+        ({"scattering": "multiple", "distribution": "beckmann", **AL}, "distribution='ggx'"),
     ],
 )
 def test_bad_options_are_refused_by_name(options, words):

@@ -39,8 +39,8 @@ def test_a_store_carries_operators_between_blocks_and_keeps_the_latest(tmp_path,
         a = exit_operator(grid, 1.5, 0.3)
     with memory_cache(store):
         assert exit_operator(grid, 1.5, 0.3) is a
-        for alpha in (0.31, 0.32, 0.33):
-            exit_operator(grid, 1.5, alpha)
+        for j in range(MEMORY_OPERATORS):
+            exit_operator(grid, 1.5, 0.31 + 0.01 * j)
     assert len(store) == MEMORY_OPERATORS
     with memory_cache(store):
         assert exit_operator(grid, 1.5, 0.3) is not a  # evicted, rebuilt
