@@ -34,6 +34,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from .base import Model, ModelError, Parameters, lambert
 from .layered_medium import MEDIUM_NAMES, add_medium_params, medium_of, medium_option
+from .layered_options import check_distribution as _distribution
+from .layered_options import check_scattering as _scattering
+from .layered_options import flag as _flag
+from .layered_options import is_real as _real
 
 __all__ = ["Layered"]
 
@@ -49,46 +53,6 @@ _PHI_STEPS = (2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0)
 #: a fitted alpha 2.4 % low); the cost of a trace barely depends on the grid
 _AUTO_THETA_STEPS = (1.0, 2.0, 3.0)
 _AUTO_PHI_STEPS = (2.0, 3.0, 4.0, 5.0, 6.0)
-
-
-def _distribution(name: Any, base: str, coherent: bool) -> str:
-    """The checked ``distribution`` option: a registered name, GGX where only GGX is written."""
-    from ..microfacet import DISTRIBUTIONS
-
-    if name not in DISTRIBUTIONS:
-        raise ModelError(
-            f"layered option 'distribution' must be one of {list(DISTRIBUTIONS)}; got {name!r}"
-        )
-    if name != "ggx" and (base == "diffuse" or coherent):
-        reason = (
-            "the closed form of a coated Lambertian base is written for GGX"
-            if base == "diffuse"
-            else "the coherent mode's facets are GGX"
-        )
-        raise ModelError(
-            f"layered option distribution={name!r} needs base='conductor' without "
-            f"coherent: {reason}"
-        )
-    return str(name)
-
-
-def _scattering(name: Any, base: str, coherent: bool = False, distribution: str = "ggx") -> bool:
-    """The checked ``scattering`` option; True for multiple scattering on the top.
-
-    Over a conductor, multiple scattering is traced with the evaluated estimator
-    (``docs/tracer.md``), which needs the incoherent coating's GGX top.
-    """
-    if name not in ("single", "multiple"):
-        raise ModelError(
-            f"layered option 'scattering' must be 'single' or 'multiple'; got {name!r}"
-        )
-    if name == "multiple" and base != "diffuse" and (coherent or distribution != "ggx"):
-        raise ModelError(
-            "layered option scattering='multiple' over a conductor needs the incoherent "
-            "coating with distribution='ggx' (its single events have closed forms there; "
-            "docs/tracer.md)"
-        )
-    return name == "multiple"
 
 
 def _auto_step(spacing: float, steps: tuple[float, ...]) -> float:
@@ -773,18 +737,6 @@ class Layered(Model):
                     albedo = trace(cfg).albedo()
             out.append(albedo + (p["kd"] if self._floor else 0.0))
         return np.asarray(out, float).reshape(np.shape(theta_i_deg))
-
-
-def _flag(v: Any, name: str) -> bool:
-    if isinstance(v, bool):
-        return v
-    if isinstance(v, str) and v.lower() in ("true", "false"):
-        return v.lower() == "true"
-    raise ModelError(f"layered option {name!r} must be true or false; got {v!r}")
-
-
-def _real(v: Any) -> bool:
-    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
 
 
 def _bilinear(m: NDArray, u: NDArray, v: NDArray) -> NDArray[np.float64]:

@@ -9,7 +9,8 @@ estimator over either base: a diffuse base then goes through the walk (``rays``,
 replicates, Monte Carlo error), not the renewal closed form
 (:mod:`labbrdf.tracer.coated_lambert`), which holds for a clear coating only: through a
 medium a ray reaches the top from below in a direction the medium chose, not with the
-cosine law. Single scattering on the top and the incoherent mode only.
+cosine law. Either scattering on the top (multiple: the evaluated multiple-scattering
+walk); the incoherent mode only.
 """
 
 from __future__ import annotations
@@ -39,11 +40,10 @@ def medium_option(model: Model, medium: Any, scattering: Any, closed: bool) -> b
     model._medium = medium  # type: ignore[attr-defined]  # Model has no such field
     if not medium:
         return closed
-    if getattr(model, "_coherent", False) or scattering != "single":
+    if getattr(model, "_coherent", False):
         raise ModelError(
-            "layered option medium=True needs scattering='single' without coherent: the "
-            "scattering coating is traced by the evaluated walk (the coherent film has no "
-            "volume; multiple scattering on the top is only counted there)"
+            "layered option medium=True needs the incoherent coating: the coherent film "
+            "has no volume to scatter in"
         )
     cls = type(model)
     model.fd_rel_step = cls.fd_rel_step

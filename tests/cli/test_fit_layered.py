@@ -75,7 +75,10 @@ def test_fit_layered_incoherent_reports_how_the_monte_carlo_noise_entered(microf
         ([*AL, "--param", "grid=4x7"], "theta step must be one of"),
         ([*AL, "--fix", "alpha=0.2"], "has no parameter 'alpha'"),
         ([*AL, "--param", "base=diffuse"], "takes no substrate index n, k"),
-        ([*AL, "--param", "scattering=multiple"], "scattering='multiple' needs base='diffuse'"),
+        (
+            [*AL, "--param", "scattering=multiple", "--param", "coherent=true"],
+            "scattering='multiple' over a conductor needs the incoherent coating",
+        ),
     ],
 )
 def test_fit_layered_errors_exit_2_with_the_reason(microfacet_bsdf, capsys, extra, words):

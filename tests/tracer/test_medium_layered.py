@@ -26,10 +26,12 @@ def _points(theta_i_deg: float = 45.0):
 
 
 def test_medium_option_is_checked():
-    with pytest.raises(ModelError, match="medium=True needs scattering='single'"):
-        models.get("layered", base="diffuse", medium=True, scattering="multiple")
-    with pytest.raises(ModelError, match="medium=True needs scattering='single'"):
+    with pytest.raises(ModelError, match="medium=True needs the incoherent coating"):
         models.get("layered", n=1.55, k=7.71, coherent=True, medium=True)
+    # multiple scattering on the top goes through the evaluated multiple-scattering walk
+    m = models.get("layered", base="diffuse", medium=True, scattering="multiple", grid="6x12")
+    cfg = m._config({**PARAMS, "n_coat": 1.5}, 45.0, 550.0)
+    assert cfg.scattering == "multiple" and cfg.coating.medium is not None and m.stochastic
     with pytest.raises(ModelError, match="'medium' must be true or false"):
         models.get("layered", base="diffuse", medium="yes")
 
