@@ -145,6 +145,21 @@ def _angle_value(text: str) -> float:
     return x
 
 
+def _medium_value(text: str) -> tuple[float, float, float]:
+    """The argparse type of ``--medium TAU,SSA,G``: three finite numbers."""
+    parts = text.split(",")
+    try:
+        values = tuple(float(x) for x in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: expected TAU,SSA,G (optical thickness, single-scattering albedo, "
+            "HG asymmetry), e.g. 0.8,0.9,0.5"
+        )
+    return values[0], values[1], values[2]
+
+
 def _row_range(text: str) -> str:
     """The argparse type of ``--theta-i-range``: ``MIN:MAX``, ``MIN:``, ``:MAX`` or one value.
 
@@ -311,6 +326,7 @@ OPTION_NAMES = {
     "coating_surface": "--coating-surface",
     "distribution": "--distribution",
     "base_albedo": "--base-albedo",
+    "medium": "--medium",
 }
 
 

@@ -15,6 +15,7 @@ from ._options import (
     _angle_value,
     _channel,
     _emit_json,
+    _medium_value,
     _option_errors,
     _pixel_size,
     _warn,
@@ -53,6 +54,7 @@ def cmd_trace(args: argparse.Namespace) -> int:
             thickness_nm=args.thickness,
             coating_alpha=args.coating_alpha,
             coating_surface=args.coating_surface,
+            medium=args.medium,
             distribution=args.distribution,
             channel=_channel(args.channel),
             unit=args.unit,
@@ -135,6 +137,14 @@ def add_parser(sub: Any) -> None:
         metavar="FILE",
         help="measured height map of the coating's top: its slope table (and, for "
         "reference, its ML GGX alpha)",
+    )
+    s.add_argument(
+        "--medium",
+        type=_medium_value,
+        default=None,
+        metavar="TAU,SSA,G",
+        help="a scattering coating: a Henyey-Greenstein medium of optical thickness TAU, "
+        "single-scattering albedo SSA and asymmetry G fills the coating",
     )
     s.add_argument(
         "--distribution",

@@ -18,6 +18,7 @@ spells them as its options).
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import warnings
 from collections.abc import Callable
@@ -27,6 +28,7 @@ from ..adapters.topography import HeightMap
 from ..errors import SetupError, escaped
 from ..nk import NkError
 from ..tracer.config import Coating, Substrate, TraceConfig
+from ..tracer.medium import Medium
 from .coating import coating_from_fit
 from .index import bulk_index
 from .slopes import analytic_table, height_map, measured_substrate, pitch
@@ -138,6 +140,18 @@ def _coating(
     )
 
 
+def _with_medium(coating: Coating | None, medium: tuple[float, float, float]) -> Coating:
+    """The coating filled with the Henyey-Greenstein medium ``(tau, ssa, g)``."""
+    if coating is None:
+        raise SetupError(
+            "{medium} needs a coating: {coating_index} and {thickness_nm}, or {coating_from}"
+        )
+    try:
+        return dataclasses.replace(coating, medium=Medium(*medium))
+    except ValueError as exc:
+        raise SetupError(f"{{medium}} {escaped(exc)}") from None
+
+
 def trace_config_from_inputs(
     wavelength_nm: float,
     theta_i_deg: float,
@@ -152,6 +166,7 @@ def trace_config_from_inputs(
     thickness_nm: float | None = None,
     coating_alpha: float | None = None,
     coating_surface: PathLike | HeightMap | None = None,
+    medium: tuple[float, float, float] | None = None,
     distribution: Literal["ggx", "beckmann"] = "ggx",
     channel: int | str | None = None,
     unit: str | None = None,
@@ -193,6 +208,10 @@ def trace_config_from_inputs(
         Roughness of the coating's top [1] (default: the substrate's alpha) ...
     coating_surface : path-like or HeightMap, optional
         ... or a measured areal height map of the top: its slope table.
+    medium : (float, float, float), optional
+        A scattering coating: optical thickness [1], single-scattering albedo [1] and
+        Henyey-Greenstein asymmetry [1] of the medium filling it
+        (:class:`labbrdf.tracer.Medium`); needs a coating.
     distribution : {"ggx", "beckmann"}
         Microfacet distribution of the interfaces given by an alpha (measured maps always
         use their own slope table).
@@ -247,6 +266,8 @@ def trace_config_from_inputs(
         distribution,
         read,
     )
+    if medium is not None:
+        coating = _with_medium(coating, medium)
     return TraceConfig(
         wavelength_nm=wavelength_nm,
         theta_i_deg=theta_i_deg,
