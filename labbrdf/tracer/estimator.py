@@ -293,8 +293,7 @@ def _vertex_map(
             c = c.copy()
             c[..., 1:, :] = 0.0
             c[..., :, 1:] = 0.0
-        y = op.apply(c).reshape(levels[j * LEVELS : (j + 1) * LEVELS].shape)
-        out += np.einsum("lr,lbr...->br...", v, y)
+        out += op.apply(c, rows=v)
     return out
 
 

@@ -106,7 +106,9 @@ class ExitOperator:
         """Size of the stored spectrum [bytes]."""
         return int(self.spectrum.nbytes)
 
-    def apply(self, cells: NDArray[np.float64]) -> NDArray[np.float64]:
+    def apply(
+        self, cells: NDArray[np.float64], rows: NDArray[np.float64] | None = None
+    ) -> NDArray[np.float64]:
         """Exit BRDF sums of up-going cell sums.
 
         Parameters
@@ -114,15 +116,21 @@ class ExitOperator:
         cells : ndarray, shape (B, n_theta, n_phi, 4, 4)
             Summed Mueller weights of the rays reaching the interface from below, per
             batch and cell, in the cells' meridional frames.
+        rows : ndarray, shape (L, n_theta), optional
+            Weights per output row of ``L`` groups of batches (``B = L x B'``, group
+            major): the result is ``sum_l rows[l, o] (T10 cells[l B' + b])(o)``. The sum
+            is taken on the spectrum, before the inverse FFT (linear), so only ``B'``
+            inverse transforms are done (:mod:`.height_basis`'s levels).
 
         Returns
         -------
-        ndarray, shape (B, n_theta, n_phi, 4, 4)
+        ndarray, shape (B, n_theta, n_phi, 4, 4), or (B', ...) with ``rows``
             ``sum_cells T10 W`` per bin [sr^-1 x rays]; divide by the rays.
         """
         b, nt, npf = cells.shape[0], self.n_theta, self.n_phi
         used = np.flatnonzero(np.any(cells != 0, axis=(0, 2, 3, 4)))
-        out = np.zeros((b, nt, npf, 4, 4))
+        levels = 1 if rows is None else rows.shape[0]
+        out = np.zeros((b // levels, nt, npf, 4, 4))
         if used.size == 0:
             return out
         if used.size > 0.7 * nt:  # a column copy would cost more than it saves
@@ -136,9 +144,13 @@ class ExitOperator:
         else:
             cols = (used[:, None] * 4 + np.arange(4)[None, :]).ravel()
             op = self.spectrum[:, :, cols]
-        y = np.matmul(op, x.astype(np.complex64))  # (F, 4 nt, 4B)
-        y = y.reshape(nf, nt, 4, b, 4).transpose(3, 1, 0, 2, 4)  # (B, nt, F, 4, 4)
-        out[...] = np.fft.irfft(y.astype(np.complex128), n=npf, axis=2)
+        y = np.matmul(op, x.astype(np.complex64)).astype(np.complex128)  # (F, 4 nt, 4B)
+        if rows is None:
+            y = y.reshape(nf, nt, 4, b, 4).transpose(3, 1, 0, 2, 4)  # (B, nt, F, 4, 4)
+        else:
+            y = y.reshape(nf, nt, 4, levels, b // levels, 4)
+            y = np.einsum("lr,frilbj->brfij", rows, y)  # (B', nt, F, 4, 4)
+        out[...] = np.fft.irfft(y, n=npf, axis=2)
         return out
 
 
