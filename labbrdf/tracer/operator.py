@@ -243,24 +243,27 @@ def build_exit_operator(
     tu = q_theta[iq]
     ku = np.stack([np.sin(tu), np.zeros_like(tu), np.cos(tu)])
     ph = dj * step + dphi_o[aj]
+    cos_ph, sin_ph = np.cos(ph), np.sin(ph)
     wq = q_w[iq]
-    rest = np.arange(half, npf)
     spec = np.empty((half, nt * 4, nt * 4), dtype=np.complex64)
     for io in range(nt):
         th = theta_o[io, ai]
-        wo = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)])
+        sin_th = np.sin(th)
+        wo = np.stack([sin_th * cos_ph, sin_th * sin_ph, np.cos(th)])
         M = kernel(ku, wo)
         rows = M.reshape(16, -1) * (w[io, ai, aj] * wq)
         T = np.empty((16, nt * half))
         for e in range(16):
             T[e] = np.bincount(flat, weights=rows[e], minlength=nt * half)
         T4 = T.reshape(4, 4, nt, half)
-        # full circle from the half: T(-dphi) = P T(dphi) P
+        # full circle from the half: T(-dphi) = P T(dphi) P, dphi = (npf - j) step for
+        # j = half .. npf - 1 (slices: the same values as the index list npf - j)
         full = np.empty((4, 4, nt, npf))
         full[..., :half] = T4
-        full[..., half:] = T4[..., npf - rest] * PARITY[:, :, None, None]
+        full[..., half:] = T4[..., npf - half : 0 : -1] * PARITY[:, :, None, None]
         sp = np.fft.rfft(full, axis=-1)  # (i, k, u, F)
-        spec[:, io * 4 : io * 4 + 4, :] = sp.transpose(3, 0, 2, 1).reshape(half, 4, nt * 4)
+        # straight into the (F, 4 rows, 4 nt) slab seen as (F, i, u, k): one strided copy
+        spec[:, io * 4 : io * 4 + 4, :].reshape(half, 4, nt, 4)[...] = sp.transpose(3, 0, 2, 1)
     return ExitOperator(spec, nt, npf, time.perf_counter() - t0)
 
 

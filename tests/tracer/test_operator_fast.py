@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
-from labbrdf.tracer.operator import ExitOperator
+from labbrdf.tracer.binning import Grid
+from labbrdf.tracer.operator import ExitOperator, build_exit_operator
 
 
 def test_apply_with_row_weights_is_the_weighted_sum_of_the_groups() -> None:
@@ -22,3 +25,23 @@ def test_apply_with_row_weights_is_the_weighted_sum_of_the_groups() -> None:
     got = op.apply(cells, rows=rows)
     assert got.shape == (b, nt, npf, 4, 4)
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-12 * np.abs(want).max())
+
+
+REFERENCE = Path(__file__).with_name("data") / "exit_operators_v3.npz"
+
+
+def test_build_equals_the_plain_builds_numbers() -> None:
+    # the faster build against the spectra the plain loop built (data/README.md), to the
+    # float32 round-off of the stored spectrum
+    eps = np.finfo(np.float32).eps
+    with np.load(REFERENCE) as ref:
+        for name in ref.files:
+            ts, ps, alpha, masking, kind = name.split("_", 4)
+            grid = Grid(float(ts), float(ps))
+            op = build_exit_operator(
+                grid, 1.5, float(alpha), nodes=(2, 2), masking=masking, kind=kind
+            )
+            want = ref[name]
+            assert op.spectrum.shape == want.shape and op.spectrum.dtype == want.dtype, name
+            tol = 8 * eps * np.abs(want).max()
+            np.testing.assert_allclose(op.spectrum, want, rtol=0, atol=tol, err_msg=name)
