@@ -13,6 +13,8 @@ errors: the batch estimates ``f_b`` share ``F_r,first`` and differ only in the w
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -25,8 +27,11 @@ from .evaluate import (
     reflection_mueller,
     transmission_mueller,
 )
-from .operator import PARITY, exit_operator
+from .operator import PARITY, ExitOperator, exit_operators
 from .setup import WalkSetup, scalar_abcs
+
+#: the operator kinds of the later vertices' levels, in the order of the levels
+VERTEX_KINDS = ("transmission", "reflection", "reflection_away")
 
 __all__ = [
     "exit_map",
@@ -233,11 +238,21 @@ def exit_map(
     # the sum over the cos-weighted solid angle
     out = cells[1] / grid.cos_solid_angle_sr[None, :, :, None, None]
     info = {"operator_seconds": 0.0, "operator_mb": 0.0, "exit_sampled": 1.0}
-    if not su.sampled_exit:
-        op_sums, info = _operator_map(cfg, su, grid, cells[0])
-        out = out + op_sums
+    # one output node per degree of bin width (a coarse bin is not one point)
+    nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
+    requests = [] if su.sampled_exit else [(masking_of(cfg), "transmission")]
     if cells.shape[0] > 2:
-        out = out + _vertex_map(cfg, su, grid, cells[2:], info)
+        requests += [("incident", kind) for kind in VERTEX_KINDS]
+    # the next operator is built while the products of the current one run
+    ops = exit_operators(grid, su.n_coat, su.alpha_top, requests, nodes=nodes)
+    try:
+        if not su.sampled_exit:
+            op_sums, info = _operator_map(cfg, next(ops), cells[0])
+            out = out + op_sums
+        if cells.shape[0] > 2:
+            out = out + _vertex_map(cfg, su, ops, cells[2:], info)
+    finally:
+        ops.close()
     if cfg.scalar:
         m00 = out[..., 0, 0].copy()
         out[...] = 0.0
@@ -246,12 +261,9 @@ def exit_map(
 
 
 def _operator_map(
-    cfg: TraceConfig, su: WalkSetup, grid: Grid, cells: NDArray[np.float64]
+    cfg: TraceConfig, op: ExitOperator, cells: NDArray[np.float64]
 ) -> tuple[NDArray[np.float64], dict[str, float]]:
     """The exit operator applied to the internal cell sums (B, n_theta, n_phi, 4, 4)."""
-    # one output node per degree of bin width (a coarse bin is not one point)
-    nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
-    op = exit_operator(grid, su.n_coat, su.alpha_top, nodes=nodes, masking=masking_of(cfg))
     info = {"operator_seconds": op.seconds, "operator_mb": op.nbytes / 1e6}
     if cfg.scalar:
         # the scalar walk carries M00 alone; the operator's (0, 0) element is the scalar
@@ -265,25 +277,23 @@ def _operator_map(
 def _vertex_map(
     cfg: TraceConfig,
     su: WalkSetup,
-    grid: Grid,
+    ops: Iterator[ExitOperator],
     levels: NDArray[np.float64],
     info: dict[str, float],
 ) -> NDArray[np.float64]:
     """The later vertices' escapes: ``sum_k V_k(row) Op(level k)`` [sr^-1 x rays].
 
     ``levels``: (2 LEVELS, B, ...), the transmission levels then the reflection levels
-    (:mod:`.height_basis`); the operators carry ``G1`` of the vertex's direction only,
-    the rows' ``V_k`` the escape ``c^Lambda(theta_o)``. ``info`` gains the build seconds.
+    (:mod:`.height_basis`); ``ops`` gives the operators of :data:`VERTEX_KINDS` in order
+    (masking "incident"): they carry ``G1`` of the vertex's direction only, the rows'
+    ``V_k`` the escape ``c^Lambda(theta_o)``. ``info`` gains the build seconds.
     """
     from .height_basis import LEVELS, row_basis
 
-    nodes = (int(np.ceil(cfg.theta_step_deg - 1e-9)), int(np.ceil(cfg.phi_step_deg - 1e-9)))
     v = row_basis(cfg.theta_step_deg, cfg.phi_step_deg, float(su.alpha_top))
     out = np.zeros(levels.shape[1:])
-    for j, kind in enumerate(("transmission", "reflection", "reflection_away")):
-        op = exit_operator(
-            grid, su.n_coat, su.alpha_top, nodes=nodes, masking="incident", kind=kind
-        )
+    for j in range(len(VERTEX_KINDS)):
+        op = next(ops)
         info["operator_seconds"] = info.get("operator_seconds", 0.0) + op.seconds
         info["operator_mb"] = info.get("operator_mb", 0.0) + op.nbytes / 1e6
         # the levels as more batches: one pass over the operator for all of them

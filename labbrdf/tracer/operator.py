@@ -28,9 +28,10 @@ import hashlib
 import json
 import time
 from collections import OrderedDict
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
-from contextvars import ContextVar
+from contextvars import ContextVar, copy_context
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,7 +51,14 @@ from .evaluate import (
 from .exit_sampled import lobe_width_rad
 from .interfaces import fresnel_abcs
 
-__all__ = ["ExitOperator", "build_exit_operator", "cache_dir", "exit_operator", "memory_cache"]
+__all__ = [
+    "ExitOperator",
+    "build_exit_operator",
+    "cache_dir",
+    "exit_operator",
+    "exit_operators",
+    "memory_cache",
+]
 
 # part of the cache key: bump when the operator's definition or its file format changes
 VERSION = 3
@@ -423,3 +431,40 @@ def exit_operator(
     )
     _cache.store(key, op.spectrum)
     return op
+
+
+def exit_operators(
+    grid: Grid,
+    n_below: float,
+    alpha: float,
+    requests: Sequence[tuple[str, str]],
+    *,
+    n_above: float = 1.0,
+    nodes: tuple[int, int] = (1, 1),
+) -> Iterator[ExitOperator]:
+    """:func:`exit_operator` of each ``(masking, kind)`` request, in order, one ahead.
+
+    While the caller uses operator ``k`` (its products are BLAS and FFT calls that release
+    the GIL), operator ``k + 1`` is built, or loaded, and stored in one worker thread, in
+    a copy of the caller's context (so inside :func:`memory_cache` too). Each operator is
+    built alone, as :func:`exit_operator` builds it: the results do not depend on the
+    overlap. At most two operators are held at once (the one in use and the next).
+    """
+
+    def get(masking: str, kind: str) -> ExitOperator:
+        return exit_operator(
+            grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking, kind=kind
+        )
+
+    if len(requests) < 2:
+        for masking, kind in requests:
+            yield get(masking, kind)
+        return
+    with ThreadPoolExecutor(max_workers=1, thread_name_prefix="labbrdf-operator") as pool:
+        pending: Future[ExitOperator] = pool.submit(copy_context().run, get, *requests[0])
+        for nxt in (*requests[1:], None):
+            op = pending.result()
+            if nxt is not None:
+                pending = pool.submit(copy_context().run, get, *nxt)
+            yield op
+            del op

@@ -2,12 +2,18 @@
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from pathlib import Path
 
 import numpy as np
 
 from labbrdf.tracer.binning import Grid
-from labbrdf.tracer.operator import ExitOperator, build_exit_operator
+from labbrdf.tracer.operator import (
+    ExitOperator,
+    build_exit_operator,
+    exit_operators,
+    memory_cache,
+)
 
 
 def test_apply_with_row_weights_is_the_weighted_sum_of_the_groups() -> None:
@@ -45,3 +51,19 @@ def test_build_equals_the_plain_builds_numbers() -> None:
             assert op.spectrum.shape == want.shape and op.spectrum.dtype == want.dtype, name
             tol = 8 * eps * np.abs(want).max()
             np.testing.assert_allclose(op.spectrum, want, rtol=0, atol=tol, err_msg=name)
+
+
+def test_operators_built_one_ahead_are_the_plain_builds_and_use_the_memory_cache() -> None:
+    # the next operator is built in a worker thread: the same numbers as built alone, and
+    # inside memory_cache the worker keeps them in the caller's store (not on disk)
+    grid = Grid(30.0, 40.0)
+    requests = [("correlated", "transmission")] + [
+        ("incident", kind) for kind in ("transmission", "reflection", "reflection_away")
+    ]
+    store: OrderedDict = OrderedDict()
+    with memory_cache(store):
+        ops = list(exit_operators(grid, 1.5, 0.2, requests, nodes=(2, 2)))
+    assert len(store) == len(requests)
+    for op, (masking, kind) in zip(ops, requests, strict=True):
+        alone = build_exit_operator(grid, 1.5, 0.2, nodes=(2, 2), masking=masking, kind=kind)
+        np.testing.assert_array_equal(op.spectrum, alone.spectrum)
