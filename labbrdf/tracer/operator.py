@@ -28,7 +28,7 @@ import hashlib
 import json
 import time
 from collections import OrderedDict
-from collections.abc import Iterator, Sequence
+from collections.abc import Generator, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from contextvars import ContextVar, copy_context
@@ -441,7 +441,7 @@ def exit_operators(
     *,
     n_above: float = 1.0,
     nodes: tuple[int, int] = (1, 1),
-) -> Iterator[ExitOperator]:
+) -> Generator[ExitOperator, None, None]:
     """:func:`exit_operator` of each ``(masking, kind)`` request, in order, one ahead.
 
     While the caller uses operator ``k`` (its products are BLAS and FFT calls that release
@@ -451,20 +451,26 @@ def exit_operators(
     overlap. At most two operators are held at once (the one in use and the next).
     """
 
-    def get(masking: str, kind: str) -> ExitOperator:
+    def get(request: tuple[str, str]) -> ExitOperator:
+        masking, kind = request
         return exit_operator(
             grid, n_below, alpha, n_above=n_above, nodes=nodes, masking=masking, kind=kind
         )
 
     if len(requests) < 2:
-        for masking, kind in requests:
-            yield get(masking, kind)
+        for request in requests:
+            yield get(request)
         return
     with ThreadPoolExecutor(max_workers=1, thread_name_prefix="labbrdf-operator") as pool:
-        pending: Future[ExitOperator] = pool.submit(copy_context().run, get, *requests[0])
+
+        def ahead(request: tuple[str, str]) -> Future[ExitOperator]:
+            ctx = copy_context()
+            return pool.submit(lambda: ctx.run(get, request))
+
+        pending = ahead(requests[0])
         for nxt in (*requests[1:], None):
             op = pending.result()
             if nxt is not None:
-                pending = pool.submit(copy_context().run, get, *nxt)
+                pending = ahead(nxt)
             yield op
             del op
