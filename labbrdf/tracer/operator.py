@@ -145,14 +145,15 @@ class ExitOperator:
             used = np.arange(nt)
         spec_in = np.fft.rfft(cells[:, used], axis=2)  # (B, u, F, 4, 4)
         nf = spec_in.shape[2]
-        # (F, 4u, 4B): rows (u, k), columns (b, j)
-        x = spec_in.transpose(2, 1, 3, 0, 4).reshape(nf, used.size * 4, b * 4)
+        # (F, 4u, 4B): rows (u, k), columns (b, j); one strided copy that also casts
+        x = np.empty((nf, used.size * 4, b * 4), dtype=np.complex64)
+        x.reshape(nf, used.size, 4, b, 4)[...] = spec_in.transpose(2, 1, 3, 0, 4)
         if used.size == nt:
             op = self.spectrum
         else:
             cols = (used[:, None] * 4 + np.arange(4)[None, :]).ravel()
             op = self.spectrum[:, :, cols]
-        y = np.matmul(op, x.astype(np.complex64)).astype(np.complex128)  # (F, 4 nt, 4B)
+        y = np.matmul(op, x).astype(np.complex128)  # (F, 4 nt, 4B)
         if rows is None:
             y = y.reshape(nf, nt, 4, b, 4).transpose(3, 1, 0, 2, 4)  # (B, nt, F, 4, 4)
         else:
