@@ -27,10 +27,10 @@ wall clock mostly measures the other processes. Item 1b also prints the wall clo
 next operator is built in a worker thread while the current one's products run.
 
 Item 1b measured (``--only-evaluated``, ``OPENBLAS_NUM_THREADS=1``, 2 cores with a test
-suite beside, load 2.5): 1 % per lobe bin in 10.3 s wall / 9.7 s CPU with the four
-operators built, 6.0 / 5.9 s from the disk cache, 4.6 / 4.6 s in memory (before the
-level sums on the spectrum, the direct slab writes and the build one ahead: 14.5 / 7.6 /
-5.7 s wall on the same machine, back to back).
+suite on one, load 1.1): 1 % per lobe bin in 8.2 s wall / 9.8 s CPU with the four
+operators built, 5.0 / 6.0 s from the disk cache, 4.5 / 4.5 s in memory (before the
+level sums on the spectrum, the direct copies and the build one ahead: 14.5 / 7.8 / 5.4 s
+wall, back to back; at load 2.5: 10.3 / 6.0 / 4.6 s wall against 14.5 / 7.6 / 5.7).
 
 Usage: ``python benchmarks/bench_multiple.py [--rays N] [--evaluated-rays M]
 [--only-evaluated] [--fit RAYS]`` (default 2e5 rays per counting run, 1.2e5 per evaluated run).
